@@ -1,0 +1,99 @@
+//! `learn data inspect FILE`.
+
+use std::path::PathBuf;
+
+use data::FlightLog;
+
+use super::Global;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// A Neural-Fly CSV flight log.
+    pub file: PathBuf,
+}
+
+fn range3(name: &str, values: &[[f64; 3]]) -> String {
+    let mut parts = Vec::new();
+    for (axis, label) in ["x", "y", "z"].iter().enumerate() {
+        let (lo, hi) = values
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v[axis]), hi.max(v[axis]))
+            });
+        parts.push(format!("{label} [{lo:.3}, {hi:.3}]"));
+    }
+    format!("  {name:<16} {}", parts.join("  "))
+}
+
+pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
+    let log = FlightLog::read(&args.file)?;
+    let n = log.len();
+    let dt = log.sample_interval();
+    println!("file:      {}", args.file.display());
+    if let Some(meta) = &log.meta {
+        println!(
+            "flight:    vehicle {}, trajectory {}, controller {}, condition {}",
+            meta.vehicle, meta.trajectory, meta.method, meta.condition
+        );
+    }
+    println!("samples:   {n}");
+    println!("duration:  {:.3} s", log.time[n - 1] - log.time[0]);
+    println!("rate:      {:.3} Hz (dt = {dt:.6} s)", 1.0 / dt);
+    let mut optional = Vec::new();
+    for (name, present) in [
+        ("p_d", log.position_desired.is_some()),
+        ("v_d", log.velocity_desired.is_some()),
+        ("q_sp", log.attitude_setpoint.is_some()),
+        ("fa", log.residual_force.is_some()),
+    ] {
+        optional.push(format!("{name}{}", if present { "" } else { " (absent)" }));
+    }
+    println!(
+        "columns:   t, p, v, q, R, w, T_sp, hover_throttle, pwm; optional: {}",
+        optional.join(", ")
+    );
+    println!("ranges:");
+    println!("{}", range3("p [m]", &log.position));
+    println!("{}", range3("v [m/s]", &log.velocity));
+    println!("{}", range3("w [rad/s]", &log.body_rate));
+    let (lo, hi) = log
+        .thrust_setpoint
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        });
+    println!("  {:<16} [{lo:.4}, {hi:.4}]", "T_sp");
+    let (lo, hi) = log
+        .motor_command
+        .iter()
+        .flatten()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        });
+    println!("  {:<16} [{lo:.1}, {hi:.1}]", "pwm");
+    let (frame, body, world) = log.rate_frame();
+    let mut problems = Vec::new();
+    if frame == data::RateFrame::World {
+        problems.push(format!(
+            "`w` matches the world-frame rate vee(dR Rᵀ) (RMS {world:.4} rad/s) better than the body-frame rate (RMS {body:.4} rad/s)"
+        ));
+    }
+    if let Some(pwm) = log
+        .motor_command
+        .iter()
+        .flatten()
+        .find(|p| !(500.0..=2500.0).contains(*p))
+    {
+        problems.push(format!("a pwm value ({pwm:.1}) lies outside 500..2500"));
+    }
+    println!("rate frame: {frame:?} (RMS against R: body {body:.4}, world {world:.4} rad/s)");
+    if problems.is_empty() {
+        println!("problems:  none found");
+    } else {
+        println!("problems:");
+        for problem in problems {
+            println!("  - {problem}");
+        }
+    }
+    Ok(())
+}

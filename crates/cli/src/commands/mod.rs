@@ -1,0 +1,74 @@
+//! Subcommands of `learn`.
+
+mod conditions;
+mod inspect;
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+
+/// Learned-library system identification: SINDy and LeARN on quadrotor flights.
+#[derive(Parser, Debug)]
+#[command(name = "learn", version, about)]
+pub struct Cli {
+    /// Flight data directory (default: $NEURAL_FLY_DIR, then data/neural-fly).
+    #[arg(long, global = true)]
+    pub data: Option<PathBuf>,
+    /// No progress bars.
+    #[arg(long, global = true)]
+    pub quiet: bool,
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Work with flight logs.
+    Data {
+        #[command(subcommand)]
+        command: DataCommand,
+    },
+    /// List the wind conditions of the experiment and which flight files are present.
+    Conditions(conditions::Args),
+}
+
+#[derive(Subcommand, Debug)]
+pub enum DataCommand {
+    /// Duration, rate, columns, ranges and problems of one flight log.
+    Inspect(inspect::Args),
+}
+
+/// Runs the parsed command.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    let global = Global {
+        data: cli.data,
+        quiet: cli.quiet,
+    };
+    match cli.command {
+        Command::Data {
+            command: DataCommand::Inspect(args),
+        } => inspect::run(&global, args),
+        Command::Conditions(args) => conditions::run(&global, args),
+    }
+}
+
+/// Options every subcommand may use.
+#[derive(Debug, Clone)]
+pub struct Global {
+    pub data: Option<PathBuf>,
+    pub quiet: bool,
+}
+
+impl Global {
+    /// The data directory, resolved as documented in the README.
+    pub fn data_dir(&self) -> anyhow::Result<PathBuf> {
+        Ok(data::resolve_data_dir(self.data.as_deref())?)
+    }
+
+    /// Whether progress bars may be drawn (not quiet, standard error is a terminal).
+    #[allow(dead_code)]
+    pub fn show_progress(&self) -> bool {
+        use std::io::IsTerminal;
+        !self.quiet && std::io::stderr().is_terminal()
+    }
+}

@@ -1,0 +1,375 @@
+//! Typed Neural-Fly flight logs.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{DataError, Result};
+use crate::table::{TextTable, file_row};
+use crate::time::check_time_axis;
+
+/// `<vehicle>_<trajectory>_<method>_<condition>.csv`, as the Neural-Fly data names its files.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FlightMeta {
+    pub vehicle: String,
+    pub trajectory: String,
+    pub method: String,
+    pub condition: String,
+}
+
+impl FlightMeta {
+    /// Parses the metadata from a file name; `None` when it does not follow the scheme.
+    pub fn from_file_name(path: &Path) -> Option<Self> {
+        let stem = path.file_stem()?.to_str()?;
+        let mut parts = stem.splitn(4, '_');
+        let vehicle = parts.next()?.to_string();
+        let trajectory = parts.next()?.to_string();
+        let rest: Vec<&str> = parts.collect();
+        if rest.len() != 2 || rest.iter().any(|p| p.is_empty()) || vehicle.is_empty() {
+            return None;
+        }
+        // The method may itself contain '_' in other datasets; the condition never does.
+        let (method, condition) = match rest[1].rsplit_once('_') {
+            Some((extra, condition)) => (format!("{}_{extra}", rest[0]), condition.to_string()),
+            None => (rest[0].to_string(), rest[1].to_string()),
+        };
+        Some(Self {
+            vehicle,
+            trajectory,
+            method,
+            condition,
+        })
+    }
+}
+
+/// One flight: every sample of a Neural-Fly CSV log, typed.
+///
+/// Conventions (see `UPSTREAM-README.md` of the data): world frame z up, gravity along −z;
+/// `rotation` maps body to world; quaternions are `[x, y, z, w]` (scalar last); thrust acts along the
+/// third column of `rotation`. `body_rate` is the `w` column as recorded: check its frame with
+/// [`FlightLog::rate_frame`] before relying on it.
+#[derive(Clone, Debug)]
+pub struct FlightLog {
+    pub path: PathBuf,
+    pub meta: Option<FlightMeta>,
+    /// Time in seconds, strictly increasing at a uniform rate.
+    pub time: Vec<f64>,
+    pub position: Vec<[f64; 3]>,
+    pub velocity: Vec<[f64; 3]>,
+    pub quaternion: Vec<[f64; 4]>,
+    /// Body to world, row-major.
+    pub rotation: Vec<[[f64; 3]; 3]>,
+    /// The `w` column, rad/s.
+    pub body_rate: Vec<[f64; 3]>,
+    /// `T_sp`: normalised thrust setpoint.
+    pub thrust_setpoint: Vec<f64>,
+    pub hover_throttle: Vec<f64>,
+    /// `pwm`: the four motor commands, about 1000 to 2000.
+    pub motor_command: Vec<[f64; 4]>,
+    pub position_desired: Option<Vec<[f64; 3]>>,
+    pub velocity_desired: Option<Vec<[f64; 3]>>,
+    pub attitude_setpoint: Option<Vec<[f64; 4]>>,
+    /// `fa`: the residual force computed upstream, N.
+    pub residual_force: Option<Vec<[f64; 3]>>,
+}
+
+/// The columns a flight log must have (and `q` or `R`, at least one of them).
+pub const REQUIRED_COLUMNS: [&str; 7] = ["t", "p", "v", "w", "T_sp", "hover_throttle", "pwm"];
+
+/// The frame in which the recorded angular rate `w` is expressed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RateFrame {
+    Body,
+    World,
+}
+
+impl FlightLog {
+    /// Reads and validates a log. Errors name the file, row and column.
+    pub fn read(path: &Path) -> Result<Self> {
+        let table = TextTable::read(path)?;
+        let time = table.scalars("t")?;
+        check_time_axis(path, &time, crate::time::DEFAULT_UNIFORM_TOLERANCE)?;
+        let has_q = table.has_column("q");
+        let has_r = table.has_column("R");
+        if !has_q && !has_r {
+            return Err(DataError::MissingColumn {
+                path: path.to_path_buf(),
+                column: "q (or R)".to_string(),
+                present: table.column_names().join(", "),
+            });
+        }
+        let quaternion = if has_q {
+            Some(table.arrays::<4>("q")?)
+        } else {
+            None
+        };
+        let rotation = if has_r {
+            Some(
+                table
+                    .arrays::<9>("R")?
+                    .into_iter()
+                    .map(|m| [[m[0], m[1], m[2]], [m[3], m[4], m[5]], [m[6], m[7], m[8]]])
+                    .collect::<Vec<_>>(),
+            )
+        } else {
+            None
+        };
+        let (quaternion, rotation) = match (quaternion, rotation) {
+            (Some(q), Some(r)) => (q, r),
+            (Some(q), None) => {
+                let r = q.iter().map(rotation_from_quaternion).collect();
+                (q, r)
+            }
+            (None, Some(r)) => (r.iter().map(quaternion_from_rotation).collect(), r),
+            (None, None) => unreachable!("checked above"),
+        };
+        check_unit_quaternions(path, &quaternion, has_q)?;
+        let optional3 = |name: &str| -> Result<Option<Vec<[f64; 3]>>> {
+            if table.has_column(name) {
+                table.arrays::<3>(name).map(Some)
+            } else {
+                Ok(None)
+            }
+        };
+        let log = Self {
+            path: path.to_path_buf(),
+            meta: FlightMeta::from_file_name(path),
+            position: table.arrays::<3>("p")?,
+            velocity: table.arrays::<3>("v")?,
+            body_rate: table.arrays::<3>("w")?,
+            thrust_setpoint: table.scalars("T_sp")?,
+            hover_throttle: table.scalars("hover_throttle")?,
+            motor_command: table.arrays::<4>("pwm")?,
+            position_desired: optional3("p_d")?,
+            velocity_desired: optional3("v_d")?,
+            attitude_setpoint: if table.has_column("q_sp") {
+                Some(table.arrays::<4>("q_sp")?)
+            } else {
+                None
+            },
+            residual_force: optional3("fa")?,
+            time,
+            quaternion,
+            rotation,
+        };
+        Ok(log)
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.time.len()
+    }
+
+    /// Whether the log has no samples (never true for a log that was read successfully).
+    pub fn is_empty(&self) -> bool {
+        self.time.is_empty()
+    }
+
+    /// The mean sample interval, s.
+    pub fn sample_interval(&self) -> f64 {
+        (self.time[self.len() - 1] - self.time[0]) / (self.len() - 1) as f64
+    }
+
+    /// The wind condition from the file name, or `"unknown"`.
+    pub fn condition(&self) -> &str {
+        self.meta
+            .as_ref()
+            .map(|m| m.condition.as_str())
+            .unwrap_or("unknown")
+    }
+
+    /// Decides in which frame `w` was recorded by comparing it with the rates implied by the rotation
+    /// matrices: world frame vee(Ṙ Rᵀ) and body frame vee(Rᵀ Ṙ), with Ṙ by central differences.
+    /// Returns the frame with the smaller RMS error and both errors (body, world).
+    pub fn rate_frame(&self) -> (RateFrame, f64, f64) {
+        let n = self.len();
+        let (mut body_error, mut world_error, mut count) = (0.0, 0.0, 0usize);
+        for k in 1..n.saturating_sub(1) {
+            let dt = self.time[k + 1] - self.time[k - 1];
+            let rdot = mat_scale(
+                &mat_sub(&self.rotation[k + 1], &self.rotation[k - 1]),
+                1.0 / dt,
+            );
+            let r = &self.rotation[k];
+            let world = vee(&mat_mul(&rdot, &transpose(r)));
+            let body = vee(&mat_mul(&transpose(r), &rdot));
+            let w = self.body_rate[k];
+            for i in 0..3 {
+                body_error += (w[i] - body[i]).powi(2);
+                world_error += (w[i] - world[i]).powi(2);
+            }
+            count += 3;
+        }
+        let body_rms = (body_error / count.max(1) as f64).sqrt();
+        let world_rms = (world_error / count.max(1) as f64).sqrt();
+        let frame = if world_rms < body_rms {
+            RateFrame::World
+        } else {
+            RateFrame::Body
+        };
+        (frame, body_rms, world_rms)
+    }
+}
+
+fn check_unit_quaternions(path: &Path, quaternion: &[[f64; 4]], recorded: bool) -> Result<()> {
+    if !recorded {
+        return Ok(());
+    }
+    for (index, q) in quaternion.iter().enumerate() {
+        let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if (norm - 1.0).abs() > 1e-3 {
+            return Err(DataError::BadCell {
+                path: path.to_path_buf(),
+                row: file_row(index),
+                column: "q".to_string(),
+                value: format!("{q:?}"),
+                reason: format!("not a unit quaternion (norm {norm:.6})"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Rotation matrix (body to world) of a unit quaternion `[x, y, z, w]`.
+pub fn rotation_from_quaternion(q: &[f64; 4]) -> [[f64; 3]; 3] {
+    let [x, y, z, w] = *q;
+    [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - z * w),
+            2.0 * (x * z + y * w),
+        ],
+        [
+            2.0 * (x * y + z * w),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - x * w),
+        ],
+        [
+            2.0 * (x * z - y * w),
+            2.0 * (y * z + x * w),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ]
+}
+
+/// Unit quaternion `[x, y, z, w]` (w ≥ 0) of a rotation matrix.
+pub fn quaternion_from_rotation(r: &[[f64; 3]; 3]) -> [f64; 4] {
+    let trace = r[0][0] + r[1][1] + r[2][2];
+    let q = if trace > 0.0 {
+        let s = (trace + 1.0).sqrt() * 2.0;
+        [
+            (r[2][1] - r[1][2]) / s,
+            (r[0][2] - r[2][0]) / s,
+            (r[1][0] - r[0][1]) / s,
+            0.25 * s,
+        ]
+    } else if r[0][0] > r[1][1] && r[0][0] > r[2][2] {
+        let s = (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt() * 2.0;
+        [
+            0.25 * s,
+            (r[0][1] + r[1][0]) / s,
+            (r[0][2] + r[2][0]) / s,
+            (r[2][1] - r[1][2]) / s,
+        ]
+    } else if r[1][1] > r[2][2] {
+        let s = (1.0 + r[1][1] - r[0][0] - r[2][2]).sqrt() * 2.0;
+        [
+            (r[0][1] + r[1][0]) / s,
+            0.25 * s,
+            (r[1][2] + r[2][1]) / s,
+            (r[0][2] - r[2][0]) / s,
+        ]
+    } else {
+        let s = (1.0 + r[2][2] - r[0][0] - r[1][1]).sqrt() * 2.0;
+        [
+            (r[0][2] + r[2][0]) / s,
+            (r[1][2] + r[2][1]) / s,
+            0.25 * s,
+            (r[1][0] - r[0][1]) / s,
+        ]
+    };
+    if q[3] < 0.0 { q.map(|v| -v) } else { q }
+}
+
+type Mat3 = [[f64; 3]; 3];
+
+fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
+    let mut out = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            out[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    out
+}
+
+fn transpose(a: &Mat3) -> Mat3 {
+    let mut out = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            out[i][j] = a[j][i];
+        }
+    }
+    out
+}
+
+fn mat_sub(a: &Mat3, b: &Mat3) -> Mat3 {
+    let mut out = *a;
+    for i in 0..3 {
+        for j in 0..3 {
+            out[i][j] -= b[i][j];
+        }
+    }
+    out
+}
+
+fn mat_scale(a: &Mat3, s: f64) -> Mat3 {
+    a.map(|row| row.map(|v| v * s))
+}
+
+/// The vector of a skew-symmetric matrix (its antisymmetric part, to be robust to noise).
+fn vee(s: &Mat3) -> [f64; 3] {
+    [
+        0.5 * (s[2][1] - s[1][2]),
+        0.5 * (s[0][2] - s[2][0]),
+        0.5 * (s[1][0] - s[0][1]),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn file_names_follow_the_neural_fly_scheme() {
+        let meta =
+            FlightMeta::from_file_name(Path::new("x/custom_figure8_NF-C_70p20sint.csv")).unwrap();
+        assert_eq!(meta.vehicle, "custom");
+        assert_eq!(meta.trajectory, "figure8");
+        assert_eq!(meta.method, "NF-C");
+        assert_eq!(meta.condition, "70p20sint");
+        assert!(FlightMeta::from_file_name(Path::new("flight.csv")).is_none());
+    }
+
+    #[test]
+    fn quaternion_and_rotation_round_trip() {
+        let q = {
+            let raw = [0.1, -0.3, 0.2, 0.9];
+            let n = raw.iter().map(|v: &f64| v * v).sum::<f64>().sqrt();
+            raw.map(|v| v / n)
+        };
+        let r = rotation_from_quaternion(&q);
+        let back = quaternion_from_rotation(&r);
+        for i in 0..4 {
+            assert!((q[i] - back[i]).abs() < 1e-12);
+        }
+        let rrt = mat_mul(&r, &transpose(&r));
+        for i in 0..3 {
+            for j in 0..3 {
+                let expected = if i == j { 1.0 } else { 0.0 };
+                assert!((rrt[i][j] - expected).abs() < 1e-12);
+            }
+        }
+    }
+}

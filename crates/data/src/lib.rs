@@ -1,0 +1,40 @@
+//! Flight data for learned-library system identification.
+//!
+//! What it is for: reading Neural-Fly flight logs into a typed, validated [`FlightLog`]; reading plain
+//! numeric CSVs by column name ([`NumericTable`]); the paper's three [`Formulation`]s as data (which
+//! state, which inputs, with which scalings); derivative estimators ([`Derivative`]); support/query
+//! splits ([`SplitSpec`]); the experiment's wind conditions ([`ExperimentConditions`]); and finding the
+//! data directory ([`resolve_data_dir`]).
+//!
+//! What it is not for: fitting anything. Models live in `sindy` and `learn`, tables in `report`.
+//!
+//! Every error is a [`DataError`] whose message is one line naming the file, and where it applies
+//! the row (line number in the file, header = line 1) and column: `file:row:column: message`.
+
+mod conditions;
+mod derivative;
+mod error;
+mod flight_log;
+mod formulation;
+mod numeric;
+mod source;
+mod split;
+mod table;
+mod time;
+mod write;
+
+pub use conditions::{Condition, ExperimentConditions, FlightFile, PaperTraining, Role};
+pub use derivative::Derivative;
+pub use error::{DataError, Result};
+pub use flight_log::{
+    FlightLog, FlightMeta, REQUIRED_COLUMNS, RateFrame, quaternion_from_rotation,
+    rotation_from_quaternion,
+};
+pub use formulation::{Formulation, Segment};
+pub use numeric::NumericTable;
+pub use source::{DATA_DIR_VARIABLE, DEFAULT_DATA_DIR, file_sha256, resolve_data_dir};
+pub use split::{Split, SplitSpec};
+pub use time::{DEFAULT_UNIFORM_TOLERANCE, check_time_axis};
+
+/// Re-exported so that downstream crates name the same matrix type.
+pub use faer::Mat;

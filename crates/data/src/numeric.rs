@@ -1,0 +1,55 @@
+//! Plain numeric CSV files read by column name (for `learn sindy` on any data).
+
+use std::path::{Path, PathBuf};
+
+use crate::error::Result;
+use crate::table::TextTable;
+use crate::time::check_time_axis;
+
+/// Selected columns of a numeric CSV, validated (every cell a finite number).
+#[derive(Clone, Debug)]
+pub struct NumericTable {
+    pub path: PathBuf,
+    pub names: Vec<String>,
+    pub columns: Vec<Vec<f64>>,
+}
+
+impl NumericTable {
+    /// Reads the named columns of `path`, in the order given.
+    pub fn read(path: &Path, columns: &[&str]) -> Result<Self> {
+        let table = TextTable::read(path)?;
+        let parsed = columns
+            .iter()
+            .map(|name| table.scalars(name))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            names: columns.iter().map(|s| s.to_string()).collect(),
+            columns: parsed,
+        })
+    }
+
+    /// Reads the named columns and checks that `time` is a strictly increasing, uniform time axis.
+    pub fn read_with_time(path: &Path, time: &str, columns: &[&str]) -> Result<(Vec<f64>, Self)> {
+        let mut names = vec![time];
+        names.extend_from_slice(columns);
+        let mut table = Self::read(path, &names)?;
+        let time_values = table.columns.remove(0);
+        table.names.remove(0);
+        check_time_axis(path, &time_values, crate::time::DEFAULT_UNIFORM_TOLERANCE)?;
+        Ok((time_values, table))
+    }
+
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.columns.first().map_or(0, Vec::len)
+    }
+
+    /// A column by name.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .map(|i| self.columns[i].as_slice())
+    }
+}

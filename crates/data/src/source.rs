@@ -1,0 +1,87 @@
+//! Where flight data comes from, and fingerprints of the files used.
+
+use std::path::{Path, PathBuf};
+
+use sha2::{Digest, Sha256};
+
+use crate::error::{DataError, Result};
+
+/// The environment variable naming the data directory.
+pub const DATA_DIR_VARIABLE: &str = "NEURAL_FLY_DIR";
+
+/// The default data directory, relative to the project root (filled by `make data`).
+pub const DEFAULT_DATA_DIR: &str = "data/neural-fly";
+
+/// Finds the data directory: `flag` if given, else `$NEURAL_FLY_DIR`, else `data/neural-fly` in the
+/// current directory or the nearest ancestor that has one. A given flag or variable that does not
+/// name a directory is an error (it is never silently skipped).
+pub fn resolve_data_dir(flag: Option<&Path>) -> Result<PathBuf> {
+    if let Some(dir) = flag {
+        return existing_dir(dir, "--data");
+    }
+    if let Some(dir) = std::env::var_os(DATA_DIR_VARIABLE).filter(|v| !v.is_empty()) {
+        return existing_dir(Path::new(&dir), DATA_DIR_VARIABLE);
+    }
+    let cwd = std::env::current_dir().map_err(|source| DataError::Io {
+        path: PathBuf::from("."),
+        source,
+    })?;
+    for ancestor in cwd.ancestors() {
+        let candidate = ancestor.join(DEFAULT_DATA_DIR);
+        if candidate.is_dir() {
+            return Ok(candidate);
+        }
+    }
+    Err(DataError::NoDataDir {
+        tried: format!(
+            "${DATA_DIR_VARIABLE} (unset), {DEFAULT_DATA_DIR} in {} and its parents",
+            cwd.display()
+        ),
+    })
+}
+
+fn existing_dir(dir: &Path, origin: &str) -> Result<PathBuf> {
+    if dir.is_dir() {
+        Ok(dir.to_path_buf())
+    } else {
+        Err(DataError::NoDataDir {
+            tried: format!("{} (from {origin}) is not a directory", dir.display()),
+        })
+    }
+}
+
+/// SHA-256 of a file, hex encoded.
+pub fn file_sha256(path: &Path) -> Result<String> {
+    let bytes = std::fs::read(path).map_err(|source| DataError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let digest = Sha256::digest(&bytes);
+    Ok(digest.iter().map(|b| format!("{b:02x}")).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_flag_that_is_not_a_directory_is_an_error() {
+        let message = resolve_data_dir(Some(Path::new("/no/such/dir")))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("/no/such/dir") && message.contains("make data"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn hashes_are_sha256() {
+        let path = std::env::temp_dir().join(format!("hash-{}", std::process::id()));
+        std::fs::write(&path, b"abc").unwrap();
+        assert_eq!(
+            file_sha256(&path).unwrap(),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+    }
+}

@@ -1,0 +1,78 @@
+//! Support / query splits of one flight.
+
+use std::ops::Range;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{DataError, Result};
+
+/// How a flight of n samples is cut into a support segment (fit, adapt) and a query segment
+/// (generalisation, never used to fit or choose anything).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum SplitSpec {
+    /// The paper's protocol: support = rows [0, n/2), query = rows [n/2, n) (integer division).
+    Halves,
+    /// Contiguous: support = the first ⌊fraction·n⌋ rows, query = the rest.
+    Fraction { support: f64 },
+}
+
+/// The two contiguous segments of a split.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Split {
+    pub support: Range<usize>,
+    pub query: Range<usize>,
+}
+
+impl SplitSpec {
+    /// Cuts `n` rows; both segments must keep at least two rows.
+    pub fn split(&self, n: usize) -> Result<Split> {
+        let cut = match *self {
+            Self::Halves => n / 2,
+            Self::Fraction { support } => {
+                if !(support > 0.0 && support < 1.0) {
+                    return Err(DataError::Invalid {
+                        what: "split".to_string(),
+                        message: format!("support fraction {support} must lie in (0, 1)"),
+                    });
+                }
+                (support * n as f64).floor() as usize
+            }
+        };
+        if cut < 2 || n - cut < 2 {
+            return Err(DataError::Invalid {
+                what: "split".to_string(),
+                message: format!("{n} rows are too few to split ({cut} / {})", n - cut),
+            });
+        }
+        Ok(Split {
+            support: 0..cut,
+            query: cut..n,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn halves_use_integer_division() {
+        let split = SplitSpec::Halves.split(2511).unwrap();
+        assert_eq!(split.support, 0..1255);
+        assert_eq!(split.query, 1255..2511);
+    }
+
+    #[test]
+    fn fractions_are_checked() {
+        assert_eq!(
+            SplitSpec::Fraction { support: 0.25 }
+                .split(100)
+                .unwrap()
+                .query,
+            25..100
+        );
+        assert!(SplitSpec::Fraction { support: 1.5 }.split(100).is_err());
+        assert!(SplitSpec::Halves.split(3).is_err());
+    }
+}

@@ -1,0 +1,91 @@
+//! Writing flight logs in the Neural-Fly CSV layout (used by the simulator and by tests that make
+//! their own small data).
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+
+use crate::error::{DataError, Result};
+use crate::flight_log::FlightLog;
+
+fn list(values: &[f64]) -> String {
+    let inner: Vec<String> = values.iter().map(|v| format!("{v:?}")).collect();
+    format!("\"[{}]\"", inner.join(", "))
+}
+
+fn matrix(m: &[[f64; 3]; 3]) -> String {
+    let rows: Vec<String> = m
+        .iter()
+        .map(|row| {
+            let inner: Vec<String> = row.iter().map(|v| format!("{v:?}")).collect();
+            format!("[{}]", inner.join(", "))
+        })
+        .collect();
+    format!("\"[{}]\"", rows.join(", "))
+}
+
+impl FlightLog {
+    /// Writes the log as a Neural-Fly CSV (unnamed index column first; optional columns only when
+    /// present). Numbers are written with full precision, so reading the file back is lossless.
+    pub fn write_csv(&self, path: &Path) -> Result<()> {
+        let io = |source| DataError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut header = String::from(",t,p");
+        let optional = [
+            ("p_d", self.position_desired.is_some()),
+            ("v_d", self.velocity_desired.is_some()),
+            ("q_sp", self.attitude_setpoint.is_some()),
+            ("fa", self.residual_force.is_some()),
+        ];
+        if optional[0].1 {
+            header.push_str(",p_d");
+        }
+        header.push_str(",v");
+        if optional[1].1 {
+            header.push_str(",v_d");
+        }
+        header.push_str(",q,R,w,T_sp");
+        if optional[2].1 {
+            header.push_str(",q_sp");
+        }
+        header.push_str(",hover_throttle");
+        if optional[3].1 {
+            header.push_str(",fa");
+        }
+        header.push_str(",pwm\n");
+        let mut text = header;
+        for k in 0..self.len() {
+            let _ = write!(text, "{k},{:?},{}", self.time[k], list(&self.position[k]));
+            if let Some(pd) = &self.position_desired {
+                let _ = write!(text, ",{}", list(&pd[k]));
+            }
+            let _ = write!(text, ",{}", list(&self.velocity[k]));
+            if let Some(vd) = &self.velocity_desired {
+                let _ = write!(text, ",{}", list(&vd[k]));
+            }
+            let _ = write!(
+                text,
+                ",{},{},{},{}",
+                list(&self.quaternion[k]),
+                matrix(&self.rotation[k]),
+                list(&self.body_rate[k]),
+                list(&[self.thrust_setpoint[k]])
+            );
+            if let Some(qsp) = &self.attitude_setpoint {
+                let _ = write!(text, ",{}", list(&qsp[k]));
+            }
+            let _ = write!(text, ",{}", list(&[self.hover_throttle[k]]));
+            if let Some(fa) = &self.residual_force {
+                let _ = write!(text, ",{}", list(&fa[k]));
+            }
+            let _ = writeln!(text, ",{}", list(&self.motor_command[k]));
+        }
+        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(parent).map_err(io)?;
+        }
+        let mut file = std::fs::File::create(path).map_err(io)?;
+        file.write_all(text.as_bytes()).map_err(io)
+    }
+}

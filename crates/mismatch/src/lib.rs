@@ -1,0 +1,1 @@
+//! mismatch (under construction)

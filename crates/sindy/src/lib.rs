@@ -1,0 +1,1 @@
+//! sindy (under construction)

@@ -1,0 +1,43 @@
+//! The one error type of the learn crate.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong while configuring, training, adapting or explaining LeARN.
+/// Each variant renders as one line naming the file, field or condition involved.
+#[derive(Debug, thiserror::Error)]
+pub enum LearnError {
+    #[error(transparent)]
+    Data(#[from] data::DataError),
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: field '{field}': {message}", path.display())]
+    Config {
+        path: PathBuf,
+        field: String,
+        message: String,
+    },
+    #[error("{}: not a LeARN checkpoint: {message}", path.display())]
+    Checkpoint { path: PathBuf, message: String },
+    #[error(
+        "protocol '{protocol}': no meta-training flight for evaluation condition '{condition}' ({detail})"
+    )]
+    NoTrainingFlights {
+        protocol: String,
+        condition: String,
+        detail: String,
+    },
+    #[error("unknown protocol '{name}' (known: paper, leave-condition-out, auto)")]
+    UnknownProtocol { name: String },
+    #[error("{what}: {message}")]
+    Mismatch { what: String, message: String },
+    #[error(
+        "meta-training diverged at iteration {iteration} (loss {loss}); lower the outer or inner step in the configuration"
+    )]
+    Diverged { iteration: usize, loss: f64 },
+}
+
+/// Result with a [`LearnError`].
+pub type Result<T> = std::result::Result<T, LearnError>;

@@ -1,0 +1,417 @@
+//! The experiment the tables report: meta-train per (formulation, evaluation condition), adapt
+//! online on the evaluation flight's support segment, predict its query segment.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use data::{ExperimentConditions, FlightLog, Formulation, Mat, file_sha256};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::adapt::adapt_online;
+use crate::config::CheckedConfig;
+use crate::dataset::{Protocol, Standardiser, flight_segments, from_row_major, segment_batch};
+use crate::error::{LearnError, Result};
+use crate::maml::Batch;
+use crate::model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel};
+use crate::network::{Architecture, mean_squared_error};
+use crate::train::{TaskData, meta_train};
+
+/// A flight log with its file's SHA-256.
+struct LoadedFlight {
+    log: FlightLog,
+    sha256: String,
+}
+
+/// Configuration, conditions, protocol and every flight needed, loaded once.
+pub struct Experiment {
+    config: CheckedConfig,
+    conditions: ExperimentConditions,
+    data_dir: PathBuf,
+    protocol: Protocol,
+    flights: BTreeMap<PathBuf, LoadedFlight>,
+}
+
+/// One segment of the evaluation flight: time, targets and the adapted model's predictions.
+#[derive(Clone, Debug)]
+pub struct SegmentPrediction {
+    pub time: Vec<f64>,
+    /// ẋ (forward difference on this segment), samples × I.
+    pub targets: Mat<f64>,
+    /// The adapted model's predictions, samples × I.
+    pub predictions: Mat<f64>,
+}
+
+/// The numbers of one table cell, as written to JSON.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CellSummary {
+    pub formulation: Formulation,
+    /// The condition's file name, e.g. `70p20sint`.
+    pub condition: String,
+    /// The condition as printed in tables, e.g. `70psin20`.
+    pub label: String,
+    pub protocol: Protocol,
+    pub seed: u64,
+    /// The adapted model on the support segment.
+    pub adapt_mse: f64,
+    /// The adapted model, frozen, on the query segment.
+    pub gen_mse: f64,
+    /// The meta-trained model before adaptation, on the support segment.
+    pub unadapted_adapt_mse: f64,
+    /// The meta-trained model before adaptation, on the query segment.
+    pub unadapted_gen_mse: f64,
+    /// The evaluated flight.
+    pub evaluation_file: DataFile,
+}
+
+/// Everything one cell produces.
+#[derive(Clone, Debug)]
+pub struct CellResult {
+    pub summary: CellSummary,
+    pub support: SegmentPrediction,
+    pub query: SegmentPrediction,
+    /// The meta-trained model (the checkpoint).
+    pub model: MetaTrainedModel,
+    /// θ after online adaptation on the support segment.
+    pub adapted_parameters: Vec<f64>,
+}
+
+impl Experiment {
+    /// Resolves the protocol (`None`: `paper` if its flights are present, else
+    /// `leave-condition-out`) and reads every flight it needs, in parallel.
+    pub fn load(
+        config: CheckedConfig,
+        conditions: ExperimentConditions,
+        data_dir: &Path,
+        protocol: Option<Protocol>,
+    ) -> Result<Self> {
+        let protocol = Protocol::resolve(protocol, &conditions, data_dir);
+        let mut paths: Vec<PathBuf> = Vec::new();
+        for condition in conditions.evaluation() {
+            paths.push(conditions.flight_path(
+                data_dir,
+                condition,
+                &conditions.evaluation_controller,
+            ));
+            paths.extend(protocol.training_files(&conditions, data_dir, &condition.name)?);
+        }
+        paths.sort();
+        paths.dedup();
+        let loaded: Vec<(PathBuf, LoadedFlight)> = paths
+            .par_iter()
+            .map(|path| {
+                let log = FlightLog::read(path)?;
+                let sha256 = file_sha256(path)?;
+                Ok((path.clone(), LoadedFlight { log, sha256 }))
+            })
+            .collect::<Result<_>>()?;
+        Ok(Self {
+            config,
+            conditions,
+            data_dir: data_dir.to_path_buf(),
+            protocol,
+            flights: loaded.into_iter().collect(),
+        })
+    }
+
+    /// The protocol every result of this experiment is produced under.
+    pub fn protocol(&self) -> Protocol {
+        self.protocol
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &CheckedConfig {
+        &self.config
+    }
+
+    /// The names of the evaluation conditions, in table order.
+    pub fn evaluation_conditions(&self) -> Vec<String> {
+        self.conditions
+            .evaluation()
+            .map(|c| c.name.clone())
+            .collect()
+    }
+
+    fn flight(&self, path: &Path) -> Result<&LoadedFlight> {
+        self.flights.get(path).ok_or_else(|| LearnError::Mismatch {
+            what: path.display().to_string(),
+            message: "flight was not loaded by this experiment".to_string(),
+        })
+    }
+
+    fn data_file(&self, path: &Path) -> Result<DataFile> {
+        Ok(DataFile {
+            path: path
+                .strip_prefix(&self.data_dir)
+                .unwrap_or(path)
+                .to_path_buf(),
+            sha256: self.flight(path)?.sha256.clone(),
+        })
+    }
+
+    /// Meta-trains a model for `formulation`, leaving out `evaluation_condition` under
+    /// `leave-condition-out` (under `paper` the condition only names the fold).
+    pub fn meta_train(
+        &self,
+        formulation: Formulation,
+        evaluation_condition: &str,
+        seed: u64,
+    ) -> Result<MetaTrainedModel> {
+        let config = self.config.get();
+        let files =
+            self.protocol
+                .training_files(&self.conditions, &self.data_dir, evaluation_condition)?;
+        let mut raw_tasks = Vec::with_capacity(files.len());
+        let mut data_files = Vec::with_capacity(files.len());
+        for path in &files {
+            let (support, query) = flight_segments(&self.flight(path)?.log, formulation)?;
+            raw_tasks.push((path, segment_batch(&support), segment_batch(&query)));
+            data_files.push(self.data_file(path)?);
+        }
+        let input_dim = formulation.input_names().len();
+        let standardiser = if config.standardise_inputs {
+            Standardiser::fit(
+                raw_tasks
+                    .iter()
+                    .flat_map(|(_, s, q)| [s.inputs.as_slice(), q.inputs.as_slice()]),
+                input_dim,
+            )
+        } else {
+            Standardiser::identity(input_dim)
+        };
+        let tasks: Vec<TaskData> = raw_tasks
+            .into_iter()
+            .map(|(path, support, query)| TaskData {
+                name: path.display().to_string(),
+                support: standardised(&standardiser, support),
+                query: standardised(&standardiser, query),
+            })
+            .collect();
+        let architecture = architecture(formulation, config);
+        let outcome = meta_train(&architecture, &tasks, &config.meta_training, seed)?;
+        let held_out = self
+            .conditions
+            .condition(evaluation_condition)?
+            .name
+            .clone();
+        Ok(MetaTrainedModel {
+            format: CHECKPOINT_FORMAT.to_string(),
+            formulation,
+            protocol: self.protocol,
+            held_out_condition: (self.protocol == Protocol::LeaveConditionOut).then_some(held_out),
+            seed,
+            config: config.clone(),
+            architecture,
+            standardiser,
+            parameters: outcome.parameters,
+            data_files,
+            meta_loss_history: outcome.meta_loss_history,
+        })
+    }
+
+    /// Adapts `model` online on the support segment of the evaluation flight of
+    /// `evaluation_condition` and predicts both segments. Refuses a `leave-condition-out` model
+    /// that was not trained for this condition's fold.
+    pub fn evaluate(
+        &self,
+        model: &MetaTrainedModel,
+        evaluation_condition: &str,
+    ) -> Result<CellResult> {
+        let condition = self.conditions.condition(evaluation_condition)?;
+        if let Some(held_out) = &model.held_out_condition
+            && held_out != &condition.name
+        {
+            return Err(LearnError::Mismatch {
+                what: format!("evaluation on '{}'", condition.name),
+                message: format!(
+                    "the model was meta-trained with '{held_out}' left out, not this condition"
+                ),
+            });
+        }
+        let path = self.conditions.flight_path(
+            &self.data_dir,
+            condition,
+            &self.conditions.evaluation_controller,
+        );
+        let log = &self.flight(&path)?.log;
+        let (support, query) = flight_segments(log, model.formulation)?;
+        let support_batch = standardised(&model.standardiser, segment_batch(&support));
+        let query_batch = standardised(&model.standardiser, segment_batch(&query));
+        let architecture = &model.architecture;
+        let adapted = adapt_online(
+            architecture,
+            &model.parameters,
+            &support_batch.inputs,
+            &support_batch.targets,
+            &self.config.get().adaptation,
+        );
+        let support_predictions = architecture.predict(&adapted, &support_batch.inputs);
+        let query_predictions = architecture.predict(&adapted, &query_batch.inputs);
+        let state_dim = architecture.state_dim;
+        let summary = CellSummary {
+            formulation: model.formulation,
+            condition: condition.name.clone(),
+            label: condition.label().to_string(),
+            protocol: model.protocol,
+            seed: model.seed,
+            adapt_mse: mean_squared_error(&support_predictions, &support_batch.targets),
+            gen_mse: mean_squared_error(&query_predictions, &query_batch.targets),
+            unadapted_adapt_mse: architecture.loss(
+                &model.parameters,
+                &support_batch.inputs,
+                &support_batch.targets,
+            ),
+            unadapted_gen_mse: architecture.loss(
+                &model.parameters,
+                &query_batch.inputs,
+                &query_batch.targets,
+            ),
+            evaluation_file: self.data_file(&path)?,
+        };
+        Ok(CellResult {
+            summary,
+            support: SegmentPrediction {
+                time: support.time.clone(),
+                targets: support.targets.clone(),
+                predictions: from_row_major(&support_predictions, state_dim),
+            },
+            query: SegmentPrediction {
+                time: query.time.clone(),
+                targets: query.targets.clone(),
+                predictions: from_row_major(&query_predictions, state_dim),
+            },
+            model: model.clone(),
+            adapted_parameters: adapted,
+        })
+    }
+
+    /// Meta-trains and evaluates one cell.
+    pub fn run_cell(
+        &self,
+        formulation: Formulation,
+        evaluation_condition: &str,
+        seed: u64,
+    ) -> Result<CellResult> {
+        let model = self.meta_train(formulation, evaluation_condition, seed)?;
+        self.evaluate(&model, evaluation_condition)
+    }
+
+    /// Every cell of the given formulations (× every evaluation condition), in parallel, returned
+    /// in table order. Under `paper` one model per formulation serves all conditions.
+    pub fn run_cells(&self, formulations: &[Formulation], seed: u64) -> Result<Vec<CellResult>> {
+        let conditions = self.evaluation_conditions();
+        if self.protocol == Protocol::Paper {
+            let models: Vec<MetaTrainedModel> = formulations
+                .par_iter()
+                .map(|&f| self.meta_train(f, &conditions[0], seed))
+                .collect::<Result<_>>()?;
+            let jobs: Vec<(&MetaTrainedModel, &String)> = models
+                .iter()
+                .flat_map(|m| conditions.iter().map(move |c| (m, c)))
+                .collect();
+            return jobs
+                .par_iter()
+                .map(|(model, condition)| self.evaluate(model, condition))
+                .collect();
+        }
+        let jobs: Vec<(Formulation, &String)> = formulations
+            .iter()
+            .flat_map(|&f| conditions.iter().map(move |c| (f, c)))
+            .collect();
+        jobs.par_iter()
+            .map(|(formulation, condition)| self.run_cell(*formulation, condition, seed))
+            .collect()
+    }
+
+    /// Generalisation and adaptation MSE of every cell for each seed (the seed-to-seed spread).
+    pub fn seed_spread(
+        &self,
+        formulations: &[Formulation],
+        seeds: &[u64],
+    ) -> Result<Vec<SpreadCell>> {
+        let mut runs: Vec<Vec<CellSummary>> = Vec::with_capacity(seeds.len());
+        for &seed in seeds {
+            let cells = self.run_cells(formulations, seed)?;
+            runs.push(cells.into_iter().map(|c| c.summary).collect());
+        }
+        let cell_count = runs.first().map_or(0, Vec::len);
+        Ok((0..cell_count)
+            .map(|cell| {
+                let first = &runs[0][cell];
+                let gen_values: Vec<f64> = runs.iter().map(|r| r[cell].gen_mse).collect();
+                let adapt_values: Vec<f64> = runs.iter().map(|r| r[cell].adapt_mse).collect();
+                SpreadCell {
+                    formulation: first.formulation,
+                    condition: first.condition.clone(),
+                    label: first.label.clone(),
+                    protocol: first.protocol,
+                    seeds: seeds.to_vec(),
+                    gen_mse: Spread::of(gen_values),
+                    adapt_mse: Spread::of(adapt_values),
+                }
+            })
+            .collect())
+    }
+}
+
+/// Statistics of one MSE over seeds.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Spread {
+    pub values: Vec<f64>,
+    pub mean: f64,
+    /// Sample standard deviation (n − 1).
+    pub std: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+impl Spread {
+    /// The statistics of `values`.
+    pub fn of(values: Vec<f64>) -> Self {
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let std = if values.len() > 1 {
+            (values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0)).sqrt()
+        } else {
+            0.0
+        };
+        let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        Self {
+            values,
+            mean,
+            std,
+            min,
+            max,
+        }
+    }
+}
+
+/// The seed-to-seed spread of one table cell.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SpreadCell {
+    pub formulation: Formulation,
+    pub condition: String,
+    pub label: String,
+    pub protocol: Protocol,
+    pub seeds: Vec<u64>,
+    pub gen_mse: Spread,
+    pub adapt_mse: Spread,
+}
+
+/// The architecture of `formulation` under `config`.
+pub fn architecture(formulation: Formulation, config: &crate::config::LearnConfig) -> Architecture {
+    Architecture {
+        input_dim: formulation.input_names().len(),
+        state_dim: formulation.state_dim(),
+        basis_per_input: config.basis_per_input,
+        hidden: config.hidden_layers.clone(),
+    }
+}
+
+fn standardised(standardiser: &Standardiser, batch: Batch) -> Batch {
+    Batch {
+        inputs: standardiser.apply(&batch.inputs),
+        targets: batch.targets,
+    }
+}

@@ -1,0 +1,108 @@
+//! A meta-trained LeARN model and its JSON checkpoint.
+
+use std::path::{Path, PathBuf};
+
+use data::Formulation;
+use serde::{Deserialize, Serialize};
+
+use crate::config::LearnConfig;
+use crate::dataset::{Protocol, Standardiser};
+use crate::error::{LearnError, Result};
+use crate::network::Architecture;
+
+/// The format tag written into every checkpoint.
+pub const CHECKPOINT_FORMAT: &str = "learn-checkpoint/1";
+
+/// A data file a model was trained or evaluated on, with its SHA-256.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DataFile {
+    pub path: PathBuf,
+    pub sha256: String,
+}
+
+/// Meta-trained parameters with everything needed to use and to reproduce them. Saved as JSON.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MetaTrainedModel {
+    /// Always [`CHECKPOINT_FORMAT`].
+    pub format: String,
+    pub formulation: Formulation,
+    pub protocol: Protocol,
+    /// The evaluation condition left out of meta-training (`leave-condition-out`), if any.
+    pub held_out_condition: Option<String>,
+    /// The seed of initialisation and task sampling.
+    pub seed: u64,
+    pub config: LearnConfig,
+    pub architecture: Architecture,
+    /// Input standardisation (meta-training statistics; the identity when switched off).
+    pub standardiser: Standardiser,
+    /// θ = [ψ; φ], see [`crate::network`] for the layout.
+    pub parameters: Vec<f64>,
+    /// The meta-training flights.
+    pub data_files: Vec<DataFile>,
+    /// Mean meta-loss per meta-iteration.
+    pub meta_loss_history: Vec<f64>,
+}
+
+impl MetaTrainedModel {
+    /// Predictions (rows × I, row-major) for raw inputs (rows × (I+U), row-major).
+    pub fn predict(&self, raw_inputs: &[f64]) -> Vec<f64> {
+        self.architecture
+            .predict(&self.parameters, &self.standardiser.apply(raw_inputs))
+    }
+
+    /// Writes the checkpoint as JSON, creating parent directories.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        let io = |source| LearnError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(parent).map_err(io)?;
+        }
+        let text = serde_json::to_string(self).map_err(|error| LearnError::Checkpoint {
+            path: path.to_path_buf(),
+            message: error.to_string(),
+        })?;
+        std::fs::write(path, text).map_err(io)
+    }
+
+    /// Reads and checks a checkpoint.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| LearnError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let bad = |message: String| LearnError::Checkpoint {
+            path: path.to_path_buf(),
+            message,
+        };
+        let model: Self = serde_json::from_str(&text).map_err(|error| bad(error.to_string()))?;
+        if model.format != CHECKPOINT_FORMAT {
+            return Err(bad(format!(
+                "format '{}', expected '{CHECKPOINT_FORMAT}'",
+                model.format
+            )));
+        }
+        let expected = model.architecture.parameter_count();
+        if model.parameters.len() != expected {
+            return Err(bad(format!(
+                "{} parameters, the architecture needs {expected}",
+                model.parameters.len()
+            )));
+        }
+        let dim = model.architecture.input_dim;
+        if model.standardiser.mean.len() != dim || model.standardiser.std.len() != dim {
+            return Err(bad(format!("standardiser does not have {dim} features")));
+        }
+        if model.formulation.input_names().len() != dim
+            || model.formulation.state_dim() != model.architecture.state_dim
+        {
+            return Err(bad(format!(
+                "architecture does not fit formulation '{}'",
+                model.formulation.name()
+            )));
+        }
+        Ok(model)
+    }
+}

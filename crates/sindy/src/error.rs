@@ -1,0 +1,71 @@
+//! The crate's one error type. Every message is one line naming what was wrong and where.
+
+use std::path::PathBuf;
+
+/// Errors of the sindy crate.
+#[derive(Debug, thiserror::Error)]
+pub enum SindyError {
+    /// A parameter outside its valid range, e.g. a negative threshold.
+    #[error("invalid {name}: {message}")]
+    InvalidParameter { name: String, message: String },
+    /// A library or optimizer specification that does not parse.
+    #[error("cannot parse {kind} '{text}': {message}")]
+    Parse {
+        kind: &'static str,
+        text: String,
+        message: String,
+    },
+    /// Matrices or name lists whose sizes do not agree.
+    #[error("{what}: {message}")]
+    Shape { what: String, message: String },
+    /// A NaN or infinite value in the data.
+    #[error("{what}: non-finite value at row {row}, column {column}")]
+    NonFinite {
+        what: String,
+        row: usize,
+        column: usize,
+    },
+    /// A solver that did not reach a solution.
+    #[error("{solver} failed on target '{target}': {message}")]
+    Solver {
+        solver: &'static str,
+        target: String,
+        message: String,
+    },
+    /// A model that cannot be written, e.g. one with custom (closure) features.
+    #[error("cannot save the model: {0}")]
+    NotSerialisable(String),
+    /// A model file whose content is inconsistent.
+    #[error("{path}: field '{field}': {message}")]
+    ModelFile {
+        path: PathBuf,
+        field: String,
+        message: String,
+    },
+    /// Reading or writing a file.
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// Errors from the data crate (derivatives, segments, flight logs).
+    #[error(transparent)]
+    Data(#[from] data::DataError),
+}
+
+/// The crate's result type.
+pub type Result<T> = std::result::Result<T, SindyError>;
+
+pub(crate) fn invalid(name: &str, message: impl Into<String>) -> SindyError {
+    SindyError::InvalidParameter {
+        name: name.to_string(),
+        message: message.into(),
+    }
+}
+
+pub(crate) fn shape(what: &str, message: impl Into<String>) -> SindyError {
+    SindyError::Shape {
+        what: what.to_string(),
+        message: message.into(),
+    }
+}

@@ -1,0 +1,497 @@
+//! Feature libraries Θ(X): the candidate terms a sparse model chooses from.
+//!
+//! Feature names (used by equations, the CLI and the model JSON):
+//! - constant `1`;
+//! - monomials: factors in input order joined by `*`, powers as `^p`: `x`, `x^2`, `x*y`, `x^2*u`;
+//! - Fourier: `sin(x)`, `cos(x)`, `sin(2*x)`, `cos(2*x)`;
+//! - custom: the function's name template with `{}` replaced by the input name, e.g. `exp(x)`.
+//!
+//! Feature order follows PySINDy: polynomial terms degree by degree (constant first), within a
+//! degree the combinations with replacement of the inputs in lexicographic order (scikit-learn's
+//! `PolynomialFeatures`); Fourier terms frequency by frequency, and for each input `sin` then `cos`
+//! (`sin(x0), cos(x0), sin(x1), cos(x1), …, sin(2*x0), …`); concatenations part by part.
+
+use std::fmt;
+use std::sync::Arc;
+
+use faer::{Mat, MatRef};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Result, SindyError, invalid};
+
+/// A serialisable description of a library made of polynomial and Fourier parts.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LibrarySpec {
+    /// All monomials of the inputs up to `degree`, with the constant `1` if `constant`.
+    Polynomial { degree: usize, constant: bool },
+    /// `sin(k·z)` and `cos(k·z)` of every input z, for k = 1..=frequencies.
+    Fourier { frequencies: usize },
+    /// The features of each part, one part after the other.
+    Concatenation { parts: Vec<LibrarySpec> },
+}
+
+impl LibrarySpec {
+    /// Parses the command-line form: parts joined by `+`, each `poly:D` (with constant),
+    /// `poly:D:noconstant` or `fourier:K`. Example: `poly:2+fourier:1`.
+    pub fn parse(text: &str) -> Result<Self> {
+        let error = |message: String| SindyError::Parse {
+            kind: "library",
+            text: text.to_string(),
+            message,
+        };
+        let mut parts = Vec::new();
+        for part in text.split('+').map(str::trim) {
+            let fields: Vec<&str> = part.split(':').collect();
+            let number = |index: usize| -> Result<usize> {
+                let field = fields.get(index).ok_or_else(|| {
+                    error(format!("'{part}' needs a number, e.g. poly:2 or fourier:1"))
+                })?;
+                field
+                    .parse()
+                    .map_err(|_| error(format!("'{field}' in '{part}' is not a whole number")))
+            };
+            let spec = match (fields[0], fields.len()) {
+                ("poly", 2) => Self::Polynomial {
+                    degree: number(1)?,
+                    constant: true,
+                },
+                ("poly", 3) if fields[2] == "noconstant" => Self::Polynomial {
+                    degree: number(1)?,
+                    constant: false,
+                },
+                ("fourier", 2) => Self::Fourier {
+                    frequencies: number(1)?,
+                },
+                _ => {
+                    return Err(error(format!(
+                        "unknown part '{part}' (known: poly:D, poly:D:noconstant, fourier:K)"
+                    )));
+                }
+            };
+            parts.push(spec);
+        }
+        let spec = if parts.len() == 1 {
+            parts.remove(0)
+        } else {
+            Self::Concatenation { parts }
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+
+    /// Checks that every part yields at least one feature.
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            Self::Polynomial { degree, constant } => {
+                if *degree == 0 && !*constant {
+                    return Err(invalid(
+                        "polynomial library",
+                        "degree 0 without constant has no feature",
+                    ));
+                }
+            }
+            Self::Fourier { frequencies } => {
+                if *frequencies == 0 {
+                    return Err(invalid("Fourier library", "frequencies must be at least 1"));
+                }
+            }
+            Self::Concatenation { parts } => {
+                if parts.is_empty() {
+                    return Err(invalid(
+                        "library",
+                        "a concatenation needs at least one part",
+                    ));
+                }
+                parts.iter().try_for_each(Self::validate)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for LibrarySpec {
+    /// The command-line form accepted by [`LibrarySpec::parse`].
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Polynomial {
+                degree,
+                constant: true,
+            } => write!(f, "poly:{degree}"),
+            Self::Polynomial {
+                degree,
+                constant: false,
+            } => write!(f, "poly:{degree}:noconstant"),
+            Self::Fourier { frequencies } => write!(f, "fourier:{frequencies}"),
+            Self::Concatenation { parts } => {
+                for (i, part) in parts.iter().enumerate() {
+                    if i > 0 {
+                        write!(f, "+")?;
+                    }
+                    write!(f, "{part}")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// A named scalar function applied to every input, e.g. `exp({})`.
+#[derive(Clone)]
+pub struct CustomFunction {
+    template: String,
+    function: Arc<dyn Fn(f64) -> f64 + Send + Sync>,
+}
+
+impl CustomFunction {
+    /// `template` names the feature, `{}` standing for the input's name (e.g. `exp({})`).
+    pub fn new(
+        template: impl Into<String>,
+        function: impl Fn(f64) -> f64 + Send + Sync + 'static,
+    ) -> Result<Self> {
+        let template = template.into();
+        if !template.contains("{}") {
+            return Err(invalid(
+                "custom feature",
+                format!("name template '{template}' must contain {{}} for the input name"),
+            ));
+        }
+        Ok(Self {
+            template,
+            function: Arc::new(function),
+        })
+    }
+
+    fn name(&self, input: &str) -> String {
+        self.template.replace("{}", input)
+    }
+}
+
+impl fmt::Debug for CustomFunction {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "CustomFunction({})", self.template)
+    }
+}
+
+#[derive(Clone, Debug)]
+enum Part {
+    Polynomial { degree: usize, constant: bool },
+    Fourier { frequencies: usize },
+    Custom(Vec<CustomFunction>),
+}
+
+/// A checked feature library: maps inputs X (one row per sample) to features Θ(X).
+#[derive(Clone, Debug)]
+pub struct FeatureLibrary {
+    parts: Vec<Part>,
+}
+
+impl FeatureLibrary {
+    /// Builds the library a specification describes.
+    pub fn from_spec(spec: &LibrarySpec) -> Result<Self> {
+        spec.validate()?;
+        let mut parts = Vec::new();
+        collect_parts(spec, &mut parts);
+        Ok(Self { parts })
+    }
+
+    /// A library of custom functions, each applied to every input.
+    pub fn custom(functions: Vec<CustomFunction>) -> Result<Self> {
+        if functions.is_empty() {
+            return Err(invalid("custom library", "needs at least one function"));
+        }
+        Ok(Self {
+            parts: vec![Part::Custom(functions)],
+        })
+    }
+
+    /// This library's features followed by `other`'s.
+    pub fn concat(mut self, other: FeatureLibrary) -> Self {
+        self.parts.extend(other.parts);
+        self
+    }
+
+    /// The specification of this library, or `None` if it has custom functions (closures cannot be
+    /// written to a file).
+    pub fn spec(&self) -> Option<LibrarySpec> {
+        let mut specs = Vec::with_capacity(self.parts.len());
+        for part in &self.parts {
+            specs.push(match part {
+                Part::Polynomial { degree, constant } => LibrarySpec::Polynomial {
+                    degree: *degree,
+                    constant: *constant,
+                },
+                Part::Fourier { frequencies } => LibrarySpec::Fourier {
+                    frequencies: *frequencies,
+                },
+                Part::Custom(_) => return None,
+            });
+        }
+        Some(if specs.len() == 1 {
+            specs.remove(0)
+        } else {
+            LibrarySpec::Concatenation { parts: specs }
+        })
+    }
+
+    /// Names of the features for inputs named `inputs`, in column order of [`Self::transform`].
+    pub fn feature_names(&self, inputs: &[&str]) -> Vec<String> {
+        let mut names = Vec::new();
+        for part in &self.parts {
+            match part {
+                Part::Polynomial { degree, constant } => {
+                    for term in monomials(inputs.len(), *degree, *constant) {
+                        names.push(monomial_name(&term, inputs));
+                    }
+                }
+                Part::Fourier { frequencies } => {
+                    for k in 1..=*frequencies {
+                        for input in inputs {
+                            let argument = if k == 1 {
+                                input.to_string()
+                            } else {
+                                format!("{k}*{input}")
+                            };
+                            names.push(format!("sin({argument})"));
+                            names.push(format!("cos({argument})"));
+                        }
+                    }
+                }
+                Part::Custom(functions) => {
+                    for function in functions {
+                        for input in inputs {
+                            names.push(function.name(input));
+                        }
+                    }
+                }
+            }
+        }
+        names
+    }
+
+    /// Number of features for `inputs` input variables.
+    pub fn feature_count(&self, inputs: usize) -> usize {
+        self.parts
+            .iter()
+            .map(|part| match part {
+                Part::Polynomial { degree, constant } => {
+                    monomials(inputs, *degree, *constant).len()
+                }
+                Part::Fourier { frequencies } => 2 * frequencies * inputs,
+                Part::Custom(functions) => functions.len() * inputs,
+            })
+            .sum()
+    }
+
+    /// Θ(X): one row per sample of `inputs`, one column per feature.
+    pub fn transform(&self, inputs: MatRef<'_, f64>) -> Mat<f64> {
+        let (n, dim) = (inputs.nrows(), inputs.ncols());
+        let mut theta = Mat::<f64>::zeros(n, self.feature_count(dim));
+        let mut column = 0;
+        for part in &self.parts {
+            match part {
+                Part::Polynomial { degree, constant } => {
+                    for term in monomials(dim, *degree, *constant) {
+                        let mut out = theta.col_mut(column);
+                        for i in 0..n {
+                            out[i] = term.iter().map(|&j| inputs[(i, j)]).product();
+                        }
+                        column += 1;
+                    }
+                }
+                Part::Fourier { frequencies } => {
+                    for k in 1..=*frequencies {
+                        let k = k as f64;
+                        for j in 0..dim {
+                            for i in 0..n {
+                                let (sin, cos) = (k * inputs[(i, j)]).sin_cos();
+                                theta[(i, column)] = sin;
+                                theta[(i, column + 1)] = cos;
+                            }
+                            column += 2;
+                        }
+                    }
+                }
+                Part::Custom(functions) => {
+                    for function in functions {
+                        for j in 0..dim {
+                            for i in 0..n {
+                                theta[(i, column)] = (function.function)(inputs[(i, j)]);
+                            }
+                            column += 1;
+                        }
+                    }
+                }
+            }
+        }
+        theta
+    }
+
+    /// Θ of one sample `x`, written into `out` (cleared first). Used by simulation.
+    pub fn transform_row(&self, x: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        for part in &self.parts {
+            match part {
+                Part::Polynomial { degree, constant } => {
+                    for term in monomials(x.len(), *degree, *constant) {
+                        out.push(term.iter().map(|&j| x[j]).product());
+                    }
+                }
+                Part::Fourier { frequencies } => {
+                    for k in 1..=*frequencies {
+                        for value in x {
+                            let (sin, cos) = (k as f64 * value).sin_cos();
+                            out.push(sin);
+                            out.push(cos);
+                        }
+                    }
+                }
+                Part::Custom(functions) => {
+                    for function in functions {
+                        out.extend(x.iter().map(|&v| (function.function)(v)));
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn collect_parts(spec: &LibrarySpec, parts: &mut Vec<Part>) {
+    match spec {
+        LibrarySpec::Polynomial { degree, constant } => parts.push(Part::Polynomial {
+            degree: *degree,
+            constant: *constant,
+        }),
+        LibrarySpec::Fourier { frequencies } => parts.push(Part::Fourier {
+            frequencies: *frequencies,
+        }),
+        LibrarySpec::Concatenation { parts: specs } => {
+            specs.iter().for_each(|s| collect_parts(s, parts));
+        }
+    }
+}
+
+/// The monomials of `dim` inputs up to `degree`, each as the sorted list of its factors' input
+/// indices (empty = the constant), in scikit-learn's `PolynomialFeatures` order.
+fn monomials(dim: usize, degree: usize, constant: bool) -> Vec<Vec<usize>> {
+    let mut terms = Vec::new();
+    if constant {
+        terms.push(Vec::new());
+    }
+    for d in 1..=degree {
+        combinations_with_replacement(dim, d, 0, &mut Vec::with_capacity(d), &mut terms);
+    }
+    terms
+}
+
+fn combinations_with_replacement(
+    dim: usize,
+    remaining: usize,
+    start: usize,
+    current: &mut Vec<usize>,
+    out: &mut Vec<Vec<usize>>,
+) {
+    if remaining == 0 {
+        out.push(current.clone());
+        return;
+    }
+    for j in start..dim {
+        current.push(j);
+        combinations_with_replacement(dim, remaining - 1, j, current, out);
+        current.pop();
+    }
+}
+
+fn monomial_name(term: &[usize], inputs: &[&str]) -> String {
+    if term.is_empty() {
+        return "1".to_string();
+    }
+    let mut factors = Vec::new();
+    let mut k = 0;
+    while k < term.len() {
+        let power = term[k..].iter().take_while(|&&j| j == term[k]).count();
+        let name = inputs[term[k]];
+        factors.push(if power == 1 {
+            name.to_string()
+        } else {
+            format!("{name}^{power}")
+        });
+        k += power;
+    }
+    factors.join("*")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polynomial_names_follow_scikit_learn_order() {
+        let library = FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap();
+        assert_eq!(
+            library.feature_names(&["x", "y"]),
+            vec!["1", "x", "y", "x^2", "x*y", "y^2"]
+        );
+        let cubic = FeatureLibrary::from_spec(&LibrarySpec::Polynomial {
+            degree: 3,
+            constant: false,
+        })
+        .unwrap();
+        let names = cubic.feature_names(&["x", "u"]);
+        assert_eq!(names.len(), cubic.feature_count(2));
+        assert!(names.contains(&"x^2*u".to_string()));
+        assert_eq!(names[2..5], ["x^2", "x*u", "u^2"]);
+    }
+
+    #[test]
+    fn fourier_names_and_values_follow_pysindy_order() {
+        let library = FeatureLibrary::from_spec(&LibrarySpec::Fourier { frequencies: 2 }).unwrap();
+        assert_eq!(
+            library.feature_names(&["x", "u"]),
+            vec![
+                "sin(x)", "cos(x)", "sin(u)", "cos(u)", "sin(2*x)", "cos(2*x)", "sin(2*u)",
+                "cos(2*u)"
+            ]
+        );
+        let inputs = Mat::from_fn(2, 2, |i, j| 0.3 + i as f64 + 0.5 * j as f64);
+        let theta = library.transform(inputs.as_ref());
+        assert_eq!(theta[(1, 5)], (2.0f64 * 1.3).cos());
+        assert_eq!(theta[(0, 2)], 0.8f64.sin());
+        let mut row = Vec::new();
+        library.transform_row(&[1.3, 1.8], &mut row);
+        assert_eq!(row, (0..8).map(|j| theta[(1, j)]).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn concatenation_and_custom_functions() {
+        let spec = LibrarySpec::parse("poly:1:noconstant+fourier:1").unwrap();
+        assert_eq!(spec.to_string(), "poly:1:noconstant+fourier:1");
+        let library = FeatureLibrary::from_spec(&spec).unwrap().concat(
+            FeatureLibrary::custom(vec![CustomFunction::new("exp({})", f64::exp).unwrap()])
+                .unwrap(),
+        );
+        assert_eq!(
+            library.feature_names(&["x"]),
+            vec!["x", "sin(x)", "cos(x)", "exp(x)"]
+        );
+        assert!(library.spec().is_none());
+        let theta = library.transform(Mat::from_fn(1, 1, |_, _| 2.0).as_ref());
+        assert_eq!(theta[(0, 3)], 2.0f64.exp());
+    }
+
+    #[test]
+    fn bad_specifications_are_rejected_with_the_text() {
+        for text in [
+            "poly",
+            "poly:x",
+            "spline:3",
+            "fourier:0",
+            "poly:0:noconstant",
+        ] {
+            let error = LibrarySpec::parse(text).unwrap_err().to_string();
+            assert!(!error.contains('\n'), "{error}");
+            assert!(error.contains("librar") || error.contains(text), "{error}");
+        }
+        assert!(CustomFunction::new("exp", f64::exp).is_err());
+    }
+}

@@ -1,0 +1,580 @@
+//! SINDy models: fit on trajectories with controls, predict, score, print, simulate.
+
+use data::Derivative;
+use faer::{Mat, MatRef};
+
+use crate::error::{Result, SindyError, invalid, shape};
+use crate::library::{FeatureLibrary, LibrarySpec};
+use crate::optimizer::OptimizerSpec;
+
+/// One recorded trajectory: states x(t), optional controls u(t), optional derivatives ẋ(t).
+/// Samples must be uniformly spaced in time when derivatives are estimated from the states.
+#[derive(Clone, Debug)]
+pub struct Trajectory {
+    /// Time of each sample, s, strictly increasing.
+    pub time: Vec<f64>,
+    /// One row per sample, one column per state.
+    pub states: Mat<f64>,
+    /// One row per sample, one column per control (zero columns: no control).
+    pub controls: Mat<f64>,
+    /// ẋ, one row per sample; `None`: estimated with the model's [`Derivative`].
+    pub derivatives: Option<Mat<f64>>,
+}
+
+impl Trajectory {
+    /// A trajectory without controls; checks that `time` matches the rows and increases.
+    pub fn new(time: Vec<f64>, states: Mat<f64>) -> Result<Self> {
+        if time.len() != states.nrows() {
+            return Err(shape(
+                "trajectory",
+                format!("{} times for {} state rows", time.len(), states.nrows()),
+            ));
+        }
+        if let Some(k) = time.windows(2).position(|w| !increasing(w[0], w[1])) {
+            return Err(shape(
+                "trajectory",
+                format!("time is not strictly increasing at sample {}", k + 1),
+            ));
+        }
+        let controls = Mat::zeros(states.nrows(), 0);
+        Ok(Self {
+            time,
+            states,
+            controls,
+            derivatives: None,
+        })
+    }
+
+    /// Adds control inputs, one row per sample.
+    pub fn with_controls(mut self, controls: Mat<f64>) -> Result<Self> {
+        if controls.nrows() != self.states.nrows() {
+            return Err(shape(
+                "trajectory",
+                format!(
+                    "{} control rows for {} state rows",
+                    controls.nrows(),
+                    self.states.nrows()
+                ),
+            ));
+        }
+        self.controls = controls;
+        Ok(self)
+    }
+
+    /// Adds known derivatives ẋ, same shape as the states.
+    pub fn with_derivatives(mut self, derivatives: Mat<f64>) -> Result<Self> {
+        if derivatives.shape() != self.states.shape() {
+            return Err(shape(
+                "trajectory",
+                format!(
+                    "derivatives are {:?}, states {:?}",
+                    derivatives.shape(),
+                    self.states.shape()
+                ),
+            ));
+        }
+        self.derivatives = Some(derivatives);
+        Ok(self)
+    }
+
+    /// The states, controls and (already estimated) targets of a data-crate segment.
+    pub fn from_segment(segment: &data::Segment) -> Self {
+        Self {
+            time: segment.time.clone(),
+            states: segment.states.clone(),
+            controls: segment.controls.clone(),
+            derivatives: Some(segment.targets.clone()),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.states.nrows()
+    }
+
+    /// X = [x, u], one row per sample.
+    fn inputs(&self) -> Mat<f64> {
+        concatenate_columns(self.states.as_ref(), self.controls.as_ref())
+    }
+
+    /// ẋ: the given derivatives, or the estimate of `derivative` on each state column.
+    fn targets(&self, derivative: Derivative) -> Result<Mat<f64>> {
+        if let Some(d) = &self.derivatives {
+            return Ok(d.clone());
+        }
+        let n = self.len();
+        if n < 2 {
+            return Err(shape("trajectory", "needs at least two samples"));
+        }
+        let dt = (self.time[n - 1] - self.time[0]) / (n - 1) as f64;
+        let mut targets = Mat::zeros(n, self.states.ncols());
+        for j in 0..self.states.ncols() {
+            let column: Vec<f64> = (0..n).map(|i| self.states[(i, j)]).collect();
+            for (i, value) in derivative.apply(&column, dt)?.into_iter().enumerate() {
+                targets[(i, j)] = value;
+            }
+        }
+        Ok(targets)
+    }
+}
+
+/// Goodness of fit of ẋ on a trajectory.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Score {
+    /// Mean over samples and state dimensions of the squared error.
+    pub mse: f64,
+    /// Coefficient of determination averaged uniformly over state dimensions (scikit-learn's
+    /// `r2_score`, PySINDy's default score).
+    pub r2: f64,
+}
+
+/// Settings of a SINDy fit, checked when [`SindyParams::fit`] runs.
+#[derive(Clone, Debug)]
+pub struct SindyParams {
+    state_names: Vec<String>,
+    control_names: Vec<String>,
+    library: FeatureLibrary,
+    library_spec: Option<LibrarySpec>,
+    optimizer: OptimizerSpec,
+    derivative: Derivative,
+}
+
+impl SindyParams {
+    /// Defaults as in PySINDy: polynomial library of degree 2 with constant, STLSQ threshold 0.1
+    /// (alpha 0.05, 20 iterations); derivatives by central differences.
+    pub fn new(state_names: &[&str], control_names: &[&str]) -> Self {
+        let spec = LibrarySpec::Polynomial {
+            degree: 2,
+            constant: true,
+        };
+        Self {
+            state_names: state_names.iter().map(|s| s.to_string()).collect(),
+            control_names: control_names.iter().map(|s| s.to_string()).collect(),
+            library: FeatureLibrary::from_spec(&spec).expect("a valid built-in library"),
+            library_spec: Some(spec),
+            optimizer: OptimizerSpec::stlsq(0.1),
+            derivative: Derivative::Central,
+        }
+    }
+
+    /// Uses `library` (polynomial, Fourier, custom or concatenated).
+    pub fn library(mut self, library: FeatureLibrary) -> Self {
+        self.library_spec = library.spec();
+        self.library = library;
+        self
+    }
+
+    /// Uses `optimizer`.
+    pub fn optimizer(mut self, optimizer: OptimizerSpec) -> Self {
+        self.optimizer = optimizer;
+        self
+    }
+
+    /// Estimates missing derivatives with `derivative`.
+    pub fn derivative(mut self, derivative: Derivative) -> Self {
+        self.derivative = derivative;
+        self
+    }
+
+    /// Fits one model on all `trajectories` (their samples stacked).
+    pub fn fit(&self, trajectories: &[Trajectory]) -> Result<SindyModel> {
+        self.check_names()?;
+        if trajectories.is_empty() {
+            return Err(invalid("trajectories", "at least one is needed"));
+        }
+        let (dim_x, dim_u) = (self.state_names.len(), self.control_names.len());
+        let mut inputs = Vec::with_capacity(trajectories.len());
+        let mut targets = Vec::with_capacity(trajectories.len());
+        for (index, trajectory) in trajectories.iter().enumerate() {
+            if trajectory.states.ncols() != dim_x || trajectory.controls.ncols() != dim_u {
+                return Err(shape(
+                    &format!("trajectory {index}"),
+                    format!(
+                        "{} states and {} controls, the model names {dim_x} and {dim_u}",
+                        trajectory.states.ncols(),
+                        trajectory.controls.ncols()
+                    ),
+                ));
+            }
+            inputs.push(trajectory.inputs());
+            targets.push(trajectory.targets(self.derivative)?);
+        }
+        let inputs = stack_rows(&inputs);
+        let targets = stack_rows(&targets);
+        self.fit_matrices(inputs.as_ref(), targets.as_ref())
+    }
+
+    /// Fits on inputs X = [x, u] and targets ẋ given as matrices (one row per sample).
+    pub fn fit_matrices(
+        &self,
+        inputs: MatRef<'_, f64>,
+        targets: MatRef<'_, f64>,
+    ) -> Result<SindyModel> {
+        self.check_names()?;
+        let optimizer = self.optimizer.checked()?;
+        let (dim_x, dim_u) = (self.state_names.len(), self.control_names.len());
+        if inputs.ncols() != dim_x + dim_u || targets.ncols() != dim_x {
+            return Err(shape(
+                "fit",
+                format!(
+                    "inputs have {} columns and targets {}, expected {} and {dim_x}",
+                    inputs.ncols(),
+                    targets.ncols(),
+                    dim_x + dim_u
+                ),
+            ));
+        }
+        if inputs.nrows() != targets.nrows() || inputs.nrows() == 0 {
+            return Err(shape(
+                "fit",
+                format!(
+                    "{} input rows, {} target rows",
+                    inputs.nrows(),
+                    targets.nrows()
+                ),
+            ));
+        }
+        check_finite("inputs", inputs)?;
+        check_finite("targets", targets)?;
+        let names = self.input_names();
+        let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let theta = self.library.transform(inputs);
+        check_finite("library", theta.as_ref())?;
+        let coefficients = optimizer.fit(theta.as_ref(), targets, &self.state_names)?;
+        Ok(SindyModel {
+            feature_names: self.library.feature_names(&input_names),
+            state_names: self.state_names.clone(),
+            control_names: self.control_names.clone(),
+            library: self.library.clone(),
+            library_spec: self.library_spec.clone(),
+            optimizer: self.optimizer,
+            derivative: self.derivative,
+            coefficients,
+        })
+    }
+
+    fn input_names(&self) -> Vec<String> {
+        self.state_names
+            .iter()
+            .chain(&self.control_names)
+            .cloned()
+            .collect()
+    }
+
+    fn check_names(&self) -> Result<()> {
+        if self.state_names.is_empty() {
+            return Err(invalid("state names", "at least one state is needed"));
+        }
+        let names = self.input_names();
+        for (i, name) in names.iter().enumerate() {
+            if name.is_empty() || names[..i].contains(name) {
+                return Err(invalid(
+                    "variable names",
+                    format!("'{name}' is empty or given twice"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A fitted SINDy model ẋ = ξ·Θ(x, u).
+#[derive(Clone, Debug)]
+pub struct SindyModel {
+    pub(crate) state_names: Vec<String>,
+    pub(crate) control_names: Vec<String>,
+    pub(crate) feature_names: Vec<String>,
+    pub(crate) library: FeatureLibrary,
+    pub(crate) library_spec: Option<LibrarySpec>,
+    pub(crate) optimizer: OptimizerSpec,
+    pub(crate) derivative: Derivative,
+    /// One row per state, one column per feature.
+    pub(crate) coefficients: Mat<f64>,
+}
+
+impl SindyModel {
+    /// Names of the states, in column order.
+    pub fn state_names(&self) -> &[String] {
+        &self.state_names
+    }
+
+    /// Names of the controls, in column order.
+    pub fn control_names(&self) -> &[String] {
+        &self.control_names
+    }
+
+    /// Names of the library's features, in column order.
+    pub fn feature_names(&self) -> &[String] {
+        &self.feature_names
+    }
+
+    /// ξ: one row per state, one column per feature (PySINDy's `coefficients()`).
+    pub fn coefficients(&self) -> MatRef<'_, f64> {
+        self.coefficients.as_ref()
+    }
+
+    /// The coefficient of `feature` in the equation of `state`, if both exist.
+    pub fn coefficient(&self, state: &str, feature: &str) -> Option<f64> {
+        let i = self.state_names.iter().position(|s| s == state)?;
+        let j = self.feature_names.iter().position(|f| f == feature)?;
+        Some(self.coefficients[(i, j)])
+    }
+
+    /// The optimizer the model was fitted with.
+    pub fn optimizer(&self) -> OptimizerSpec {
+        self.optimizer
+    }
+
+    /// The derivative estimator used for trajectories without derivatives.
+    pub fn derivative(&self) -> Derivative {
+        self.derivative
+    }
+
+    /// The library's specification (`None` for custom functions).
+    pub fn library_spec(&self) -> Option<&LibrarySpec> {
+        self.library_spec.as_ref()
+    }
+
+    /// Predicted ẋ for inputs X = [x, u] (one row per sample).
+    pub fn predict_inputs(&self, inputs: MatRef<'_, f64>) -> Result<Mat<f64>> {
+        let expected = self.state_names.len() + self.control_names.len();
+        if inputs.ncols() != expected {
+            return Err(shape(
+                "predict",
+                format!("{} input columns, the model has {expected}", inputs.ncols()),
+            ));
+        }
+        let theta = self.library.transform(inputs);
+        Ok(theta * self.coefficients.transpose())
+    }
+
+    /// Predicted ẋ for states x and controls u (one row per sample; u may have zero columns when
+    /// the model has no control).
+    pub fn predict(&self, states: MatRef<'_, f64>, controls: MatRef<'_, f64>) -> Result<Mat<f64>> {
+        if states.nrows() != controls.nrows() {
+            return Err(shape(
+                "predict",
+                format!(
+                    "{} state rows, {} control rows",
+                    states.nrows(),
+                    controls.nrows()
+                ),
+            ));
+        }
+        self.predict_inputs(concatenate_columns(states, controls).as_ref())
+    }
+
+    /// MSE and R² of the predicted ẋ against the trajectory's derivatives (estimated with the
+    /// model's derivative estimator when the trajectory has none).
+    pub fn score(&self, trajectory: &Trajectory) -> Result<Score> {
+        let predicted = self.predict(trajectory.states.as_ref(), trajectory.controls.as_ref())?;
+        let actual = trajectory.targets(self.derivative)?;
+        Ok(Score {
+            mse: mean_squared_error(predicted.as_ref(), actual.as_ref()),
+            r2: r2_score(predicted.as_ref(), actual.as_ref()),
+        })
+    }
+
+    /// One line per state: `x' = 1.000 y - 0.100 x` with `precision` decimals; the constant
+    /// feature is printed as a bare number; a state without terms reads `x' = 0`.
+    pub fn equations(&self, precision: usize) -> Vec<String> {
+        self.state_names
+            .iter()
+            .enumerate()
+            .map(|(i, state)| {
+                let mut line = format!("{state}' =");
+                let mut first = true;
+                for (j, feature) in self.feature_names.iter().enumerate() {
+                    let c = self.coefficients[(i, j)];
+                    if c == 0.0 {
+                        continue;
+                    }
+                    let magnitude = format!("{:.precision$}", c.abs());
+                    let sign = match (first, c < 0.0) {
+                        (true, false) => " ".to_string(),
+                        (true, true) => " -".to_string(),
+                        (false, false) => " + ".to_string(),
+                        (false, true) => " - ".to_string(),
+                    };
+                    line.push_str(&sign);
+                    line.push_str(&magnitude);
+                    if feature != "1" {
+                        line.push(' ');
+                        line.push_str(feature);
+                    }
+                    first = false;
+                }
+                if first {
+                    line.push_str(" 0");
+                }
+                line
+            })
+            .collect()
+    }
+
+    /// The right-hand side f(x, u) at one point.
+    fn rhs(
+        &self,
+        state: &[f64],
+        control: &[f64],
+        row: &mut Vec<f64>,
+        input: &mut Vec<f64>,
+    ) -> Vec<f64> {
+        input.clear();
+        input.extend_from_slice(state);
+        input.extend_from_slice(control);
+        self.library.transform_row(input, row);
+        (0..self.state_names.len())
+            .map(|i| {
+                (0..row.len())
+                    .map(|j| self.coefficients[(i, j)] * row[j])
+                    .sum()
+            })
+            .collect()
+    }
+
+    /// Integrates ẋ = f(x, u) from `x0` over the sample times `time` with classic RK4, one step
+    /// per interval. The controls (one row per time, or zero columns without control) are
+    /// interpolated linearly between samples, so the mid-step control is the mean of the two
+    /// neighbouring samples. Returns the states at every time (first row = `x0`).
+    pub fn simulate(
+        &self,
+        x0: &[f64],
+        time: &[f64],
+        controls: MatRef<'_, f64>,
+    ) -> Result<Mat<f64>> {
+        let dim_x = self.state_names.len();
+        if x0.len() != dim_x {
+            return Err(shape(
+                "simulate",
+                format!("x0 has {} values, the model {dim_x} states", x0.len()),
+            ));
+        }
+        if controls.ncols() != self.control_names.len() || controls.nrows() != time.len() {
+            return Err(shape(
+                "simulate",
+                format!(
+                    "controls are {}x{}, expected {}x{}",
+                    controls.nrows(),
+                    controls.ncols(),
+                    time.len(),
+                    self.control_names.len()
+                ),
+            ));
+        }
+        if time.is_empty() || time.windows(2).any(|w| !increasing(w[0], w[1])) {
+            return Err(shape(
+                "simulate",
+                "time must be non-empty and strictly increasing",
+            ));
+        }
+        let mut states = Mat::zeros(time.len(), dim_x);
+        let mut x = x0.to_vec();
+        let (mut row, mut input) = (Vec::new(), Vec::new());
+        let control_at =
+            |k: usize| -> Vec<f64> { (0..controls.ncols()).map(|j| controls[(k, j)]).collect() };
+        for j in 0..dim_x {
+            states[(0, j)] = x[j];
+        }
+        for k in 0..time.len() - 1 {
+            let h = time[k + 1] - time[k];
+            let (u0, u1) = (control_at(k), control_at(k + 1));
+            let middle: Vec<f64> = u0.iter().zip(&u1).map(|(a, b)| 0.5 * (a + b)).collect();
+            let step = |x: &[f64], d: &[f64], scale: f64| -> Vec<f64> {
+                x.iter().zip(d).map(|(a, b)| a + scale * b).collect()
+            };
+            let k1 = self.rhs(&x, &u0, &mut row, &mut input);
+            let k2 = self.rhs(&step(&x, &k1, h / 2.0), &middle, &mut row, &mut input);
+            let k3 = self.rhs(&step(&x, &k2, h / 2.0), &middle, &mut row, &mut input);
+            let k4 = self.rhs(&step(&x, &k3, h), &u1, &mut row, &mut input);
+            for j in 0..dim_x {
+                x[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+                states[(k + 1, j)] = x[j];
+            }
+            if x.iter().any(|v| !v.is_finite()) {
+                return Err(SindyError::Solver {
+                    solver: "RK4 simulation",
+                    target: self.state_names.join(","),
+                    message: format!("the state diverged at t = {}", time[k + 1]),
+                });
+            }
+        }
+        Ok(states)
+    }
+}
+
+/// Mean over all samples and all columns of the squared difference.
+pub fn mean_squared_error(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -> f64 {
+    let (n, m) = actual.shape();
+    let mut sum = 0.0;
+    for j in 0..m {
+        for i in 0..n {
+            let e = predicted[(i, j)] - actual[(i, j)];
+            sum += e * e;
+        }
+    }
+    sum / (n * m) as f64
+}
+
+/// Coefficient of determination, averaged uniformly over columns (scikit-learn's `r2_score`).
+pub fn r2_score(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -> f64 {
+    let (n, m) = actual.shape();
+    let mut total = 0.0;
+    for j in 0..m {
+        let mean = (0..n).map(|i| actual[(i, j)]).sum::<f64>() / n as f64;
+        let residual: f64 = (0..n)
+            .map(|i| (actual[(i, j)] - predicted[(i, j)]).powi(2))
+            .sum();
+        let spread: f64 = (0..n).map(|i| (actual[(i, j)] - mean).powi(2)).sum();
+        total += match (spread > 0.0, residual > 0.0) {
+            (true, _) => 1.0 - residual / spread,
+            (false, false) => 1.0,
+            (false, true) => 0.0,
+        };
+    }
+    total / m as f64
+}
+
+fn concatenate_columns(left: MatRef<'_, f64>, right: MatRef<'_, f64>) -> Mat<f64> {
+    let split = left.ncols();
+    Mat::from_fn(left.nrows(), split + right.ncols(), |i, j| {
+        if j < split {
+            left[(i, j)]
+        } else {
+            right[(i, j - split)]
+        }
+    })
+}
+
+fn stack_rows(blocks: &[Mat<f64>]) -> Mat<f64> {
+    let rows = blocks.iter().map(Mat::nrows).sum();
+    let cols = blocks.first().map_or(0, Mat::ncols);
+    let mut out = Mat::zeros(rows, cols);
+    let mut offset = 0;
+    for block in blocks {
+        out.as_mut()
+            .submatrix_mut(offset, 0, block.nrows(), cols)
+            .copy_from(block);
+        offset += block.nrows();
+    }
+    out
+}
+
+fn check_finite(what: &str, matrix: MatRef<'_, f64>) -> Result<()> {
+    for j in 0..matrix.ncols() {
+        for i in 0..matrix.nrows() {
+            if !matrix[(i, j)].is_finite() {
+                return Err(SindyError::NonFinite {
+                    what: what.to_string(),
+                    row: i,
+                    column: j,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether `b` is a finite time strictly after `a`.
+fn increasing(a: f64, b: f64) -> bool {
+    b.is_finite() && a.is_finite() && b > a
+}

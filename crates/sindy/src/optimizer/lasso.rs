@@ -1,0 +1,190 @@
+//! LASSO, `min ½‖Θξ − y‖² + λ‖ξ‖₁` for each target column, as a quadratic program solved by
+//! clarabel, then polished on the found support.
+//!
+//! (scikit-learn's `Lasso(alpha)` minimises `1/(2n)‖Θξ − y‖² + alpha‖ξ‖₁`: the same problem with
+//! `alpha = λ/n`.)
+//!
+//! QP in the Gram form (the library is tall, n ≫ p): variables `[ξ; t]` (2p),
+//! `P = blockdiag(ΘᵀΘ, 0)`, `q = [−Θᵀy; λ·1]`, subject to `ξ − t ≤ 0` and `−ξ − t ≤ 0`
+//! (a non-negative cone of dimension 2p); at the optimum `t = |ξ|`. The interior-point solution is
+//! then polished: on the support S with signs s, the optimum solves `Θ_SᵀΘ_S ξ_S = Θ_Sᵀy − λs`; the
+//! polished point is kept when it has the same signs and satisfies the KKT conditions at least as
+//! well. [`kkt_violation`] measures how far any ξ is from optimal.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+use faer::{Mat, MatRef};
+use rayon::prelude::*;
+
+use crate::error::{Result, SindyError, invalid};
+use crate::linalg::ridge_from_gram;
+
+/// Checked LASSO settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lasso {
+    lambda: f64,
+}
+
+impl Lasso {
+    /// Checks `lambda ≥ 0` and finite.
+    pub fn new(lambda: f64) -> Result<Self> {
+        if !(lambda.is_finite() && lambda >= 0.0) {
+            return Err(invalid("LASSO lambda", format!("{lambda} must be ≥ 0")));
+        }
+        Ok(Self { lambda })
+    }
+
+    /// Fits every column of `targets` on `theta`; ξ one row per target, one column per feature.
+    pub fn fit(
+        &self,
+        theta: MatRef<'_, f64>,
+        targets: MatRef<'_, f64>,
+        target_names: &[String],
+    ) -> Result<Mat<f64>> {
+        let gram = theta.transpose() * theta;
+        let moments = theta.transpose() * targets;
+        let columns = (0..targets.ncols())
+            .into_par_iter()
+            .map(|i| {
+                let name = target_names
+                    .get(i)
+                    .cloned()
+                    .unwrap_or_else(|| format!("column {i}"));
+                self.fit_one(gram.as_ref(), moments.col(i).as_mat(), &name)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Mat::from_fn(targets.ncols(), theta.ncols(), |i, j| {
+            columns[i][j]
+        }))
+    }
+
+    fn fit_one(
+        &self,
+        gram: MatRef<'_, f64>,
+        moments: MatRef<'_, f64>,
+        name: &str,
+    ) -> Result<Vec<f64>> {
+        let p = gram.nrows();
+        let solver_error = |message: String| SindyError::Solver {
+            solver: "clarabel LASSO",
+            target: name.to_string(),
+            message,
+        };
+        // P: upper triangle of ΘᵀΘ in the ξ block, column by column.
+        let (mut rows, mut cols, mut values) = (Vec::new(), Vec::new(), Vec::new());
+        for j in 0..p {
+            for i in 0..=j {
+                rows.push(i);
+                cols.push(j);
+                values.push(gram[(i, j)]);
+            }
+        }
+        let quadratic = CscMatrix::new_from_triplets(2 * p, 2 * p, rows, cols, values);
+        let mut linear: Vec<f64> = (0..p).map(|j| -moments[(j, 0)]).collect();
+        linear.extend(std::iter::repeat_n(self.lambda, p));
+        // Rows 0..p: ξ − t (+ s = 0); rows p..2p: −ξ − t.
+        let (mut rows, mut cols, mut values) = (Vec::new(), Vec::new(), Vec::new());
+        for j in 0..p {
+            rows.extend([j, p + j, j, p + j]);
+            cols.extend([j, j, p + j, p + j]);
+            values.extend([1.0, -1.0, -1.0, -1.0]);
+        }
+        let constraints = CscMatrix::new_from_triplets(2 * p, 2 * p, rows, cols, values);
+        let bounds = vec![0.0; 2 * p];
+        let cones = [SupportedConeT::NonnegativeConeT(2 * p)];
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .tol_gap_abs(1e-11)
+            .tol_gap_rel(1e-11)
+            .tol_feas(1e-11)
+            .build()
+            .map_err(|e| solver_error(e.to_string()))?;
+        let mut solver =
+            DefaultSolver::new(&quadratic, &linear, &constraints, &bounds, &cones, settings)
+                .map_err(|e| solver_error(e.to_string()))?;
+        solver.solve();
+        match solver.solution.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => {}
+            status => return Err(solver_error(format!("status {status:?}"))),
+        }
+        let solution: Vec<f64> = solver.solution.x[..p].to_vec();
+        Ok(self.polish(gram, moments, solution))
+    }
+
+    fn polish(
+        &self,
+        gram: MatRef<'_, f64>,
+        moments: MatRef<'_, f64>,
+        solution: Vec<f64>,
+    ) -> Vec<f64> {
+        let scale = solution
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(1e-300);
+        let support: Vec<usize> = (0..solution.len())
+            .filter(|&j| solution[j].abs() > 1e-7 * scale)
+            .collect();
+        let mut polished = vec![0.0; solution.len()];
+        if !support.is_empty() {
+            let sub_gram = Mat::from_fn(support.len(), support.len(), |a, b| {
+                gram[(support[a], support[b])]
+            });
+            let rhs = Mat::from_fn(support.len(), 1, |a, _| {
+                moments[(support[a], 0)] - self.lambda * solution[support[a]].signum()
+            });
+            let exact = ridge_from_gram(sub_gram.as_ref(), rhs.as_ref(), 0.0);
+            for (a, &j) in support.iter().enumerate() {
+                polished[j] = exact[(a, 0)];
+            }
+        }
+        let same_signs = support
+            .iter()
+            .all(|&j| polished[j].signum() == solution[j].signum() && polished[j].is_finite());
+        if same_signs
+            && gram_kkt_violation(gram, moments, &polished, self.lambda)
+                <= gram_kkt_violation(gram, moments, &solution, self.lambda)
+        {
+            polished
+        } else {
+            solution
+        }
+    }
+}
+
+/// Largest violation of the LASSO optimality conditions by ξ for one target, with
+/// g = Θᵀ(y − Θξ): `|g_j − λ·sign(ξ_j)|` where ξ_j ≠ 0, `max(|g_j| − λ, 0)` where ξ_j = 0.
+/// Zero at the exact optimum.
+pub fn kkt_violation(
+    theta: MatRef<'_, f64>,
+    target: &[f64],
+    coefficients: &[f64],
+    lambda: f64,
+) -> f64 {
+    let gram = theta.transpose() * theta;
+    let y = Mat::from_fn(target.len(), 1, |i, _| target[i]);
+    let moments = theta.transpose() * &y;
+    gram_kkt_violation(gram.as_ref(), moments.as_ref(), coefficients, lambda)
+}
+
+fn gram_kkt_violation(
+    gram: MatRef<'_, f64>,
+    moments: MatRef<'_, f64>,
+    coefficients: &[f64],
+    lambda: f64,
+) -> f64 {
+    (0..coefficients.len())
+        .map(|j| {
+            let fitted: f64 = (0..coefficients.len())
+                .map(|k| gram[(j, k)] * coefficients[k])
+                .sum();
+            let gradient = moments[(j, 0)] - fitted;
+            if coefficients[j] != 0.0 {
+                (gradient - lambda * coefficients[j].signum()).abs()
+            } else {
+                (gradient.abs() - lambda).max(0.0)
+            }
+        })
+        .fold(0.0, f64::max)
+}

@@ -1,1 +1,36 @@
-//! physics (under construction)
+//! Quadrotor rigid-body physics for the sim-to-real mismatch tool.
+//!
+//! What it is for: the nominal model read from JSON ([`NominalModel`]: mass, gravity, inertia, and
+//! how thrust and torques follow from a recorded command); the vocabulary of unmodelled effects
+//! ([`Effects`], ids and parameter names are an output contract); a closed-loop simulator
+//! ([`simulate`]: RK4 rigid body, geometric tracking controller that knows only the nominal model,
+//! figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`]) that writes Neural-Fly logs;
+//! and the residual force of a recorded flight ([`residual_force`], the `fa` column).
+//!
+//! What it is not for: analysing mismatches (the `mismatch` crate), reading CSVs (the `data` crate).
+//!
+//! Conventions: world z up, gravity along −z; `R` body to world; quaternions `[x, y, z, w]`;
+//! `m v̇ = m [0, 0, −g] + R [0, 0, T]`, `J ω̇ = −ω × (J ω) + τ` with `ω` the body rate.
+
+// Index loops over 3- and 4-vectors read like the formulas they implement.
+#![allow(clippy::needless_range_loop)]
+
+mod controller;
+mod effects;
+mod error;
+mod model;
+mod residual;
+mod simulator;
+mod trajectory;
+pub mod vector;
+
+pub use controller::{ControlOutput, Gains, GeometricController, MeasuredState};
+pub use effects::{
+    Delay, EFFECT_IDS, Effects, GROUND_EFFECT_MAX_RATIO, GroundEffect, InertiaScale, LinearDrag,
+    MotorLag, QuadraticDrag, ThrustScale, TorqueBias, Wind, ground_ratio,
+};
+pub use error::{PhysicsError, Result};
+pub use model::{Mixer, NominalModel, ThrustSource, Wrench, angular_acceleration_with_inertia};
+pub use residual::{five_point_derivative, residual_force};
+pub use simulator::{Noise, Scenario, simulate};
+pub use trajectory::{LowPass, Reference, ReferenceGenerator, Trajectory};

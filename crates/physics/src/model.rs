@@ -1,0 +1,461 @@
+//! The nominal quadrotor model read from JSON: mass, gravity, inertia and how the collective thrust
+//! (and, with a mixer, the body torques) follow from a recorded command.
+//!
+//! Equations (z up, gravity along −z, `R` body to world, `ω` body rate):
+//! `m v̇ = m [0, 0, −g] + R [0, 0, T]` and `J ω̇ = −ω × (J ω) + τ`.
+//! With `"thrust_source": "T_sp"`, `T = m g T_sp / hover_throttle` and the torques are unknown;
+//! with `"mixer"`, `[T, τx, τy, τz] = b0 · s²` where `s_i = (pwm_i − pwm_offset) / pwm_scale`.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+use serde_json::{Map, Value};
+
+use crate::error::{PhysicsError, Result};
+use crate::vector::{E3, Vec3, add, cross, hadamard, mat_vec, scale};
+
+/// Where the collective thrust comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum ThrustSource {
+    /// The motor commands through the mixer matrix (thrust and torques).
+    #[serde(rename = "mixer")]
+    Mixer,
+    /// The normalised thrust setpoint scaled by the hover throttle (thrust only).
+    #[serde(rename = "T_sp")]
+    ThrustSetpoint,
+}
+
+/// The map from motor commands to thrust and torques.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Mixer {
+    pub pwm_offset: f64,
+    pub pwm_scale: f64,
+    /// `[T, τx, τy, τz] = b0 · s²`.
+    pub b0: [[f64; 4]; 4],
+    #[serde(skip)]
+    inverse: [[f64; 4]; 4],
+}
+
+/// Thrust (N) and, when the model knows them, body torques (N·m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wrench {
+    pub thrust: f64,
+    pub torque: Option<Vec3>,
+}
+
+/// The nominal model.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NominalModel {
+    pub mass_kg: f64,
+    pub gravity_m_s2: f64,
+    /// Diagonal of the inertia matrix, kg·m².
+    pub inertia_kg_m2: Vec3,
+    pub thrust_source: ThrustSource,
+    pub mixer: Option<Mixer>,
+    /// Height of the ground plane in the world frame (optional field, default 0), m.
+    pub ground_height_m: f64,
+}
+
+impl Mixer {
+    /// Builds a mixer; fails (naming `field`) when `b0` is not invertible.
+    fn new(pwm_offset: f64, pwm_scale: f64, b0: [[f64; 4]; 4]) -> Option<Self> {
+        let inverse = invert4(&b0)?;
+        Some(Self {
+            pwm_offset,
+            pwm_scale,
+            b0,
+            inverse,
+        })
+    }
+
+    /// Normalised motor speeds `s_i = (pwm_i − pwm_offset) / pwm_scale`, clipped at 0.
+    pub fn speeds(&self, pwm: &[f64; 4]) -> [f64; 4] {
+        pwm.map(|p| ((p - self.pwm_offset) / self.pwm_scale).max(0.0))
+    }
+
+    /// The motor commands of normalised speeds.
+    pub fn pwm(&self, speeds: &[f64; 4]) -> [f64; 4] {
+        speeds.map(|s| self.pwm_offset + self.pwm_scale * s)
+    }
+
+    /// `[T, τx, τy, τz] = b0 · s²`.
+    pub fn wrench(&self, speeds: &[f64; 4]) -> [f64; 4] {
+        let squared = speeds.map(|s| s * s);
+        let mut out = [0.0; 4];
+        for (i, row) in self.b0.iter().enumerate() {
+            out[i] = (0..4).map(|j| row[j] * squared[j]).sum();
+        }
+        out
+    }
+
+    /// The speeds (clipped to [0, 1]) that produce a wrench `[T, τx, τy, τz]` as closely as the
+    /// limits allow.
+    pub fn speeds_for(&self, wrench: &[f64; 4]) -> [f64; 4] {
+        let mut out = [0.0; 4];
+        for (i, row) in self.inverse.iter().enumerate() {
+            let squared: f64 = (0..4).map(|j| row[j] * wrench[j]).sum();
+            out[i] = squared.max(0.0).sqrt().min(1.0);
+        }
+        out
+    }
+}
+
+impl NominalModel {
+    /// Reads and validates a model file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| PhysicsError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_json(&text, path)
+    }
+
+    /// Parses and validates model JSON; `origin` names the file in errors.
+    pub fn from_json(text: &str, origin: &Path) -> Result<Self> {
+        let value: Value = serde_json::from_str(text).map_err(|error| PhysicsError::Json {
+            path: origin.to_path_buf(),
+            message: error.to_string(),
+        })?;
+        let fields = FieldReader {
+            path: origin.to_path_buf(),
+        };
+        let object = value
+            .as_object()
+            .ok_or_else(|| fields.error("(top level)", "expected a JSON object"))?;
+        let mass_kg = fields.positive(object, "mass_kg")?;
+        let gravity_m_s2 = fields.positive(object, "gravity_m_s2")?;
+        let inertia = fields.numbers(object, "inertia_kg_m2", 3)?;
+        if let Some(bad) = inertia.iter().position(|v| *v <= 0.0) {
+            return Err(fields.error(
+                &format!("inertia_kg_m2[{bad}]"),
+                "must be a positive number",
+            ));
+        }
+        let thrust_source = match object.get("thrust_source") {
+            None => {
+                return Err(
+                    fields.error("thrust_source", "missing (expected \"mixer\" or \"T_sp\")")
+                );
+            }
+            Some(Value::String(s)) if s == "mixer" => ThrustSource::Mixer,
+            Some(Value::String(s)) if s == "T_sp" => ThrustSource::ThrustSetpoint,
+            Some(other) => {
+                return Err(fields.error(
+                    "thrust_source",
+                    &format!("expected \"mixer\" or \"T_sp\", found {other}"),
+                ));
+            }
+        };
+        let mixer = match object.get("mixer") {
+            None | Some(Value::Null) => None,
+            Some(Value::Object(mixer)) => Some(fields.mixer(mixer)?),
+            Some(other) => {
+                return Err(fields.error("mixer", &format!("expected an object, found {other}")));
+            }
+        };
+        if thrust_source == ThrustSource::Mixer && mixer.is_none() {
+            return Err(fields.error("mixer", "missing, but thrust_source is \"mixer\""));
+        }
+        let ground_height_m = match object.get("ground_height_m") {
+            None => 0.0,
+            Some(_) => fields.finite(object, "ground_height_m")?,
+        };
+        Ok(Self {
+            mass_kg,
+            gravity_m_s2,
+            inertia_kg_m2: [inertia[0], inertia[1], inertia[2]],
+            thrust_source,
+            mixer,
+            ground_height_m,
+        })
+    }
+
+    /// Serialises the model in the documented JSON schema.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a model serialises")
+    }
+
+    /// Whether the model predicts body torques (it has a mixer and uses it).
+    pub fn predicts_torque(&self) -> bool {
+        self.thrust_source == ThrustSource::Mixer
+    }
+
+    /// The actuator states the recorded command asks for: the four normalised motor speeds with a
+    /// mixer, or `[T, 0, 0, 0]` (N) with `T_sp`. Delays and lags act on these.
+    pub fn actuator_command(
+        &self,
+        thrust_setpoint: f64,
+        hover_throttle: f64,
+        pwm: &[f64; 4],
+    ) -> [f64; 4] {
+        match self.thrust_source {
+            ThrustSource::Mixer => self
+                .mixer
+                .as_ref()
+                .expect("validated: a mixer model has a mixer")
+                .speeds(pwm),
+            ThrustSource::ThrustSetpoint => [
+                self.mass_kg * self.gravity_m_s2 * thrust_setpoint / hover_throttle,
+                0.0,
+                0.0,
+                0.0,
+            ],
+        }
+    }
+
+    /// How many entries of an actuator command are used (4 motors, or 1 thrust).
+    pub fn actuator_count(&self) -> usize {
+        match self.thrust_source {
+            ThrustSource::Mixer => 4,
+            ThrustSource::ThrustSetpoint => 1,
+        }
+    }
+
+    /// Thrust and torques produced by actuator states.
+    pub fn wrench(&self, actuators: &[f64; 4]) -> Wrench {
+        match self.thrust_source {
+            ThrustSource::Mixer => {
+                let w = self
+                    .mixer
+                    .as_ref()
+                    .expect("validated: a mixer model has a mixer")
+                    .wrench(actuators);
+                Wrench {
+                    thrust: w[0],
+                    torque: Some([w[1], w[2], w[3]]),
+                }
+            }
+            ThrustSource::ThrustSetpoint => Wrench {
+                thrust: actuators[0],
+                torque: None,
+            },
+        }
+    }
+
+    /// Nominal `v̇ = [0, 0, −g] + R e3 T / m`.
+    pub fn translational_acceleration(&self, rotation: &crate::vector::Mat3, thrust: f64) -> Vec3 {
+        add(
+            [0.0, 0.0, -self.gravity_m_s2],
+            scale(mat_vec(rotation, E3), thrust / self.mass_kg),
+        )
+    }
+
+    /// Nominal `ω̇ = J⁻¹ (τ − ω × J ω)`.
+    pub fn angular_acceleration(&self, rate: Vec3, torque: Vec3) -> Vec3 {
+        angular_acceleration_with_inertia(self.inertia_kg_m2, rate, torque)
+    }
+
+    /// The residual force `fa = m v̇ − m [0, 0, −g] − R e3 T` (N) for an acceleration `v̇`.
+    pub fn residual_force(
+        &self,
+        acceleration: Vec3,
+        rotation: &crate::vector::Mat3,
+        thrust: f64,
+    ) -> Vec3 {
+        let predicted = self.translational_acceleration(rotation, thrust);
+        scale(crate::vector::sub(acceleration, predicted), self.mass_kg)
+    }
+}
+
+/// `ω̇ = J⁻¹ (τ − ω × J ω)` for a diagonal inertia `J`.
+pub fn angular_acceleration_with_inertia(inertia: Vec3, rate: Vec3, torque: Vec3) -> Vec3 {
+    let gyroscopic = cross(rate, hadamard(inertia, rate));
+    let net = crate::vector::sub(torque, gyroscopic);
+    [
+        net[0] / inertia[0],
+        net[1] / inertia[1],
+        net[2] / inertia[2],
+    ]
+}
+
+struct FieldReader {
+    path: PathBuf,
+}
+
+impl FieldReader {
+    fn error(&self, field: &str, message: &str) -> PhysicsError {
+        PhysicsError::Field {
+            path: self.path.clone(),
+            field: field.to_string(),
+            message: message.to_string(),
+        }
+    }
+
+    fn finite_value(&self, value: Option<&Value>, field: &str) -> Result<f64> {
+        match value {
+            None => Err(self.error(field, "missing")),
+            Some(Value::Number(n)) => n
+                .as_f64()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| self.error(field, "not a finite number")),
+            Some(other) => Err(self.error(field, &format!("expected a number, found {other}"))),
+        }
+    }
+
+    fn finite(&self, object: &Map<String, Value>, field: &str) -> Result<f64> {
+        self.finite_value(object.get(field), field)
+    }
+
+    fn positive(&self, object: &Map<String, Value>, field: &str) -> Result<f64> {
+        let value = self.finite(object, field)?;
+        if value <= 0.0 {
+            return Err(self.error(field, &format!("must be positive, found {value}")));
+        }
+        Ok(value)
+    }
+
+    fn numbers_of(&self, value: Option<&Value>, field: &str, count: usize) -> Result<Vec<f64>> {
+        let array = match value {
+            None => return Err(self.error(field, "missing")),
+            Some(Value::Array(a)) => a,
+            Some(other) => {
+                return Err(self.error(
+                    field,
+                    &format!("expected a list of {count} numbers, found {other}"),
+                ));
+            }
+        };
+        if array.len() != count {
+            return Err(self.error(
+                field,
+                &format!("expected {count} numbers, found {}", array.len()),
+            ));
+        }
+        array
+            .iter()
+            .enumerate()
+            .map(|(i, v)| self.finite_value(Some(v), &format!("{field}[{i}]")))
+            .collect()
+    }
+
+    fn numbers(&self, object: &Map<String, Value>, field: &str, count: usize) -> Result<Vec<f64>> {
+        self.numbers_of(object.get(field), field, count)
+    }
+
+    fn mixer(&self, mixer: &Map<String, Value>) -> Result<Mixer> {
+        let pwm_offset = self.finite_value(mixer.get("pwm_offset"), "mixer.pwm_offset")?;
+        let pwm_scale = self.finite_value(mixer.get("pwm_scale"), "mixer.pwm_scale")?;
+        if pwm_scale <= 0.0 {
+            return Err(self.error("mixer.pwm_scale", "must be positive"));
+        }
+        let rows = match mixer.get("b0") {
+            None => return Err(self.error("mixer.b0", "missing")),
+            Some(Value::Array(rows)) if rows.len() == 4 => rows,
+            Some(_) => return Err(self.error("mixer.b0", "expected 4 rows of 4 numbers")),
+        };
+        let mut b0 = [[0.0; 4]; 4];
+        for (i, row) in rows.iter().enumerate() {
+            let values = self.numbers_of(Some(row), &format!("mixer.b0[{i}]"), 4)?;
+            b0[i].copy_from_slice(&values);
+        }
+        Mixer::new(pwm_offset, pwm_scale, b0)
+            .ok_or_else(|| self.error("mixer.b0", "the matrix is singular (cannot be inverted)"))
+    }
+}
+
+/// Inverse of a 4x4 matrix by Gauss–Jordan elimination with partial pivoting.
+fn invert4(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
+    let mut a = *m;
+    let mut inv = [[0.0; 4]; 4];
+    for (i, row) in inv.iter_mut().enumerate() {
+        row[i] = 1.0;
+    }
+    let magnitude = m.iter().flatten().fold(0.0f64, |acc, v| acc.max(v.abs()));
+    for col in 0..4 {
+        let pivot = (col..4).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[pivot][col].abs() <= 1e-12 * magnitude.max(f64::MIN_POSITIVE) {
+            return None;
+        }
+        a.swap(col, pivot);
+        inv.swap(col, pivot);
+        let p = a[col][col];
+        for j in 0..4 {
+            a[col][j] /= p;
+            inv[col][j] /= p;
+        }
+        for i in 0..4 {
+            if i != col {
+                let f = a[i][col];
+                for j in 0..4 {
+                    a[i][j] -= f * a[col][j];
+                    inv[i][j] -= f * inv[col][j];
+                }
+            }
+        }
+    }
+    Some(inv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MIXER_MODEL: &str = r#"{"mass_kg": 1.8, "gravity_m_s2": 9.81, "inertia_kg_m2": [0.02, 0.02, 0.035],
+        "thrust_source": "mixer",
+        "mixer": {"pwm_offset": 1000.0, "pwm_scale": 1000.0,
+                  "b0": [[9.7, 9.7, 9.7, 9.7], [-1.0, 1.0, 1.0, -1.0], [1.0, -1.0, 1.0, -1.0], [0.15, 0.15, -0.15, -0.15]]}}"#;
+
+    fn parse(text: &str) -> Result<NominalModel> {
+        NominalModel::from_json(text, Path::new("model.json"))
+    }
+
+    #[test]
+    fn reads_a_mixer_model_and_inverts_the_mixer() {
+        let model = parse(MIXER_MODEL).unwrap();
+        assert!(model.predicts_torque());
+        let mixer = model.mixer.as_ref().unwrap();
+        let speeds = [0.6, 0.7, 0.65, 0.62];
+        let back = mixer.speeds_for(&mixer.wrench(&speeds));
+        for i in 0..4 {
+            assert!((back[i] - speeds[i]).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn errors_name_the_field() {
+        let missing = MIXER_MODEL.replace("\"mass_kg\": 1.8,", "");
+        let error = parse(&missing).unwrap_err().to_string();
+        assert!(
+            error.contains("mass_kg") && error.contains("missing"),
+            "{error}"
+        );
+        let bad_row = MIXER_MODEL.replace("[0.15, 0.15, -0.15, -0.15]", "[0.15, 0.15]");
+        let error = parse(&bad_row).unwrap_err().to_string();
+        assert!(error.contains("mixer.b0[3]"), "{error}");
+        let singular = MIXER_MODEL.replace("[0.15, 0.15, -0.15, -0.15]", "[9.7, 9.7, 9.7, 9.7]");
+        assert!(
+            parse(&singular)
+                .unwrap_err()
+                .to_string()
+                .contains("singular")
+        );
+        let source = MIXER_MODEL.replace("\"mixer\",", "\"motors\",");
+        assert!(
+            parse(&source)
+                .unwrap_err()
+                .to_string()
+                .contains("thrust_source")
+        );
+        let inertia = MIXER_MODEL.replace("0.035]", "-0.035]");
+        assert!(
+            parse(&inertia)
+                .unwrap_err()
+                .to_string()
+                .contains("inertia_kg_m2[2]")
+        );
+        assert!(!parse("{").unwrap_err().to_string().contains('\n'));
+    }
+
+    #[test]
+    fn thrust_setpoint_model_scales_by_hover_throttle() {
+        let model = parse(
+            r#"{"mass_kg": 2.644, "gravity_m_s2": 9.81, "inertia_kg_m2": [0.03, 0.03, 0.05], "thrust_source": "T_sp"}"#,
+        )
+        .unwrap();
+        let command = model.actuator_command(0.5, 0.5, &[0.0; 4]);
+        assert!((model.wrench(&command).thrust - 2.644 * 9.81).abs() < 1e-12);
+        let level = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let a = model.translational_acceleration(&level, 2.644 * 9.81);
+        assert!(a.iter().all(|v| v.abs() < 1e-12));
+    }
+}

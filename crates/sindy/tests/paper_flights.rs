@@ -1,0 +1,79 @@
+//! The paper's SINDy columns on the real baseline flights: the 12 cells against the published
+//! values (paper/published.json) and against PySINDy (scripts/golden/sindy_paper.json).
+
+mod common;
+
+use common::{golden, real_data_dir, workspace};
+use data::{Derivative, ExperimentConditions, FlightLog, Formulation, SplitSpec};
+use sindy::{SindyConfig, evaluate_flight};
+
+/// Allowed distance from the published value, per formulation (issue 3).
+fn paper_tolerance(formulation: Formulation) -> f64 {
+    match formulation {
+        Formulation::Translational => 0.01,
+        Formulation::Attitude => 0.07,
+        Formulation::Full => 0.04,
+    }
+}
+
+#[test]
+fn the_twelve_sindy_cells_match_the_paper_and_pysindy() {
+    let Some(data_dir) = real_data_dir() else {
+        return;
+    };
+    let conditions =
+        ExperimentConditions::load(&workspace().join("experiments/conditions.json")).unwrap();
+    let published = common::json("paper/published.json");
+    let pysindy = golden("sindy_paper.json");
+    let mut cells = 0;
+    for condition in conditions.evaluation() {
+        let path = conditions.flight_path(&data_dir, condition, &conditions.evaluation_controller);
+        let log = FlightLog::read(&path).unwrap();
+        for formulation in Formulation::ALL {
+            let evaluation = evaluate_flight(
+                &SindyConfig::paper(),
+                &log,
+                formulation,
+                SplitSpec::Halves,
+                Derivative::Forward,
+            )
+            .unwrap();
+            let label = condition.label();
+            let paper = &published["tables"][formulation.name()][label]["sindy"];
+            let reference = &pysindy["tables"][formulation.name()][label];
+            for (name, ours) in [
+                ("adapt", evaluation.support_mse),
+                ("gen", evaluation.query_mse),
+            ] {
+                let paper_value = paper[name].as_f64().unwrap();
+                let pysindy_value = reference[name].as_f64().unwrap();
+                assert!(
+                    (ours - paper_value).abs() <= paper_tolerance(formulation),
+                    "{} {label} {name}: {ours} vs paper {paper_value}",
+                    formulation.name()
+                );
+                assert!(
+                    (ours - pysindy_value).abs() <= 1e-9 * pysindy_value,
+                    "{} {label} {name}: {ours} vs PySINDy {pysindy_value}",
+                    formulation.name()
+                );
+            }
+            let features: Vec<String> =
+                serde_json::from_value(reference["features"].clone()).unwrap();
+            assert_eq!(features.len(), evaluation.model.feature_names().len());
+            let coefficients = common::matrix(&reference["coefficients"]);
+            let ours = evaluation.model.coefficients();
+            for i in 0..coefficients.nrows() {
+                for j in 0..coefficients.ncols() {
+                    assert_eq!(ours[(i, j)] == 0.0, coefficients[(i, j)] == 0.0);
+                    assert!(
+                        (ours[(i, j)] - coefficients[(i, j)]).abs()
+                            < 1e-7 * (1.0 + coefficients[(i, j)].abs())
+                    );
+                }
+            }
+            cells += 1;
+        }
+    }
+    assert_eq!(cells, 12);
+}

@@ -2,6 +2,7 @@
 
 mod conditions;
 mod inspect;
+mod sindy;
 
 use std::path::PathBuf;
 
@@ -30,6 +31,8 @@ pub enum Command {
     },
     /// List the wind conditions of the experiment and which flight files are present.
     Conditions(conditions::Args),
+    /// Fit a SINDy model on any numeric CSV: print its equations, optionally save it as JSON.
+    Sindy(sindy::Args),
 }
 
 #[derive(Subcommand, Debug)]
@@ -49,6 +52,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
             command: DataCommand::Inspect(args),
         } => inspect::run(&global, args),
         Command::Conditions(args) => conditions::run(&global, args),
+        Command::Sindy(args) => sindy::run(&global, args),
     }
 }
 

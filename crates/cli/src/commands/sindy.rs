@@ -1,0 +1,134 @@
+//! `learn sindy --csv FILE --time t --state x,y [--control u] --library poly:2+fourier:1 ...`:
+//! fits a SINDy model on any numeric CSV, prints its equations, optionally writes the model JSON.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use data::{Derivative, NumericTable};
+use sindy::{FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, SindyParams, Trajectory};
+
+use super::Global;
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OptimizerKind {
+    /// Sequentially thresholded least squares (PySINDy's STLSQ).
+    Stlsq,
+    /// min ½‖Θξ − ẋ‖² + λ‖ξ‖₁, solved with clarabel.
+    Lasso,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// A numeric CSV file with a header row.
+    #[arg(long)]
+    pub csv: PathBuf,
+    /// The time column (uniformly sampled, strictly increasing).
+    #[arg(long, default_value = "t")]
+    pub time: String,
+    /// State columns, comma-separated (x in ẋ = f(x, u)).
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub state: Vec<String>,
+    /// Control columns, comma-separated (u).
+    #[arg(long, value_delimiter = ',')]
+    pub control: Vec<String>,
+    /// Library: parts joined by '+', each poly:D, poly:D:noconstant or fourier:K.
+    #[arg(long, default_value = "poly:2")]
+    pub library: String,
+    /// Optimizer.
+    #[arg(long, value_enum, default_value = "stlsq")]
+    pub optimizer: OptimizerKind,
+    /// STLSQ threshold.
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    pub threshold: f64,
+    /// STLSQ ridge strength.
+    #[arg(long, default_value_t = sindy::DEFAULT_ALPHA, allow_negative_numbers = true)]
+    pub alpha: f64,
+    /// STLSQ iteration limit.
+    #[arg(long, default_value_t = sindy::DEFAULT_MAX_ITER)]
+    pub max_iter: usize,
+    /// LASSO weight λ (required with --optimizer lasso).
+    #[arg(long, allow_negative_numbers = true)]
+    pub lambda: Option<f64>,
+    /// Derivative estimator: forward, central, savgol or savgol:WINDOW:ORDER.
+    #[arg(long, default_value = "central")]
+    pub derivative: String,
+    /// Decimals printed in the equations.
+    #[arg(long, default_value_t = 3)]
+    pub precision: usize,
+    /// Write the model as JSON here (never overwrites an existing file without --force).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Allow --out to replace an existing file.
+    #[arg(long)]
+    pub force: bool,
+}
+
+fn optimizer(args: &Args) -> anyhow::Result<OptimizerSpec> {
+    Ok(match args.optimizer {
+        OptimizerKind::Stlsq => {
+            if args.lambda.is_some() {
+                bail!("--lambda applies to --optimizer lasso only");
+            }
+            OptimizerSpec::Stlsq {
+                threshold: args.threshold,
+                alpha: args.alpha,
+                max_iter: args.max_iter,
+            }
+        }
+        OptimizerKind::Lasso => OptimizerSpec::Lasso {
+            lambda: args.lambda.context("--optimizer lasso needs --lambda L")?,
+        },
+    })
+}
+
+pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
+    // Everything that can be checked without reading the file is checked first.
+    let library = FeatureLibrary::from_spec(&LibrarySpec::parse(&args.library)?)?;
+    let optimizer = optimizer(&args)?;
+    optimizer.checked()?;
+    let derivative = Derivative::parse(&args.derivative)?;
+    if let Some(out) = &args.out
+        && out.exists()
+        && !args.force
+    {
+        bail!("{} exists (use --force to replace it)", out.display());
+    }
+
+    let columns: Vec<&str> = args
+        .state
+        .iter()
+        .chain(&args.control)
+        .map(String::as_str)
+        .collect();
+    let (time, table) = NumericTable::read_with_time(&args.csv, &args.time, &columns)?;
+    let n = table.rows();
+    let dim_x = args.state.len();
+    let states = Mat::from_fn(n, dim_x, |i, j| table.columns[j][i]);
+    let controls = Mat::from_fn(n, args.control.len(), |i, j| table.columns[dim_x + j][i]);
+    let trajectory = Trajectory::new(time, states)?.with_controls(controls)?;
+
+    let state_names: Vec<&str> = args.state.iter().map(String::as_str).collect();
+    let control_names: Vec<&str> = args.control.iter().map(String::as_str).collect();
+    let model = SindyParams::new(&state_names, &control_names)
+        .library(library)
+        .optimizer(optimizer)
+        .derivative(derivative)
+        .fit(std::slice::from_ref(&trajectory))
+        .with_context(|| format!("fitting {}", args.csv.display()))?;
+    for line in model.equations(args.precision) {
+        println!("{line}");
+    }
+    let score = model.score(&trajectory)?;
+    eprintln!(
+        "{} samples, {} features; MSE {:.6}, R² {:.6}",
+        n,
+        model.feature_names().len(),
+        score.mse,
+        score.r2
+    );
+    if let Some(out) = &args.out {
+        model.save(out, args.force)?;
+        eprintln!("model written to {}", out.display());
+    }
+    Ok(())
+}

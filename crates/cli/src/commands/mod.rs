@@ -1,7 +1,9 @@
 //! Subcommands of `learn`.
 
+mod check_paper;
 mod conditions;
 mod inspect;
+mod reproduce;
 mod sindy;
 
 use std::path::PathBuf;
@@ -33,6 +35,10 @@ pub enum Command {
     Conditions(conditions::Args),
     /// Fit a SINDy model on any numeric CSV: print its equations, optionally save it as JSON.
     Sindy(sindy::Args),
+    /// Run SINDy and LeARN on every formulation and condition: tables, figures, summary.
+    Reproduce(reproduce::Args),
+    /// Compare the latest results with the paper's numbers within declared tolerances.
+    CheckPaper(check_paper::Args),
 }
 
 #[derive(Subcommand, Debug)]
@@ -53,6 +59,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         } => inspect::run(&global, args),
         Command::Conditions(args) => conditions::run(&global, args),
         Command::Sindy(args) => sindy::run(&global, args),
+        Command::Reproduce(args) => reproduce::run(&global, args),
+        Command::CheckPaper(args) => check_paper::run(&global, args),
     }
 }
 

@@ -1,0 +1,240 @@
+//! Run configurations (`experiments/reproduce.json`, `experiments/ci.json`): which formulations,
+//! which conditions file, which split, derivative and SINDy configuration, which LeARN
+//! configuration (with overrides) and which seeds. Checked once.
+
+use std::path::{Path, PathBuf};
+
+use data::{Derivative, ExperimentConditions, Formulation, SplitSpec, file_sha256};
+use learn::{CheckedConfig, LearnConfig, Protocol};
+use serde::{Deserialize, Serialize};
+use sindy::SindyConfig;
+
+use crate::error::{PipelineError, Result};
+
+/// The LeARN part of a run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LearnRun {
+    /// The LeARN hyper-parameter file (e.g. `experiments/learn.json`).
+    pub config: PathBuf,
+    /// A JSON merge patch (RFC 7396) applied to that file before it is checked, e.g.
+    /// `{"meta_training": {"iterations": 40}}` for a smaller budget with the same protocol.
+    #[serde(default, skip_serializing_if = "serde_json::Value::is_null")]
+    pub overrides: serde_json::Value,
+    /// `auto` (the paper's protocol when its training flights are present, else
+    /// `leave-condition-out`), `paper` or `leave-condition-out`.
+    #[serde(default = "auto")]
+    pub protocol: String,
+    /// Seeds of the reported LeARN run: each cell is the mean over them; figures use the first.
+    pub seeds: Vec<u64>,
+}
+
+fn auto() -> String {
+    "auto".to_string()
+}
+
+/// One run configuration file. Relative paths are relative to the project root.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunConfig {
+    /// A short name recorded in every output, e.g. `reproduce` or `ci`.
+    pub name: String,
+    pub description: String,
+    /// The tables to produce, in order.
+    pub formulations: Vec<Formulation>,
+    /// The wind conditions (`experiments/conditions.json`): one table row per evaluation condition.
+    pub conditions: PathBuf,
+    /// The paper's numbers (`paper/published.json`).
+    pub published: PathBuf,
+    /// Support / query split of each evaluation flight (the paper: halves).
+    pub split: SplitSpec,
+    /// Target derivative estimate (the paper: forward differences on each segment).
+    pub derivative: Derivative,
+    pub sindy: SindyConfig,
+    pub learn: LearnRun,
+}
+
+/// A run configuration whose values and files were checked, with everything it names loaded.
+#[derive(Clone, Debug)]
+pub struct CheckedRunConfig {
+    pub raw: RunConfig,
+    /// The file it was read from and its SHA-256.
+    pub path: PathBuf,
+    pub sha256: String,
+    /// Paths as resolved against the project root.
+    pub conditions_path: PathBuf,
+    pub published_path: PathBuf,
+    pub learn_config_path: PathBuf,
+    pub conditions: ExperimentConditions,
+    /// The LeARN configuration after the overrides, checked.
+    pub learn: CheckedConfig,
+    /// `None`: decided from the data present.
+    pub protocol: Option<Protocol>,
+}
+
+impl RunConfig {
+    /// Reads and checks a run configuration; relative paths are taken from `root`.
+    pub fn load(path: &Path, root: &Path) -> Result<CheckedRunConfig> {
+        let text = read(path)?;
+        let raw: RunConfig =
+            serde_json::from_str(&text).map_err(|error| PipelineError::Config {
+                path: path.to_path_buf(),
+                field: format!("line {} column {}", error.line(), error.column()),
+                message: error.to_string(),
+            })?;
+        raw.check(path, root)
+    }
+
+    fn check(self, path: &Path, root: &Path) -> Result<CheckedRunConfig> {
+        let error = |field: &str, message: String| PipelineError::Config {
+            path: path.to_path_buf(),
+            field: field.to_string(),
+            message,
+        };
+        if self.formulations.is_empty() {
+            return Err(error("formulations", "name at least one".to_string()));
+        }
+        for (index, formulation) in self.formulations.iter().enumerate() {
+            if self.formulations[..index].contains(formulation) {
+                return Err(error(
+                    "formulations",
+                    format!("'{}' is listed twice", formulation.name()),
+                ));
+            }
+        }
+        // LeARN's evaluation is defined on halves with forward-difference targets; both columns
+        // of a table must be scored on the same data.
+        if self.split != SplitSpec::Halves {
+            return Err(error(
+                "split",
+                "LeARN evaluates on halves ({\"kind\": \"halves\"}); both methods must share the split"
+                    .to_string(),
+            ));
+        }
+        if self.derivative != Derivative::Forward {
+            return Err(error(
+                "derivative",
+                "LeARN's targets are forward differences ({\"kind\": \"forward\"}); both methods must share them"
+                    .to_string(),
+            ));
+        }
+        if self.learn.seeds.is_empty() {
+            return Err(error("learn.seeds", "name at least one seed".to_string()));
+        }
+        for (index, seed) in self.learn.seeds.iter().enumerate() {
+            if self.learn.seeds[..index].contains(seed) {
+                return Err(error("learn.seeds", format!("seed {seed} is listed twice")));
+            }
+        }
+        let protocol = Protocol::parse(&self.learn.protocol)?;
+        let resolve = |p: &Path| {
+            if p.is_absolute() {
+                p.to_path_buf()
+            } else {
+                root.join(p)
+            }
+        };
+        let conditions_path = resolve(&self.conditions);
+        let published_path = resolve(&self.published);
+        let learn_config_path = resolve(&self.learn.config);
+        let conditions = ExperimentConditions::load(&conditions_path)?;
+        if conditions.evaluation().next().is_none() {
+            return Err(error(
+                "conditions",
+                format!("{} has no evaluation condition", conditions_path.display()),
+            ));
+        }
+        let learn = load_learn_config(&learn_config_path, &self.learn.overrides, path)?;
+        Ok(CheckedRunConfig {
+            sha256: file_sha256(path)?,
+            path: path.to_path_buf(),
+            conditions_path,
+            published_path,
+            learn_config_path,
+            conditions,
+            learn,
+            protocol,
+            raw: self,
+        })
+    }
+}
+
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|source| PipelineError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Reads a LeARN configuration, applies the run's overrides and checks the result.
+fn load_learn_config(
+    path: &Path,
+    overrides: &serde_json::Value,
+    run_config: &Path,
+) -> Result<CheckedConfig> {
+    if !(overrides.is_null() || overrides.is_object()) {
+        return Err(PipelineError::Config {
+            path: run_config.to_path_buf(),
+            field: "learn.overrides".to_string(),
+            message: "must be a JSON object (a merge patch)".to_string(),
+        });
+    }
+    let text = read(path)?;
+    let mut value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|error| PipelineError::Config {
+            path: path.to_path_buf(),
+            field: format!("line {} column {}", error.line(), error.column()),
+            message: error.to_string(),
+        })?;
+    merge_patch(&mut value, overrides);
+    let config: LearnConfig =
+        serde_json::from_value(value).map_err(|error| PipelineError::Config {
+            path: run_config.to_path_buf(),
+            field: "learn.overrides".to_string(),
+            message: format!("{} with these overrides: {error}", path.display()),
+        })?;
+    Ok(config.check(path)?)
+}
+
+/// RFC 7396: objects merge key by key, `null` removes a key, anything else replaces.
+pub fn merge_patch(target: &mut serde_json::Value, patch: &serde_json::Value) {
+    let Some(patch_object) = patch.as_object() else {
+        if !patch.is_null() {
+            *target = patch.clone();
+        }
+        return;
+    };
+    if !target.is_object() {
+        *target = serde_json::Value::Object(Default::default());
+    }
+    let object = target.as_object_mut().expect("made an object above");
+    for (key, value) in patch_object {
+        if value.is_null() {
+            object.remove(key);
+        } else {
+            merge_patch(
+                object.entry(key.clone()).or_insert(serde_json::Value::Null),
+                value,
+            );
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn merge_patch_follows_rfc_7396() {
+        let mut target = json!({"a": {"b": 1, "c": 2}, "d": [1, 2], "e": 5});
+        merge_patch(
+            &mut target,
+            &json!({"a": {"b": 10, "c": null}, "d": [3], "f": true}),
+        );
+        assert_eq!(target, json!({"a": {"b": 10}, "d": [3], "e": 5, "f": true}));
+        let mut unchanged = json!({"a": 1});
+        merge_patch(&mut unchanged, &serde_json::Value::Null);
+        assert_eq!(unchanged, json!({"a": 1}));
+    }
+}

@@ -1,0 +1,49 @@
+//! The pipeline crate's one error type.
+
+use std::path::PathBuf;
+
+/// Everything that can stop a run.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    #[error(transparent)]
+    Data(#[from] data::DataError),
+    #[error(transparent)]
+    Sindy(#[from] sindy::SindyError),
+    #[error(transparent)]
+    Learn(#[from] learn::LearnError),
+    #[error(transparent)]
+    Report(#[from] report::ReportError),
+    /// A file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// A run configuration field is missing or wrong.
+    #[error("{}: {field}: {message}", path.display())]
+    Config {
+        path: PathBuf,
+        field: String,
+        message: String,
+    },
+    /// Two parts of a run disagree (e.g. the targets SINDy and LeARN were scored against).
+    #[error("{what}: {message}")]
+    Mismatch { what: String, message: String },
+}
+
+/// The crate's result type.
+pub type Result<T> = std::result::Result<T, PipelineError>;
+
+/// Writes `text` to `path`, creating the parent directory.
+pub(crate) fn write_text(path: &std::path::Path, text: &str) -> Result<()> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(|source| PipelineError::Io {
+            path: parent.to_path_buf(),
+            source,
+        })?;
+    }
+    std::fs::write(path, text).map_err(|source| PipelineError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}

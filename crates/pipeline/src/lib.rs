@@ -1,0 +1,35 @@
+//! The experiments of the paper, end to end: what `make reproduce` and `learn reproduce` run.
+//!
+//! What it is for: reading a run configuration ([`RunConfig`], `experiments/reproduce.json` or
+//! `experiments/ci.json`); running SINDy (`sindy`) and LeARN (`learn`) on every formulation ×
+//! evaluation condition of `experiments/conditions.json` ([`run`]); turning the numbers and
+//! predictions into the paper's tables and figures and a `summary.json` with full provenance
+//! ([`write_outputs`]); and the check of the results against the paper ([`check_paper`]).
+//!
+//! What it is not for: any model or metric (those live in `sindy` and `learn`), rendering (the
+//! `report` crate), argument parsing (the `learn` binary).
+//!
+//! Adding a wind condition needs no code: a flight in the data directory and one entry in the
+//! conditions file make a new row in every table and a new figure per table.
+//!
+//! Definitions, shared by both methods: support = the first half of each evaluation flight, query =
+//! the second half; targets = forward differences on each segment. **Adaptation MSE**: the model
+//! fitted (SINDy) or adapted online (LeARN) on the support segment, scored on that segment.
+//! **Generalisation MSE**: the same model, unchanged, scored on the query segment.
+
+mod config;
+mod error;
+mod output;
+mod run;
+mod summary;
+
+pub use config::{CheckedRunConfig, LearnRun, RunConfig, merge_patch};
+pub use error::{PipelineError, Result};
+pub use output::{
+    OutputPaths, README_BEGIN, README_END, check_paper, update_readme, write_outputs,
+};
+pub use run::{RunOptions, RunOutcome, figure_file_name, git_commit, run};
+pub use summary::{
+    CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,
+    StageTiming, Summary, Timings,
+};

@@ -1,0 +1,527 @@
+//! Running the experiment: SINDy and LeARN on every formulation × evaluation condition.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use data::{Condition, FlightLog, Formulation, Mat, Segment, file_sha256};
+use indicatif::{ProgressBar, ProgressStyle};
+use learn::{CellResult, DataFile, EquationRule, Experiment, explain, row_major};
+use rayon::prelude::*;
+use report::{MethodTrace, Mse, OutputAxis, PublishedTables, QualitativeFigure, ResultsTable, Row};
+use sindy::SegmentEvaluation;
+
+use crate::config::CheckedRunConfig;
+use crate::error::{PipelineError, Result};
+use crate::summary::{
+    CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,
+    StageTiming, Summary,
+};
+
+/// How a run reports progress.
+pub struct RunOptions<'a> {
+    /// Draw progress bars (the caller decides: not quiet and a terminal).
+    pub show_progress: bool,
+    /// Called when a stage finishes, with its wall time.
+    pub on_stage: &'a (dyn Fn(&StageTiming) + Sync),
+}
+
+/// Everything a run produced, ready to be written.
+pub struct RunOutcome {
+    pub tables: Vec<ResultsTable>,
+    /// File name (e.g. `full_35wind.svg`) and figure.
+    pub figures: Vec<(String, QualitativeFigure)>,
+    pub summary: Summary,
+    pub timings: Vec<StageTiming>,
+}
+
+/// One formulation on one evaluation flight.
+struct Cell<'a> {
+    formulation: Formulation,
+    condition: &'a Condition,
+    flight: &'a EvaluationFlight,
+    support: Segment,
+    query: Segment,
+    sindy: SegmentEvaluation,
+}
+
+struct EvaluationFlight {
+    log: FlightLog,
+    file: DataFile,
+}
+
+/// Times stages and reports each one as it ends.
+struct Stopwatch<'a> {
+    options: &'a RunOptions<'a>,
+    timings: Vec<StageTiming>,
+}
+
+impl Stopwatch<'_> {
+    fn time<T>(&mut self, stage: &str, work: impl FnOnce() -> Result<T>) -> Result<T> {
+        let start = Instant::now();
+        let value = work()?;
+        let timing = StageTiming {
+            stage: stage.to_string(),
+            seconds: start.elapsed().as_secs_f64(),
+        };
+        (self.options.on_stage)(&timing);
+        self.timings.push(timing);
+        Ok(value)
+    }
+}
+
+fn progress_bar(show: bool, length: usize, message: &str) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(length as u64).with_message(message.to_string());
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>12} [{bar:32}] {pos}/{len} cells, {elapsed}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+/// Runs SINDy and LeARN for every formulation and evaluation condition of `config`, on the
+/// flights under `data_dir`. `root` is the project root (for the git commit and relative paths).
+pub fn run(
+    config: &CheckedRunConfig,
+    data_dir: &Path,
+    root: &Path,
+    options: &RunOptions,
+) -> Result<RunOutcome> {
+    let mut stopwatch = Stopwatch {
+        options,
+        timings: Vec::new(),
+    };
+    let conditions: Vec<&Condition> = config.conditions.evaluation().collect();
+    let (experiment, flights) = stopwatch.time("load flights", || {
+        let experiment = Experiment::load(
+            config.learn.clone(),
+            config.conditions.clone(),
+            data_dir,
+            config.protocol,
+        )?;
+        let flights = conditions
+            .par_iter()
+            .map(|condition| load_evaluation_flight(config, data_dir, condition))
+            .collect::<Result<Vec<_>>>()?;
+        Ok((experiment, flights))
+    })?;
+
+    let jobs: Vec<(Formulation, usize)> = config
+        .raw
+        .formulations
+        .iter()
+        .flat_map(|&f| (0..conditions.len()).map(move |c| (f, c)))
+        .collect();
+    let cells = stopwatch.time("SINDy", || {
+        let bar = progress_bar(options.show_progress, jobs.len(), "SINDy");
+        let cells = jobs
+            .par_iter()
+            .map(|&(formulation, index)| {
+                let cell = sindy_cell(config, formulation, conditions[index], &flights[index]);
+                bar.inc(1);
+                cell
+            })
+            .collect::<Result<Vec<_>>>();
+        bar.finish_and_clear();
+        cells
+    })?;
+
+    let seeds = &config.raw.learn.seeds;
+    let learn_results = stopwatch.time("LeARN meta-training and adaptation", || {
+        let bar = progress_bar(options.show_progress, jobs.len() * seeds.len(), "LeARN");
+        let mut per_seed = Vec::with_capacity(seeds.len());
+        for &seed in seeds {
+            per_seed.push(learn_cells(&experiment, &cells, seed, &bar)?);
+        }
+        bar.finish_and_clear();
+        Ok(per_seed)
+    })?;
+
+    let (tables, figures, summary) = stopwatch.time("tables, figures and summary", || {
+        let published = PublishedTables::load(&config.published_path)?;
+        let protocol = experiment.protocol().name().to_string();
+        let tables = build_tables(config, &cells, &learn_results, &published, &protocol);
+        let figures = cells
+            .iter()
+            .enumerate()
+            .map(|(index, cell)| figure(cell, &learn_results[0][index]))
+            .collect::<Result<Vec<_>>>()?;
+        let records = cells
+            .iter()
+            .enumerate()
+            .map(|(index, cell)| record(cell, &learn_results, index))
+            .collect::<Result<Vec<_>>>()?;
+        let provenance = provenance(config, root, &flights, &learn_results, protocol)?;
+        let summary = Summary {
+            format: SUMMARY_FORMAT.to_string(),
+            run: config.raw.name.clone(),
+            description: config.raw.description.clone(),
+            provenance,
+            tables: tables.clone(),
+            cells: records,
+        };
+        Ok((tables, figures, summary))
+    })?;
+
+    Ok(RunOutcome {
+        tables,
+        figures,
+        summary,
+        timings: stopwatch.timings,
+    })
+}
+
+fn load_evaluation_flight(
+    config: &CheckedRunConfig,
+    data_dir: &Path,
+    condition: &Condition,
+) -> Result<EvaluationFlight> {
+    let path = config.conditions.flight_path(
+        data_dir,
+        condition,
+        &config.conditions.evaluation_controller,
+    );
+    let log = FlightLog::read(&path)?;
+    let file = DataFile {
+        path: path.strip_prefix(data_dir).unwrap_or(&path).to_path_buf(),
+        sha256: file_sha256(&path)?,
+    };
+    Ok(EvaluationFlight { log, file })
+}
+
+fn sindy_cell<'a>(
+    config: &CheckedRunConfig,
+    formulation: Formulation,
+    condition: &'a Condition,
+    flight: &'a EvaluationFlight,
+) -> Result<Cell<'a>> {
+    let split = config.raw.split.split(flight.log.len())?;
+    let support = formulation.segment(&flight.log, split.support, config.raw.derivative)?;
+    let query = formulation.segment(&flight.log, split.query, config.raw.derivative)?;
+    let sindy = sindy::fit_and_evaluate(&config.raw.sindy, &support, &query)?;
+    Ok(Cell {
+        formulation,
+        condition,
+        flight,
+        support,
+        query,
+        sindy,
+    })
+}
+
+/// LeARN for every cell with one seed, in the cells' order. Under the `paper` protocol one
+/// meta-trained model per formulation serves every condition.
+fn learn_cells(
+    experiment: &Experiment,
+    cells: &[Cell],
+    seed: u64,
+    bar: &ProgressBar,
+) -> Result<Vec<CellResult>> {
+    let shared_models = if experiment.protocol() == learn::Protocol::Paper {
+        let mut formulations: Vec<Formulation> = cells.iter().map(|c| c.formulation).collect();
+        formulations.dedup();
+        let first_condition = &cells[0].condition.name;
+        formulations
+            .par_iter()
+            .map(|&f| Ok((f, experiment.meta_train(f, first_condition, seed)?)))
+            .collect::<Result<Vec<_>>>()?
+    } else {
+        Vec::new()
+    };
+    cells
+        .par_iter()
+        .map(|cell| {
+            let result = match shared_models.iter().find(|(f, _)| *f == cell.formulation) {
+                Some((_, model)) => experiment.evaluate(model, &cell.condition.name)?,
+                None => experiment.run_cell(cell.formulation, &cell.condition.name, seed)?,
+            };
+            check_same_targets(cell, &result)?;
+            bar.inc(1);
+            Ok(result)
+        })
+        .collect()
+}
+
+/// Both methods must be scored against the same targets on the same rows.
+fn check_same_targets(cell: &Cell, result: &CellResult) -> Result<()> {
+    let pairs = [
+        (&cell.support.targets, &result.support.targets, "support"),
+        (&cell.query.targets, &result.query.targets, "query"),
+    ];
+    for (ours, theirs, segment) in pairs {
+        let same_shape = ours.nrows() == theirs.nrows() && ours.ncols() == theirs.ncols();
+        let largest = if same_shape {
+            max_abs_difference(ours, theirs)
+        } else {
+            f64::INFINITY
+        };
+        if largest > 1e-12 {
+            return Err(PipelineError::Mismatch {
+                what: format!(
+                    "{} {} {segment} segment",
+                    cell.formulation.name(),
+                    cell.condition.label()
+                ),
+                message: format!("SINDy and LeARN targets differ (largest difference {largest:e})"),
+            });
+        }
+    }
+    Ok(())
+}
+
+fn max_abs_difference(a: &Mat<f64>, b: &Mat<f64>) -> f64 {
+    let mut largest = 0.0f64;
+    for j in 0..a.ncols() {
+        for i in 0..a.nrows() {
+            largest = largest.max((a[(i, j)] - b[(i, j)]).abs());
+        }
+    }
+    largest
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, count) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    sum / count as f64
+}
+
+/// The LeARN errors of cell `index`, averaged over seeds.
+fn learn_mse(learn_results: &[Vec<CellResult>], index: usize) -> Mse {
+    Mse {
+        adaptation: mean(learn_results.iter().map(|r| r[index].summary.adapt_mse)),
+        generalisation: mean(learn_results.iter().map(|r| r[index].summary.gen_mse)),
+    }
+}
+
+fn build_tables(
+    config: &CheckedRunConfig,
+    cells: &[Cell],
+    learn_results: &[Vec<CellResult>],
+    published: &PublishedTables,
+    protocol: &str,
+) -> Vec<ResultsTable> {
+    config
+        .raw
+        .formulations
+        .iter()
+        .map(|formulation| {
+            let rows = cells
+                .iter()
+                .enumerate()
+                .filter(|(_, cell)| cell.formulation == *formulation)
+                .map(|(index, cell)| {
+                    Row::new(
+                        cell.condition.label(),
+                        Mse {
+                            adaptation: cell.sindy.support_mse,
+                            generalisation: cell.sindy.query_mse,
+                        },
+                        learn_mse(learn_results, index),
+                    )
+                })
+                .collect();
+            let mut table = ResultsTable {
+                table: formulation.name().to_string(),
+                protocol: protocol.to_string(),
+                rows,
+            };
+            table.attach_published(published);
+            table
+        })
+        .collect()
+}
+
+/// Column `j` of two stacked matrices.
+fn stacked_column(top: &Mat<f64>, bottom: &Mat<f64>, j: usize) -> Vec<f64> {
+    (0..top.nrows())
+        .map(|i| top[(i, j)])
+        .chain((0..bottom.nrows()).map(|i| bottom[(i, j)]))
+        .collect()
+}
+
+/// The figure's file name: table and condition label, with anything unusual replaced by `-`.
+pub fn figure_file_name(table: &str, label: &str) -> String {
+    let clean: String = label
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect();
+    format!("{table}_{clean}.svg")
+}
+
+fn figure(cell: &Cell, learn_result: &CellResult) -> Result<(String, QualitativeFigure)> {
+    let outputs = cell.formulation.target_names();
+    let column = |top: &Mat<f64>, bottom: &Mat<f64>| -> Vec<Vec<f64>> {
+        (0..outputs.len())
+            .map(|j| stacked_column(top, bottom, j))
+            .collect()
+    };
+    let figure = QualitativeFigure {
+        table: cell.formulation.name().to_string(),
+        condition: cell.condition.label().to_string(),
+        time: cell
+            .support
+            .time
+            .iter()
+            .chain(&cell.query.time)
+            .copied()
+            .collect(),
+        split: cell.support.len(),
+        outputs: outputs.iter().map(|o| OutputAxis::for_target(o)).collect(),
+        truth: column(&cell.support.targets, &cell.query.targets),
+        methods: vec![
+            MethodTrace {
+                method: "SINDy".to_string(),
+                prediction: column(&cell.sindy.support_prediction, &cell.sindy.query_prediction),
+            },
+            MethodTrace {
+                method: "LeARN".to_string(),
+                prediction: column(
+                    &learn_result.support.predictions,
+                    &learn_result.query.predictions,
+                ),
+            },
+        ],
+    };
+    figure.validate()?;
+    Ok((
+        figure_file_name(cell.formulation.name(), cell.condition.label()),
+        figure,
+    ))
+}
+
+fn record(cell: &Cell, learn_results: &[Vec<CellResult>], index: usize) -> Result<CellRecord> {
+    let first = &learn_results[0][index];
+    let model = &first.model;
+    let support_inputs = model.standardiser.apply(&row_major(&cell.support.inputs()));
+    let explanation = explain(
+        cell.formulation,
+        &model.architecture,
+        &first.adapted_parameters,
+        &support_inputs,
+        EquationRule::default(),
+    );
+    let mse = learn_mse(learn_results, index);
+    Ok(CellRecord {
+        table: cell.formulation.name().to_string(),
+        condition: cell.condition.name.clone(),
+        label: cell.condition.label().to_string(),
+        flight: cell.flight.file.clone(),
+        support_rows: [cell.support.rows.start, cell.support.rows.end],
+        query_rows: [cell.query.rows.start, cell.query.rows.end],
+        sindy: SindyCell {
+            adapt: cell.sindy.support_mse,
+            r#gen: cell.sindy.query_mse,
+            equations: cell.sindy.model.equations(3),
+        },
+        learn: LearnCell {
+            adapt: mse.adaptation,
+            r#gen: mse.generalisation,
+            seeds: learn_results
+                .iter()
+                .map(|results| {
+                    let result = &results[index];
+                    LearnSeedCell {
+                        seed: result.summary.seed,
+                        adapt: result.summary.adapt_mse,
+                        r#gen: result.summary.gen_mse,
+                        unadapted_adapt: result.summary.unadapted_adapt_mse,
+                        unadapted_gen: result.summary.unadapted_gen_mse,
+                        final_meta_loss: result.model.meta_loss_history.last().copied(),
+                    }
+                })
+                .collect(),
+            explanation,
+        },
+    })
+}
+
+fn file_ref(written: &Path, resolved: &Path) -> Result<FileRef> {
+    Ok(FileRef {
+        path: written.to_path_buf(),
+        sha256: file_sha256(resolved)?,
+    })
+}
+
+/// `git rev-parse HEAD` in `root`, or `unknown`.
+pub fn git_commit(root: &Path) -> String {
+    std::process::Command::new("git")
+        .arg("-C")
+        .arg(root)
+        .args(["rev-parse", "HEAD"])
+        .output()
+        .ok()
+        .filter(|output| output.status.success())
+        .and_then(|output| String::from_utf8(output.stdout).ok())
+        .map(|text| text.trim().to_string())
+        .filter(|text| !text.is_empty())
+        .unwrap_or_else(|| "unknown".to_string())
+}
+
+fn provenance(
+    config: &CheckedRunConfig,
+    root: &Path,
+    flights: &[EvaluationFlight],
+    learn_results: &[Vec<CellResult>],
+    protocol: String,
+) -> Result<Provenance> {
+    let mut data_files: Vec<DataFile> = flights.iter().map(|f| f.file.clone()).collect();
+    for result in learn_results.iter().flatten() {
+        data_files.extend(result.model.data_files.iter().cloned());
+        data_files.push(result.summary.evaluation_file.clone());
+    }
+    data_files.sort_by(|a, b| a.path.cmp(&b.path));
+    data_files.dedup_by(|a, b| a.path == b.path);
+    let run_config_path = config
+        .path
+        .strip_prefix(root)
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| config.path.clone());
+    Ok(Provenance {
+        git_commit: git_commit(root),
+        run_config: FileRef {
+            path: run_config_path,
+            sha256: config.sha256.clone(),
+        },
+        conditions: file_ref(&config.raw.conditions, &config.conditions_path)?,
+        published: file_ref(&config.raw.published, &config.published_path)?,
+        learn_config: file_ref(&config.raw.learn.config, &config.learn_config_path)?,
+        learn_overrides: config.raw.learn.overrides.clone(),
+        data_files,
+        protocol,
+        split: config.raw.split,
+        derivative: config.raw.derivative,
+        seeds: config.raw.learn.seeds.clone(),
+        sindy: config.raw.sindy.clone(),
+        learn: config.learn.get().clone(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn figure_names_are_safe() {
+        assert_eq!(figure_file_name("full", "70psin20"), "full_70psin20.svg");
+        assert_eq!(
+            figure_file_name("attitude", "8 m/s gust"),
+            "attitude_8-m-s-gust.svg"
+        );
+    }
+
+    #[test]
+    fn stacked_columns_follow_time_order() {
+        let top = Mat::from_fn(2, 2, |i, j| (i * 10 + j) as f64);
+        let bottom = Mat::from_fn(1, 2, |_, j| 100.0 + j as f64);
+        assert_eq!(stacked_column(&top, &bottom, 1), vec![1.0, 11.0, 101.0]);
+        assert_eq!(mean([1.0, 2.0, 6.0].into_iter()), 3.0);
+    }
+}

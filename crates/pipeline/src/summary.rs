@@ -1,0 +1,121 @@
+//! `results/summary.json`: every number of a run and where it came from. Wall times are kept
+//! apart (`timings.json`) so that two runs of the same commit write byte-identical summaries.
+
+use std::path::PathBuf;
+
+use data::{Derivative, SplitSpec};
+use learn::{DataFile, Explanation, LearnConfig};
+use report::ResultsTable;
+use serde::Serialize;
+use sindy::SindyConfig;
+
+/// The format tag of `summary.json`.
+pub const SUMMARY_FORMAT: &str = "learn-results/1";
+
+/// A configuration file a run read.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FileRef {
+    /// As written in the run configuration (relative to the project root).
+    pub path: PathBuf,
+    pub sha256: String,
+}
+
+/// Where the numbers come from.
+#[derive(Clone, Debug, Serialize)]
+pub struct Provenance {
+    /// `git rev-parse HEAD` of the project, or `unknown` outside a git checkout.
+    pub git_commit: String,
+    pub run_config: FileRef,
+    pub conditions: FileRef,
+    pub published: FileRef,
+    pub learn_config: FileRef,
+    /// The merge patch applied to the LeARN configuration.
+    pub learn_overrides: serde_json::Value,
+    /// Every flight read (relative to the data directory), with its SHA-256.
+    pub data_files: Vec<DataFile>,
+    /// The LeARN protocol (`paper` or `leave-condition-out`).
+    pub protocol: String,
+    pub split: SplitSpec,
+    pub derivative: Derivative,
+    pub seeds: Vec<u64>,
+    pub sindy: SindyConfig,
+    /// The LeARN configuration in effect (after the overrides).
+    pub learn: LearnConfig,
+}
+
+/// SINDy on one flight.
+#[derive(Clone, Debug, Serialize)]
+pub struct SindyCell {
+    pub adapt: f64,
+    pub r#gen: f64,
+    /// The fitted equations, three decimals.
+    pub equations: Vec<String>,
+}
+
+/// LeARN on one flight with one seed.
+#[derive(Clone, Debug, Serialize)]
+pub struct LearnSeedCell {
+    pub seed: u64,
+    pub adapt: f64,
+    pub r#gen: f64,
+    /// The meta-trained model before online adaptation.
+    pub unadapted_adapt: f64,
+    pub unadapted_gen: f64,
+    /// Mean meta-loss of the last meta-iteration.
+    pub final_meta_loss: Option<f64>,
+}
+
+/// LeARN on one flight: the mean over seeds, each seed, and the adapted model explained.
+#[derive(Clone, Debug, Serialize)]
+pub struct LearnCell {
+    pub adapt: f64,
+    pub r#gen: f64,
+    pub seeds: Vec<LearnSeedCell>,
+    /// The first seed's adapted model, explained over the support segment.
+    pub explanation: Explanation,
+}
+
+/// One table cell row: one formulation on one evaluation flight.
+#[derive(Clone, Debug, Serialize)]
+pub struct CellRecord {
+    pub table: String,
+    /// The condition's file name, e.g. `70p20sint`.
+    pub condition: String,
+    /// As printed in the tables, e.g. `70psin20`.
+    pub label: String,
+    pub flight: DataFile,
+    /// Rows of the flight in the support and query segments, `[start, end)`.
+    pub support_rows: [usize; 2],
+    pub query_rows: [usize; 2],
+    pub sindy: SindyCell,
+    pub learn: LearnCell,
+}
+
+/// The whole `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub format: String,
+    /// The run configuration's name, e.g. `reproduce`.
+    pub run: String,
+    pub description: String,
+    pub provenance: Provenance,
+    pub tables: Vec<ResultsTable>,
+    pub cells: Vec<CellRecord>,
+}
+
+/// Wall time of one stage.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StageTiming {
+    pub stage: String,
+    pub seconds: f64,
+}
+
+/// `timings.json`: the only part of a run's output that changes between identical runs.
+#[derive(Clone, Debug, Serialize)]
+pub struct Timings {
+    pub run: String,
+    /// Rayon worker threads.
+    pub threads: usize,
+    pub stages: Vec<StageTiming>,
+    pub total_seconds: f64,
+}

@@ -38,8 +38,9 @@ pub enum Trajectory {
         first: Vec3,
         second: Vec3,
         period_s: f64,
+        /// Low-altitude passes (non-overlapping).
         #[serde(default)]
-        low_pass: Option<LowPass>,
+        low_passes: Vec<LowPass>,
         #[serde(default)]
         yaw_amplitude_rad: f64,
         #[serde(default = "default_yaw_period")]
@@ -77,18 +78,28 @@ impl Trajectory {
         let bad = |field: &str, message: &str| Err((field.to_string(), message.to_string()));
         match self {
             Self::Figure8 {
-                period_s, low_pass, ..
+                period_s,
+                low_passes,
+                ..
             } => {
                 if !(period_s.is_finite() && *period_s > 0.0) {
                     return bad("trajectory.period_s", "must be positive");
                 }
-                if let Some(pass) = low_pass
-                    && !(pass.ramp_s > 0.0 && pass.end_s - pass.start_s >= 2.0 * pass.ramp_s)
-                {
-                    return bad(
-                        "trajectory.low_pass",
-                        "needs ramp_s > 0 and end_s − start_s ≥ 2 ramp_s",
-                    );
+                for pass in low_passes {
+                    if !(pass.ramp_s > 0.0 && pass.end_s - pass.start_s >= 2.0 * pass.ramp_s) {
+                        return bad(
+                            "trajectory.low_passes",
+                            "each needs ramp_s > 0 and end_s − start_s ≥ 2 ramp_s",
+                        );
+                    }
+                }
+                for pair in low_passes.windows(2) {
+                    if pair[1].start_s < pair[0].end_s {
+                        return bad(
+                            "trajectory.low_passes",
+                            "must be in time order and not overlap",
+                        );
+                    }
                 }
             }
             Self::RandomWaypoints {
@@ -170,7 +181,7 @@ impl ReferenceGenerator {
                 first,
                 second,
                 period_s,
-                low_pass,
+                low_passes,
                 yaw_amplitude_rad,
                 yaw_period_s,
             } => {
@@ -183,7 +194,7 @@ impl ReferenceGenerator {
                     scale(*first, -omega * omega * s1),
                     scale(*second, -4.0 * omega * omega * s2),
                 );
-                if let Some(pass) = low_pass {
+                if let Some(pass) = low_passes.iter().find(|p| t < p.end_s) {
                     let (b, db, ddb) = low_pass_blend(pass, t);
                     let (f, df, ddf) = (position[2], velocity[2], acceleration[2]);
                     let h = pass.height_m;
@@ -269,18 +280,27 @@ mod tests {
             first: [1.5, 0.0, 0.0],
             second: [0.0, 0.8, 0.3],
             period_s: 6.0,
-            low_pass: Some(LowPass {
-                start_s: 10.0,
-                end_s: 20.0,
-                height_m: 0.3,
-                ramp_s: 2.0,
-            }),
+            low_passes: vec![
+                LowPass {
+                    start_s: 10.0,
+                    end_s: 20.0,
+                    height_m: 0.3,
+                    ramp_s: 2.0,
+                },
+                LowPass {
+                    start_s: 30.0,
+                    end_s: 36.0,
+                    height_m: 0.4,
+                    ramp_s: 1.5,
+                },
+            ],
             yaw_amplitude_rad: 0.3,
             yaw_period_s: 10.0,
         };
         assert!(trajectory.validate().is_ok());
         let generator = trajectory.generator();
-        check_derivatives(&generator, &[1.0, 10.7, 11.5, 15.0, 18.3, 19.1, 25.0]);
+        check_derivatives(&generator, &[1.0, 10.7, 11.5, 15.0, 18.3, 19.1, 25.0, 30.5, 35.0]);
+        assert!((generator.at(33.0).position[2] - 0.4).abs() < 1e-12);
         assert!((generator.at(15.0).position[2] - 0.3).abs() < 1e-12);
     }
 

@@ -22,7 +22,7 @@ fn scenario(effects: Effects, seed: u64) -> Scenario {
             first: [1.5, 0.0, 0.0],
             second: [0.0, 0.8, 0.3],
             period_s: 6.0,
-            low_pass: None,
+            low_passes: Vec::new(),
             yaw_amplitude_rad: 0.2,
             yaw_period_s: 10.0,
         },

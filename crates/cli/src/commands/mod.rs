@@ -3,8 +3,12 @@
 mod check_paper;
 mod conditions;
 mod inspect;
-mod reproduce;
 mod sindy;
+mod reproduce;
+mod meta_train;
+mod explain;
+mod mismatch;
+mod simulate;
 
 use std::path::PathBuf;
 
@@ -39,6 +43,14 @@ pub enum Command {
     Reproduce(reproduce::Args),
     /// Compare the latest results with the paper's numbers within declared tolerances.
     CheckPaper(check_paper::Args),
+    /// Meta-train LeARN, adapt online on each evaluation flight, print and save the LeARN columns.
+    MetaTrain(meta_train::Args),
+    /// The inputs that dominate each output of a LeARN checkpoint through ℰ, and its equations.
+    Explain(explain::Args),
+    /// Simulate a closed-loop flight of the plant (nominal model plus effects) as a Neural-Fly log.
+    Simulate(simulate::Args),
+    /// Locate where a recording disagrees with a nominal model, name and fit the missing physics.
+    Mismatch(mismatch::Args),
 }
 
 #[derive(Subcommand, Debug)]
@@ -61,6 +73,10 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sindy(args) => sindy::run(&global, args),
         Command::Reproduce(args) => reproduce::run(&global, args),
         Command::CheckPaper(args) => check_paper::run(&global, args),
+        Command::MetaTrain(args) => meta_train::run(&global, args),
+        Command::Explain(args) => explain::run(&global, args),
+        Command::Simulate(args) => simulate::run(&global, args),
+        Command::Mismatch(args) => mismatch::run(&global, args),
     }
 }
 

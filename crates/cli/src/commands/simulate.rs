@@ -1,0 +1,46 @@
+//! `learn simulate --scenario FILE --out FILE.csv`: a closed-loop flight of the simulated plant,
+//! written as a Neural-Fly log.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+
+use super::Global;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Scenario JSON (model, trajectory, effects, noise, seed).
+    #[arg(long)]
+    pub scenario: PathBuf,
+    /// Output CSV.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Overwrite an existing output file.
+    #[arg(long)]
+    pub force: bool,
+}
+
+pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
+    if args.out.exists() && !args.force {
+        bail!("{}: already exists (pass --force to overwrite)", args.out.display());
+    }
+    let (scenario, model) = physics::Scenario::load(&args.scenario)?;
+    let name = args
+        .out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "flight".to_string());
+    let log = physics::simulate(&model, &scenario, &name)
+        .with_context(|| format!("{}", args.scenario.display()))?;
+    log.write_csv(&args.out)?;
+    let effects = scenario.effects.ids();
+    println!(
+        "wrote {} ({} rows, {:.1} s, seed {}, effects: {})",
+        args.out.display(),
+        log.len(),
+        scenario.duration_s,
+        scenario.seed,
+        if effects.is_empty() { "none".to_string() } else { effects.join(", ") }
+    );
+    Ok(())
+}

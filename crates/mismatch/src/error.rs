@@ -1,0 +1,39 @@
+//! The one error type of the mismatch crate.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong while analysing a recording; each renders as one line.
+#[derive(Debug, thiserror::Error)]
+pub enum MismatchError {
+    #[error(transparent)]
+    Data(#[from] data::DataError),
+    #[error(transparent)]
+    Physics(#[from] physics::PhysicsError),
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: already exists (pass --force to overwrite)", path.display())]
+    Exists { path: PathBuf },
+    #[error("{}: {message}", path.display())]
+    Recording { path: PathBuf, message: String },
+    #[error("{}: cannot draw the figure: {message}", path.display())]
+    Plot { path: PathBuf, message: String },
+    #[error("{}: field '{field}': {message}", path.display())]
+    Config {
+        path: PathBuf,
+        field: String,
+        message: String,
+    },
+}
+
+/// Shorthand for results of this crate.
+pub type Result<T, E = MismatchError> = std::result::Result<T, E>;
+
+pub(crate) fn io_error(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> MismatchError + '_ {
+    move |source| MismatchError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}

@@ -1,0 +1,175 @@
+//! The library of candidate physics terms. Each candidate is one effect of the vocabulary (or, for
+//! the timing term, the first-order signature shared by a delay and a motor lag) with named terms,
+//! their formulas and units. A term's column is the change of the model's matched prediction when
+//! its coefficient moves away from zero, computed with the same forward model that later fits the
+//! effect exactly, so the linear screen and the nonlinear fit describe the same physics.
+
+use physics::{
+    Delay, Effects, GroundEffect, InertiaScale, LinearDrag, QuadraticDrag, ThrustScale, TorqueBias,
+};
+use serde::Serialize;
+
+use crate::problem::{Channels, Problem};
+
+/// One term of the library.
+#[derive(Clone, Debug, Serialize)]
+pub struct Term {
+    pub name: String,
+    pub formula: String,
+    /// Units of the term's column (an acceleration per unit coefficient).
+    pub units: String,
+    /// The coefficient and its units.
+    pub coefficient: String,
+}
+
+/// A group of terms that stands for one effect.
+#[derive(Clone, Debug, Serialize)]
+pub struct Candidate {
+    /// A vocabulary id, or `delay_or_motor_lag` for the timing term.
+    pub id: String,
+    pub terms: Vec<Term>,
+    /// Indices of the candidate's columns in the design.
+    #[serde(skip)]
+    pub columns: Vec<usize>,
+}
+
+/// The id of the first-order timing candidate (resolved into `delay` or `motor_lag` by the fit).
+pub const TIMING: &str = "delay_or_motor_lag";
+
+fn term(name: &str, formula: &str, units: &str, coefficient: &str) -> Term {
+    Term {
+        name: name.to_string(),
+        formula: formula.to_string(),
+        units: units.to_string(),
+        coefficient: coefficient.to_string(),
+    }
+}
+
+/// The candidates for a problem and their columns (per analysed row, per channel).
+pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) {
+    let base = problem.predict(&Effects::default());
+    let mut columns: Vec<Vec<Channels>> = Vec::new();
+    let mut candidates = Vec::new();
+    let mut add = |id: &str, terms: Vec<Term>, perturbed: Vec<(Effects, f64)>| {
+        let start = columns.len();
+        for (effects, step) in perturbed {
+            let predicted = problem.predict(&effects);
+            columns.push(
+                predicted
+                    .iter()
+                    .zip(&base)
+                    .map(|(p, b)| {
+                        let mut out = [0.0; 6];
+                        for c in 0..6 {
+                            out[c] = (p[c] - b[c]) / step;
+                        }
+                        out
+                    })
+                    .collect(),
+            );
+        }
+        candidates.push(Candidate {
+            id: id.to_string(),
+            terms,
+            columns: (start..columns.len()).collect(),
+        });
+    };
+    let with = |f: &dyn Fn(&mut Effects)| {
+        let mut e = Effects::default();
+        f(&mut e);
+        e
+    };
+    let step = 1e-3;
+    add(
+        "thrust_scale",
+        vec![term("thrust", "R e3 T / m", "m/s²", "k − 1 (1)")],
+        vec![(with(&|e| e.thrust_scale = Some(ThrustScale { k: 1.0 + step })), step)],
+    );
+    let axes = ["x", "y", "z"];
+    add(
+        "linear_drag",
+        axes.iter()
+            .map(|a| {
+                term(
+                    &format!("rotor_drag_{a}"),
+                    &format!("−R e_{a} e_{a}ᵀ Rᵀ v"),
+                    "m/s",
+                    &format!("d{a} (1/s)"),
+                )
+            })
+            .collect(),
+        (0..3)
+            .map(|i| {
+                let mut d = [0.0; 3];
+                d[i] = 1.0;
+                (with(&|e| e.linear_drag = Some(LinearDrag { d })), 1.0)
+            })
+            .collect(),
+    );
+    add(
+        "quadratic_drag",
+        vec![term("air_drag", "−|v| v", "m²/s²", "c (1/m)")],
+        vec![(with(&|e| e.quadratic_drag = Some(QuadraticDrag { c: 1.0 })), 1.0)],
+    );
+    let small_radius: f64 = 0.02;
+    add(
+        "ground_effect",
+        vec![term(
+            "ground_thrust",
+            "R e3 T / (16 m z²)",
+            "1/s²",
+            "r² (m²)",
+        )],
+        vec![(
+            with(&|e| e.ground_effect = Some(GroundEffect { r_m: small_radius })),
+            small_radius * small_radius,
+        )],
+    );
+    let timing_step = problem.recording.dt / 4.0;
+    add(
+        TIMING,
+        vec![term(
+            "command_rate",
+            "−d/dt (R e3 T / m, J⁻¹ τ)",
+            "m/s³, rad/s³",
+            "delay or lag time constant (s)",
+        )],
+        vec![(with(&|e| e.delay = Some(Delay { delay_s: timing_step })), timing_step)],
+    );
+    if problem.channels == 6 {
+        add(
+            "torque_bias",
+            axes.iter()
+                .map(|a| term(&format!("torque_bias_{a}"), &format!("e_{a}"), "1", &format!("b{a} (rad/s²)")))
+                .collect(),
+            (0..3)
+                .map(|i| {
+                    let mut b = [0.0; 3];
+                    b[i] = 1.0;
+                    (with(&|e| e.torque_bias = Some(TorqueBias { b })), 1.0)
+                })
+                .collect(),
+        );
+        add(
+            "inertia_scale",
+            axes.iter()
+                .map(|a| {
+                    term(
+                        &format!("torque_response_{a}"),
+                        &format!("e_{a} e_{a}ᵀ J⁻¹ (τ − ω × J ω)"),
+                        "rad/s²",
+                        &format!("1/k{a} − 1 (1)"),
+                    )
+                })
+                .collect(),
+            (0..3)
+                .map(|i| {
+                    let mut k = [1.0; 3];
+                    k[i] = 1.0 / (1.0 + step);
+                    (with(&|e| e.inertia_scale = Some(InertiaScale { k })), step)
+                })
+                .collect(),
+        );
+    }
+    (candidates, columns)
+}

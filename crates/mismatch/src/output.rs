@@ -1,0 +1,197 @@
+//! Writing an analysis: `mismatch.json`, `mismatch.svg` (residual per channel before and after,
+//! located windows shaded) and `mismatch.md` (plain words).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use plotters::prelude::*;
+
+use crate::analysis::Analysis;
+use crate::error::{MismatchError, Result, io_error};
+use crate::problem::CHANNEL_NAMES;
+
+/// The three files of an analysis in `dir`.
+pub fn output_paths(dir: &Path) -> [PathBuf; 3] {
+    ["mismatch.json", "mismatch.svg", "mismatch.md"].map(|name| dir.join(name))
+}
+
+/// Fails if any output file exists and `force` is off.
+pub fn check_outputs(dir: &Path, force: bool) -> Result<()> {
+    if force {
+        return Ok(());
+    }
+    match output_paths(dir).into_iter().find(|p| p.exists()) {
+        Some(path) => Err(MismatchError::Exists { path }),
+        None => Ok(()),
+    }
+}
+
+/// Writes the three files.
+pub fn write_outputs(analysis: &Analysis, dir: &Path, force: bool) -> Result<()> {
+    check_outputs(dir, force)?;
+    std::fs::create_dir_all(dir).map_err(io_error(dir))?;
+    let [json, svg, markdown] = output_paths(dir);
+    let text = serde_json::to_string_pretty(&analysis.report).expect("the report serialises");
+    std::fs::write(&json, text + "\n").map_err(io_error(&json))?;
+    write_figure(analysis, &svg)?;
+    std::fs::write(&markdown, markdown_text(analysis)).map_err(io_error(&markdown))?;
+    Ok(())
+}
+
+fn units(channel: usize) -> &'static str {
+    if channel < 3 { "m/s²" } else { "rad/s²" }
+}
+
+/// The figure: one panel per channel.
+pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
+    let plot_error = |e: &dyn std::fmt::Display| MismatchError::Plot {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let problem = &analysis.problem;
+    let channels = problem.channels;
+    let root = SVGBackend::new(path, (1100, 60 + 190 * channels as u32)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| plot_error(&e))?;
+    let (title, body) = root.split_vertically(50);
+    title
+        .titled(
+            "Residual (recorded smoothed derivative − model): nominal model in grey, with the found effects in blue; located windows shaded; held-out part right of the dashed line",
+            ("sans-serif", 15),
+        )
+        .map_err(|e| plot_error(&e))?;
+    let panels = body.split_evenly((channels, 1));
+    let time = &problem.time;
+    let (t0, t1) = (time[0], time[time.len() - 1]);
+    let split_time = time[problem.split.min(time.len() - 1)];
+    for (c, panel) in panels.iter().enumerate() {
+        let values = analysis.before.iter().chain(&analysis.after).map(|r| r[c]);
+        let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        let margin = 0.05 * (hi - lo).max(1e-9);
+        let (lo, hi) = (lo - margin, hi + margin);
+        let mut chart = ChartBuilder::on(panel)
+            .margin(8)
+            .x_label_area_size(28)
+            .y_label_area_size(60)
+            .caption(format!("{} ({})", CHANNEL_NAMES[c], units(c)), ("sans-serif", 14))
+            .build_cartesian_2d(t0..t1, lo..hi)
+            .map_err(|e| plot_error(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("t (s)")
+            .light_line_style(WHITE)
+            .draw()
+            .map_err(|e| plot_error(&e))?;
+        for window in analysis.report.windows.iter().filter(|w| w.channel == CHANNEL_NAMES[c]) {
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(window.t_start, lo), (window.t_end, hi)],
+                    RGBColor(255, 200, 200).mix(0.5).filled(),
+                )))
+                .map_err(|e| plot_error(&e))?;
+        }
+        chart
+            .draw_series(LineSeries::new(
+                time.iter().zip(&analysis.before).map(|(t, r)| (*t, r[c])),
+                RGBColor(150, 150, 150).stroke_width(1),
+            ))
+            .map_err(|e| plot_error(&e))?
+            .label("nominal model")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], RGBColor(150, 150, 150)));
+        chart
+            .draw_series(LineSeries::new(
+                time.iter().zip(&analysis.after).map(|(t, r)| (*t, r[c])),
+                RGBColor(30, 90, 200).stroke_width(1),
+            ))
+            .map_err(|e| plot_error(&e))?
+            .label("with found effects")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], RGBColor(30, 90, 200)));
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(split_time, lo), (split_time, hi)],
+                4,
+                4,
+                BLACK.stroke_width(1),
+            ))
+            .map_err(|e| plot_error(&e))?;
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| plot_error(&e))?;
+    }
+    root.present().map_err(|e| plot_error(&e))?;
+    Ok(())
+}
+
+/// The report in plain words.
+pub fn markdown_text(analysis: &Analysis) -> String {
+    let report = &analysis.report;
+    let mut md = String::new();
+    let _ = writeln!(md, "# Sim-to-real mismatch: {}\n", report.recording);
+    let _ = writeln!(md, "Nominal model: `{}`. The recording's velocity and body rate were differentiated with a smoothed derivative and compared with what the nominal model predicts from the recorded attitude and commands (the prediction is smoothed with the same weights). Every mean squared error below is measured against that smoothed derivative.\n", report.model);
+    let frame = match report.rate_frame.used {
+        data::RateFrame::Body => "the body frame",
+        data::RateFrame::World => "the world frame (converted to body rates)",
+    };
+    let _ = writeln!(
+        md,
+        "The `w` column was read in {frame}: it matches the rate implied by the recorded attitude with an RMS error of {:.4} rad/s in the body frame and {:.4} rad/s in the world frame.\n",
+        report.rate_frame.body_rms, report.rate_frame.world_rms
+    );
+    let _ = writeln!(md, "## Where the model and the recording disagree\n");
+    let _ = writeln!(md, "| channel | residual RMS | noise floor | significant |\n|---|---|---|---|");
+    for c in &report.channels {
+        let _ = writeln!(
+            md,
+            "| {} | {:.4} | {:.4} | {} |",
+            c.name,
+            c.residual_rms,
+            c.noise_floor,
+            if c.significant { "yes" } else { "no" }
+        );
+    }
+    if analysis.problem.channels == 3 {
+        let _ = writeln!(md, "\nThe model has no mixer, so it predicts no torques: only the translational channels are compared.");
+    }
+    if report.windows.is_empty() {
+        let _ = writeln!(md, "\nNo stretch of the flight disagrees by more than {:.1} times the noise floor.", report.settings.window_factor);
+    } else {
+        let _ = writeln!(md, "\nStretches where the residual exceeds {:.1} times the noise floor (1 s moving RMS):\n", report.settings.window_factor);
+        for w in &report.windows {
+            let _ = writeln!(md, "- {} from {:.1} s to {:.1} s", w.channel, w.t_start, w.t_end);
+        }
+    }
+    let _ = writeln!(md, "\n## What is missing from the model\n");
+    if report.effects.is_empty() {
+        let _ = writeln!(md, "Nothing: no candidate term explains the residual consistently better than noise (none passed cross-validation in at least {:.0}% of the bootstrap resamples).", 100.0 * report.selection.settings.stability_threshold);
+    } else {
+        for e in &report.effects {
+            let _ = writeln!(
+                md,
+                "- **{}** — {} It accounts for {:.0}% of the nominal model's (noise-normalised) residual.",
+                e.id,
+                e.description,
+                100.0 * e.explained_fraction
+            );
+        }
+    }
+    let _ = writeln!(md, "\nCandidates and how often each was chosen in {} bootstrap resamples:\n", report.selection.settings.resamples);
+    for c in &report.selection.candidates {
+        let terms: Vec<String> = c.candidate.terms.iter().map(|t| format!("`{}` = {} [{}]", t.name, t.formula, t.units)).collect();
+        let _ = writeln!(md, "- {} ({}): {:.0}%{}", c.candidate.id, terms.join(", "), 100.0 * c.selection_frequency, if c.kept { ", kept" } else { "" });
+    }
+    if let Some(timing) = &report.selection.timing_alternatives {
+        let _ = writeln!(md, "\nThe command-rate term was resolved by fitting both a pure delay and a first-order motor lag exactly; noise-normalised fit errors: {timing}. The smaller one was kept.");
+    }
+    let fit = &report.fit;
+    let reduction = |before: f64, after: f64| 100.0 * (1.0 - after / before.max(1e-300));
+    let _ = writeln!(md, "\n## Does the fit improve?\n");
+    let _ = writeln!(md, "The parameters were fitted on {:.1}–{:.1} s and checked on the held-out {:.1}–{:.1} s.\n", fit.t_start, fit.t_end, fit.heldout.t_start, fit.heldout.t_end);
+    let _ = writeln!(md, "| part | MSE nominal | MSE with effects | reduction |\n|---|---|---|---|");
+    let _ = writeln!(md, "| fit | {:.5} | {:.5} | {:.1}% |", fit.before.mse, fit.after.mse, reduction(fit.before.mse, fit.after.mse));
+    let _ = writeln!(md, "| held out | {:.5} | {:.5} | {:.1}% |", fit.heldout.before.mse, fit.heldout.after.mse, reduction(fit.heldout.before.mse, fit.heldout.after.mse));
+    let _ = writeln!(md, "\nFigure: `mismatch.svg`.");
+    md
+}

@@ -1,0 +1,100 @@
+//! A flight log turned into what the analysis needs: attitude, velocity, height, body rate and the
+//! actuator commands the nominal model reads from the recorded command columns.
+
+use std::path::PathBuf;
+
+use data::{FlightLog, RateFrame};
+use physics::NominalModel;
+use physics::vector::{Mat3, Vec3, mat_t_vec};
+
+use crate::error::{MismatchError, Result};
+
+/// The recorded signals, per row.
+#[derive(Clone, Debug)]
+pub struct Recording {
+    pub path: PathBuf,
+    /// Sample interval, s.
+    pub dt: f64,
+    pub time: Vec<f64>,
+    pub rotation: Vec<Mat3>,
+    pub velocity: Vec<Vec3>,
+    /// Height above the model's ground plane, m.
+    pub height: Vec<f64>,
+    /// Body rate, rad/s (converted from the world frame when the `w` column is in the world frame).
+    pub body_rate: Vec<Vec3>,
+    /// The frame the `w` column was found to be in, with the RMS errors (body, world) of the check.
+    pub rate_frame: RateFrame,
+    pub rate_frame_errors: (f64, f64),
+    /// Actuator commands (four normalised motor speeds, or `[T, 0, 0, 0]` in N), held from each row
+    /// to the next.
+    pub commands: Vec<[f64; 4]>,
+}
+
+impl Recording {
+    /// Prepares a log for a model; needs at least `min_rows` rows.
+    pub fn new(log: &FlightLog, model: &NominalModel, min_rows: usize) -> Result<Self> {
+        let bad = |message: String| MismatchError::Recording {
+            path: log.path.clone(),
+            message,
+        };
+        if log.len() < min_rows {
+            return Err(bad(format!(
+                "{} rows, the analysis needs at least {min_rows}",
+                log.len()
+            )));
+        }
+        if let Some(row) = log.hover_throttle.iter().position(|h| *h <= 0.0)
+            && model.thrust_source == physics::ThrustSource::ThrustSetpoint
+        {
+            return Err(bad(format!(
+                "row {}: hover_throttle must be positive to scale T_sp",
+                row + 2
+            )));
+        }
+        let (frame, body_rms, world_rms) = log.rate_frame();
+        let body_rate = match frame {
+            RateFrame::Body => log.body_rate.clone(),
+            RateFrame::World => log
+                .rotation
+                .iter()
+                .zip(&log.body_rate)
+                .map(|(r, w)| mat_t_vec(r, *w))
+                .collect(),
+        };
+        let commands = (0..log.len())
+            .map(|k| {
+                model.actuator_command(
+                    log.thrust_setpoint[k],
+                    log.hover_throttle[k],
+                    &log.motor_command[k],
+                )
+            })
+            .collect();
+        Ok(Self {
+            path: log.path.clone(),
+            dt: log.sample_interval(),
+            time: log.time.clone(),
+            rotation: log.rotation.clone(),
+            velocity: log.velocity.clone(),
+            height: log
+                .position
+                .iter()
+                .map(|p| p[2] - model.ground_height_m)
+                .collect(),
+            body_rate,
+            rate_frame: frame,
+            rate_frame_errors: (body_rms, world_rms),
+            commands,
+        })
+    }
+
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.time.len()
+    }
+
+    /// Whether there are no rows.
+    pub fn is_empty(&self) -> bool {
+        self.time.is_empty()
+    }
+}

@@ -1,0 +1,206 @@
+//! Fitting the parameters of the selected effects with the exact forward model: linear estimates
+//! from the screen, 1-D profile searches for the nonlinear parameters (delay, lag time constant,
+//! ground-effect radius), then Levenberg–Marquardt on all parameters together (whitened residual,
+//! fit rows only).
+
+use faer::Mat;
+use faer::linalg::solvers::Solve;
+use physics::{
+    Delay, Effects, GroundEffect, InertiaScale, LinearDrag, MotorLag, QuadraticDrag, ThrustScale,
+    TorqueBias, Wind,
+};
+
+use crate::problem::{Channels, Problem};
+use crate::selection::Design;
+
+/// One scalar parameter of the vocabulary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Parameter {
+    ThrustScale,
+    LinearDrag(usize),
+    QuadraticDrag,
+    Wind(usize),
+    GroundRadius,
+    TorqueBias(usize),
+    InertiaScale(usize),
+    Delay,
+    MotorLag,
+}
+
+impl Parameter {
+    /// The smallest admissible value.
+    fn lower_bound(self) -> f64 {
+        match self {
+            Self::ThrustScale | Self::InertiaScale(_) => 0.05,
+            Self::LinearDrag(_) | Self::QuadraticDrag | Self::GroundRadius | Self::Delay | Self::MotorLag => 0.0,
+            Self::Wind(_) | Self::TorqueBias(_) => f64::NEG_INFINITY,
+        }
+    }
+
+    /// A typical magnitude, for finite-difference steps.
+    fn typical(self) -> f64 {
+        match self {
+            Self::ThrustScale | Self::InertiaScale(_) | Self::Wind(_) => 1.0,
+            Self::LinearDrag(_) | Self::GroundRadius | Self::TorqueBias(_) => 0.1,
+            Self::QuadraticDrag => 0.01,
+            Self::Delay | Self::MotorLag => 0.01,
+        }
+    }
+
+    /// The vocabulary id the parameter belongs to.
+    pub fn effect_id(self) -> &'static str {
+        match self {
+            Self::ThrustScale => "thrust_scale",
+            Self::LinearDrag(_) => "linear_drag",
+            Self::QuadraticDrag => "quadratic_drag",
+            Self::Wind(_) => "wind",
+            Self::GroundRadius => "ground_effect",
+            Self::TorqueBias(_) => "torque_bias",
+            Self::InertiaScale(_) => "inertia_scale",
+            Self::Delay => "delay",
+            Self::MotorLag => "motor_lag",
+        }
+    }
+}
+
+/// Effects built from parameter values (absent parameters keep their effect absent).
+pub fn effects_from(parameters: &[Parameter], values: &[f64]) -> Effects {
+    let mut e = Effects::default();
+    for (p, &v) in parameters.iter().zip(values) {
+        match *p {
+            Parameter::ThrustScale => e.thrust_scale = Some(ThrustScale { k: v }),
+            Parameter::LinearDrag(i) => e.linear_drag.get_or_insert(LinearDrag { d: [0.0; 3] }).d[i] = v,
+            Parameter::QuadraticDrag => e.quadratic_drag = Some(QuadraticDrag { c: v }),
+            Parameter::Wind(i) => e.wind.get_or_insert(Wind { w_air: [0.0; 3] }).w_air[i] = v,
+            Parameter::GroundRadius => e.ground_effect = Some(GroundEffect { r_m: v }),
+            Parameter::TorqueBias(i) => e.torque_bias.get_or_insert(TorqueBias { b: [0.0; 3] }).b[i] = v,
+            Parameter::InertiaScale(i) => e.inertia_scale.get_or_insert(InertiaScale { k: [1.0; 3] }).k[i] = v,
+            Parameter::Delay => e.delay = Some(Delay { delay_s: v }),
+            Parameter::MotorLag => e.motor_lag = Some(MotorLag { tau_s: v }),
+        }
+    }
+    e
+}
+
+/// Whitened residual over rows `range`, flattened.
+fn whitened(problem: &Problem, residual: &[Channels], range: std::ops::Range<usize>) -> Vec<f64> {
+    residual[range]
+        .iter()
+        .flat_map(|r| (0..problem.channels).map(move |c| r[c] / problem.noise_floor[c]))
+        .collect()
+}
+
+/// Whitened sum of squares of the model with these parameters over rows `range`.
+pub fn objective(problem: &Problem, parameters: &[Parameter], values: &[f64], range: std::ops::Range<usize>) -> f64 {
+    problem.whitened_sse(&problem.residual(&effects_from(parameters, values)), range)
+}
+
+/// Levenberg–Marquardt with a forward-difference Jacobian and bounds by projection.
+pub fn levenberg_marquardt(
+    problem: &Problem,
+    parameters: &[Parameter],
+    initial: &[f64],
+    range: std::ops::Range<usize>,
+    iterations: usize,
+) -> (Vec<f64>, f64) {
+    let project = |values: &mut [f64]| {
+        for (v, p) in values.iter_mut().zip(parameters) {
+            *v = v.max(p.lower_bound());
+        }
+    };
+    let mut values = initial.to_vec();
+    project(&mut values);
+    let evaluate = |values: &[f64]| whitened(problem, &problem.residual(&effects_from(parameters, values)), range.clone());
+    let mut residual = evaluate(&values);
+    let mut sse: f64 = residual.iter().map(|r| r * r).sum();
+    let k = parameters.len();
+    if k == 0 {
+        return (values, sse);
+    }
+    let mut damping = 1e-3;
+    for _ in 0..iterations {
+        let mut jacobian: Vec<Vec<f64>> = Vec::with_capacity(k);
+        for j in 0..k {
+            let step = 1e-4 * values[j].abs().max(parameters[j].typical());
+            let mut shifted = values.clone();
+            shifted[j] += step;
+            let r = evaluate(&shifted);
+            jacobian.push(r.iter().zip(&residual).map(|(a, b)| (a - b) / step).collect());
+        }
+        let mut normal = Mat::<f64>::zeros(k, k);
+        let mut gradient = Mat::<f64>::zeros(k, 1);
+        for i in 0..k {
+            gradient[(i, 0)] = jacobian[i].iter().zip(&residual).map(|(a, b)| a * b).sum();
+            for j in 0..=i {
+                let v: f64 = jacobian[i].iter().zip(&jacobian[j]).map(|(a, b)| a * b).sum();
+                normal[(i, j)] = v;
+                normal[(j, i)] = v;
+            }
+        }
+        let mut improved = false;
+        for _ in 0..8 {
+            let mut system = normal.clone();
+            for i in 0..k {
+                system[(i, i)] += damping * normal[(i, i)].max(1e-12);
+            }
+            let step = system.full_piv_lu().solve(&gradient);
+            let mut trial: Vec<f64> = (0..k).map(|i| values[i] - step[(i, 0)]).collect();
+            project(&mut trial);
+            let trial_residual = evaluate(&trial);
+            let trial_sse: f64 = trial_residual.iter().map(|r| r * r).sum();
+            if trial_sse.is_finite() && trial_sse < sse {
+                let relative = (sse - trial_sse) / sse.max(1e-300);
+                values = trial;
+                residual = trial_residual;
+                sse = trial_sse;
+                damping = (damping / 3.0).max(1e-9);
+                improved = relative > 1e-9;
+                break;
+            }
+            damping *= 10.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    (values, sse)
+}
+
+/// 1-D profile search of one nonlinear effect: for each grid value, the residual of the nominal
+/// model plus that effect is regressed on `other_columns` (the linear screen's columns of the other
+/// selected effects); returns the grid value with the smallest whitened error and that error.
+pub fn profile_search(
+    problem: &Problem,
+    columns: &[Vec<Channels>],
+    other_columns: &[usize],
+    range: std::ops::Range<usize>,
+    block_rows: usize,
+    grid: &[f64],
+    effect: impl Fn(f64) -> Effects + Sync,
+) -> (f64, f64) {
+    use rayon::prelude::*;
+    let scores: Vec<(f64, f64)> = grid
+        .par_iter()
+        .map(|&value| {
+            let residual = problem.residual(&effect(value));
+            let used: Vec<Vec<Channels>> = other_columns.iter().map(|&c| columns[c].clone()).collect();
+            let design = Design::new(problem, &residual, &used, range.clone(), block_rows);
+            let ones = vec![1.0; design.blocks()];
+            let all: Vec<usize> = (0..used.len()).collect();
+            let theta = design.solve(&ones, &all);
+            let mut fitted = residual.clone();
+            for (j, column) in used.iter().enumerate() {
+                for (row, values) in fitted.iter_mut().zip(column) {
+                    for c in 0..problem.channels {
+                        row[c] -= theta[j] * values[c];
+                    }
+                }
+            }
+            (value, problem.whitened_sse(&fitted, range.clone()))
+        })
+        .collect();
+    scores
+        .into_iter()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("a non-empty grid")
+}

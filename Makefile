@@ -17,6 +17,20 @@ build:
 
 test: data
 	$(CARGO) test --workspace
+	$(MAKE) check-paper
+
+# The paper's tables and figures from one command (experiments/reproduce.json): results/,
+# paper/tables/ and the README's tables block. Stage times are printed; see results/timings.json.
+reproduce: build
+	$(LEARN) $(QUIET) reproduce --config experiments/reproduce.json --out results --latex-dir paper/tables --readme README.md
+
+# The regression against the paper: the same protocol with a smaller LeARN budget
+# (experiments/ci.json), written to a git-ignored scratch directory, then compared with
+# paper/published.json under the tolerances of paper/tolerances.json (non-zero exit on regression).
+CI_RESULTS := results/.scratch/ci
+check-paper: build
+	$(LEARN) $(QUIET) reproduce --config experiments/ci.json --out $(CI_RESULTS) --latex-dir $(CI_RESULTS)/latex
+	$(LEARN) check-paper --results $(CI_RESULTS)/tables
 
 lint:
 	$(CARGO) fmt --all -- --check

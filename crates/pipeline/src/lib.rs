@@ -28,7 +28,9 @@ pub use error::{PipelineError, Result};
 pub use output::{
     OutputPaths, README_BEGIN, README_END, check_paper, update_readme, write_outputs,
 };
-pub use run::{RunOptions, RunOutcome, figure_file_name, git_commit, run};
+pub use run::{
+    GENERATED_PATHS, RunOptions, RunOutcome, figure_file_name, git_commit, run, uncommitted_inputs,
+};
 pub use summary::{
     CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,
     StageTiming, Summary, Timings,

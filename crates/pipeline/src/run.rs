@@ -32,6 +32,8 @@ pub struct RunOutcome {
     pub figures: Vec<(String, QualitativeFigure)>,
     pub summary: Summary,
     pub timings: Vec<StageTiming>,
+    /// See [`uncommitted_inputs`].
+    pub uncommitted_inputs: Option<bool>,
 }
 
 /// One formulation on one evaluation flight.
@@ -171,6 +173,7 @@ pub fn run(
         figures,
         summary,
         timings: stopwatch.timings,
+        uncommitted_inputs: uncommitted_inputs(root),
     })
 }
 
@@ -450,19 +453,39 @@ fn file_ref(written: &Path, resolved: &Path) -> Result<FileRef> {
     })
 }
 
-/// `git rev-parse HEAD` in `root`, or `unknown`.
-pub fn git_commit(root: &Path) -> String {
+/// Paths a run writes (relative to the project root); they do not count as inputs of a run.
+pub const GENERATED_PATHS: [&str; 3] = ["results", "paper/tables", "README.md"];
+
+fn git(root: &Path, arguments: &[&str]) -> Option<String> {
+    let exclusions = GENERATED_PATHS.map(|p| format!(":(exclude){p}"));
     std::process::Command::new("git")
         .arg("-C")
         .arg(root)
-        .args(["rev-parse", "HEAD"])
+        .args(arguments)
+        .arg("--")
+        .arg(".")
+        .args(&exclusions)
         .output()
         .ok()
         .filter(|output| output.status.success())
         .and_then(|output| String::from_utf8(output.stdout).ok())
+}
+
+/// The last commit that changed an input of the run (anything but [`GENERATED_PATHS`]), or
+/// `unknown` outside a git checkout. Committing regenerated results on their own therefore leaves
+/// this value, and so `summary.json`, unchanged.
+pub fn git_commit(root: &Path) -> String {
+    git(root, &["log", "-1", "--format=%H"])
         .map(|text| text.trim().to_string())
         .filter(|text| !text.is_empty())
         .unwrap_or_else(|| "unknown".to_string())
+}
+
+/// Whether tracked inputs of the run (anything but [`GENERATED_PATHS`]) differ from
+/// [`git_commit`]; `None` outside a git checkout.
+pub fn uncommitted_inputs(root: &Path) -> Option<bool> {
+    git(root, &["status", "--porcelain", "--untracked-files=no"])
+        .map(|text| !text.trim().is_empty())
 }
 
 fn provenance(

@@ -23,7 +23,7 @@ pub struct FileRef {
 /// Where the numbers come from.
 #[derive(Clone, Debug, Serialize)]
 pub struct Provenance {
-    /// `git rev-parse HEAD` of the project, or `unknown` outside a git checkout.
+    /// The last commit that changed an input of the run (see `pipeline::git_commit`).
     pub git_commit: String,
     pub run_config: FileRef,
     pub conditions: FileRef,
@@ -110,10 +110,13 @@ pub struct StageTiming {
     pub seconds: f64,
 }
 
-/// `timings.json`: the only part of a run's output that changes between identical runs.
+/// `timings.json`: what changes between two runs of the same inputs: wall times, threads, and
+/// whether the working tree had uncommitted changes to the inputs.
 #[derive(Clone, Debug, Serialize)]
 pub struct Timings {
     pub run: String,
+    /// Tracked inputs differed from `git_commit` when the run started (`None`: not a checkout).
+    pub uncommitted_inputs: Option<bool>,
     /// Rayon worker threads.
     pub threads: usize,
     pub stages: Vec<StageTiming>,

@@ -8,7 +8,9 @@ use crate::error::Result;
 use crate::library::{Candidate, TIMING, build_library};
 use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
-use crate::refine::{Parameter, effects_from, levenberg_marquardt, objective, profile_search};
+use crate::refine::{
+    Parameter, effect_column, effects_from, levenberg_marquardt, objective, profile_search, profile_wind,
+};
 use crate::selection::{Design, Selection, SelectionSettings, stability_selection};
 
 /// Settings of an analysis (recorded in the output).
@@ -162,13 +164,14 @@ pub fn analyze(log: &FlightLog, model: &NominalModel, model_name: &str, settings
     let before = problem.residual(&nominal);
     let fit_rows = 0..problem.split;
 
-    let (candidates, columns) = build_library(&problem);
+    let (candidates, mut columns) = build_library(&problem);
+    let wind_start = profile_nonlinear(&problem, &before, &candidates, &mut columns, fit_rows.clone(), settings.selection.block_rows);
     let groups: Vec<Vec<usize>> = candidates.iter().map(|c| c.columns.clone()).collect();
     let block_rows = settings.selection.block_rows;
     let design = Design::new(&problem, &before, &columns, fit_rows.clone(), block_rows);
     let selection = stability_selection(&design, &groups, &settings.selection);
 
-    let fitted = fit_parameters(&problem, &candidates, &columns, &design, &selection, settings);
+    let fitted = fit_parameters(&problem, &candidates, &columns, &design, &selection, settings, wind_start);
     let (effects, timing_alternatives, wind_test) = fitted;
     let after = problem.residual(&effects);
     let report = build_report(
@@ -193,6 +196,59 @@ pub fn analyze(log: &FlightLog, model: &NominalModel, model_name: &str, settings
     })
 }
 
+/// Replaces the screen columns of the nonlinear candidates by the exact effect at the parameters
+/// a profile search finds next to all other columns: the ground-effect radius, the better of a
+/// delay and a motor lag, and the air velocity of the quadratic drag. Returns that air velocity.
+fn profile_nonlinear(
+    problem: &Problem,
+    before: &[Channels],
+    candidates: &[Candidate],
+    columns: &mut [Vec<Channels>],
+    range: std::ops::Range<usize>,
+    block_rows: usize,
+) -> [f64; 3] {
+    let base = problem.predict(&Effects::default());
+    let total = columns.len();
+    let others_of = |candidate: &Candidate| -> Vec<usize> {
+        (0..total).filter(|c| !candidate.columns.contains(c)).collect()
+    };
+    let find = |id: &str| candidates.iter().find(|c| c.id == id);
+    if let Some(candidate) = find("ground_effect") {
+        let others = others_of(candidate);
+        let grid: Vec<f64> = (1..=60).map(|i| i as f64 * 0.02).collect();
+        let effect = |r: f64| effects_from(&[Parameter::GroundRadius], &[r]);
+        let (radius, _) = profile_search(problem, columns, &others, range.clone(), block_rows, &grid, effect);
+        columns[candidate.columns[0]] = effect_column(problem, &base, &effect(radius), radius * radius);
+    }
+    if let Some(candidate) = find(TIMING) {
+        let others = others_of(candidate);
+        let grid: Vec<f64> = (1..=60).map(|i| i as f64 * 0.0025).collect();
+        let best = [Parameter::Delay, Parameter::MotorLag]
+            .into_iter()
+            .map(|kind| {
+                let (value, sse) = profile_search(problem, columns, &others, range.clone(), block_rows, &grid, |v| {
+                    effects_from(&[kind], &[v])
+                });
+                (kind, value, sse)
+            })
+            .min_by(|a, b| a.2.total_cmp(&b.2))
+            .expect("two kinds");
+        columns[candidate.columns[0]] = effect_column(problem, &base, &effects_from(&[best.0], &[best.1]), best.1);
+    }
+    let mut wind = [0.0; 3];
+    if let Some(candidate) = find("quadratic_drag") {
+        let others = others_of(candidate);
+        let (w, _) = profile_wind(problem, before, columns, &others, range.clone(), block_rows);
+        wind = w;
+        let effects = effects_from(
+            &[Parameter::QuadraticDrag, Parameter::Wind(0), Parameter::Wind(1), Parameter::Wind(2)],
+            &[1.0, w[0], w[1], w[2]],
+        );
+        columns[candidate.columns[0]] = effect_column(problem, &base, &effects, 1.0);
+    }
+    wind
+}
+
 type FitOutcome = (Effects, Option<serde_json::Value>, Option<serde_json::Value>);
 
 fn fit_parameters(
@@ -202,6 +258,7 @@ fn fit_parameters(
     design: &Design,
     selection: &Selection,
     settings: &AnalysisSettings,
+    wind_start: [f64; 3],
 ) -> FitOutcome {
     let fit_rows = 0..problem.split;
     let block_rows = settings.selection.block_rows;
@@ -293,7 +350,7 @@ fn fit_parameters(
         let mut p = parameters.clone();
         let mut v = values.clone();
         p.extend([Parameter::Wind(0), Parameter::Wind(1), Parameter::Wind(2)]);
-        v.extend([0.0; 3]);
+        v.extend(wind_start);
         let (v, sse_wind) = levenberg_marquardt(problem, &p, &v, fit_rows.clone(), settings.iterations);
         let count = (fit_rows.len() * problem.channels) as f64;
         let gain = (sse - sse_wind) / count;
@@ -307,7 +364,71 @@ fn fit_parameters(
         }
     }
     let _ = sse;
+    let (parameters, values) = backward_elimination(problem, parameters, values, settings);
     (effects_from(&parameters, &values), timing_alternatives, wind_test)
+}
+
+/// Drops, one at a time, the effect whose removal (with the others refitted) costs least, while
+/// that cost fails the selection's own test (mean whitened gain per row and channel below
+/// `min_gain`, or paired t over blocks below `min_t`). Catches terms the linear screen needed only
+/// to patch a linearisation that the exact fit no longer needs.
+fn backward_elimination(
+    problem: &Problem,
+    mut parameters: Vec<Parameter>,
+    mut values: Vec<f64>,
+    settings: &AnalysisSettings,
+) -> (Vec<Parameter>, Vec<f64>) {
+    let fit_rows = 0..problem.split;
+    loop {
+        let mut ids: Vec<&'static str> = parameters.iter().map(|p| p.effect_id()).collect();
+        ids.dedup();
+        if ids.len() < 2 {
+            return (parameters, values);
+        }
+        let full = block_sse(problem, &effects_from(&parameters, &values), settings.selection.block_rows);
+        let mut weakest: Option<(f64, Vec<Parameter>, Vec<f64>)> = None;
+        for id in ids {
+            // Wind goes with its drag; wind alone has had its own test.
+            let drop = |p: &Parameter| p.effect_id() == id || (id == "quadratic_drag" && p.effect_id() == "wind");
+            let kept: Vec<(Parameter, f64)> = parameters
+                .iter()
+                .zip(&values)
+                .filter(|(p, _)| !drop(p))
+                .map(|(p, v)| (*p, *v))
+                .collect();
+            let (reduced_parameters, start): (Vec<Parameter>, Vec<f64>) = kept.into_iter().unzip();
+            let (reduced_values, _) =
+                levenberg_marquardt(problem, &reduced_parameters, &start, fit_rows.clone(), settings.iterations / 2);
+            let reduced = block_sse(problem, &effects_from(&reduced_parameters, &reduced_values), settings.selection.block_rows);
+            let gains: Vec<f64> = reduced.iter().zip(&full).map(|(r, f)| r.1 - f.1).zip(&full).map(|(g, f)| g / f.0).collect();
+            let mean = gains.iter().sum::<f64>() / gains.len() as f64;
+            let sd = (gains.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / (gains.len() - 1).max(1) as f64).sqrt();
+            let t = mean / (sd / (gains.len() as f64).sqrt()).max(1e-300);
+            let passes = mean >= settings.selection.min_gain && t >= settings.selection.min_t;
+            if !passes && weakest.as_ref().is_none_or(|w| mean < w.0) {
+                weakest = Some((mean, reduced_parameters, reduced_values));
+            }
+        }
+        match weakest {
+            Some((_, p, v)) => {
+                parameters = p;
+                values = v;
+            }
+            None => return (parameters, values),
+        }
+    }
+}
+
+/// Per block of fit rows: (row × channel count, whitened sum of squares).
+fn block_sse(problem: &Problem, effects: &Effects, block_rows: usize) -> Vec<(f64, f64)> {
+    let residual = problem.residual(effects);
+    (0..problem.split)
+        .step_by(block_rows)
+        .map(|start| {
+            let end = (start + block_rows).min(problem.split);
+            (((end - start) * problem.channels) as f64, problem.whitened_sse(&residual, start..end))
+        })
+        .collect()
 }
 
 /// Paired t-statistic of the per-fold whitened error difference between two fitted models.

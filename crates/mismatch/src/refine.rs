@@ -166,9 +166,29 @@ pub fn levenberg_marquardt(
     (values, sse)
 }
 
+/// Whitened sum of squares of `residual` after regressing it on `extra` and `columns[others]`.
+pub fn projected_sse(
+    problem: &Problem,
+    residual: &[Channels],
+    extra: &[&Vec<Channels>],
+    columns: &[Vec<Channels>],
+    others: &[usize],
+    range: std::ops::Range<usize>,
+    block_rows: usize,
+) -> f64 {
+    let used: Vec<Vec<Channels>> = extra
+        .iter()
+        .map(|c| (*c).clone())
+        .chain(others.iter().map(|&c| columns[c].clone()))
+        .collect();
+    let design = Design::new(problem, residual, &used, range, block_rows);
+    let all: Vec<usize> = (0..used.len()).collect();
+    design.fitted_sse(&all)
+}
+
 /// 1-D profile search of one nonlinear effect: for each grid value, the residual of the nominal
 /// model plus that effect is regressed on `other_columns` (the linear screen's columns of the other
-/// selected effects); returns the grid value with the smallest whitened error and that error.
+/// effects); returns the grid value with the smallest whitened error and that error.
 pub fn profile_search(
     problem: &Problem,
     columns: &[Vec<Channels>],
@@ -179,28 +199,73 @@ pub fn profile_search(
     effect: impl Fn(f64) -> Effects + Sync,
 ) -> (f64, f64) {
     use rayon::prelude::*;
-    let scores: Vec<(f64, f64)> = grid
-        .par_iter()
+    grid.par_iter()
         .map(|&value| {
             let residual = problem.residual(&effect(value));
-            let used: Vec<Vec<Channels>> = other_columns.iter().map(|&c| columns[c].clone()).collect();
-            let design = Design::new(problem, &residual, &used, range.clone(), block_rows);
-            let ones = vec![1.0; design.blocks()];
-            let all: Vec<usize> = (0..used.len()).collect();
-            let theta = design.solve(&ones, &all);
-            let mut fitted = residual.clone();
-            for (j, column) in used.iter().enumerate() {
-                for (row, values) in fitted.iter_mut().zip(column) {
-                    for c in 0..problem.channels {
-                        row[c] -= theta[j] * values[c];
-                    }
-                }
-            }
-            (value, problem.whitened_sse(&fitted, range.clone()))
+            let sse = projected_sse(problem, &residual, &[], columns, other_columns, range.clone(), block_rows);
+            (value, sse)
         })
-        .collect();
-    scores
+        .collect::<Vec<_>>()
         .into_iter()
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .expect("a non-empty grid")
+}
+
+/// The change of the matched prediction caused by `effects`, per analysed row.
+pub fn effect_column(problem: &Problem, base: &[Channels], effects: &Effects, scale: f64) -> Vec<Channels> {
+    problem
+        .predict(effects)
+        .iter()
+        .zip(base)
+        .map(|(p, b)| {
+            let mut out = [0.0; 6];
+            for c in 0..problem.channels {
+                out[c] = (p[c] - b[c]) / scale;
+            }
+            out
+        })
+        .collect()
+}
+
+/// Air velocity that best explains `residual` with a free drag coefficient on the column
+/// `−|v − w| (v − w)` next to the other columns: coordinate-wise searches, coarse then fine.
+pub fn profile_wind(
+    problem: &Problem,
+    residual: &[Channels],
+    columns: &[Vec<Channels>],
+    others: &[usize],
+    range: std::ops::Range<usize>,
+    block_rows: usize,
+) -> ([f64; 3], f64) {
+    use rayon::prelude::*;
+    let base = problem.predict(&Effects::default());
+    let score = |w: [f64; 3]| {
+        let effects = effects_from(
+            &[Parameter::QuadraticDrag, Parameter::Wind(0), Parameter::Wind(1), Parameter::Wind(2)],
+            &[1.0, w[0], w[1], w[2]],
+        );
+        let column = effect_column(problem, &base, &effects, 1.0);
+        projected_sse(problem, residual, &[&column], columns, others, range.clone(), block_rows)
+    };
+    let mut best = ([0.0; 3], score([0.0; 3]));
+    for (step, span) in [(0.5, 12), (0.1, 5), (0.02, 5)] {
+        for _sweep in 0..2 {
+            for axis in 0..3 {
+                let candidates: Vec<([f64; 3], f64)> = (-span..=span)
+                    .into_par_iter()
+                    .map(|i| {
+                        let mut w = best.0;
+                        w[axis] += i as f64 * step;
+                        (w, score(w))
+                    })
+                    .collect();
+                for candidate in candidates {
+                    if candidate.1 < best.1 {
+                        best = candidate;
+                    }
+                }
+            }
+        }
+    }
+    best
 }

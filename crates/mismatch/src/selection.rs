@@ -4,7 +4,8 @@
 //! Rows are whitened (each channel divided by its noise floor), so on noise alone the mean square
 //! per row and channel is about 1. A group enters only when it lowers the cross-validated error in
 //! every sense that matters: on average by at least `min_gain` (noise-floor units) and consistently
-//! across folds (paired t-statistic above `min_t`). A group is kept when it enters in at least
+//! across the time blocks (paired t-statistic of the per-block cross-validated gains above `min_t`;
+//! blocks, not folds, so that an effect present in only part of the flight can pass). A group is kept when it enters in at least
 //! `stability_threshold` of the resamples. All sums go through per-block Gram matrices, so a
 //! resample or a fold costs a few small solves.
 
@@ -152,26 +153,31 @@ impl Design {
         sse
     }
 
-    /// Cross-validated mean square per row and channel of each fold.
-    pub fn fold_errors(&self, weights: &[f64], fold_of_block: &[usize], folds: usize, columns: &[usize]) -> Vec<f64> {
-        (0..folds)
-            .map(|f| {
-                let train: Vec<f64> = weights
-                    .iter()
-                    .zip(fold_of_block)
-                    .map(|(w, fb)| if *fb == f { 0.0 } else { *w })
-                    .collect();
-                let theta = self.solve(&train, columns);
-                let (mut sse, mut count) = (0.0, 0.0);
-                for b in 0..self.blocks() {
-                    if fold_of_block[b] == f && weights[b] > 0.0 {
-                        sse += weights[b] * self.block_sse(b, columns, &theta);
-                        count += weights[b] * self.counts[b];
-                    }
+    /// Cross-validated mean square per row and channel of every block: each block is predicted by
+    /// the fit on the folds it is not in. Blocks with zero weight give NaN.
+    pub fn block_errors(&self, weights: &[f64], fold_of_block: &[usize], folds: usize, columns: &[usize]) -> Vec<f64> {
+        let mut errors = vec![f64::NAN; self.blocks()];
+        for f in 0..folds {
+            let train: Vec<f64> = weights
+                .iter()
+                .zip(fold_of_block)
+                .map(|(w, fb)| if *fb == f { 0.0 } else { *w })
+                .collect();
+            let theta = self.solve(&train, columns);
+            for b in 0..self.blocks() {
+                if fold_of_block[b] == f && weights[b] > 0.0 {
+                    errors[b] = self.block_sse(b, columns, &theta) / self.counts[b];
                 }
-                if count > 0.0 { sse / count } else { f64::NAN }
-            })
-            .collect()
+            }
+        }
+        errors
+    }
+
+    /// In-sample whitened sum of squares with all blocks and least-squares coefficients.
+    pub fn fitted_sse(&self, columns: &[usize]) -> f64 {
+        let ones = vec![1.0; self.blocks()];
+        let theta = self.solve(&ones, columns);
+        (0..self.blocks()).map(|b| self.block_sse(b, columns, &theta)).sum()
     }
 
     /// Number of columns.
@@ -187,7 +193,7 @@ pub fn stepwise(design: &Design, weights: &[f64], groups: &[Vec<usize>], setting
     let fold_of_block: Vec<usize> = (0..blocks).map(|b| b * folds / blocks).collect();
     let mut chosen: Vec<usize> = Vec::new();
     let mut columns: Vec<usize> = Vec::new();
-    let mut current = design.fold_errors(weights, &fold_of_block, folds, &columns);
+    let mut current = design.block_errors(weights, &fold_of_block, folds, &columns);
     loop {
         let mut best: Option<(usize, f64, Vec<f64>)> = None;
         for (g, group) in groups.iter().enumerate() {
@@ -195,19 +201,23 @@ pub fn stepwise(design: &Design, weights: &[f64], groups: &[Vec<usize>], setting
                 continue;
             }
             let trial_columns: Vec<usize> = columns.iter().chain(group).copied().collect();
-            let errors = design.fold_errors(weights, &fold_of_block, folds, &trial_columns);
-            let gains: Vec<f64> = current
-                .iter()
-                .zip(&errors)
-                .filter(|(a, b)| a.is_finite() && b.is_finite())
-                .map(|(a, b)| a - b)
-                .collect();
-            if gains.len() < 2 {
+            let errors = design.block_errors(weights, &fold_of_block, folds, &trial_columns);
+            // Paired comparison over blocks, each counted as often as the resample drew it.
+            let (mut total, mut total_squares, mut count) = (0.0, 0.0, 0.0);
+            for b in 0..blocks {
+                let gain = current[b] - errors[b];
+                if weights[b] > 0.0 && gain.is_finite() {
+                    total += weights[b] * gain;
+                    total_squares += weights[b] * gain * gain;
+                    count += weights[b];
+                }
+            }
+            if count < 2.0 {
                 continue;
             }
-            let mean = gains.iter().sum::<f64>() / gains.len() as f64;
-            let variance = gains.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / (gains.len() - 1) as f64;
-            let t = mean / (variance.sqrt() / (gains.len() as f64).sqrt()).max(1e-300);
+            let mean = total / count;
+            let variance = ((total_squares - count * mean * mean) / (count - 1.0)).max(0.0);
+            let t = mean / (variance.sqrt() / count.sqrt()).max(1e-300);
             if mean >= settings.min_gain && t >= settings.min_t && best.as_ref().is_none_or(|(_, m, _)| mean > *m) {
                 best = Some((g, mean, errors));
             }

@@ -2,7 +2,7 @@
 //! `LinearRegression`) and the ridge normal equations (as scikit-learn's `ridge_regression`,
 //! Cholesky solver).
 
-use faer::linalg::solvers::{Solve, SolveLstsq};
+use faer::linalg::solvers::{Qr, Solve, SolveLstsq};
 use faer::{Mat, MatRef, Side};
 
 /// Minimum-norm least-squares solution of `a·x ≈ b` (every column of `b` a right-hand side).
@@ -13,17 +13,24 @@ pub fn least_squares(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
     if a.ncols() == 0 {
         return Mat::zeros(0, b.ncols());
     }
-    if a.nrows() >= a.ncols() {
-        let qr = a.qr();
-        let r = qr.thin_R();
-        let diagonal: Vec<f64> = (0..r.ncols()).map(|i| r[(i, i)].abs()).collect();
-        let largest = diagonal.iter().copied().fold(0.0, f64::max);
-        let tolerance = rank_tolerance(a) * largest;
-        if largest > 0.0 && diagonal.iter().all(|&d| d > tolerance * 1e3) {
-            return qr.solve_lstsq(b);
-        }
+    match full_rank_qr(a) {
+        Some((qr, _)) => qr.solve_lstsq(b),
+        None => pseudo_inverse_solve(a, b),
     }
-    pseudo_inverse_solve(a, b)
+}
+
+/// The Householder QR of a tall `a` and its triangular factor R, if no diagonal entry of R is
+/// negligible (`|R_ii| ≤ 1000·ε·max(m, n)·max|R_jj|` counts as rank-deficient).
+pub fn full_rank_qr(a: MatRef<'_, f64>) -> Option<(Qr<f64>, Mat<f64>)> {
+    if a.nrows() < a.ncols() {
+        return None;
+    }
+    let qr = a.qr();
+    let r = qr.thin_R().to_owned();
+    let diagonal: Vec<f64> = (0..r.ncols()).map(|i| r[(i, i)].abs()).collect();
+    let largest = diagonal.iter().copied().fold(0.0, f64::max);
+    let tolerance = 1e3 * rank_tolerance(a) * largest;
+    (largest > 0.0 && diagonal.iter().all(|&d| d > tolerance)).then_some((qr, r))
 }
 
 fn rank_tolerance(a: MatRef<'_, f64>) -> f64 {

@@ -14,7 +14,9 @@ use faer::{Mat, MatRef};
 use rayon::prelude::*;
 
 use crate::error::{Result, invalid};
-use crate::linalg::{least_squares, ridge_from_gram};
+use faer::linalg::solvers::SolveLstsq;
+
+use crate::linalg::{full_rank_qr, least_squares, ridge_from_gram};
 
 /// Work (samples × features²) above which targets are fitted in parallel.
 const PARALLEL_WORK: usize = 100_000;
@@ -62,17 +64,25 @@ impl Stlsq {
     pub fn fit(&self, theta: MatRef<'_, f64>, targets: MatRef<'_, f64>) -> StlsqFit {
         let gram = theta.transpose() * theta;
         let moments = theta.transpose() * targets;
-        let reference = least_squares(theta, targets);
+        let reduced = ReducedProblem::new(theta, targets);
+        let reference = match &reduced {
+            Some(reduced) => reduced.solution.clone(),
+            None => least_squares(theta, targets),
+        };
         let fit_target = |i: usize| -> (Vec<f64>, usize) {
             let reference_pattern: Vec<bool> = (0..theta.ncols())
                 .map(|j| reference[(j, i)] != 0.0)
                 .collect();
-            self.fit_one(
-                theta,
-                targets.col(i).as_mat(),
-                gram.as_ref(),
-                moments.col(i).as_mat(),
-                reference_pattern,
+            let support = self.select(gram.as_ref(), moments.col(i).as_mat(), reference_pattern);
+            (
+                refit(
+                    theta,
+                    targets.col(i).as_mat(),
+                    reduced.as_ref(),
+                    i,
+                    &support.0,
+                ),
+                support.1,
             )
         };
         let work = theta.nrows() * theta.ncols() * theta.ncols();
@@ -91,15 +101,15 @@ impl Stlsq {
         }
     }
 
-    fn fit_one(
+    /// The thresholding iterations of one target: the kept features (|ξ| > 1e-14) and the
+    /// number of iterations run.
+    fn select(
         &self,
-        theta: MatRef<'_, f64>,
-        target: MatRef<'_, f64>,
         gram: MatRef<'_, f64>,
         moments: MatRef<'_, f64>,
         mut previous_pattern: Vec<bool>,
-    ) -> (Vec<f64>, usize) {
-        let features = theta.ncols();
+    ) -> (Vec<usize>, usize) {
+        let features = gram.ncols();
         let mut active: Vec<usize> = (0..features).collect();
         let mut coefficients = vec![0.0; features];
         let mut iterations = 0;
@@ -134,18 +144,62 @@ impl Stlsq {
             }
             previous_pattern = pattern;
         }
-        let support: Vec<usize> = (0..features)
+        let support = (0..features)
             .filter(|&j| coefficients[j].abs() > 1e-14)
             .collect();
-        let mut unbiased = vec![0.0; features];
-        if !support.is_empty() {
-            let sub_theta =
-                Mat::from_fn(theta.nrows(), support.len(), |i, a| theta[(i, support[a])]);
-            let refit = least_squares(sub_theta.as_ref(), target);
-            for (a, &j) in support.iter().enumerate() {
-                unbiased[j] = refit[(a, 0)];
-            }
-        }
-        (unbiased, iterations)
+        (support, iterations)
     }
+}
+
+/// Θ = QR of the full library, with Qᵀy for every target: a least-squares problem on a subset S
+/// of the columns, `min ‖Θ_S ξ − y‖`, equals `min ‖R_S ξ − Qᵀy‖` (p rows instead of n), solved
+/// as stably as a QR of Θ_S. `None` when Θ is wide or rank-deficient.
+struct ReducedProblem {
+    triangular: Mat<f64>,
+    projected: Mat<f64>,
+    /// The least-squares solution on all features, one column per target.
+    solution: Mat<f64>,
+}
+
+impl ReducedProblem {
+    fn new(theta: MatRef<'_, f64>, targets: MatRef<'_, f64>) -> Option<Self> {
+        let (qr, triangular) = full_rank_qr(theta)?;
+        let solution = qr.solve_lstsq(targets);
+        // Qᵀy = R·ξ_ls.
+        let projected = &triangular * &solution;
+        Some(Self {
+            triangular,
+            projected,
+            solution,
+        })
+    }
+}
+
+/// The unregularised least-squares refit on `support` (PySINDy's `unbias` step).
+fn refit(
+    theta: MatRef<'_, f64>,
+    target: MatRef<'_, f64>,
+    reduced: Option<&ReducedProblem>,
+    index: usize,
+    support: &[usize],
+) -> Vec<f64> {
+    let mut unbiased = vec![0.0; theta.ncols()];
+    if support.is_empty() {
+        return unbiased;
+    }
+    let solution = match reduced {
+        Some(reduced) => {
+            let r = &reduced.triangular;
+            let sub = Mat::from_fn(r.nrows(), support.len(), |i, a| r[(i, support[a])]);
+            least_squares(sub.as_ref(), reduced.projected.col(index).as_mat())
+        }
+        None => {
+            let sub = Mat::from_fn(theta.nrows(), support.len(), |i, a| theta[(i, support[a])]);
+            least_squares(sub.as_ref(), target)
+        }
+    };
+    for (a, &j) in support.iter().enumerate() {
+        unbiased[j] = solution[(a, 0)];
+    }
+    unbiased
 }

@@ -184,7 +184,7 @@ pub fn latex(table: &ResultsTable) -> String {
                 for metric in Metric::ALL {
                     let _ = write!(
                         out,
-                        " & {{\\scriptsize {} ({})}}",
+                        " & {{\\scriptsize {} (${}$)}}",
                         value(published.get(method).get(metric)),
                         signed(difference.get(method).get(metric))
                     );
@@ -280,7 +280,7 @@ mod tests {
         assert!(text.contains("\\label{tab:translational_comparison}"));
         assert!(text.contains("\\begin{tabular}{l cccc}"));
         assert!(text.contains("35wind   & 0.156 & \\textbf{0.194} & \\textbf{0.150} & 0.210 \\\\"));
-        assert!(text.contains("{\\scriptsize 0.155 (-0.005)}"));
+        assert!(text.contains("{\\scriptsize 0.155 ($-0.005$)}"));
         assert!(text.contains("new\\_wind"));
         for rule in [
             "\\toprule",

@@ -38,3 +38,8 @@ lint:
 
 fmt:
 	$(CARGO) fmt --all
+
+# Speed against the Python references, in one run on this machine (needs `make data`; creates
+# .venv through scripts/python-env.sh if missing). One command per line: other parts append theirs.
+bench: data
+	scripts/bench/sindy.sh

@@ -286,39 +286,46 @@ impl FeatureLibrary {
     /// Θ(X): one row per sample of `inputs`, one column per feature.
     pub fn transform(&self, inputs: MatRef<'_, f64>) -> Mat<f64> {
         let (n, dim) = (inputs.nrows(), inputs.ncols());
+        let columns: Vec<Vec<f64>> = (0..dim)
+            .map(|j| inputs.col(j).iter().copied().collect())
+            .collect();
         let mut theta = Mat::<f64>::zeros(n, self.feature_count(dim));
-        let mut column = 0;
+        let mut next = 0;
+        let mut cosines = vec![0.0; n];
         for part in &self.parts {
             match part {
                 Part::Polynomial { degree, constant } => {
                     for term in monomials(dim, *degree, *constant) {
-                        let mut out = theta.col_mut(column);
-                        for i in 0..n {
-                            out[i] = term.iter().map(|&j| inputs[(i, j)]).product();
+                        let out = column_slice(&mut theta, next);
+                        next += 1;
+                        out.fill(1.0);
+                        for &j in &term {
+                            out.iter_mut().zip(&columns[j]).for_each(|(o, x)| *o *= x);
                         }
-                        column += 1;
                     }
                 }
                 Part::Fourier { frequencies } => {
                     for k in 1..=*frequencies {
                         let k = k as f64;
-                        for j in 0..dim {
-                            for i in 0..n {
-                                let (sin, cos) = (k * inputs[(i, j)]).sin_cos();
-                                theta[(i, column)] = sin;
-                                theta[(i, column + 1)] = cos;
+                        for input in &columns {
+                            let sines = column_slice(&mut theta, next);
+                            for ((sine, cosine), x) in sines.iter_mut().zip(&mut cosines).zip(input)
+                            {
+                                (*sine, *cosine) = (k * x).sin_cos();
                             }
-                            column += 2;
+                            column_slice(&mut theta, next + 1).copy_from_slice(&cosines);
+                            next += 2;
                         }
                     }
                 }
                 Part::Custom(functions) => {
                     for function in functions {
-                        for j in 0..dim {
-                            for i in 0..n {
-                                theta[(i, column)] = (function.function)(inputs[(i, j)]);
-                            }
-                            column += 1;
+                        for input in &columns {
+                            let out = column_slice(&mut theta, next);
+                            next += 1;
+                            out.iter_mut()
+                                .zip(input)
+                                .for_each(|(o, &x)| *o = (function.function)(x));
                         }
                     }
                 }
@@ -354,6 +361,15 @@ impl FeatureLibrary {
             }
         }
     }
+}
+
+/// Column `j` of a freshly allocated (column-major, contiguous) matrix as a slice.
+fn column_slice(matrix: &mut Mat<f64>, j: usize) -> &mut [f64] {
+    matrix
+        .col_mut(j)
+        .try_as_col_major_mut()
+        .expect("owned matrices store columns contiguously")
+        .as_slice_mut()
 }
 
 fn collect_parts(spec: &LibrarySpec, parts: &mut Vec<Part>) {

@@ -505,13 +505,16 @@ impl SindyModel {
 /// Mean over all samples and all columns of the squared difference.
 pub fn mean_squared_error(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -> f64 {
     let (n, m) = actual.shape();
-    let mut sum = 0.0;
-    for j in 0..m {
-        for i in 0..n {
-            let e = predicted[(i, j)] - actual[(i, j)];
-            sum += e * e;
-        }
-    }
+    let sum: f64 = (0..m)
+        .map(|j| {
+            predicted
+                .col(j)
+                .iter()
+                .zip(actual.col(j).iter())
+                .map(|(p, a)| (p - a) * (p - a))
+                .sum::<f64>()
+        })
+        .sum();
     sum / (n * m) as f64
 }
 
@@ -561,14 +564,12 @@ fn stack_rows(blocks: &[Mat<f64>]) -> Mat<f64> {
 
 fn check_finite(what: &str, matrix: MatRef<'_, f64>) -> Result<()> {
     for j in 0..matrix.ncols() {
-        for i in 0..matrix.nrows() {
-            if !matrix[(i, j)].is_finite() {
-                return Err(SindyError::NonFinite {
-                    what: what.to_string(),
-                    row: i,
-                    column: j,
-                });
-            }
+        if let Some(i) = matrix.col(j).iter().position(|v| !v.is_finite()) {
+            return Err(SindyError::NonFinite {
+                what: what.to_string(),
+                row: i,
+                column: j,
+            });
         }
     }
     Ok(())

@@ -1,0 +1,97 @@
+//! Run configurations: checked once, with one-line errors naming the file and field.
+
+use std::path::{Path, PathBuf};
+
+use pipeline::RunConfig;
+use serde_json::{Value, json};
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn committed(name: &str) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(workspace().join(name)).unwrap()).unwrap()
+}
+
+/// Writes `config` to a temporary file and loads it against the workspace root.
+fn load(name: &str, config: &Value) -> Result<pipeline::CheckedRunConfig, String> {
+    let dir = std::env::temp_dir().join(format!("pipeline-config-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{name}.json"));
+    std::fs::write(&path, config.to_string()).unwrap();
+    RunConfig::load(&path, &workspace()).map_err(|e| e.to_string())
+}
+
+#[test]
+fn the_committed_configurations_share_the_protocol_and_differ_in_budget() {
+    let reproduce = RunConfig::load(
+        &workspace().join("experiments/reproduce.json"),
+        &workspace(),
+    )
+    .unwrap();
+    let ci = RunConfig::load(&workspace().join("experiments/ci.json"), &workspace()).unwrap();
+    assert_eq!(reproduce.raw.formulations, ci.raw.formulations);
+    assert_eq!(reproduce.raw.conditions, ci.raw.conditions);
+    assert_eq!(reproduce.raw.split, ci.raw.split);
+    assert_eq!(reproduce.raw.derivative, ci.raw.derivative);
+    assert_eq!(reproduce.raw.sindy, ci.raw.sindy);
+    assert_eq!(reproduce.raw.learn.protocol, ci.raw.learn.protocol);
+    let (full, small) = (reproduce.learn.get(), ci.learn.get());
+    assert_eq!(full.adaptation, small.adaptation);
+    assert_eq!(full.hidden_layers, small.hidden_layers);
+    assert!(small.meta_training.iterations <= full.meta_training.iterations);
+}
+
+#[test]
+fn overrides_are_merged_before_the_learn_configuration_is_checked() {
+    let mut config = committed("experiments/reproduce.json");
+    config["learn"]["overrides"] = json!({"meta_training": {"iterations": 3}});
+    let checked = load("overrides", &config).unwrap();
+    assert_eq!(checked.learn.get().meta_training.iterations, 3);
+
+    config["learn"]["overrides"] = json!({"meta_training": {"iterationz": 3}});
+    let message = load("unknown-override", &config).unwrap_err();
+    assert!(
+        message.contains("learn.overrides") && message.contains("iterationz"),
+        "{message}"
+    );
+    config["learn"]["overrides"] = json!({"meta_training": {"inner_step": -1.0}});
+    let message = load("bad-override", &config).unwrap_err();
+    assert!(message.contains("inner_step"), "{message}");
+}
+
+#[test]
+fn bad_values_name_the_file_and_field() {
+    let base = committed("experiments/reproduce.json");
+    let cases = [
+        (
+            "split",
+            json!({"kind": "fraction", "support": 0.7}),
+            "split",
+        ),
+        ("derivative", json!({"kind": "central"}), "derivative"),
+        ("formulations", json!([]), "formulations"),
+    ];
+    for (field, value, expected) in cases {
+        let mut config = base.clone();
+        config[field] = value;
+        let message = load(field, &config).unwrap_err();
+        assert!(
+            message.contains(&format!("{field}.json")) && message.contains(expected),
+            "{message}"
+        );
+    }
+    let mut config = base.clone();
+    config["learn"]["seeds"] = json!([1, 1]);
+    assert!(load("seeds", &config).unwrap_err().contains("learn.seeds"));
+    let mut config = base.clone();
+    config["learn"]["protocol"] = json!("sometimes");
+    assert!(load("protocol", &config).unwrap_err().contains("sometimes"));
+    let mut config = base;
+    config["conditions"] = json!("experiments/no-such-file.json");
+    assert!(
+        load("conditions", &config)
+            .unwrap_err()
+            .contains("no-such-file.json")
+    );
+}

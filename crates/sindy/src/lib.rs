@@ -45,7 +45,6 @@
 //!
 //! Every error is a [`SindyError`] with a one-line message.
 
-mod causal;
 mod error;
 mod library;
 mod linalg;
@@ -53,11 +52,7 @@ mod model;
 mod optimizer;
 mod persist;
 mod pipeline;
-mod regression;
-mod selection;
-mod variant;
 
-pub use causal::{CausalLibrary, first_order_lag};
 pub use error::{Result, SindyError};
 pub use library::{CustomFunction, FeatureLibrary, LibrarySpec};
 pub use linalg::least_squares;
@@ -68,11 +63,6 @@ pub use optimizer::{
 };
 pub use persist::MODEL_FORMAT;
 pub use pipeline::{SegmentEvaluation, SindyConfig, evaluate_flight, fit_and_evaluate};
-pub use regression::{
-    Bagging, EnsemblePrediction, LinearFit, Penalty, RegressionFit, RegressionSpec, select_rows,
-};
-pub use selection::{BlockedFolds, Fold, Selection, cross_validate};
-pub use variant::{LibraryRegression, VariantEvaluation, evaluate_features};
 
 /// Re-exported so that users name the same matrix types.
 pub use faer::{Mat, MatRef};

@@ -9,7 +9,8 @@ use crate::library::{Candidate, TIMING, build_library};
 use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
 use crate::refine::{
-    Parameter, effect_column, effects_from, levenberg_marquardt, objective, profile_search, profile_wind,
+    Parameter, effect_column, effects_from, levenberg_marquardt, objective, profile_search,
+    profile_wind,
 };
 use crate::selection::{Design, Selection, SelectionSettings, stability_selection};
 
@@ -156,22 +157,47 @@ pub struct Analysis {
 }
 
 /// Analyses a recording against a nominal model. `model_name` only labels the output.
-pub fn analyze(log: &FlightLog, model: &NominalModel, model_name: &str, settings: &AnalysisSettings) -> Result<Analysis> {
+pub fn analyze(
+    log: &FlightLog,
+    model: &NominalModel,
+    model_name: &str,
+    settings: &AnalysisSettings,
+) -> Result<Analysis> {
     let min_rows = 8 * settings.derivative.min_samples().max(5);
     let recording = Recording::new(log, model, min_rows)?;
-    let problem = Problem::new(recording, model.clone(), settings.derivative, settings.heldout_fraction)?;
+    let problem = Problem::new(
+        recording,
+        model.clone(),
+        settings.derivative,
+        settings.heldout_fraction,
+    )?;
     let nominal = Effects::default();
     let before = problem.residual(&nominal);
     let fit_rows = 0..problem.split;
 
     let (candidates, mut columns) = build_library(&problem);
-    let wind_start = profile_nonlinear(&problem, &before, &candidates, &mut columns, fit_rows.clone(), settings.selection.block_rows);
+    let wind_start = profile_nonlinear(
+        &problem,
+        &before,
+        &candidates,
+        &mut columns,
+        fit_rows.clone(),
+        settings.selection.block_rows,
+    );
     let groups: Vec<Vec<usize>> = candidates.iter().map(|c| c.columns.clone()).collect();
     let block_rows = settings.selection.block_rows;
     let design = Design::new(&problem, &before, &columns, fit_rows.clone(), block_rows);
     let selection = stability_selection(&design, &groups, &settings.selection);
 
-    let fitted = fit_parameters(&problem, &candidates, &columns, &design, &selection, settings, wind_start);
+    let fitted = fit_parameters(
+        &problem,
+        &candidates,
+        &columns,
+        &design,
+        &selection,
+        settings,
+        wind_start,
+    );
     let (effects, timing_alternatives, wind_test) = fitted;
     let after = problem.residual(&effects);
     let report = build_report(
@@ -210,15 +236,26 @@ fn profile_nonlinear(
     let base = problem.predict(&Effects::default());
     let total = columns.len();
     let others_of = |candidate: &Candidate| -> Vec<usize> {
-        (0..total).filter(|c| !candidate.columns.contains(c)).collect()
+        (0..total)
+            .filter(|c| !candidate.columns.contains(c))
+            .collect()
     };
     let find = |id: &str| candidates.iter().find(|c| c.id == id);
     if let Some(candidate) = find("ground_effect") {
         let others = others_of(candidate);
         let grid: Vec<f64> = (1..=60).map(|i| i as f64 * 0.02).collect();
         let effect = |r: f64| effects_from(&[Parameter::GroundRadius], &[r]);
-        let (radius, _) = profile_search(problem, columns, &others, range.clone(), block_rows, &grid, effect);
-        columns[candidate.columns[0]] = effect_column(problem, &base, &effect(radius), radius * radius);
+        let (radius, _) = profile_search(
+            problem,
+            columns,
+            &others,
+            range.clone(),
+            block_rows,
+            &grid,
+            effect,
+        );
+        columns[candidate.columns[0]] =
+            effect_column(problem, &base, &effect(radius), radius * radius);
     }
     if let Some(candidate) = find(TIMING) {
         let others = others_of(candidate);
@@ -226,14 +263,21 @@ fn profile_nonlinear(
         let best = [Parameter::Delay, Parameter::MotorLag]
             .into_iter()
             .map(|kind| {
-                let (value, sse) = profile_search(problem, columns, &others, range.clone(), block_rows, &grid, |v| {
-                    effects_from(&[kind], &[v])
-                });
+                let (value, sse) = profile_search(
+                    problem,
+                    columns,
+                    &others,
+                    range.clone(),
+                    block_rows,
+                    &grid,
+                    |v| effects_from(&[kind], &[v]),
+                );
                 (kind, value, sse)
             })
             .min_by(|a, b| a.2.total_cmp(&b.2))
             .expect("two kinds");
-        columns[candidate.columns[0]] = effect_column(problem, &base, &effects_from(&[best.0], &[best.1]), best.1);
+        columns[candidate.columns[0]] =
+            effect_column(problem, &base, &effects_from(&[best.0], &[best.1]), best.1);
     }
     let mut wind = [0.0; 3];
     if let Some(candidate) = find("quadratic_drag") {
@@ -241,7 +285,12 @@ fn profile_nonlinear(
         let (w, _) = profile_wind(problem, before, columns, &others, range.clone(), block_rows);
         wind = w;
         let effects = effects_from(
-            &[Parameter::QuadraticDrag, Parameter::Wind(0), Parameter::Wind(1), Parameter::Wind(2)],
+            &[
+                Parameter::QuadraticDrag,
+                Parameter::Wind(0),
+                Parameter::Wind(1),
+                Parameter::Wind(2),
+            ],
             &[1.0, w[0], w[1], w[2]],
         );
         columns[candidate.columns[0]] = effect_column(problem, &base, &effects, 1.0);
@@ -249,7 +298,11 @@ fn profile_nonlinear(
     wind
 }
 
-type FitOutcome = (Effects, Option<serde_json::Value>, Option<serde_json::Value>);
+type FitOutcome = (
+    Effects,
+    Option<serde_json::Value>,
+    Option<serde_json::Value>,
+);
 
 fn fit_parameters(
     problem: &Problem,
@@ -269,12 +322,21 @@ fn fit_parameters(
     let kept_columns: Vec<usize> = kept.iter().flat_map(|c| c.columns.clone()).collect();
     let ones = vec![1.0; design.blocks()];
     let theta = design.solve(&ones, &kept_columns);
-    let coefficient = |column: usize| theta[kept_columns.iter().position(|c| *c == column).expect("kept")];
+    let coefficient = |column: usize| {
+        theta[kept_columns
+            .iter()
+            .position(|c| *c == column)
+            .expect("kept")]
+    };
     let mut parameters = Vec::new();
     let mut values = Vec::new();
     let mut timing = false;
     for candidate in &kept {
-        let others: Vec<usize> = kept_columns.iter().copied().filter(|c| !candidate.columns.contains(c)).collect();
+        let others: Vec<usize> = kept_columns
+            .iter()
+            .copied()
+            .filter(|c| !candidate.columns.contains(c))
+            .collect();
         let cols = &candidate.columns;
         match candidate.id.as_str() {
             "thrust_scale" => {
@@ -293,9 +355,15 @@ fn fit_parameters(
             }
             "ground_effect" => {
                 let grid: Vec<f64> = (1..=60).map(|i| i as f64 * 0.02).collect();
-                let (radius, _) = profile_search(problem, columns, &others, fit_rows.clone(), block_rows, &grid, |r| {
-                    effects_from(&[Parameter::GroundRadius], &[r])
-                });
+                let (radius, _) = profile_search(
+                    problem,
+                    columns,
+                    &others,
+                    fit_rows.clone(),
+                    block_rows,
+                    &grid,
+                    |r| effects_from(&[Parameter::GroundRadius], &[r]),
+                );
                 parameters.push(Parameter::GroundRadius);
                 values.push(radius);
             }
@@ -315,6 +383,7 @@ fn fit_parameters(
             other => unreachable!("unknown candidate {other}"),
         }
     }
+    let screen_values = values.clone();
     let mut timing_alternatives = None;
     let (mut parameters, mut values, mut sse) = if timing {
         let others: Vec<usize> = kept
@@ -326,14 +395,21 @@ fn fit_parameters(
         let mut best: Option<(Vec<Parameter>, Vec<f64>, f64)> = None;
         let mut scores = serde_json::Map::new();
         for kind in [Parameter::Delay, Parameter::MotorLag] {
-            let (start, _) = profile_search(problem, columns, &others, fit_rows.clone(), block_rows, &grid, |v| {
-                effects_from(&[kind], &[v])
-            });
+            let (start, _) = profile_search(
+                problem,
+                columns,
+                &others,
+                fit_rows.clone(),
+                block_rows,
+                &grid,
+                |v| effects_from(&[kind], &[v]),
+            );
             let mut p = parameters.clone();
             let mut v = values.clone();
             p.push(kind);
             v.push(start);
-            let (v, sse) = levenberg_marquardt(problem, &p, &v, fit_rows.clone(), settings.iterations);
+            let (v, sse) =
+                levenberg_marquardt(problem, &p, &v, fit_rows.clone(), settings.iterations);
             scores.insert(kind.effect_id().to_string(), serde_json::json!(sse));
             if best.as_ref().is_none_or(|b| sse < b.2) {
                 best = Some((p, v, sse));
@@ -342,30 +418,68 @@ fn fit_parameters(
         timing_alternatives = Some(serde_json::Value::Object(scores));
         best.expect("two alternatives tried")
     } else {
-        let (v, sse) = levenberg_marquardt(problem, &parameters, &values, fit_rows.clone(), settings.iterations);
+        let (v, sse) = levenberg_marquardt(
+            problem,
+            &parameters,
+            &values,
+            fit_rows.clone(),
+            settings.iterations,
+        );
         (parameters.clone(), v, sse)
     };
     let mut wind_test = None;
     if parameters.contains(&Parameter::QuadraticDrag) {
-        let mut p = parameters.clone();
-        let mut v = values.clone();
-        p.extend([Parameter::Wind(0), Parameter::Wind(1), Parameter::Wind(2)]);
-        v.extend(wind_start);
-        let (v, sse_wind) = levenberg_marquardt(problem, &p, &v, fit_rows.clone(), settings.iterations);
+        // The screen's drag column was already at the profiled air velocity: fit with wind, then
+        // test whether still air explains the residual as well.
+        let mut with_wind = parameters.clone();
+        with_wind.extend([Parameter::Wind(0), Parameter::Wind(1), Parameter::Wind(2)]);
+        // Two starts: the still-air fit, and the screen's estimates (the still-air fit may have
+        // pushed the drag coefficient to its bound); both with the profiled air velocity.
+        let starts = [values.clone(), {
+            let mut v = values.clone();
+            v[..screen_values.len()].copy_from_slice(&screen_values);
+            v
+        }];
+        let (v, sse_wind) = starts
+            .iter()
+            .map(|start| {
+                let mut start = start.clone();
+                start.extend(wind_start);
+                levenberg_marquardt(
+                    problem,
+                    &with_wind,
+                    &start,
+                    fit_rows.clone(),
+                    settings.iterations,
+                )
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("two starts");
         let count = (fit_rows.len() * problem.channels) as f64;
         let gain = (sse - sse_wind) / count;
-        let t = fold_t_statistic(problem, &parameters, &values, &p, &v, settings.selection.folds);
+        let t = fold_t_statistic(
+            problem,
+            &parameters,
+            &values,
+            &with_wind,
+            &v,
+            settings.selection.folds,
+        );
         let accepted = gain >= settings.selection.min_gain && t >= settings.selection.min_t;
         wind_test = Some(serde_json::json!({"gain": gain, "t": t, "accepted": accepted}));
         if accepted {
-            parameters = p;
+            parameters = with_wind;
             values = v;
             sse = sse_wind;
         }
     }
     let _ = sse;
     let (parameters, values) = backward_elimination(problem, parameters, values, settings);
-    (effects_from(&parameters, &values), timing_alternatives, wind_test)
+    (
+        effects_from(&parameters, &values),
+        timing_alternatives,
+        wind_test,
+    )
 }
 
 /// Drops, one at a time, the effect whose removal (with the others refitted) costs least, while
@@ -385,11 +499,17 @@ fn backward_elimination(
         if ids.len() < 2 {
             return (parameters, values);
         }
-        let full = block_sse(problem, &effects_from(&parameters, &values), settings.selection.block_rows);
+        let full = block_sse(
+            problem,
+            &effects_from(&parameters, &values),
+            settings.selection.block_rows,
+        );
         let mut weakest: Option<(f64, Vec<Parameter>, Vec<f64>)> = None;
         for id in ids {
             // Wind goes with its drag; wind alone has had its own test.
-            let drop = |p: &Parameter| p.effect_id() == id || (id == "quadratic_drag" && p.effect_id() == "wind");
+            let drop = |p: &Parameter| {
+                p.effect_id() == id || (id == "quadratic_drag" && p.effect_id() == "wind")
+            };
             let kept: Vec<(Parameter, f64)> = parameters
                 .iter()
                 .zip(&values)
@@ -397,12 +517,29 @@ fn backward_elimination(
                 .map(|(p, v)| (*p, *v))
                 .collect();
             let (reduced_parameters, start): (Vec<Parameter>, Vec<f64>) = kept.into_iter().unzip();
-            let (reduced_values, _) =
-                levenberg_marquardt(problem, &reduced_parameters, &start, fit_rows.clone(), settings.iterations / 2);
-            let reduced = block_sse(problem, &effects_from(&reduced_parameters, &reduced_values), settings.selection.block_rows);
-            let gains: Vec<f64> = reduced.iter().zip(&full).map(|(r, f)| r.1 - f.1).zip(&full).map(|(g, f)| g / f.0).collect();
+            let (reduced_values, _) = levenberg_marquardt(
+                problem,
+                &reduced_parameters,
+                &start,
+                fit_rows.clone(),
+                settings.iterations / 2,
+            );
+            let reduced = block_sse(
+                problem,
+                &effects_from(&reduced_parameters, &reduced_values),
+                settings.selection.block_rows,
+            );
+            let gains: Vec<f64> = reduced
+                .iter()
+                .zip(&full)
+                .map(|(r, f)| r.1 - f.1)
+                .zip(&full)
+                .map(|(g, f)| g / f.0)
+                .collect();
             let mean = gains.iter().sum::<f64>() / gains.len() as f64;
-            let sd = (gains.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / (gains.len() - 1).max(1) as f64).sqrt();
+            let sd = (gains.iter().map(|g| (g - mean).powi(2)).sum::<f64>()
+                / (gains.len() - 1).max(1) as f64)
+                .sqrt();
             let t = mean / (sd / (gains.len() as f64).sqrt()).max(1e-300);
             let passes = mean >= settings.selection.min_gain && t >= settings.selection.min_t;
             if !passes && weakest.as_ref().is_none_or(|w| mean < w.0) {
@@ -426,7 +563,10 @@ fn block_sse(problem: &Problem, effects: &Effects, block_rows: usize) -> Vec<(f6
         .step_by(block_rows)
         .map(|start| {
             let end = (start + block_rows).min(problem.split);
-            (((end - start) * problem.channels) as f64, problem.whitened_sse(&residual, start..end))
+            (
+                ((end - start) * problem.channels) as f64,
+                problem.whitened_sse(&residual, start..end),
+            )
         })
         .collect()
 }
@@ -450,12 +590,17 @@ fn fold_t_statistic(
         })
         .collect();
     let mean = gains.iter().sum::<f64>() / folds as f64;
-    let sd = (gains.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / (folds - 1).max(1) as f64).sqrt();
+    let sd =
+        (gains.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / (folds - 1).max(1) as f64).sqrt();
     mean / (sd / (folds as f64).sqrt()).max(1e-300)
 }
 
 /// Windows where the centred moving RMS of a channel's residual exceeds `factor` × floor.
-fn locate_windows(problem: &Problem, residual: &[Channels], settings: &AnalysisSettings) -> Vec<Window> {
+fn locate_windows(
+    problem: &Problem,
+    residual: &[Channels],
+    settings: &AnalysisSettings,
+) -> Vec<Window> {
     let half = ((settings.window_s / problem.recording.dt) / 2.0).round() as usize;
     let rows = residual.len();
     let mut windows = Vec::new();
@@ -517,7 +662,11 @@ fn build_report(
     let fit_rows = 0..problem.split;
     let heldout_rows = problem.split..problem.rows();
     let channel_mse = |residual: &[Channels], c: usize, range: std::ops::Range<usize>| {
-        residual[range.clone()].iter().map(|r| r[c] * r[c]).sum::<f64>() / range.len().max(1) as f64
+        residual[range.clone()]
+            .iter()
+            .map(|r| r[c] * r[c])
+            .sum::<f64>()
+            / range.len().max(1) as f64
     };
     let channels = (0..problem.channels)
         .map(|c| {

@@ -31,7 +31,9 @@ pub enum MismatchError {
 /// Shorthand for results of this crate.
 pub type Result<T, E = MismatchError> = std::result::Result<T, E>;
 
-pub(crate) fn io_error(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> MismatchError + '_ {
+pub(crate) fn io_error(
+    path: &std::path::Path,
+) -> impl FnOnce(std::io::Error) -> MismatchError + '_ {
     move |source| MismatchError::Io {
         path: path.to_path_buf(),
         source,

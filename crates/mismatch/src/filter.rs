@@ -89,12 +89,20 @@ impl MatchedSmoother {
 
     /// Standard-deviation gain of the derivative on white noise of unit variance (for dt = 1).
     pub fn sample_noise_gain(&self) -> f64 {
-        self.sample_weights.iter().map(|w| w * w).sum::<f64>().sqrt()
+        self.sample_weights
+            .iter()
+            .map(|w| w * w)
+            .sum::<f64>()
+            .sqrt()
     }
 
     /// Standard-deviation gain of the interval smoothing on white noise of unit variance.
     pub fn interval_noise_gain(&self) -> f64 {
-        self.interval_weights.iter().map(|w| w * w).sum::<f64>().sqrt()
+        self.interval_weights
+            .iter()
+            .map(|w| w * w)
+            .sum::<f64>()
+            .sqrt()
     }
 }
 
@@ -124,7 +132,9 @@ mod tests {
         assert!((sum - 1.0).abs() < 1e-12, "{sum}");
         // For any signal: derivative of the samples = matched smoothing of the interval slopes.
         let dt = 0.02;
-        let x: Vec<f64> = (0..80).map(|k| (0.37 * k as f64).sin() + 0.01 * (k * k) as f64).collect();
+        let x: Vec<f64> = (0..80)
+            .map(|k| (0.37 * k as f64).sin() + 0.01 * (k * k) as f64)
+            .collect();
         let slopes: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]) / dt).collect();
         let direct = smoother.derivative_of(&x, dt);
         let matched = smoother.smooth_intervals(&slopes);
@@ -141,7 +151,9 @@ mod tests {
         let mut state = 99u64;
         let x: Vec<f64> = (0..4000)
             .map(|k| {
-                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 let u = (state >> 11) as f64 / (1u64 << 53) as f64;
                 (k as f64 * 0.01).sin() * 3.0 + 0.01 * (u - 0.5) * 12f64.sqrt()
             })

@@ -48,7 +48,13 @@ pub fn predict_intervals(
             let velocity = lerp(recording.velocity[k], recording.velocity[k + 1], s);
             let height = recording.height[k] + s * (recording.height[k + 1] - recording.height[k]);
             let wrench = model.wrench(&actuators[k * SUBSTEPS + j]);
-            let a = effects.translational_acceleration(model, &rotation, velocity, height, wrench.thrust);
+            let a = effects.translational_acceleration(
+                model,
+                &rotation,
+                velocity,
+                height,
+                wrench.thrust,
+            );
             for i in 0..3 {
                 sum_translational[i] += a[i];
             }
@@ -81,7 +87,11 @@ fn lerp(a: Vec3, b: Vec3, s: f64) -> Vec3 {
 }
 
 fn lerp_matrix(a: &Mat3, b: &Mat3, s: f64) -> Mat3 {
-    [lerp(a[0], b[0], s), lerp(a[1], b[1], s), lerp(a[2], b[2], s)]
+    [
+        lerp(a[0], b[0], s),
+        lerp(a[1], b[1], s),
+        lerp(a[2], b[2], s),
+    ]
 }
 
 /// The actuator states at the midpoint of every sub-interval: the held command stream delayed by
@@ -101,7 +111,11 @@ pub fn actuator_trace(
     let mut out = Vec::with_capacity(total);
     let mut state = commands[0];
     let decay_full = if lag > 0.0 { (-h / lag).exp() } else { 0.0 };
-    let decay_half = if lag > 0.0 { (-h / (2.0 * lag)).exp() } else { 0.0 };
+    let decay_half = if lag > 0.0 {
+        (-h / (2.0 * lag)).exp()
+    } else {
+        0.0
+    };
     for step in 0..total {
         let start = step as f64 * h - delay;
         let end = start + h;
@@ -149,8 +163,14 @@ mod tests {
         // Half a sub-interval of delay mixes two commands half and half at the switch.
         let half = actuator_trace(&commands, dt, 1, dt / SUBSTEPS as f64 / 2.0, 0.0);
         assert!((half[SUBSTEPS * 2][0] - 1.5).abs() < 1e-9);
-        // A lag never overshoots and moves towards the command.
-        let lagged = actuator_trace(&commands, dt, 1, 0.0, 0.05);
-        assert!(lagged[SUBSTEPS * 2 + 9][0] < 2.0 && lagged[SUBSTEPS * 2 + 9][0] > 1.0);
+        // A lag follows a step monotonically, without overshoot, and reaches 1 − e^(−t/τ).
+        let step: Vec<[f64; 4]> = (0..6)
+            .map(|k| [if k >= 2 { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0])
+            .collect();
+        let lagged = actuator_trace(&step, dt, 1, 0.0, 0.05);
+        let response: Vec<f64> = lagged[SUBSTEPS * 2..].iter().map(|a| a[0]).collect();
+        assert!(response.windows(2).all(|w| w[1] > w[0] && w[1] < 1.0));
+        let midpoint = (SUBSTEPS as f64 + 0.5) * dt / SUBSTEPS as f64;
+        assert!((response[SUBSTEPS] - (1.0 - (-midpoint / 0.05f64).exp())).abs() < 1e-12);
     }
 }

@@ -83,7 +83,10 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
     add(
         "thrust_scale",
         vec![term("thrust", "R e3 T / m", "m/s²", "k − 1 (1)")],
-        vec![(with(&|e| e.thrust_scale = Some(ThrustScale { k: 1.0 + step })), step)],
+        vec![(
+            with(&|e| e.thrust_scale = Some(ThrustScale { k: 1.0 + step })),
+            step,
+        )],
     );
     let axes = ["x", "y", "z"];
     add(
@@ -109,7 +112,10 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
     add(
         "quadratic_drag",
         vec![term("air_drag", "−|v| v", "m²/s²", "c (1/m)")],
-        vec![(with(&|e| e.quadratic_drag = Some(QuadraticDrag { c: 1.0 })), 1.0)],
+        vec![(
+            with(&|e| e.quadratic_drag = Some(QuadraticDrag { c: 1.0 })),
+            1.0,
+        )],
     );
     let small_radius: f64 = 0.02;
     add(
@@ -134,13 +140,27 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
             "m/s³, rad/s³",
             "delay or lag time constant (s)",
         )],
-        vec![(with(&|e| e.delay = Some(Delay { delay_s: timing_step })), timing_step)],
+        vec![(
+            with(&|e| {
+                e.delay = Some(Delay {
+                    delay_s: timing_step,
+                })
+            }),
+            timing_step,
+        )],
     );
     if problem.channels == 6 {
         add(
             "torque_bias",
             axes.iter()
-                .map(|a| term(&format!("torque_bias_{a}"), &format!("e_{a}"), "1", &format!("b{a} (rad/s²)")))
+                .map(|a| {
+                    term(
+                        &format!("torque_bias_{a}"),
+                        &format!("e_{a}"),
+                        "1",
+                        &format!("b{a} (rad/s²)"),
+                    )
+                })
                 .collect(),
             (0..3)
                 .map(|i| {

@@ -65,14 +65,19 @@ pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
     let split_time = time[problem.split.min(time.len() - 1)];
     for (c, panel) in panels.iter().enumerate() {
         let values = analysis.before.iter().chain(&analysis.after).map(|r| r[c]);
-        let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
         let margin = 0.05 * (hi - lo).max(1e-9);
         let (lo, hi) = (lo - margin, hi + margin);
         let mut chart = ChartBuilder::on(panel)
             .margin(8)
             .x_label_area_size(28)
             .y_label_area_size(60)
-            .caption(format!("{} ({})", CHANNEL_NAMES[c], units(c)), ("sans-serif", 14))
+            .caption(
+                format!("{} ({})", CHANNEL_NAMES[c], units(c)),
+                ("sans-serif", 14),
+            )
             .build_cartesian_2d(t0..t1, lo..hi)
             .map_err(|e| plot_error(&e))?;
         chart
@@ -81,7 +86,12 @@ pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
             .light_line_style(WHITE)
             .draw()
             .map_err(|e| plot_error(&e))?;
-        for window in analysis.report.windows.iter().filter(|w| w.channel == CHANNEL_NAMES[c]) {
+        for window in analysis
+            .report
+            .windows
+            .iter()
+            .filter(|w| w.channel == CHANNEL_NAMES[c])
+        {
             chart
                 .draw_series(std::iter::once(Rectangle::new(
                     [(window.t_start, lo), (window.t_end, hi)],
@@ -130,7 +140,11 @@ pub fn markdown_text(analysis: &Analysis) -> String {
     let report = &analysis.report;
     let mut md = String::new();
     let _ = writeln!(md, "# Sim-to-real mismatch: {}\n", report.recording);
-    let _ = writeln!(md, "Nominal model: `{}`. The recording's velocity and body rate were differentiated with a smoothed derivative and compared with what the nominal model predicts from the recorded attitude and commands (the prediction is smoothed with the same weights). Every mean squared error below is measured against that smoothed derivative.\n", report.model);
+    let _ = writeln!(
+        md,
+        "Nominal model: `{}`. The recording's velocity and body rate were differentiated with a smoothed derivative and compared with what the nominal model predicts from the recorded attitude and commands (the prediction is smoothed with the same weights). Every mean squared error below is measured against that smoothed derivative.\n",
+        report.model
+    );
     let frame = match report.rate_frame.used {
         data::RateFrame::Body => "the body frame",
         data::RateFrame::World => "the world frame (converted to body rates)",
@@ -141,7 +155,10 @@ pub fn markdown_text(analysis: &Analysis) -> String {
         report.rate_frame.body_rms, report.rate_frame.world_rms
     );
     let _ = writeln!(md, "## Where the model and the recording disagree\n");
-    let _ = writeln!(md, "| channel | residual RMS | noise floor | significant |\n|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "| channel | residual RMS | noise floor | significant |\n|---|---|---|---|"
+    );
     for c in &report.channels {
         let _ = writeln!(
             md,
@@ -153,19 +170,38 @@ pub fn markdown_text(analysis: &Analysis) -> String {
         );
     }
     if analysis.problem.channels == 3 {
-        let _ = writeln!(md, "\nThe model has no mixer, so it predicts no torques: only the translational channels are compared.");
+        let _ = writeln!(
+            md,
+            "\nThe model has no mixer, so it predicts no torques: only the translational channels are compared."
+        );
     }
     if report.windows.is_empty() {
-        let _ = writeln!(md, "\nNo stretch of the flight disagrees by more than {:.1} times the noise floor.", report.settings.window_factor);
+        let _ = writeln!(
+            md,
+            "\nNo stretch of the flight disagrees by more than {:.1} times the noise floor.",
+            report.settings.window_factor
+        );
     } else {
-        let _ = writeln!(md, "\nStretches where the residual exceeds {:.1} times the noise floor (1 s moving RMS):\n", report.settings.window_factor);
+        let _ = writeln!(
+            md,
+            "\nStretches where the residual exceeds {:.1} times the noise floor (1 s moving RMS):\n",
+            report.settings.window_factor
+        );
         for w in &report.windows {
-            let _ = writeln!(md, "- {} from {:.1} s to {:.1} s", w.channel, w.t_start, w.t_end);
+            let _ = writeln!(
+                md,
+                "- {} from {:.1} s to {:.1} s",
+                w.channel, w.t_start, w.t_end
+            );
         }
     }
     let _ = writeln!(md, "\n## What is missing from the model\n");
     if report.effects.is_empty() {
-        let _ = writeln!(md, "Nothing: no candidate term explains the residual consistently better than noise (none passed cross-validation in at least {:.0}% of the bootstrap resamples).", 100.0 * report.selection.settings.stability_threshold);
+        let _ = writeln!(
+            md,
+            "Nothing: no candidate term explains the residual consistently better than noise (none passed cross-validation in at least {:.0}% of the bootstrap resamples).",
+            100.0 * report.selection.settings.stability_threshold
+        );
     } else {
         for e in &report.effects {
             let _ = writeln!(
@@ -177,21 +213,59 @@ pub fn markdown_text(analysis: &Analysis) -> String {
             );
         }
     }
-    let _ = writeln!(md, "\nCandidates and how often each was chosen in {} bootstrap resamples:\n", report.selection.settings.resamples);
+    let _ = writeln!(
+        md,
+        "\nCandidates and how often each was chosen in {} bootstrap resamples:\n",
+        report.selection.settings.resamples
+    );
     for c in &report.selection.candidates {
-        let terms: Vec<String> = c.candidate.terms.iter().map(|t| format!("`{}` = {} [{}]", t.name, t.formula, t.units)).collect();
-        let _ = writeln!(md, "- {} ({}): {:.0}%{}", c.candidate.id, terms.join(", "), 100.0 * c.selection_frequency, if c.kept { ", kept" } else { "" });
+        let terms: Vec<String> = c
+            .candidate
+            .terms
+            .iter()
+            .map(|t| format!("`{}` = {} [{}]", t.name, t.formula, t.units))
+            .collect();
+        let _ = writeln!(
+            md,
+            "- {} ({}): {:.0}%{}",
+            c.candidate.id,
+            terms.join(", "),
+            100.0 * c.selection_frequency,
+            if c.kept { ", kept" } else { "" }
+        );
     }
     if let Some(timing) = &report.selection.timing_alternatives {
-        let _ = writeln!(md, "\nThe command-rate term was resolved by fitting both a pure delay and a first-order motor lag exactly; noise-normalised fit errors: {timing}. The smaller one was kept.");
+        let _ = writeln!(
+            md,
+            "\nThe command-rate term was resolved by fitting both a pure delay and a first-order motor lag exactly; noise-normalised fit errors: {timing}. The smaller one was kept."
+        );
     }
     let fit = &report.fit;
     let reduction = |before: f64, after: f64| 100.0 * (1.0 - after / before.max(1e-300));
     let _ = writeln!(md, "\n## Does the fit improve?\n");
-    let _ = writeln!(md, "The parameters were fitted on {:.1}–{:.1} s and checked on the held-out {:.1}–{:.1} s.\n", fit.t_start, fit.t_end, fit.heldout.t_start, fit.heldout.t_end);
-    let _ = writeln!(md, "| part | MSE nominal | MSE with effects | reduction |\n|---|---|---|---|");
-    let _ = writeln!(md, "| fit | {:.5} | {:.5} | {:.1}% |", fit.before.mse, fit.after.mse, reduction(fit.before.mse, fit.after.mse));
-    let _ = writeln!(md, "| held out | {:.5} | {:.5} | {:.1}% |", fit.heldout.before.mse, fit.heldout.after.mse, reduction(fit.heldout.before.mse, fit.heldout.after.mse));
+    let _ = writeln!(
+        md,
+        "The parameters were fitted on {:.1}–{:.1} s and checked on the held-out {:.1}–{:.1} s.\n",
+        fit.t_start, fit.t_end, fit.heldout.t_start, fit.heldout.t_end
+    );
+    let _ = writeln!(
+        md,
+        "| part | MSE nominal | MSE with effects | reduction |\n|---|---|---|---|"
+    );
+    let _ = writeln!(
+        md,
+        "| fit | {:.5} | {:.5} | {:.1}% |",
+        fit.before.mse,
+        fit.after.mse,
+        reduction(fit.before.mse, fit.after.mse)
+    );
+    let _ = writeln!(
+        md,
+        "| held out | {:.5} | {:.5} | {:.1}% |",
+        fit.heldout.before.mse,
+        fit.heldout.after.mse,
+        reduction(fit.heldout.before.mse, fit.heldout.after.mse)
+    );
     let _ = writeln!(md, "\nFigure: `mismatch.svg`.");
     md
 }

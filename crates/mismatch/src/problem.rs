@@ -106,7 +106,13 @@ impl Problem {
             let series: Vec<f64> = if c < 3 {
                 intervals.translational.iter().map(|a| a[c]).collect()
             } else {
-                intervals.angular.as_ref().expect("angular channels").iter().map(|a| a[c - 3]).collect()
+                intervals
+                    .angular
+                    .as_ref()
+                    .expect("angular channels")
+                    .iter()
+                    .map(|a| a[c - 3])
+                    .collect()
             };
             for (row, value) in out.iter_mut().zip(self.smoother.smooth_intervals(&series)) {
                 row[c] = value;

@@ -32,8 +32,22 @@ impl Parameter {
     fn lower_bound(self) -> f64 {
         match self {
             Self::ThrustScale | Self::InertiaScale(_) => 0.05,
-            Self::LinearDrag(_) | Self::QuadraticDrag | Self::GroundRadius | Self::Delay | Self::MotorLag => 0.0,
+            Self::LinearDrag(_)
+            | Self::QuadraticDrag
+            | Self::GroundRadius
+            | Self::Delay
+            | Self::MotorLag => 0.0,
             Self::Wind(_) | Self::TorqueBias(_) => f64::NEG_INFINITY,
+        }
+    }
+
+    /// The largest admissible value (a ground-effect radius beyond 1 m or a delay or lag beyond
+    /// 0.2 s is not the physics these names stand for).
+    fn upper_bound(self) -> f64 {
+        match self {
+            Self::GroundRadius => 1.0,
+            Self::Delay | Self::MotorLag => 0.2,
+            _ => f64::INFINITY,
         }
     }
 
@@ -69,12 +83,20 @@ pub fn effects_from(parameters: &[Parameter], values: &[f64]) -> Effects {
     for (p, &v) in parameters.iter().zip(values) {
         match *p {
             Parameter::ThrustScale => e.thrust_scale = Some(ThrustScale { k: v }),
-            Parameter::LinearDrag(i) => e.linear_drag.get_or_insert(LinearDrag { d: [0.0; 3] }).d[i] = v,
+            Parameter::LinearDrag(i) => {
+                e.linear_drag.get_or_insert(LinearDrag { d: [0.0; 3] }).d[i] = v
+            }
             Parameter::QuadraticDrag => e.quadratic_drag = Some(QuadraticDrag { c: v }),
             Parameter::Wind(i) => e.wind.get_or_insert(Wind { w_air: [0.0; 3] }).w_air[i] = v,
             Parameter::GroundRadius => e.ground_effect = Some(GroundEffect { r_m: v }),
-            Parameter::TorqueBias(i) => e.torque_bias.get_or_insert(TorqueBias { b: [0.0; 3] }).b[i] = v,
-            Parameter::InertiaScale(i) => e.inertia_scale.get_or_insert(InertiaScale { k: [1.0; 3] }).k[i] = v,
+            Parameter::TorqueBias(i) => {
+                e.torque_bias.get_or_insert(TorqueBias { b: [0.0; 3] }).b[i] = v
+            }
+            Parameter::InertiaScale(i) => {
+                e.inertia_scale
+                    .get_or_insert(InertiaScale { k: [1.0; 3] })
+                    .k[i] = v
+            }
             Parameter::Delay => e.delay = Some(Delay { delay_s: v }),
             Parameter::MotorLag => e.motor_lag = Some(MotorLag { tau_s: v }),
         }
@@ -91,7 +113,12 @@ fn whitened(problem: &Problem, residual: &[Channels], range: std::ops::Range<usi
 }
 
 /// Whitened sum of squares of the model with these parameters over rows `range`.
-pub fn objective(problem: &Problem, parameters: &[Parameter], values: &[f64], range: std::ops::Range<usize>) -> f64 {
+pub fn objective(
+    problem: &Problem,
+    parameters: &[Parameter],
+    values: &[f64],
+    range: std::ops::Range<usize>,
+) -> f64 {
     problem.whitened_sse(&problem.residual(&effects_from(parameters, values)), range)
 }
 
@@ -105,12 +132,18 @@ pub fn levenberg_marquardt(
 ) -> (Vec<f64>, f64) {
     let project = |values: &mut [f64]| {
         for (v, p) in values.iter_mut().zip(parameters) {
-            *v = v.max(p.lower_bound());
+            *v = v.clamp(p.lower_bound(), p.upper_bound());
         }
     };
     let mut values = initial.to_vec();
     project(&mut values);
-    let evaluate = |values: &[f64]| whitened(problem, &problem.residual(&effects_from(parameters, values)), range.clone());
+    let evaluate = |values: &[f64]| {
+        whitened(
+            problem,
+            &problem.residual(&effects_from(parameters, values)),
+            range.clone(),
+        )
+    };
     let mut residual = evaluate(&values);
     let mut sse: f64 = residual.iter().map(|r| r * r).sum();
     let k = parameters.len();
@@ -125,14 +158,23 @@ pub fn levenberg_marquardt(
             let mut shifted = values.clone();
             shifted[j] += step;
             let r = evaluate(&shifted);
-            jacobian.push(r.iter().zip(&residual).map(|(a, b)| (a - b) / step).collect());
+            jacobian.push(
+                r.iter()
+                    .zip(&residual)
+                    .map(|(a, b)| (a - b) / step)
+                    .collect(),
+            );
         }
         let mut normal = Mat::<f64>::zeros(k, k);
         let mut gradient = Mat::<f64>::zeros(k, 1);
         for i in 0..k {
             gradient[(i, 0)] = jacobian[i].iter().zip(&residual).map(|(a, b)| a * b).sum();
             for j in 0..=i {
-                let v: f64 = jacobian[i].iter().zip(&jacobian[j]).map(|(a, b)| a * b).sum();
+                let v: f64 = jacobian[i]
+                    .iter()
+                    .zip(&jacobian[j])
+                    .map(|(a, b)| a * b)
+                    .sum();
                 normal[(i, j)] = v;
                 normal[(j, i)] = v;
             }
@@ -183,6 +225,15 @@ pub fn projected_sse(
         .collect();
     let design = Design::new(problem, residual, &used, range, block_rows);
     let all: Vec<usize> = (0..used.len()).collect();
+    if !extra.is_empty() {
+        // Extra columns are physical effects with non-negative coefficients (drag): a negative
+        // fit means the column does not help, so it is left out.
+        let ones = vec![1.0; design.blocks()];
+        let theta = design.solve(&ones, &all);
+        if theta[..extra.len()].iter().any(|t| *t < 0.0) {
+            return design.fitted_sse(&all[extra.len()..]);
+        }
+    }
     design.fitted_sse(&all)
 }
 
@@ -202,7 +253,15 @@ pub fn profile_search(
     grid.par_iter()
         .map(|&value| {
             let residual = problem.residual(&effect(value));
-            let sse = projected_sse(problem, &residual, &[], columns, other_columns, range.clone(), block_rows);
+            let sse = projected_sse(
+                problem,
+                &residual,
+                &[],
+                columns,
+                other_columns,
+                range.clone(),
+                block_rows,
+            );
             (value, sse)
         })
         .collect::<Vec<_>>()
@@ -212,7 +271,12 @@ pub fn profile_search(
 }
 
 /// The change of the matched prediction caused by `effects`, per analysed row.
-pub fn effect_column(problem: &Problem, base: &[Channels], effects: &Effects, scale: f64) -> Vec<Channels> {
+pub fn effect_column(
+    problem: &Problem,
+    base: &[Channels],
+    effects: &Effects,
+    scale: f64,
+) -> Vec<Channels> {
     problem
         .predict(effects)
         .iter()
@@ -241,11 +305,24 @@ pub fn profile_wind(
     let base = problem.predict(&Effects::default());
     let score = |w: [f64; 3]| {
         let effects = effects_from(
-            &[Parameter::QuadraticDrag, Parameter::Wind(0), Parameter::Wind(1), Parameter::Wind(2)],
+            &[
+                Parameter::QuadraticDrag,
+                Parameter::Wind(0),
+                Parameter::Wind(1),
+                Parameter::Wind(2),
+            ],
             &[1.0, w[0], w[1], w[2]],
         );
         let column = effect_column(problem, &base, &effects, 1.0);
-        projected_sse(problem, residual, &[&column], columns, others, range.clone(), block_rows)
+        projected_sse(
+            problem,
+            residual,
+            &[&column],
+            columns,
+            others,
+            range.clone(),
+            block_rows,
+        )
     };
     let mut best = ([0.0; 3], score([0.0; 3]));
     for (step, span) in [(0.5, 12), (0.1, 5), (0.02, 5)] {

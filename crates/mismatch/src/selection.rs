@@ -102,7 +102,9 @@ impl Design {
             design.grams.push(gram);
             design.cross.push(cross);
             design.target_squares.push(squares);
-            design.counts.push(((end - start) * problem.channels) as f64);
+            design
+                .counts
+                .push(((end - start) * problem.channels) as f64);
             start = end;
         }
         design
@@ -155,7 +157,13 @@ impl Design {
 
     /// Cross-validated mean square per row and channel of every block: each block is predicted by
     /// the fit on the folds it is not in. Blocks with zero weight give NaN.
-    pub fn block_errors(&self, weights: &[f64], fold_of_block: &[usize], folds: usize, columns: &[usize]) -> Vec<f64> {
+    pub fn block_errors(
+        &self,
+        weights: &[f64],
+        fold_of_block: &[usize],
+        folds: usize,
+        columns: &[usize],
+    ) -> Vec<f64> {
         let mut errors = vec![f64::NAN; self.blocks()];
         for f in 0..folds {
             let train: Vec<f64> = weights
@@ -177,7 +185,9 @@ impl Design {
     pub fn fitted_sse(&self, columns: &[usize]) -> f64 {
         let ones = vec![1.0; self.blocks()];
         let theta = self.solve(&ones, columns);
-        (0..self.blocks()).map(|b| self.block_sse(b, columns, &theta)).sum()
+        (0..self.blocks())
+            .map(|b| self.block_sse(b, columns, &theta))
+            .sum()
     }
 
     /// Number of columns.
@@ -187,7 +197,12 @@ impl Design {
 }
 
 /// Forward stepwise selection of groups; returns the chosen group indices in order of entry.
-pub fn stepwise(design: &Design, weights: &[f64], groups: &[Vec<usize>], settings: &SelectionSettings) -> Vec<usize> {
+pub fn stepwise(
+    design: &Design,
+    weights: &[f64],
+    groups: &[Vec<usize>],
+    settings: &SelectionSettings,
+) -> Vec<usize> {
     let blocks = design.blocks();
     let folds = settings.folds.min(blocks).max(2);
     let fold_of_block: Vec<usize> = (0..blocks).map(|b| b * folds / blocks).collect();
@@ -218,7 +233,10 @@ pub fn stepwise(design: &Design, weights: &[f64], groups: &[Vec<usize>], setting
             let mean = total / count;
             let variance = ((total_squares - count * mean * mean) / (count - 1.0)).max(0.0);
             let t = mean / (variance.sqrt() / count.sqrt()).max(1e-300);
-            if mean >= settings.min_gain && t >= settings.min_t && best.as_ref().is_none_or(|(_, m, _)| mean > *m) {
+            if mean >= settings.min_gain
+                && t >= settings.min_t
+                && best.as_ref().is_none_or(|(_, m, _)| mean > *m)
+            {
                 best = Some((g, mean, errors));
             }
         }
@@ -245,14 +263,19 @@ pub struct Selection {
 }
 
 /// Stepwise selection on the data and on block-bootstrap resamples.
-pub fn stability_selection(design: &Design, groups: &[Vec<usize>], settings: &SelectionSettings) -> Selection {
+pub fn stability_selection(
+    design: &Design,
+    groups: &[Vec<usize>],
+    settings: &SelectionSettings,
+) -> Selection {
     let blocks = design.blocks();
     let ones = vec![1.0; blocks];
     let chosen_on_data = stepwise(design, &ones, groups, settings);
     let counts: Vec<Vec<usize>> = (0..settings.resamples)
         .into_par_iter()
         .map(|r| {
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed.wrapping_add(r as u64));
+            let mut rng =
+                rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed.wrapping_add(r as u64));
             let mut weights = vec![0.0; blocks];
             for _ in 0..blocks {
                 weights[rng.random_range(0..blocks)] += 1.0;
@@ -261,7 +284,10 @@ pub fn stability_selection(design: &Design, groups: &[Vec<usize>], settings: &Se
         })
         .collect();
     let frequencies: Vec<f64> = (0..groups.len())
-        .map(|g| counts.iter().filter(|c| c.contains(&g)).count() as f64 / settings.resamples.max(1) as f64)
+        .map(|g| {
+            counts.iter().filter(|c| c.contains(&g)).count() as f64
+                / settings.resamples.max(1) as f64
+        })
         .collect();
     let kept = (0..groups.len())
         .filter(|g| frequencies[*g] >= settings.stability_threshold)

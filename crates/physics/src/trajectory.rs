@@ -299,7 +299,10 @@ mod tests {
         };
         assert!(trajectory.validate().is_ok());
         let generator = trajectory.generator();
-        check_derivatives(&generator, &[1.0, 10.7, 11.5, 15.0, 18.3, 19.1, 25.0, 30.5, 35.0]);
+        check_derivatives(
+            &generator,
+            &[1.0, 10.7, 11.5, 15.0, 18.3, 19.1, 25.0, 30.5, 35.0],
+        );
         assert!((generator.at(33.0).position[2] - 0.4).abs() < 1e-12);
         assert!((generator.at(15.0).position[2] - 0.3).abs() < 1e-12);
     }

@@ -1,0 +1,145 @@
+//! Behaviour on short simulated flights: nothing on noise alone, the right effect and parameter
+//! when one is concealed, outputs that refuse to overwrite, errors that name the problem.
+
+use std::path::{Path, PathBuf};
+
+use mismatch::{AnalysisSettings, MismatchError, analyze, check_outputs, write_outputs};
+use physics::{
+    Effects, Noise, NominalModel, Scenario, ThrustScale, TorqueBias, Trajectory, simulate,
+};
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn model() -> NominalModel {
+    NominalModel::load(&workspace().join("experiments/mismatch/demo-quad.json")).unwrap()
+}
+
+fn flight(effects: Effects, seed: u64) -> data::FlightLog {
+    let scenario = Scenario {
+        model: "demo-quad.json".into(),
+        duration_s: 14.0,
+        warmup_s: 3.0,
+        seed,
+        physics_rate_hz: 500.0,
+        log_rate_hz: 50.0,
+        hover_throttle: 0.5,
+        trajectory: Trajectory::Figure8 {
+            center: [0.0, 0.0, 1.5],
+            first: [1.8, 0.0, 0.0],
+            second: [0.0, 0.9, 0.4],
+            period_s: 6.0,
+            low_passes: Vec::new(),
+            yaw_amplitude_rad: 0.3,
+            yaw_period_s: 9.0,
+        },
+        effects,
+        noise: Noise {
+            position_m: 0.002,
+            velocity_m_s: 0.005,
+            attitude_rad: 0.002,
+            rate_rad_s: 0.008,
+        },
+        gains: Default::default(),
+    };
+    simulate(&model(), &scenario, "test").unwrap()
+}
+
+fn settings() -> AnalysisSettings {
+    AnalysisSettings {
+        selection: mismatch::SelectionSettings {
+            resamples: 20,
+            block_rows: 25,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+#[test]
+fn finds_nothing_on_noise_alone() {
+    for seed in [1, 2] {
+        let analysis = analyze(
+            &flight(Effects::default(), seed),
+            &model(),
+            "demo",
+            &settings(),
+        )
+        .unwrap();
+        assert!(
+            analysis.report.effects.is_empty(),
+            "seed {seed}: {:?}",
+            analysis.report.effects
+        );
+        assert!(analysis.report.channels.iter().all(|c| !c.significant));
+    }
+}
+
+#[test]
+fn names_and_fits_a_concealed_thrust_loss() {
+    let effects = Effects {
+        thrust_scale: Some(ThrustScale { k: 0.9 }),
+        ..Effects::default()
+    };
+    let analysis = analyze(&flight(effects, 3), &model(), "demo", &settings()).unwrap();
+    assert_eq!(analysis.fitted.ids(), vec!["thrust_scale"]);
+    let k = analysis.fitted.thrust_scale.unwrap().k;
+    assert!((k - 0.9).abs() < 0.01, "{k}");
+    let fit = &analysis.report.fit;
+    assert!(
+        fit.heldout.after.mse < 0.4 * fit.heldout.before.mse,
+        "{fit:?}"
+    );
+    let vdot_z = &analysis.report.channels[2];
+    assert!(vdot_z.significant && vdot_z.name == "vdot_z");
+}
+
+#[test]
+fn names_a_torque_bias_and_writes_outputs_once() {
+    let effects = Effects {
+        torque_bias: Some(TorqueBias {
+            b: [0.6, -0.4, 0.25],
+        }),
+        ..Effects::default()
+    };
+    let analysis = analyze(&flight(effects, 4), &model(), "demo", &settings()).unwrap();
+    assert_eq!(analysis.fitted.ids(), vec!["torque_bias"]);
+    let b = analysis.fitted.torque_bias.unwrap().b;
+    for (found, truth) in b.iter().zip([0.6, -0.4, 0.25]) {
+        assert!((found - truth).abs() < 0.05, "{b:?}");
+    }
+    let dir = std::env::temp_dir().join(format!("mismatch-test-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    write_outputs(&analysis, &dir, false).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("mismatch.json")).unwrap()).unwrap();
+    assert_eq!(json["effects"][0]["id"], "torque_bias");
+    assert!(json["fit"]["heldout"]["after"]["mse"].as_f64().unwrap() > 0.0);
+    let svg = std::fs::read_to_string(dir.join("mismatch.svg")).unwrap();
+    assert!(svg.contains("<text") && svg.contains("wdot_x"));
+    assert!(matches!(
+        check_outputs(&dir, false),
+        Err(MismatchError::Exists { .. })
+    ));
+    assert!(write_outputs(&analysis, &dir, true).is_ok());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_too_short_recording_is_a_one_line_error() {
+    let mut log = flight(Effects::default(), 5);
+    log.time.truncate(50);
+    log.position.truncate(50);
+    log.velocity.truncate(50);
+    log.rotation.truncate(50);
+    log.quaternion.truncate(50);
+    log.body_rate.truncate(50);
+    log.thrust_setpoint.truncate(50);
+    log.hover_throttle.truncate(50);
+    log.motor_command.truncate(50);
+    let error = analyze(&log, &model(), "demo", &settings())
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("rows") && !error.contains('\n'), "{error}");
+}

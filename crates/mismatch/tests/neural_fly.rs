@@ -1,0 +1,57 @@
+//! On a real windy flight the tool names drag on the relative wind and improves the held-out fit.
+
+use std::path::{Path, PathBuf};
+
+fn real_data_dir() -> Option<PathBuf> {
+    let candidate = std::env::var_os("NEURAL_FLY_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/neural-fly"));
+    if candidate.join("experiment").is_dir() {
+        return Some(candidate);
+    }
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!(
+            "CI=true but no flight data at {} (run `make data`)",
+            candidate.display()
+        );
+    }
+    eprintln!(
+        "skipping: no flight data at {} (run `make data`)",
+        candidate.display()
+    );
+    None
+}
+
+#[test]
+fn names_drag_on_the_relative_wind_in_the_strongest_wind() {
+    let Some(dir) = real_data_dir() else {
+        return;
+    };
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let model =
+        physics::NominalModel::load(&workspace.join("experiments/mismatch/neural-fly.json"))
+            .unwrap();
+    let log =
+        data::FlightLog::read(&dir.join("experiment/custom_figure8_baseline_100wind.csv")).unwrap();
+    let analysis = mismatch::analyze(
+        &log,
+        &model,
+        "neural-fly",
+        &mismatch::AnalysisSettings::default(),
+    )
+    .unwrap();
+    assert_eq!(analysis.report.rate_frame.used, data::RateFrame::World);
+    let ids = analysis.fitted.ids();
+    assert!(
+        ids.contains(&"quadratic_drag") && ids.contains(&"wind"),
+        "{ids:?}"
+    );
+    // The wind tunnel blows along −x at about 12 m/s.
+    let wind = analysis.fitted.air_velocity();
+    assert!(wind[0] < -8.0, "{wind:?}");
+    let fit = &analysis.report.fit;
+    assert!(
+        fit.heldout.after.mse < 0.4 * fit.heldout.before.mse,
+        "{fit:?}"
+    );
+}

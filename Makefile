@@ -43,3 +43,10 @@ fmt:
 # .venv through scripts/python-env.sh if missing). One command per line: other parts append theirs.
 bench: data
 	scripts/bench/sindy.sh
+
+# Sim-to-real mismatch: the tool blind on simulated flights with concealed effects, then on the real
+# baseline flights at every wind condition. Writes results/mismatch/{summary.md,summary.json,neural-fly.md}.
+mismatch-demo: data
+	$(CARGO) build $(QUIET) -p cli
+	$(LEARN) mismatch --demo experiments/mismatch/demo.json --work target/mismatch-demo --out results/mismatch --force
+	$(LEARN) mismatch --flights experiments/conditions.json --model experiments/mismatch/neural-fly.json --out results/mismatch --force

@@ -104,7 +104,7 @@ fn markdown(
     );
     let _ = writeln!(
         md,
-        "| condition | wind speed | significant channels | effects found (parameters) | held-out MSE nominal | with effects | reduction |\n|---|---|---|---|---|---|---|"
+        "| condition | wind speed | significant channels | effects found (parameters) | drag at hover c·‖w_air‖² (m/s²) | held-out MSE nominal | with effects | reduction |\n|---|---|---|---|---|---|---|---|"
     );
     for (label, speed, report) in rows {
         let Some(report) = report else {

@@ -16,6 +16,7 @@ mod derivative;
 mod error;
 mod flight_log;
 mod formulation;
+mod noise_floor;
 mod numeric;
 mod source;
 mod split;
@@ -31,6 +32,7 @@ pub use flight_log::{
     rotation_from_quaternion,
 };
 pub use formulation::{Formulation, Segment};
+pub use noise_floor::{NoiseFloor, forward_difference_noise_floor};
 pub use numeric::NumericTable;
 pub use source::{DATA_DIR_VARIABLE, DEFAULT_DATA_DIR, file_sha256, resolve_data_dir};
 pub use split::{Split, SplitSpec};

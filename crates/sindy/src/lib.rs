@@ -45,6 +45,7 @@
 //!
 //! Every error is a [`SindyError`] with a one-line message.
 
+mod causal;
 mod error;
 mod library;
 mod linalg;
@@ -52,7 +53,11 @@ mod model;
 mod optimizer;
 mod persist;
 mod pipeline;
+mod regression;
+mod selection;
+mod variant;
 
+pub use causal::{CausalLibrary, first_order_lag};
 pub use error::{Result, SindyError};
 pub use library::{CustomFunction, FeatureLibrary, LibrarySpec};
 pub use linalg::least_squares;
@@ -63,6 +68,11 @@ pub use optimizer::{
 };
 pub use persist::MODEL_FORMAT;
 pub use pipeline::{SegmentEvaluation, SindyConfig, evaluate_flight, fit_and_evaluate};
+pub use regression::{
+    Bagging, EnsemblePrediction, LinearFit, Penalty, RegressionFit, RegressionSpec, select_rows,
+};
+pub use selection::{BlockedFolds, Fold, Selection, cross_validate};
+pub use variant::{LibraryRegression, VariantEvaluation, evaluate_features};
 
 /// Re-exported so that users name the same matrix types.
 pub use faer::{Mat, MatRef};

@@ -1,0 +1,106 @@
+//! How much of a forward-difference target no model of the current sample can explain: an
+//! estimate of its noise floor, per segment.
+//!
+//! The forward difference d[k] = (x[k+1] − x[k])/dt of a measured state x = s + e (white
+//! measurement noise e of variance σ²) carries the noise (e[k+1] − e[k])/dt: variance 2σ²/dt², and
+//! lag-one autocovariance −σ²/dt². The smooth part is estimated by a Savitzky–Golay derivative
+//! (window 21, cubic, 0.4 s at 50 Hz: [`Derivative::SMOOTH`]); the residual r = d − d_SG holds the
+//! noise plus any motion faster than that window. Two estimates, both as a mean over samples and
+//! state dimensions (the unit of the tables' MSE):
+//! - **upper** = mean r²: counts the fast motion as noise, so it bounds the noise from above (a
+//!   model that captures fast motion, e.g. through the motor commands, can go below it);
+//! - **lower** = max(0, −2·mean r[k]·r[k+1]): the noise's negative lag-one autocovariance (×2 gives
+//!   its variance), from which positively correlated fast motion subtracts, so it is a lower bound
+//!   for white noise (clipped to [0, upper]).
+
+use serde::{Deserialize, Serialize};
+
+use crate::derivative::Derivative;
+use crate::error::Result;
+use crate::formulation::Segment;
+
+/// The noise-floor estimates of one segment's forward-difference targets.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NoiseFloor {
+    /// Mean square of forward difference minus the Savitzky–Golay derivative.
+    pub upper: f64,
+    /// Twice the negative lag-one autocovariance of that residual (clipped to [0, upper]).
+    pub lower: f64,
+}
+
+/// Estimates the noise floor of the forward-difference targets of `segment`'s states, sampled
+/// every `dt` seconds. The targets of the segment itself are not read: both derivatives are
+/// recomputed from its states.
+pub fn forward_difference_noise_floor(segment: &Segment, dt: f64) -> Result<NoiseFloor> {
+    let (n, dims) = (segment.len(), segment.states.ncols());
+    let (mut square, mut lagged, mut pairs) = (0.0, 0.0, 0usize);
+    for j in 0..dims {
+        let state: Vec<f64> = segment.states.col(j).iter().copied().collect();
+        let forward = Derivative::Forward.apply(&state, dt)?;
+        let smooth = Derivative::SMOOTH.apply(&state, dt)?;
+        let residual: Vec<f64> = forward.iter().zip(&smooth).map(|(f, s)| f - s).collect();
+        square += residual.iter().map(|r| r * r).sum::<f64>();
+        lagged += residual.windows(2).map(|w| w[0] * w[1]).sum::<f64>();
+        pairs += n - 1;
+    }
+    let upper = square / (n * dims) as f64;
+    Ok(NoiseFloor {
+        upper,
+        lower: (-2.0 * lagged / pairs as f64).clamp(0.0, upper),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Formulation;
+    use faer::Mat;
+
+    /// A smooth state plus deterministic pseudo-random noise of standard deviation `sigma`.
+    fn segment(sigma: f64) -> Segment {
+        let n = 4000;
+        let dt = 0.02;
+        let mut seed = 12345u64;
+        let mut noise = || {
+            // Sum of 12 uniforms − 6: close to a standard normal.
+            (0..12)
+                .map(|_| {
+                    seed = seed
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    (seed >> 11) as f64 / (1u64 << 53) as f64
+                })
+                .sum::<f64>()
+                - 6.0
+        };
+        let states = Mat::from_fn(n, 3, |i, j| {
+            (0.5 * i as f64 * dt + j as f64).sin() + sigma * noise()
+        });
+        Segment {
+            formulation: Formulation::Translational,
+            rows: 0..n,
+            time: (0..n).map(|i| i as f64 * dt).collect(),
+            controls: Mat::zeros(n, 3),
+            targets: Mat::zeros(n, 3),
+            states,
+        }
+    }
+
+    #[test]
+    fn white_noise_lies_between_the_bounds() {
+        let (sigma, dt) = (0.01, 0.02);
+        let floor = forward_difference_noise_floor(&segment(sigma), dt).unwrap();
+        let exact = 2.0 * sigma * sigma / (dt * dt);
+        assert!(floor.lower <= floor.upper);
+        assert!(
+            floor.upper > 0.8 * exact && floor.upper < 1.2 * exact,
+            "{floor:?} vs {exact}"
+        );
+        assert!(
+            floor.lower > 0.7 * exact && floor.lower < 1.3 * exact,
+            "{floor:?} vs {exact}"
+        );
+        let quiet = forward_difference_noise_floor(&segment(0.0), dt).unwrap();
+        assert!(quiet.upper < 1e-3 * exact);
+    }
+}

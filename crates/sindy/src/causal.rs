@@ -1,0 +1,135 @@
+//! A library built from one segment in time order: terms of X = [x, u] at each sample, and
+//! first-order lags of the controls (the motors do not reach a commanded speed or thrust at once).
+//!
+//! Features, in this order (names in brackets):
+//! - `linear`: every input [`x_j`], [`u_j`];
+//! - `fourier` K: `sin(k·z)`, `cos(k·z)` of every input z, k = 1..=K (as [`crate::LibrarySpec`]);
+//! - `control_squares`: [`u_j^2`];
+//! - `control_lags` a ∈ [0, 1): `s[k] = a·s[k−1] + (1 − a)·u[k]`, `s[0] = u[0]`
+//!   [`lag0.80(u_j)`], a discrete first-order lag with time constant −dt/ln a.
+//!
+//! Every feature at sample k uses samples 0..=k of the same segment only: nothing crosses from one
+//! segment to the other, and nothing from the future of a sample is used. The constant is left to
+//! the regression (its intercept).
+
+use data::Segment;
+use faer::Mat;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Result, invalid};
+
+/// Which terms the library holds (unchecked; checked by [`CausalLibrary::features`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CausalLibrary {
+    #[serde(default)]
+    pub linear: bool,
+    /// Fourier frequencies K (0: none).
+    #[serde(default)]
+    pub fourier: usize,
+    #[serde(default)]
+    pub control_squares: bool,
+    /// Poles a of the control lags.
+    #[serde(default)]
+    pub control_lags: Vec<f64>,
+}
+
+impl CausalLibrary {
+    fn check(&self) -> Result<()> {
+        if let Some(a) = self
+            .control_lags
+            .iter()
+            .find(|a| !(a.is_finite() && **a >= 0.0 && **a < 1.0))
+        {
+            return Err(invalid(
+                "control lag",
+                format!("pole {a} must lie in [0, 1)"),
+            ));
+        }
+        if !self.linear
+            && self.fourier == 0
+            && !self.control_squares
+            && self.control_lags.is_empty()
+        {
+            return Err(invalid("causal library", "it has no feature"));
+        }
+        Ok(())
+    }
+
+    /// Θ of `segment` (one row per sample) and the feature names.
+    pub fn features(&self, segment: &Segment) -> Result<(Mat<f64>, Vec<String>)> {
+        self.check()?;
+        let formulation = segment.formulation;
+        let inputs = segment.inputs();
+        let input_names = formulation.input_names();
+        let control_names = formulation.control_names();
+        let n = segment.len();
+        let mut columns: Vec<Vec<f64>> = Vec::new();
+        let mut names: Vec<String> = Vec::new();
+        let input = |j: usize| -> Vec<f64> { inputs.col(j).iter().copied().collect() };
+        let control = |j: usize| -> Vec<f64> { segment.controls.col(j).iter().copied().collect() };
+        if self.linear {
+            for (j, name) in input_names.iter().enumerate() {
+                columns.push(input(j));
+                names.push(name.to_string());
+            }
+        }
+        for k in 1..=self.fourier {
+            let prefix = if k == 1 {
+                String::new()
+            } else {
+                format!("{k}*")
+            };
+            for (j, name) in input_names.iter().enumerate() {
+                let values = input(j);
+                columns.push(values.iter().map(|v| (k as f64 * v).sin()).collect());
+                names.push(format!("sin({prefix}{name})"));
+                columns.push(values.iter().map(|v| (k as f64 * v).cos()).collect());
+                names.push(format!("cos({prefix}{name})"));
+            }
+        }
+        if self.control_squares {
+            for (j, name) in control_names.iter().enumerate() {
+                columns.push(control(j).iter().map(|v| v * v).collect());
+                names.push(format!("{name}^2"));
+            }
+        }
+        for &pole in &self.control_lags {
+            for (j, name) in control_names.iter().enumerate() {
+                columns.push(first_order_lag(&control(j), pole));
+                names.push(format!("lag{pole:.2}({name})"));
+            }
+        }
+        let theta = Mat::from_fn(n, columns.len(), |i, j| columns[j][i]);
+        Ok((theta, names))
+    }
+}
+
+/// `s[k] = a·s[k−1] + (1 − a)·u[k]`, `s[0] = u[0]`.
+pub fn first_order_lag(signal: &[f64], pole: f64) -> Vec<f64> {
+    let mut state = signal.first().copied().unwrap_or(0.0);
+    signal
+        .iter()
+        .map(|&u| {
+            state = pole * state + (1.0 - pole) * u;
+            state
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lags_are_causal_first_order_filters() {
+        let step: Vec<f64> = (0..6).map(|k| if k < 2 { 0.0 } else { 1.0 }).collect();
+        let lagged = first_order_lag(&step, 0.5);
+        assert_eq!(lagged, vec![0.0, 0.0, 0.5, 0.75, 0.875, 0.9375]);
+        // Changing a later sample never changes an earlier output.
+        let mut later = step.clone();
+        later[4] = 10.0;
+        assert_eq!(first_order_lag(&later, 0.5)[..4], lagged[..4]);
+        assert_eq!(first_order_lag(&step, 0.0), step);
+    }
+}

@@ -11,6 +11,8 @@ PACKAGES=(
     scipy==1.17.1
     numpy==2.4.6
     pandas==3.1.1
+    # learn: JAX reference of the LeARN meta-iteration (scripts/bench/learn*)
+    jax[cpu]==0.10.2
 )
 
 if [ ! -x .venv/bin/python ]; then

@@ -415,3 +415,38 @@ fn standardised(standardiser: &Standardiser, batch: Batch) -> Batch {
         targets: batch.targets,
     }
 }
+
+/// Explains `model` over the whole of `log`: first adapted online on the flight's support segment
+/// (with the model's own adaptation settings) when `adapt` is set, then [`explain`] over every row.
+///
+/// [`explain`]: crate::explain()
+pub fn explain_flight(
+    model: &MetaTrainedModel,
+    log: &FlightLog,
+    adapt: bool,
+    rule: crate::explain::EquationRule,
+) -> Result<crate::explain::Explanation> {
+    let (support, query) = flight_segments(log, model.formulation)?;
+    let support_batch = standardised(&model.standardiser, segment_batch(&support));
+    let query_batch = standardised(&model.standardiser, segment_batch(&query));
+    let parameters = if adapt {
+        adapt_online(
+            &model.architecture,
+            &model.parameters,
+            &support_batch.inputs,
+            &support_batch.targets,
+            &model.config.adaptation,
+        )
+    } else {
+        model.parameters.clone()
+    };
+    let mut inputs = support_batch.inputs;
+    inputs.extend(query_batch.inputs);
+    Ok(crate::explain::explain(
+        model.formulation,
+        &model.architecture,
+        &parameters,
+        &inputs,
+        rule,
+    ))
+}

@@ -45,10 +45,17 @@ pub trait Scalar:
     fn value(self) -> f64;
     /// Multiplication by a plain number.
     fn scale(self, factor: f64) -> Self;
-    /// GELU(self).
-    fn gelu(self) -> Self;
-    /// GELU′(self).
-    fn gelu_derivative(self) -> Self;
+    /// (GELU(self), GELU′(self)), with one erf and one exp.
+    fn gelu_and_derivative(self) -> (Self, Self);
+}
+
+/// (Φ(x), φ(x)): the standard normal distribution and density.
+#[inline(always)]
+fn normal_cdf_and_pdf(x: f64) -> (f64, f64) {
+    (
+        0.5 * (1.0 + libm::erf(x * FRAC_1_SQRT_2)),
+        FRAC_1_SQRT_2PI * (-0.5 * x * x).exp(),
+    )
 }
 
 impl Scalar for f64 {
@@ -65,12 +72,9 @@ impl Scalar for f64 {
         self * factor
     }
     #[inline(always)]
-    fn gelu(self) -> Self {
-        gelu(self)
-    }
-    #[inline(always)]
-    fn gelu_derivative(self) -> Self {
-        gelu_derivative(self)
+    fn gelu_and_derivative(self) -> (Self, Self) {
+        let (cdf, pdf) = normal_cdf_and_pdf(self);
+        (self * cdf, cdf + self * pdf)
     }
 }
 
@@ -145,14 +149,14 @@ impl Scalar for Dual {
         Self::new(self.value * factor, self.tangent * factor)
     }
     #[inline(always)]
-    fn gelu(self) -> Self {
-        Self::new(gelu(self.value), gelu_derivative(self.value) * self.tangent)
-    }
-    #[inline(always)]
-    fn gelu_derivative(self) -> Self {
-        Self::new(
-            gelu_derivative(self.value),
-            gelu_second_derivative(self.value) * self.tangent,
+    fn gelu_and_derivative(self) -> (Self, Self) {
+        let x = self.value;
+        let (cdf, pdf) = normal_cdf_and_pdf(x);
+        let first = cdf + x * pdf;
+        let second = pdf * (2.0 - x * x);
+        (
+            Self::new(x * cdf, first * self.tangent),
+            Self::new(first, second * self.tangent),
         )
     }
 }
@@ -178,8 +182,14 @@ mod tests {
     #[test]
     fn dual_numbers_carry_first_derivatives() {
         let x = Dual::new(0.7, 1.0);
-        let y = x * x.gelu() - x.scale(3.0);
-        let exact = 2.0 * 0.7 * 0.0 + gelu(0.7) + 0.7 * gelu_derivative(0.7) - 3.0;
+        let (g, g_prime) = x.gelu_and_derivative();
+        let y = x * g - x.scale(3.0);
+        let exact = gelu(0.7) + 0.7 * gelu_derivative(0.7) - 3.0;
         assert!((y.tangent - exact).abs() < 1e-14);
+        assert!((g_prime.tangent - gelu_second_derivative(0.7)).abs() < 1e-15);
+        let (value, derivative) = 0.7f64.gelu_and_derivative();
+        assert!(
+            (value - gelu(0.7)).abs() < 1e-16 && (derivative - gelu_derivative(0.7)).abs() < 1e-16
+        );
     }
 }

@@ -2,13 +2,13 @@
 
 mod check_paper;
 mod conditions;
-mod inspect;
-mod sindy;
-mod reproduce;
-mod meta_train;
 mod explain;
+mod inspect;
+mod meta_train;
 mod mismatch;
+mod reproduce;
 mod simulate;
+mod sindy;
 
 use std::path::PathBuf;
 

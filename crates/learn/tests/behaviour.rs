@@ -1,0 +1,205 @@
+//! Meta-training, adaptation, determinism and checkpoints on synthetic tasks.
+
+mod common;
+
+use common::{small_architecture, synthetic_batch, synthetic_tasks};
+use learn::{
+    AdaptationConfig, CHECKPOINT_FORMAT, LearnConfig, MetaOrder, MetaTrainedModel,
+    MetaTrainingConfig, Optimizer, Protocol, Standardiser, adapt_online, meta_train,
+};
+
+fn meta_config(iterations: usize) -> MetaTrainingConfig {
+    MetaTrainingConfig {
+        inner_step: 0.05,
+        inner_rounds: 1,
+        outer_step: 0.01,
+        optimizer: Optimizer::Adam,
+        meta_regularisation: 1e-6,
+        order: MetaOrder::Second,
+        task_batch: 4,
+        support_batch: 16,
+        query_batch: 16,
+        iterations,
+    }
+}
+
+fn adaptation(step: f64) -> AdaptationConfig {
+    AdaptationConfig {
+        step,
+        passes: 3,
+        window: 1,
+        lipschitz_weight: 0.0,
+        lipschitz_bound: 0.0,
+    }
+}
+
+fn mean(values: &[f64]) -> f64 {
+    values.iter().sum::<f64>() / values.len() as f64
+}
+
+#[test]
+fn meta_loss_decreases_and_adaptation_beats_the_meta_initialisation() {
+    let architecture = small_architecture();
+    let tasks = synthetic_tasks(8);
+    let outcome = meta_train(&architecture, &tasks, &meta_config(150), 7).unwrap();
+    let history = &outcome.meta_loss_history;
+    let (early, late) = (mean(&history[..15]), mean(&history[history.len() - 15..]));
+    assert!(late < 0.5 * early, "meta-loss {early} -> {late}");
+
+    // A task never seen in meta-training.
+    let support = synthetic_batch(1.8, 1.3, 200, 0.0);
+    let query = synthetic_batch(1.8, 1.3, 200, 3.0);
+    let before = architecture.loss(&outcome.parameters, &query.inputs, &query.targets);
+    let adapted = adapt_online(
+        &architecture,
+        &outcome.parameters,
+        &support.inputs,
+        &support.targets,
+        &adaptation(0.01),
+    );
+    let after = architecture.loss(&adapted, &query.inputs, &query.targets);
+    assert!(after < 0.7 * before, "query MSE {before} -> {after}");
+}
+
+#[test]
+fn adaptation_with_step_zero_changes_nothing_and_the_lipschitz_term_smooths() {
+    let architecture = small_architecture();
+    let parameters = architecture.initial_parameters(2);
+    let support = synthetic_batch(1.0, 0.5, 150, 0.0);
+    let unchanged = adapt_online(
+        &architecture,
+        &parameters,
+        &support.inputs,
+        &support.targets,
+        &adaptation(0.0),
+    );
+    assert_eq!(unchanged, parameters);
+
+    // Noisy targets: the regulariser (bound 0) must reduce the jumps between consecutive predictions.
+    let mut noisy = support.clone();
+    for (k, t) in noisy.targets.iter_mut().enumerate() {
+        *t += if k % 2 == 0 { 0.8 } else { -0.8 };
+    }
+    let total_variation = |p: &[f64]| -> f64 {
+        let y = architecture.predict(p, &noisy.inputs);
+        y.windows(2).map(|w| (w[1] - w[0]).abs()).sum()
+    };
+    let plain = adapt_online(
+        &architecture,
+        &parameters,
+        &noisy.inputs,
+        &noisy.targets,
+        &adaptation(0.02),
+    );
+    let smooth = adapt_online(
+        &architecture,
+        &parameters,
+        &noisy.inputs,
+        &noisy.targets,
+        &AdaptationConfig {
+            lipschitz_weight: 0.5,
+            ..adaptation(0.02)
+        },
+    );
+    assert!(
+        total_variation(&smooth) < total_variation(&plain),
+        "{} !< {}",
+        total_variation(&smooth),
+        total_variation(&plain)
+    );
+}
+
+#[test]
+fn meta_training_is_bit_identical_for_one_and_two_threads() {
+    let architecture = small_architecture();
+    let tasks = synthetic_tasks(6);
+    let config = meta_config(12);
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| meta_train(&architecture, &tasks, &config, 3).unwrap())
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.parameters, two.parameters);
+    assert_eq!(one.meta_loss_history, two.meta_loss_history);
+    let other_seed = meta_train(&architecture, &tasks, &config, 4).unwrap();
+    assert_ne!(one.parameters, other_seed.parameters);
+}
+
+#[test]
+fn first_order_is_an_option_and_learns_too() {
+    let architecture = small_architecture();
+    let tasks = synthetic_tasks(8);
+    let config = MetaTrainingConfig {
+        order: MetaOrder::First,
+        ..meta_config(100)
+    };
+    let outcome = meta_train(&architecture, &tasks, &config, 7).unwrap();
+    let history = &outcome.meta_loss_history;
+    assert!(mean(&history[history.len() - 10..]) < mean(&history[..10]));
+}
+
+fn example_model() -> MetaTrainedModel {
+    let config = LearnConfig::load(&common::workspace().join("experiments/learn.json")).unwrap();
+    let architecture = learn::architecture(data::Formulation::Translational, config.get());
+    MetaTrainedModel {
+        format: CHECKPOINT_FORMAT.to_string(),
+        formulation: data::Formulation::Translational,
+        protocol: Protocol::LeaveConditionOut,
+        held_out_condition: Some("35wind".to_string()),
+        seed: 9,
+        config: config.get().clone(),
+        parameters: architecture.initial_parameters(9),
+        standardiser: Standardiser::identity(architecture.input_dim),
+        architecture,
+        data_files: vec![],
+        meta_loss_history: vec![1.0, 0.5],
+    }
+}
+
+#[test]
+fn checkpoints_round_trip_and_bad_ones_name_the_file() {
+    let dir = std::env::temp_dir().join(format!("learn-checkpoint-{}", std::process::id()));
+    let path = dir.join("model.json");
+    let model = example_model();
+    model.save(&path).unwrap();
+    assert_eq!(MetaTrainedModel::load(&path).unwrap(), model);
+
+    let mut short = model.clone();
+    short.parameters.pop();
+    short.save(&path).unwrap();
+    let message = MetaTrainedModel::load(&path).unwrap_err().to_string();
+    assert!(
+        message.contains("model.json") && message.contains("parameters"),
+        "{message}"
+    );
+
+    std::fs::write(&path, "{\"format\": 3}").unwrap();
+    let message = MetaTrainedModel::load(&path).unwrap_err().to_string();
+    assert!(message.contains("model.json"), "{message}");
+}
+
+#[test]
+fn bad_configurations_name_the_file_and_field() {
+    let dir = std::env::temp_dir().join(format!("learn-config-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("learn.json");
+    let text = std::fs::read_to_string(common::workspace().join("experiments/learn.json")).unwrap();
+    std::fs::write(
+        &path,
+        text.replace("\"task_batch\": ", "\"task_batch\": 0, \"x\": "),
+    )
+    .unwrap();
+    let message = LearnConfig::load(&path).unwrap_err().to_string();
+    assert!(message.contains("learn.json"), "{message}");
+    let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    value["meta_training"]["inner_step"] = serde_json::json!(-1.0);
+    std::fs::write(&path, value.to_string()).unwrap();
+    let message = LearnConfig::load(&path).unwrap_err().to_string();
+    assert!(
+        message.contains("learn.json") && message.contains("meta_training.inner_step"),
+        "{message}"
+    );
+}

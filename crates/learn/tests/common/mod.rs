@@ -1,0 +1,70 @@
+//! Synthetic tasks and the real-data directory for the behaviour tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use learn::{Architecture, Batch, TaskData};
+
+/// A small architecture for fast tests: 2 inputs, 1 state, P = 2.
+pub fn small_architecture() -> Architecture {
+    Architecture {
+        input_dim: 2,
+        state_dim: 1,
+        basis_per_input: 2,
+        hidden: vec![8, 8],
+    }
+}
+
+/// y = a·sin(2·x0) + b·x1 on a time-ordered sweep of x; the task parameters (a, b) vary by task.
+pub fn synthetic_batch(a: f64, b: f64, rows: usize, phase: f64) -> Batch {
+    let mut batch = Batch::default();
+    for k in 0..rows {
+        let t = k as f64 / rows as f64 * 6.0 + phase;
+        let (x0, x1) = (t.sin() * 1.5, (0.7 * t).cos());
+        batch.inputs.extend([x0, x1]);
+        batch.targets.push(a * (2.0 * x0).sin() + b * x1);
+    }
+    batch
+}
+
+/// Tasks with a in [0.5, 1.5], b in [−1, 1].
+pub fn synthetic_tasks(count: usize) -> Vec<TaskData> {
+    (0..count)
+        .map(|i| {
+            let a = 0.5 + i as f64 / count as f64;
+            let b = -1.0 + 2.0 * ((i * 7) % count) as f64 / count as f64;
+            TaskData {
+                name: format!("task {i}"),
+                support: synthetic_batch(a, b, 200, 0.0),
+                query: synthetic_batch(a, b, 200, 3.0),
+            }
+        })
+        .collect()
+}
+
+/// The real data directory, if present: `$NEURAL_FLY_DIR` or `data/neural-fly` of the workspace.
+/// Under CI (`CI=true`) a missing directory fails the test instead of skipping it.
+pub fn real_data_dir() -> Option<PathBuf> {
+    let candidate = std::env::var_os("NEURAL_FLY_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/neural-fly"));
+    if candidate.join("experiment").is_dir() {
+        return Some(candidate);
+    }
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!(
+            "CI=true but no flight data at {} (run `make data`)",
+            candidate.display()
+        );
+    }
+    eprintln!(
+        "skipping: no flight data at {} (run `make data`)",
+        candidate.display()
+    );
+    None
+}
+
+/// The workspace root.
+pub fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}

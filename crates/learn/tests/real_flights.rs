@@ -1,0 +1,81 @@
+//! The experiment on the real flights, with a tiny budget (skipped without data, fails under CI).
+
+mod common;
+
+use data::{ExperimentConditions, Formulation};
+use learn::{EquationRule, Experiment, LearnConfig, MetaTrainedModel, Protocol, explain_flight};
+
+#[test]
+fn leave_condition_out_cell_runs_end_to_end() {
+    let Some(data_dir) = common::real_data_dir() else {
+        return;
+    };
+    let root = common::workspace();
+    let config = LearnConfig::load(&root.join("experiments/learn.json")).unwrap();
+    let mut small = config.get().clone();
+    small.meta_training.iterations = 3;
+    small.meta_training.support_batch = 16;
+    small.meta_training.query_batch = 16;
+    small.adaptation.passes = 1;
+    let small = small.check(&root.join("experiments/learn.json")).unwrap();
+    let conditions = ExperimentConditions::load(&root.join("experiments/conditions.json")).unwrap();
+    let experiment = Experiment::load(
+        small,
+        conditions,
+        &data_dir,
+        Some(Protocol::LeaveConditionOut),
+    )
+    .unwrap();
+    assert_eq!(
+        experiment.evaluation_conditions(),
+        vec!["35wind", "70p20sint", "70wind", "100wind"]
+    );
+    let cell = experiment
+        .run_cell(Formulation::Translational, "70psin20", 5)
+        .unwrap();
+    let model = &cell.model;
+    assert_eq!(model.protocol, Protocol::LeaveConditionOut);
+    assert_eq!(model.held_out_condition.as_deref(), Some("70p20sint"));
+    // 4 other conditions × 6 controllers; none of them the held-out condition.
+    assert_eq!(model.data_files.len(), 24);
+    assert!(
+        model
+            .data_files
+            .iter()
+            .all(|f| { !f.path.to_string_lossy().contains("70p20sint") && f.sha256.len() == 64 })
+    );
+    let summary = &cell.summary;
+    assert!(summary.adapt_mse.is_finite() && summary.gen_mse.is_finite());
+    assert_eq!(summary.label, "70psin20");
+    assert_eq!(
+        cell.support.predictions.nrows() + cell.query.predictions.nrows(),
+        {
+            let n = cell.support.time.len() + cell.query.time.len();
+            n
+        }
+    );
+    assert_eq!(cell.query.predictions.ncols(), 3);
+    // The MSE is the mean over samples and outputs of the returned predictions.
+    let (p, t) = (&cell.query.predictions, &cell.query.targets);
+    let mut sum = 0.0;
+    for i in 0..p.nrows() {
+        for j in 0..p.ncols() {
+            sum += (p[(i, j)] - t[(i, j)]).powi(2);
+        }
+    }
+    let mse = sum / (p.nrows() * p.ncols()) as f64;
+    assert!((mse - summary.gen_mse).abs() < 1e-12 * mse);
+
+    // A model of another fold is refused; the checkpoint round-trips and explains.
+    assert!(experiment.evaluate(model, "35wind").is_err());
+    let path = std::env::temp_dir().join(format!("learn-real-{}.json", std::process::id()));
+    model.save(&path).unwrap();
+    let loaded = MetaTrainedModel::load(&path).unwrap();
+    assert_eq!(&loaded, model);
+    let flight = data_dir.join("experiment/custom_figure8_baseline_70p20sint.csv");
+    let log = data::FlightLog::read(&flight).unwrap();
+    let explanation = explain_flight(&loaded, &log, false, EquationRule::default()).unwrap();
+    assert_eq!(explanation.outputs.len(), 3);
+    assert!(explanation.outputs[0].equation.starts_with("v̇x = "));
+    assert_eq!(explanation.outputs[0].inputs.len(), 6);
+}

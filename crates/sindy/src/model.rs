@@ -209,6 +209,15 @@ impl SindyParams {
         inputs: MatRef<'_, f64>,
         targets: MatRef<'_, f64>,
     ) -> Result<SindyModel> {
+        Ok(self.fit_with_library_matrix(inputs, targets)?.0)
+    }
+
+    /// [`Self::fit_matrices`], also returning Θ(X) of the inputs (to predict on them for free).
+    pub(crate) fn fit_with_library_matrix(
+        &self,
+        inputs: MatRef<'_, f64>,
+        targets: MatRef<'_, f64>,
+    ) -> Result<(SindyModel, Mat<f64>)> {
         self.check_names()?;
         let optimizer = self.optimizer.checked()?;
         let (dim_x, dim_u) = (self.state_names.len(), self.control_names.len());
@@ -240,7 +249,7 @@ impl SindyParams {
         let theta = self.library.transform(inputs);
         check_finite("library", theta.as_ref())?;
         let coefficients = optimizer.fit(theta.as_ref(), targets, &self.state_names)?;
-        Ok(SindyModel {
+        let model = SindyModel {
             feature_names: self.library.feature_names(&input_names),
             state_names: self.state_names.clone(),
             control_names: self.control_names.clone(),
@@ -249,7 +258,8 @@ impl SindyParams {
             optimizer: self.optimizer,
             derivative: self.derivative,
             coefficients,
-        })
+        };
+        Ok((model, theta))
     }
 
     fn input_names(&self) -> Vec<String> {
@@ -578,4 +588,31 @@ fn check_finite(what: &str, matrix: MatRef<'_, f64>) -> Result<()> {
 /// Whether `b` is a finite time strictly after `a`.
 fn increasing(a: f64, b: f64) -> bool {
     b.is_finite() && a.is_finite() && b > a
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scores_follow_scikit_learn() {
+        let actual = Mat::from_fn(4, 2, |i, j| (i + 2 * j) as f64);
+        assert_eq!(r2_score(actual.as_ref(), actual.as_ref()), 1.0);
+        // predicting each column's mean gives R² = 0; a constant column predicted exactly counts 1
+        let means = Mat::from_fn(4, 2, |_, j| 1.5 + 2.0 * j as f64);
+        assert!(r2_score(means.as_ref(), actual.as_ref()).abs() < 1e-15);
+        let constant = Mat::from_fn(4, 1, |_, _| 3.0);
+        assert_eq!(r2_score(constant.as_ref(), constant.as_ref()), 1.0);
+        assert_eq!(mean_squared_error(means.as_ref(), actual.as_ref()), 1.25);
+    }
+
+    #[test]
+    fn trajectories_are_checked() {
+        let states = Mat::<f64>::zeros(3, 1);
+        assert!(Trajectory::new(vec![0.0, 1.0], states.clone()).is_err());
+        assert!(Trajectory::new(vec![0.0, 1.0, 1.0], states.clone()).is_err());
+        let ok = Trajectory::new(vec![0.0, 1.0, 2.0], states).unwrap();
+        assert!(ok.clone().with_controls(Mat::zeros(2, 1)).is_err());
+        assert!(ok.with_derivatives(Mat::zeros(3, 2)).is_err());
+    }
 }

@@ -88,8 +88,9 @@ pub fn fit_and_evaluate(
         None => support.targets.clone(),
         Some(derivative) => estimate(support, derivative)?,
     };
-    let model = params.fit_matrices(support.inputs().as_ref(), fit_targets.as_ref())?;
-    let support_prediction = model.predict_inputs(support.inputs().as_ref())?;
+    let (model, support_library) =
+        params.fit_with_library_matrix(support.inputs().as_ref(), fit_targets.as_ref())?;
+    let support_prediction = support_library * model.coefficients().transpose();
     let query_prediction = model.predict_inputs(query.inputs().as_ref())?;
     Ok(SegmentEvaluation {
         support_mse: mean_squared_error(support_prediction.as_ref(), support.targets.as_ref()),

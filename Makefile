@@ -5,7 +5,7 @@ CARGO ?= cargo
 LEARN := target/debug/learn
 QUIET := $(if $(CI),--quiet,)
 
-.PHONY: all data build test reproduce check-paper bench mismatch-demo lint fmt clean-results
+.PHONY: all data build test reproduce ablations check-paper bench mismatch-demo lint fmt clean-results
 
 all: build
 
@@ -23,6 +23,12 @@ test: data
 # paper/tables/ and the README's tables block. Stage times are printed; see results/timings.json.
 reproduce: build
 	$(LEARN) $(QUIET) reproduce --config experiments/reproduce.json --out results --latex-dir paper/tables --readme README.md
+
+# Variants beyond the paper (experiments/variants.json): every variant on every cell over 5 seeds,
+# model selection inside the support segment only; results/ablations/ablations.{md,json} and figures
+# with the ensemble band. Takes a few minutes (LeARN meta-training for the learned-basis variants).
+ablations: build
+	$(LEARN) $(QUIET) ablations --config experiments/variants.json --out results/ablations
 
 # The regression against the paper: the same protocol with a smaller LeARN budget
 # (experiments/ci.json), written to a git-ignored scratch directory, then compared with

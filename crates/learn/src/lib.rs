@@ -48,6 +48,7 @@ mod model;
 mod network;
 mod scalar;
 mod train;
+pub mod variants;
 
 pub use adapt::adapt_online;
 pub use config::{AdaptationConfig, CheckedConfig, LearnConfig, MetaTrainingConfig, Optimizer};

@@ -22,6 +22,7 @@ mod error;
 mod output;
 mod run;
 mod summary;
+mod variants;
 
 pub use config::{CheckedRunConfig, LearnRun, RunConfig, merge_patch};
 pub use error::{PipelineError, Result};
@@ -30,6 +31,11 @@ pub use output::{
 };
 pub use run::{
     GENERATED_PATHS, RunOptions, RunOutcome, figure_file_name, git_commit, run, uncommitted_inputs,
+};
+pub use variants::{
+    AblationRow, Ablations, AblationsOutcome, CheckedVariants, LearnedBasisSpec, SeedCell,
+    VariantCell, VariantKind, VariantSpec, VariantsConfig, ablations_markdown, run_variants,
+    write_ablations,
 };
 pub use summary::{
     CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,

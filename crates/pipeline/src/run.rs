@@ -383,6 +383,7 @@ fn figure(cell: &Cell, learn_result: &CellResult) -> Result<(String, Qualitative
             MethodTrace {
                 method: "SINDy".to_string(),
                 prediction: column(&cell.sindy.support_prediction, &cell.sindy.query_prediction),
+                band: None,
             },
             MethodTrace {
                 method: "LeARN".to_string(),
@@ -390,6 +391,7 @@ fn figure(cell: &Cell, learn_result: &CellResult) -> Result<(String, Qualitative
                     &learn_result.support.predictions,
                     &learn_result.query.predictions,
                 ),
+                band: None,
             },
         ],
     };

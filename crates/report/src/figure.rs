@@ -66,6 +66,15 @@ pub struct MethodTrace {
     /// `prediction[output][sample]`; samples before the split are the adaptation-segment
     /// prediction, from the split on the generalisation-segment prediction.
     pub prediction: Vec<Vec<f64>>,
+    /// An optional band around the prediction (e.g. an ensemble's spread), drawn shaded.
+    pub band: Option<Band>,
+}
+
+/// A band around a prediction, `lower[output][sample]` ≤ `upper[output][sample]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Band {
+    pub lower: Vec<Vec<f64>>,
+    pub upper: Vec<Vec<f64>>,
 }
 
 /// Everything one figure shows.
@@ -102,11 +111,17 @@ impl QualitativeFigure {
         if self.outputs.is_empty() || self.methods.is_empty() {
             return Err(invalid("no output or no method to draw".to_string()));
         }
-        let named_series = std::iter::once(("ground truth", &self.truth)).chain(
-            self.methods
-                .iter()
-                .map(|m| (m.method.as_str(), &m.prediction)),
-        );
+        let named_series = std::iter::once(("ground truth", &self.truth))
+            .chain(
+                self.methods
+                    .iter()
+                    .map(|m| (m.method.as_str(), &m.prediction)),
+            )
+            .chain(self.methods.iter().flat_map(|m| {
+                m.band.iter().flat_map(move |b| {
+                    [(m.method.as_str(), &b.lower), (m.method.as_str(), &b.upper)]
+                })
+            }));
         for (name, series) in named_series {
             if series.len() != self.outputs.len() {
                 return Err(invalid(format!(
@@ -272,7 +287,11 @@ impl QualitativeFigure {
     ) -> std::result::Result<(), String> {
         let panels = group.split_evenly((self.rows(), self.columns()));
         for (output, area) in panels.iter().enumerate().take(self.outputs.len()) {
-            self.draw_panel(area, output, &method.prediction[output])
+            let band = method
+                .band
+                .as_ref()
+                .map(|b| (b.lower[output].as_slice(), b.upper[output].as_slice()));
+            self.draw_panel(area, output, &method.prediction[output], band)
                 .map_err(|e| e.to_string())?;
         }
         Ok(())
@@ -283,9 +302,11 @@ impl QualitativeFigure {
         area: &DrawingArea<DB, Shift>,
         output: usize,
         prediction: &[f64],
+        band: Option<(&[f64], &[f64])>,
     ) -> std::result::Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
         let truth = &self.truth[output];
-        let (low, high) = value_range(truth.iter().chain(prediction));
+        let band_values = band.into_iter().flat_map(|(l, u)| l.iter().chain(u));
+        let (low, high) = value_range(truth.iter().chain(prediction).chain(band_values));
         let (start, end) = (self.time[0], self.time[self.time.len() - 1]);
         let mut chart = ChartBuilder::on(area)
             .margin_top(8)
@@ -324,11 +345,32 @@ impl QualitativeFigure {
             kept
         };
         let n = self.time.len();
+        // The band: one closed polygon per segment, lightly shaded in the segment's colour.
+        let polygons: Vec<(Vec<(f64, f64)>, RGBColor)> = band
+            .map(|(lower, upper)| {
+                [(0..self.split, ADAPTATION), (self.split..n, GENERALISATION)]
+                    .into_iter()
+                    .map(|(range, colour)| {
+                        let mut outline = points(range.clone(), upper);
+                        let mut bottom = points(range, lower);
+                        bottom.reverse();
+                        outline.extend(bottom);
+                        (outline, colour)
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
         let series = [
             (points(0..n, truth), GROUND_TRUTH),
             (points(0..self.split, prediction), ADAPTATION),
             (points(self.split..n, prediction), GENERALISATION),
         ];
+        for (outline, colour) in polygons {
+            chart.draw_series(std::iter::once(Polygon::new(
+                outline,
+                colour.mix(0.3).filled(),
+            )))?;
+        }
         for (line, colour) in series {
             chart.draw_series(LineSeries::new(line, colour.stroke_width(1)))?;
         }

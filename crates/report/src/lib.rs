@@ -20,7 +20,7 @@ mod table;
 pub use compare::{CellComparison, CellStatus, Comparison, Direction, ToleranceRule, Tolerances};
 pub use error::{ReportError, Result};
 pub use figure::{
-    ADAPTATION, GENERALISATION, GROUND_TRUTH, MethodTrace, OutputAxis, QualitativeFigure,
+    ADAPTATION, Band, GENERALISATION, GROUND_TRUTH, MethodTrace, OutputAxis, QualitativeFigure,
 };
 pub use published::PublishedTables;
 pub use render::{caption, latex, latex_label, markdown};

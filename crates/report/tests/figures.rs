@@ -36,10 +36,12 @@ fn synthetic_figure(outputs: &[&str]) -> QualitativeFigure {
             MethodTrace {
                 method: "SINDy".to_string(),
                 prediction: smooth(0.9),
+                band: None,
             },
             MethodTrace {
                 method: "LeARN".to_string(),
                 prediction: smooth(1.05),
+                band: None,
             },
         ],
         time,

@@ -8,6 +8,7 @@ mod meta_train;
 mod mismatch;
 mod reproduce;
 mod simulate;
+mod ablations;
 mod sindy;
 
 use std::path::PathBuf;
@@ -51,6 +52,8 @@ pub enum Command {
     Simulate(simulate::Args),
     /// Locate where a recording disagrees with a nominal model, name and fit the missing physics.
     Mismatch(mismatch::Args),
+    /// Every variant of experiments/variants.json on every cell over its seeds: ablation tables.
+    Ablations(ablations::Args),
 }
 
 #[derive(Subcommand, Debug)]
@@ -77,6 +80,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Explain(args) => explain::run(&global, args),
         Command::Simulate(args) => simulate::run(&global, args),
         Command::Mismatch(args) => mismatch::run(&global, args),
+        Command::Ablations(args) => ablations::run(&global, args),
     }
 }
 

@@ -1,0 +1,42 @@
+//! `learn ablations`: every variant of `experiments/variants.json` on every cell, over its seeds.
+
+use std::path::PathBuf;
+
+use pipeline::VariantsConfig;
+
+use super::Global;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The variants configuration (variants, seeds, headline, figure variant).
+    #[arg(long, default_value = "experiments/variants.json")]
+    pub config: PathBuf,
+    /// Where ablations.{json,md} and figures/ are written.
+    #[arg(long, default_value = "results/ablations")]
+    pub out: PathBuf,
+    /// The project root: relative paths in the configuration start here.
+    #[arg(long, default_value = ".")]
+    pub root: PathBuf,
+}
+
+pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
+    let start = std::time::Instant::now();
+    let config = VariantsConfig::load(&args.config, &args.root)?;
+    let data_dir = global.data_dir()?;
+    let quiet = global.quiet;
+    let progress = |cell: &str| {
+        if !quiet {
+            eprintln!("{:>7.1} s  {cell}", start.elapsed().as_secs_f64());
+        }
+    };
+    let outcome = pipeline::run_variants(&config, &data_dir, &progress)?;
+    let written = pipeline::write_ablations(&outcome, &args.out)?;
+    eprintln!(
+        "{:>7.1} s  total; wrote {} files under {}",
+        start.elapsed().as_secs_f64(),
+        written.len(),
+        args.out.display()
+    );
+    println!("{}", pipeline::ablations_markdown(&outcome.ablations));
+    Ok(())
+}

@@ -49,6 +49,7 @@ fmt:
 # .venv through scripts/python-env.sh if missing). One command per line: other parts append theirs.
 bench: data
 	scripts/bench/sindy.sh
+	scripts/bench/learn.sh
 
 # Sim-to-real mismatch: the tool blind on simulated flights with concealed effects, then on the real
 # baseline flights at every wind condition. Writes results/mismatch/{summary.md,summary.json,neural-fly.md}.

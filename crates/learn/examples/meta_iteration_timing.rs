@@ -52,7 +52,7 @@ fn main() {
         .collect();
     let mut parameters = architecture.initial_parameters(0);
     let inner = InnerLoop { step: 0.05, rounds };
-    let mut iteration = |parallel: bool, parameters: &mut Vec<f64>| {
+    let iteration = |parallel: bool, parameters: &mut Vec<f64>| {
         let started = Instant::now();
         let run =
             |task: &Task| meta_gradient(&architecture, parameters, task, inner, MetaOrder::Second);

@@ -1,65 +1,55 @@
-//! Scratch tuning aid (not used by the pipeline): meta-trains every cell once with a configuration,
-//! then reports adaptation / generalisation MSE for a grid of online-adaptation settings, so that
-//! the settings in `experiments/learn.json` can be chosen on measured numbers.
+//! Tuning aid (not used by the pipeline): reports the generalisation MSE of every cell for a grid of
+//! online-adaptation settings, starting from the checkpoints `learn meta-train` wrote, so that the
+//! adaptation settings of `experiments/learn.json` are chosen on measured numbers. It only reads
+//! the support segment to adapt and the query segment to score.
 //!
-//! cargo run -p learn --example tune_adaptation -- CONFIG [SEED]
+//! cargo run -p learn --example tune_adaptation -- CHECKPOINT_DIR
 
 use std::path::Path;
 
-use data::{ExperimentConditions, FlightLog, Formulation};
+use data::{ExperimentConditions, FlightLog};
 use learn::{
-    AdaptationConfig, Experiment, LearnConfig, adapt_online, flight_segments, mean_squared_error,
+    AdaptationConfig, MetaTrainedModel, adapt_online, flight_segments, mean_squared_error,
     segment_batch,
 };
 use rayon::prelude::*;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let arguments: Vec<String> = std::env::args().skip(1).collect();
-    let config = LearnConfig::load(Path::new(&arguments[0]))?;
-    let seed: u64 = arguments
-        .get(1)
-        .map_or(Ok(config.get().seed), |s| s.parse())?;
+    let directory = std::env::args()
+        .nth(1)
+        .ok_or("usage: tune_adaptation CHECKPOINT_DIR")?;
     let conditions = ExperimentConditions::load(Path::new("experiments/conditions.json"))?;
     let data_dir = data::resolve_data_dir(None)?;
-    let experiment = Experiment::load(config.clone(), conditions.clone(), &data_dir, None)?;
-    let started = std::time::Instant::now();
-    let formulations: Vec<Formulation> = match std::env::var("TUNE_FORMULATION") {
-        Ok(name) => vec![Formulation::parse(&name)?],
-        Err(_) => Formulation::ALL.to_vec(),
-    };
-    let cells = experiment.run_cells(&formulations, seed)?;
-    for cell in &cells {
-        eprintln!(
-            "{} {}: unadapted gen {:.3}, meta-loss first/last {:.3}/{:.3}",
-            cell.summary.formulation.name(),
-            cell.summary.label,
-            cell.summary.unadapted_gen_mse,
-            cell.model.meta_loss_history[0],
-            cell.model
-                .meta_loss_history
-                .iter()
-                .rev()
-                .take(20)
-                .sum::<f64>()
-                / 20.0
-        );
+    let mut paths: Vec<_> = std::fs::read_dir(&directory)?
+        .map(|entry| entry.map(|e| e.path()))
+        .collect::<Result<_, _>>()?;
+    paths.sort();
+    let mut cells = Vec::new();
+    for path in paths {
+        let model = MetaTrainedModel::load(&path)?;
+        let held_out = model
+            .held_out_condition
+            .clone()
+            .ok_or("no held-out condition")?;
+        let condition = conditions.condition(&held_out)?;
+        let flight =
+            conditions.flight_path(&data_dir, condition, &conditions.evaluation_controller);
+        let log = FlightLog::read(&flight)?;
+        let (support, query) = flight_segments(&log, model.formulation)?;
+        eprint!("{}/{} ", model.formulation.name(), condition.label());
+        cells.push((model, segment_batch(&support), segment_batch(&query)));
     }
-    eprintln!(
-        "meta-training + default adaptation: {:.1} s",
-        started.elapsed().as_secs_f64()
-    );
-    let base = config.get().adaptation.clone();
+    eprintln!();
+    let base = cells[0].0.config.adaptation.clone();
     let mut grid = Vec::new();
-    for step in [0.0003, 0.0005] {
-        for passes in [3, 5] {
-            for window in [1] {
-                if step == 0.0 && passes > 3 {
-                    continue;
-                }
+    for step in [0.0003, 0.0005, 0.001] {
+        for passes in [3, 5, 8] {
+            for (lipschitz_weight, lipschitz_bound) in [(0.0, 0.0), (0.01, 1.0), (0.05, 0.5)] {
                 grid.push(AdaptationConfig {
                     step,
                     passes,
-                    window,
+                    lipschitz_weight,
+                    lipschitz_bound,
                     ..base.clone()
                 });
             }
@@ -69,31 +59,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .par_iter()
         .map(|adaptation| {
             let mut line = format!(
-                "step {:<6} passes {} window {:<2}:",
-                adaptation.step, adaptation.passes, adaptation.window
+                "step {:<6} passes {} λ {:<4} L {:<3}:",
+                adaptation.step,
+                adaptation.passes,
+                adaptation.lipschitz_weight,
+                adaptation.lipschitz_bound
             );
             let mut total = 0.0;
-            for cell in &cells {
-                let condition = conditions.condition(&cell.summary.condition).unwrap();
-                let path =
-                    conditions.flight_path(&data_dir, condition, &conditions.evaluation_controller);
-                let log = FlightLog::read(&path).unwrap();
-                let model = &cell.model;
-                let (support, query) = flight_segments(&log, model.formulation).unwrap();
-                let (support, query) = (segment_batch(&support), segment_batch(&query));
-                let s_in = model.standardiser.apply(&support.inputs);
-                let q_in = model.standardiser.apply(&query.inputs);
+            for (model, support, query) in &cells {
+                let support_inputs = model.standardiser.apply(&support.inputs);
+                let query_inputs = model.standardiser.apply(&query.inputs);
                 let adapted = adapt_online(
                     &model.architecture,
                     &model.parameters,
-                    &s_in,
+                    &support_inputs,
                     &support.targets,
                     adaptation,
                 );
-                let gen_mse = mean_squared_error(
-                    &model.architecture.predict(&adapted, &q_in),
-                    &query.targets,
-                );
+                let predictions = model.architecture.predict(&adapted, &query_inputs);
+                let gen_mse = mean_squared_error(&predictions, &query.targets);
                 total += gen_mse;
                 line.push_str(&format!(" {gen_mse:.3}"));
             }
@@ -101,14 +85,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             line
         })
         .collect();
-    for cell in &cells {
-        eprint!(
-            "{}/{} ",
-            cell.summary.formulation.name(),
-            cell.summary.label
-        );
-    }
-    eprintln!();
     for row in rows {
         println!("{row}");
     }

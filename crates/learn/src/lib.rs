@@ -31,6 +31,16 @@
 //! query segment. MSE = mean over all samples and all output dimensions. Inputs are z-scored with
 //! the meta-training statistics (stored in the checkpoint).
 //!
+//! # Derivatives and speed
+//!
+//! One hand-written forward and backward pass, generic over [`Scalar`]: with `f64` it gives the
+//! loss gradient, with [`Dual`] numbers (θ + ε·v) the Hessian-vector product H·v
+//! (forward-over-reverse), which the exact meta-gradient chains as g ← g − α·H_s(θ_k)·g. Every
+//! derivative is checked against central finite differences (`tests/gradients.rs`). On x86-64 the
+//! passes run in a copy compiled for AVX2 when the CPU has it (no FMA, so results are bit-identical
+//! to the portable build). Checkpoints are written with shortest round-trip floats and read back
+//! exactly (serde_json `float_roundtrip`).
+//!
 //! # Determinism
 //!
 //! Initialisation and task sampling come from ChaCha8 streams seeded by the recorded seed; per-task

@@ -36,7 +36,7 @@ pub struct MetaTrainedModel {
     pub architecture: Architecture,
     /// Input standardisation (meta-training statistics; the identity when switched off).
     pub standardiser: Standardiser,
-    /// θ = [ψ; φ], see [`crate::network`] for the layout.
+    /// θ = [ψ; φ]: each layer of Θ then of ℰ, weights row-major (fan-in × fan-out) then biases.
     pub parameters: Vec<f64>,
     /// The meta-training flights.
     pub data_files: Vec<DataFile>,

@@ -18,6 +18,9 @@ use serde::{Deserialize, Serialize};
 use crate::scalar::Scalar;
 
 /// Layer sizes of both networks and the dimensions of the problem.
+///
+/// Θ(X; ψ) maps X ∈ ℝ^{I+U} to K = P·(I+U) basis values, ℰ(X; φ) to I·K values read row-major as
+/// the I×K selection matrix, and y = Θ·ℰᵀ. Basis index k = j·P + p is m_{p+1} attached to input j.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Architecture {
     /// Number of inputs I + U.

@@ -5,6 +5,12 @@ mod common;
 use data::{ExperimentConditions, Formulation};
 use learn::{EquationRule, Experiment, LearnConfig, MetaTrainedModel, Protocol, explain_flight};
 
+fn log_rows(data_dir: &std::path::Path) -> usize {
+    data::FlightLog::read(&data_dir.join("experiment/custom_figure8_baseline_70p20sint.csv"))
+        .unwrap()
+        .len()
+}
+
 #[test]
 fn leave_condition_out_cell_runs_end_to_end() {
     let Some(data_dir) = common::real_data_dir() else {
@@ -49,11 +55,9 @@ fn leave_condition_out_cell_runs_end_to_end() {
     assert_eq!(summary.label, "70psin20");
     assert_eq!(
         cell.support.predictions.nrows() + cell.query.predictions.nrows(),
-        {
-            let n = cell.support.time.len() + cell.query.time.len();
-            n
-        }
+        log_rows(&data_dir)
     );
+    assert_eq!(cell.support.time.len(), log_rows(&data_dir) / 2);
     assert_eq!(cell.query.predictions.ncols(), 3);
     // The MSE is the mean over samples and outputs of the returned predictions.
     let (p, t) = (&cell.query.predictions, &cell.query.targets);

@@ -74,14 +74,13 @@ fn published(table: &Option<Value>, cell: &CellSummary, method: &str) -> Option<
 
 fn print_cells(cells: &[CellSummary], table: &Option<Value>) {
     println!(
-        "{:<14} {:<10} {:>8} {:>8} {:>10} | {:>8} {:>8} {:>9} | {:>9}",
+        "{:<14} {:<10} {:>8} {:>8} {:>10} | {:>15} {:>12} | {:>9}",
         "formulation",
         "condition",
         "adapt",
         "gen",
-        "gen(meta)",
-        "pub.LeARN",
-        "adapt",
+        "gen(unadapted)",
+        "published adapt",
         "gen",
         "SINDy gen"
     );
@@ -95,13 +94,12 @@ fn print_cells(cells: &[CellSummary], table: &Option<Value>) {
             None => "",
         };
         println!(
-            "{:<14} {:<10} {:>8.3} {:>8.3} {:>10.3} | {:>8} {:>8} {:>6} {:<2} | {:>9}",
+            "{:<14} {:<10} {:>8.3} {:>8.3} {:>14.3} | {:>15} {:>6} {:<5} | {:>9}",
             cell.formulation.name(),
             cell.label,
             cell.adapt_mse,
             cell.gen_mse,
             cell.unadapted_gen_mse,
-            "",
             show(learn.map(|l| l.0)),
             show(learn.map(|l| l.1)),
             verdict,

@@ -54,6 +54,11 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         }
     };
     let log = FlightLog::read(&flight)?;
+    // Shown and recorded relative to the working directory when it lies below it.
+    let flight = std::env::current_dir()
+        .ok()
+        .and_then(|cwd| flight.strip_prefix(cwd).ok().map(PathBuf::from))
+        .unwrap_or(flight);
     let rule = EquationRule {
         max_terms: args.max_terms,
         ..EquationRule::default()

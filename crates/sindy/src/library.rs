@@ -285,6 +285,7 @@ impl FeatureLibrary {
 
     /// Θ(X): one row per sample of `inputs`, one column per feature.
     pub fn transform(&self, inputs: MatRef<'_, f64>) -> Mat<f64> {
+        crate::linalg::clear_upper_vector_state();
         let (n, dim) = (inputs.nrows(), inputs.ncols());
         let columns: Vec<Vec<f64>> = (0..dim)
             .map(|j| inputs.col(j).iter().copied().collect())

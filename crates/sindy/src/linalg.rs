@@ -13,10 +13,12 @@ pub fn least_squares(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
     if a.ncols() == 0 {
         return Mat::zeros(0, b.ncols());
     }
-    match full_rank_qr(a) {
+    let solution = match full_rank_qr(a) {
         Some((qr, _)) => qr.solve_lstsq(b),
         None => pseudo_inverse_solve(a, b),
-    }
+    };
+    clear_upper_vector_state();
+    solution
 }
 
 /// The Householder QR of a tall `a` and its triangular factor R, if no diagonal entry of R is
@@ -27,9 +29,11 @@ pub fn full_rank_qr(a: MatRef<'_, f64>) -> Option<(Qr<f64>, Mat<f64>)> {
     }
     let qr = a.qr();
     let r = qr.thin_R().to_owned();
+    clear_upper_vector_state();
     let diagonal: Vec<f64> = (0..r.ncols()).map(|i| r[(i, i)].abs()).collect();
     let largest = diagonal.iter().copied().fold(0.0, f64::max);
     let tolerance = 1e3 * rank_tolerance(a) * largest;
+    clear_upper_vector_state();
     (largest > 0.0 && diagonal.iter().all(|&d| d > tolerance)).then_some((qr, r))
 }
 
@@ -61,10 +65,32 @@ pub fn ridge_from_gram(gram: MatRef<'_, f64>, rhs: MatRef<'_, f64>, alpha: f64) 
     for i in 0..shifted.nrows() {
         shifted[(i, i)] += alpha;
     }
-    match shifted.llt(Side::Lower) {
+    let solution = match shifted.llt(Side::Lower) {
         Ok(cholesky) => cholesky.solve(rhs),
         Err(_) => pseudo_inverse_solve(shifted.as_ref(), rhs),
+    };
+    clear_upper_vector_state();
+    solution
+}
+
+/// Clears the upper halves of the AVX registers (`vzeroupper`).
+///
+/// faer's SIMD kernels can return with the upper register state dirty; the scalar code that follows
+/// (compiled for baseline x86-64, SSE encoding), and libm's `sin`/`cos` with it, then pays a
+/// transition penalty on every instruction: measured ~20x slower feature evaluation after a fit.
+#[inline]
+pub(crate) fn clear_upper_vector_state() {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the CPU supports AVX, checked just above.
+        unsafe { zero_upper() }
     }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn zero_upper() {
+    std::arch::x86_64::_mm256_zeroupper();
 }
 
 #[cfg(test)]

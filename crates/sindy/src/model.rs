@@ -354,7 +354,9 @@ impl SindyModel {
             ));
         }
         let theta = self.library.transform(inputs);
-        Ok(theta * self.coefficients.transpose())
+        let prediction = theta * self.coefficients.transpose();
+        crate::linalg::clear_upper_vector_state();
+        Ok(prediction)
     }
 
     /// Predicted ẋ for states x and controls u (one row per sample; u may have zero columns when

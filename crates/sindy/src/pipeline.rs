@@ -91,6 +91,7 @@ pub fn fit_and_evaluate(
     let (model, support_library) =
         params.fit_with_library_matrix(support.inputs().as_ref(), fit_targets.as_ref())?;
     let support_prediction = support_library * model.coefficients().transpose();
+    crate::linalg::clear_upper_vector_state();
     let query_prediction = model.predict_inputs(query.inputs().as_ref())?;
     Ok(SegmentEvaluation {
         support_mse: mean_squared_error(support_prediction.as_ref(), support.targets.as_ref()),

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use crate::error::{Result, invalid};
 use faer::linalg::solvers::SolveLstsq;
 
-use crate::linalg::{full_rank_qr, least_squares, ridge_from_gram};
+use crate::linalg::{clear_upper_vector_state, full_rank_qr, least_squares, ridge_from_gram};
 
 /// Work (samples × features²) above which targets are fitted in parallel.
 const PARALLEL_WORK: usize = 100_000;
@@ -69,6 +69,7 @@ impl Stlsq {
             Some(reduced) => reduced.solution.clone(),
             None => least_squares(theta, targets),
         };
+        clear_upper_vector_state();
         let fit_target = |i: usize| -> (Vec<f64>, usize) {
             let reference_pattern: Vec<bool> = (0..theta.ncols())
                 .map(|j| reference[(j, i)] != 0.0)

@@ -97,9 +97,9 @@ impl CheckedConfig {
 impl LearnConfig {
     /// Reads and checks a configuration file.
     pub fn load(path: &Path) -> Result<CheckedConfig> {
-        let text = std::fs::read_to_string(path).map_err(|source| LearnError::Io {
+        let text = std::fs::read_to_string(path).map_err(|cause| LearnError::Io {
             path: path.to_path_buf(),
-            source,
+            cause,
         })?;
         let config: Self = serde_json::from_str(&text).map_err(|error| LearnError::Config {
             path: path.to_path_buf(),

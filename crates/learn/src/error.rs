@@ -8,10 +8,11 @@ use std::path::PathBuf;
 pub enum LearnError {
     #[error(transparent)]
     Data(#[from] data::DataError),
-    #[error("{}: {source}", path.display())]
+    /// The I/O error is part of the message, not a separate cause, so it is printed once.
+    #[error("{}: {cause}", path.display())]
     Io {
         path: PathBuf,
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     #[error("{}: field '{field}': {message}", path.display())]
     Config {

@@ -53,9 +53,9 @@ impl MetaTrainedModel {
 
     /// Writes the checkpoint as JSON, creating parent directories.
     pub fn save(&self, path: &Path) -> Result<()> {
-        let io = |source| LearnError::Io {
+        let io = |cause| LearnError::Io {
             path: path.to_path_buf(),
-            source,
+            cause,
         };
         if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
             std::fs::create_dir_all(parent).map_err(io)?;
@@ -69,9 +69,9 @@ impl MetaTrainedModel {
 
     /// Reads and checks a checkpoint.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| LearnError::Io {
+        let text = std::fs::read_to_string(path).map_err(|cause| LearnError::Io {
             path: path.to_path_buf(),
-            source,
+            cause,
         })?;
         let bad = |message: String| LearnError::Checkpoint {
             path: path.to_path_buf(),

@@ -52,6 +52,10 @@ pub struct RunConfig {
     pub derivative: Derivative,
     pub sindy: SindyConfig,
     pub learn: LearnRun,
+    /// A variants file (`experiments/variants.json`) whose `reproduce` variants are added to every
+    /// row as extra columns (cheap ones only; the paper's columns are unchanged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variants: Option<PathBuf>,
 }
 
 /// A run configuration whose values and files were checked, with everything it names loaded.

@@ -32,12 +32,12 @@ pub use output::{
 pub use run::{
     GENERATED_PATHS, RunOptions, RunOutcome, figure_file_name, git_commit, run, uncommitted_inputs,
 };
-pub use variants::{
-    AblationRow, Ablations, AblationsOutcome, CheckedVariants, LearnedBasisSpec, SeedCell,
-    VariantCell, VariantKind, VariantSpec, VariantsConfig, ablations_markdown, run_variants,
-    write_ablations,
-};
 pub use summary::{
     CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,
     StageTiming, Summary, Timings,
+};
+pub use variants::{
+    AblationRow, Ablations, AblationsOutcome, CheckedVariants, LearnedBasisSpec, Outcome, SeedCell,
+    VariantCell, VariantKind, VariantSpec, VariantsConfig, ablations_markdown, evaluate_variants,
+    reproduce_columns, run_variants, write_ablations,
 };

@@ -131,6 +131,14 @@ pub fn run(
         cells
     })?;
 
+    let variant_columns = match &config.raw.variants {
+        Some(path) => stopwatch.time("variants", || {
+            let pairs: Vec<_> = cells.iter().map(|c| (&c.support, &c.query)).collect();
+            crate::variants::reproduce_columns(&root.join(path), &pairs)
+        })?,
+        None => Vec::new(),
+    };
+
     let seeds = &config.raw.learn.seeds;
     let learn_results = stopwatch.time("LeARN meta-training and adaptation", || {
         let bar = progress_bar(options.show_progress, jobs.len() * seeds.len(), "LeARN");
@@ -145,7 +153,20 @@ pub fn run(
     let (tables, figures, summary) = stopwatch.time("tables, figures and summary", || {
         let published = PublishedTables::load(&config.published_path)?;
         let protocol = experiment.protocol().name().to_string();
-        let tables = build_tables(config, &cells, &learn_results, &published, &protocol);
+        let mut tables = build_tables(config, &cells, &learn_results, &published, &protocol);
+        for (cell, columns) in cells.iter().zip(&variant_columns) {
+            let table = tables
+                .iter_mut()
+                .find(|t| t.table == cell.formulation.name());
+            let row = table.and_then(|t| {
+                t.rows
+                    .iter_mut()
+                    .find(|r| r.condition == cell.condition.label())
+            });
+            if let Some(row) = row {
+                row.variants.extend(columns.clone());
+            }
+        }
         let figures = cells
             .iter()
             .enumerate()

@@ -124,6 +124,9 @@ pub struct VariantsConfig {
     /// A bagged variant whose band is drawn in the figures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub figure_variant: Option<String>,
+    /// Cheap variants (no meta-training) that `make reproduce` adds as extra table columns.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub reproduce: Vec<String>,
     pub variants: Vec<VariantSpec>,
 }
 
@@ -135,8 +138,8 @@ pub struct CheckedVariants {
 }
 
 impl VariantsConfig {
-    /// Reads and checks `path`; relative paths start at `root`.
-    pub fn load(path: &Path, root: &Path) -> Result<CheckedVariants> {
+    /// Reads and checks `path` alone (names, candidates, headline), without the run it names.
+    pub fn read(path: &Path) -> Result<VariantsConfig> {
         let text = std::fs::read_to_string(path).map_err(|source| PipelineError::Io {
             path: path.to_path_buf(),
             source,
@@ -161,15 +164,13 @@ impl VariantsConfig {
                 return Err(error("variants", format!("'{name}' is declared twice")));
             }
         }
-        for variant in &raw.variants {
+        for (own, variant) in raw.variants.iter().enumerate() {
             if let VariantKind::Select { candidates } = &variant.kind {
                 if candidates.is_empty() {
                     return Err(error(&variant.name, "select needs candidates".to_string()));
                 }
                 for candidate in candidates {
-                    let position = names.iter().position(|n| n == candidate);
-                    let own = names.iter().position(|n| *n == variant.name);
-                    if !matches!((position, own), (Some(p), Some(o)) if p < o) {
+                    if !names[..own].contains(&candidate.as_str()) {
                         return Err(error(
                             &variant.name,
                             format!("candidate '{candidate}' must be a variant declared before it"),
@@ -178,16 +179,35 @@ impl VariantsConfig {
                 }
             }
         }
-        for (field, name) in [
+        let named = [
             ("headline", Some(&raw.headline)),
             ("figure_variant", raw.figure_variant.as_ref()),
-        ] {
+        ]
+        .into_iter()
+        .chain(raw.reproduce.iter().map(|n| ("reproduce", Some(n))));
+        for (field, name) in named {
             if let Some(name) = name
                 && !names.contains(&name.as_str())
             {
                 return Err(error(field, format!("'{name}' is not a declared variant")));
             }
         }
+        for name in &raw.reproduce {
+            if !raw.is_cheap(name) {
+                return Err(error(
+                    "reproduce",
+                    format!(
+                        "'{name}' needs LeARN meta-training: only library and select variants of them fit `make reproduce`"
+                    ),
+                ));
+            }
+        }
+        Ok(raw)
+    }
+
+    /// Reads and checks `path` and the run configuration it names; relative paths start at `root`.
+    pub fn load(path: &Path, root: &Path) -> Result<CheckedVariants> {
+        let raw = Self::read(path)?;
         let run_path = if raw.run.is_absolute() {
             raw.run.clone()
         } else {
@@ -200,6 +220,75 @@ impl VariantsConfig {
             run,
         })
     }
+
+    /// Whether the variant (and, for select, each candidate) needs no meta-training.
+    fn is_cheap(&self, name: &str) -> bool {
+        match self
+            .variants
+            .iter()
+            .find(|v| v.name == name)
+            .map(|v| &v.kind)
+        {
+            Some(VariantKind::Library(_)) => true,
+            Some(VariantKind::Select { candidates }) => candidates.iter().all(|c| self.is_cheap(c)),
+            _ => false,
+        }
+    }
+
+    /// The `reproduce` variants (and the candidates they select from), in declaration order.
+    fn reproduce_variants(&self) -> Vec<VariantSpec> {
+        let mut needed: Vec<&str> = self.reproduce.iter().map(String::as_str).collect();
+        for variant in self.variants.iter().rev() {
+            if needed.contains(&variant.name.as_str())
+                && let VariantKind::Select { candidates } = &variant.kind
+            {
+                needed.extend(candidates.iter().map(String::as_str));
+            }
+        }
+        self.variants
+            .iter()
+            .filter(|v| needed.contains(&v.name.as_str()))
+            .cloned()
+            .collect()
+    }
+}
+
+/// The extra columns `make reproduce` shows: the `reproduce` variants of the variants file at
+/// `path`, for each (support, query) pair, with the first seed of that file.
+pub fn reproduce_columns(
+    path: &Path,
+    cells: &[(&Segment, &Segment)],
+) -> Result<Vec<BTreeMap<String, report::Mse>>> {
+    let config = VariantsConfig::read(path)?;
+    let variants = config.reproduce_variants();
+    let seed = config.seeds[0];
+    cells
+        .par_iter()
+        .map(|(support, query)| {
+            let no_meta_training = || -> Result<MetaTrainedModel> {
+                Err(PipelineError::Config {
+                    path: path.to_path_buf(),
+                    field: "reproduce".to_string(),
+                    message: "a reproduce variant asked for LeARN meta-training".to_string(),
+                })
+            };
+            let outcomes = evaluate_variants(&variants, no_meta_training, support, query, seed)?;
+            Ok(variants
+                .iter()
+                .zip(outcomes)
+                .filter(|(spec, _)| config.reproduce.contains(&spec.name))
+                .map(|(spec, outcome)| {
+                    (
+                        spec.name.clone(),
+                        report::Mse {
+                            adaptation: outcome.evaluation.support_mse,
+                            generalisation: outcome.evaluation.query_mse,
+                        },
+                    )
+                })
+                .collect())
+        })
+        .collect()
 }
 
 /// Mean and spread of one variant on one cell over the seeds.
@@ -224,6 +313,9 @@ pub struct SeedCell {
     /// What was chosen inside the support segment: per output the penalty, and for `select` the
     /// candidate.
     pub chosen: BTreeMap<String, serde_json::Value>,
+    /// For bagged variants: the fraction of query targets inside the predictive band.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub query_band_coverage: Option<f64>,
 }
 
 /// One row of the ablation table: one formulation on one condition.
@@ -262,10 +354,13 @@ struct CellData<'a> {
 }
 
 /// One variant's outcome on one cell and seed, with its traces.
-struct Outcome {
-    evaluation: VariantEvaluation,
-    chosen: BTreeMap<String, serde_json::Value>,
-    support_cv: f64,
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    pub evaluation: VariantEvaluation,
+    /// Everything chosen inside the support segment (per output penalty; `variant` for select).
+    pub chosen: BTreeMap<String, serde_json::Value>,
+    /// Mean over outputs of the best support cross-validation MSE.
+    pub support_cv: f64,
 }
 
 /// Everything `make ablations` writes.
@@ -348,6 +443,11 @@ pub fn run_variants(
                     r#gen: outcomes[index].evaluation.query_mse,
                     support_cv: outcomes[index].support_cv,
                     chosen: outcomes[index].chosen.clone(),
+                    query_band_coverage: outcomes[index]
+                        .evaluation
+                        .query_band
+                        .as_ref()
+                        .map(|band| coverage(band, &cell.query.targets)),
                 })
                 .collect();
             variants.insert(spec.name.clone(), summarise(seeds));
@@ -414,37 +514,53 @@ fn evaluate_all(
     cell: &CellData,
     seed: u64,
 ) -> Result<Vec<Outcome>> {
-    let mut outcomes: Vec<Outcome> = Vec::with_capacity(config.raw.variants.len());
+    let meta_train = || -> Result<MetaTrainedModel> {
+        let experiment = experiment.expect("loaded when a learned-basis variant exists");
+        Ok(experiment.meta_train(cell.formulation, &cell.condition.name, seed)?)
+    };
+    evaluate_variants(
+        &config.raw.variants,
+        meta_train,
+        &cell.support,
+        &cell.query,
+        seed,
+    )
+}
+
+/// Every variant of `variants` on one support/query pair with one seed, in declaration order.
+/// `meta_train` is called at most once, when a learned-basis variant needs the LeARN networks; it
+/// must not read the query segment (the pipeline's leaves the evaluation flight out entirely).
+pub fn evaluate_variants(
+    variants: &[VariantSpec],
+    meta_train: impl FnOnce() -> Result<MetaTrainedModel>,
+    support: &Segment,
+    query: &Segment,
+    seed: u64,
+) -> Result<Vec<Outcome>> {
+    let mut outcomes: Vec<Outcome> = Vec::with_capacity(variants.len());
+    let mut meta_train = Some(meta_train);
     let mut meta_trained = None;
-    for spec in &config.raw.variants {
+    for spec in variants {
         let outcome = match &spec.kind {
             VariantKind::Library(variant) => {
-                let evaluation = variant.evaluate(&cell.support, &cell.query, seed)?;
-                outcome_of(evaluation, BTreeMap::new(), &cell.formulation)
+                let evaluation = variant.evaluate(support, query, seed)?;
+                outcome_of(evaluation, BTreeMap::new(), &support.formulation)
             }
             VariantKind::Select { candidates } => {
-                let scored: Vec<(usize, f64)> = candidates
+                let best = candidates
                     .iter()
-                    .map(|name| {
-                        let index = config
-                            .raw
-                            .variants
-                            .iter()
-                            .position(|v| &v.name == name)
-                            .expect("checked when loading");
-                        (index, outcomes[index].support_cv)
-                    })
-                    .collect();
-                let (best, _) = scored
-                    .iter()
-                    .copied()
-                    .min_by(|a, b| a.1.total_cmp(&b.1))
-                    .expect("checked non-empty");
+                    .filter_map(|name| variants.iter().position(|v| &v.name == name))
+                    .filter(|&index| index < outcomes.len())
+                    .min_by(|&a, &b| outcomes[a].support_cv.total_cmp(&outcomes[b].support_cv))
+                    .ok_or_else(|| PipelineError::Mismatch {
+                        what: format!("variant '{}'", spec.name),
+                        message: "no candidate declared before it".to_string(),
+                    })?;
                 let chosen_outcome = &outcomes[best];
                 let mut chosen = chosen_outcome.chosen.clone();
                 chosen.insert(
                     "variant".to_string(),
-                    serde_json::Value::String(config.raw.variants[best].name.clone()),
+                    serde_json::Value::String(variants[best].name.clone()),
                 );
                 Outcome {
                     evaluation: chosen_outcome.evaluation.clone(),
@@ -453,17 +569,13 @@ fn evaluate_all(
                 }
             }
             VariantKind::LearnedBasis(variant) => {
-                let experiment = experiment.expect("loaded when a learned-basis variant exists");
                 if meta_trained.is_none() {
-                    meta_trained = Some(experiment.meta_train(
-                        cell.formulation,
-                        &cell.condition.name,
-                        seed,
-                    )?);
+                    let train = meta_train.take().expect("called once");
+                    meta_trained = Some(train()?);
                 }
                 let model = meta_trained.as_ref().expect("set above");
-                let evaluation = variant.evaluate(model, &cell.support, &cell.query, seed)?;
-                outcome_of(evaluation, BTreeMap::new(), &cell.formulation)
+                let evaluation = variant.evaluate(model, support, query, seed)?;
+                outcome_of(evaluation, BTreeMap::new(), &support.formulation)
             }
         };
         outcomes.push(outcome);
@@ -490,6 +602,18 @@ fn outcome_of(
         chosen,
         support_cv,
     }
+}
+
+/// The fraction of `targets` inside the band.
+fn coverage(band: &EnsemblePrediction, targets: &Mat<f64>) -> f64 {
+    let (n, m) = targets.shape();
+    let inside = (0..m)
+        .flat_map(|j| (0..n).map(move |i| (i, j)))
+        .filter(|&(i, j)| {
+            band.lower[(i, j)] <= targets[(i, j)] && targets[(i, j)] <= band.upper[(i, j)]
+        })
+        .count();
+    inside as f64 / (n * m) as f64
 }
 
 fn summarise(seeds: Vec<SeedCell>) -> VariantCell {
@@ -653,6 +777,29 @@ pub fn ablations_markdown(ablations: &Ablations) -> String {
         config.headline,
         ablations.rows.iter().filter(|r| r.target.is_some()).count()
     ));
+    if let Some(name) = &config.figure_variant {
+        out.push_str(&format!(
+            "## Predictive band of `{name}` (drawn in `figures/`): share of query targets inside it\n\n\
+             Band = ensemble mean ± 2·√(members' variance + the output's support CV MSE); about 0.95 \
+             is expected if the errors were Gaussian and the query behaved like the support.\n\n\
+             | table | condition | coverage (mean over seeds) |\n|---|---|---|\n"
+        ));
+        for row in &ablations.rows {
+            let values: Vec<f64> = row.variants[name]
+                .seeds
+                .iter()
+                .filter_map(|s| s.query_band_coverage)
+                .collect();
+            if !values.is_empty() {
+                let mean = values.iter().sum::<f64>() / values.len() as f64;
+                out.push_str(&format!(
+                    "| {} | {} | {mean:.3} |\n",
+                    row.table, row.condition
+                ));
+            }
+        }
+        out.push('\n');
+    }
     out.push_str("## Best variant per cell (generalisation MSE, mean over seeds)\n\n");
     out.push_str("| table | condition | best variant | gen | target | vs target |\n|---|---|---|---|---|---|\n");
     for row in &ablations.rows {

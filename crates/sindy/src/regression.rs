@@ -14,8 +14,10 @@
 //!
 //! Bagging ([`Bagging`]): every member refits the chosen penalties on a moving-block bootstrap of
 //! the rows (blocks of contiguous samples, drawn with replacement from a SplitMix64 stream seeded by
-//! the recorded seed); the prediction is the members' mean and the band mean ± 2 standard deviations
-//! of the members (the spread of the fitted model, not of the measurement noise).
+//! the recorded seed); the prediction is the members' mean. The predictive band is
+//! mean ± 2·√(s² + σ²): s² the members' variance at that sample (the model's uncertainty) and σ²
+//! the output's cross-validation MSE on the support segment (what the model leaves unexplained,
+//! noise included), so about 95 % of the targets should fall inside it if the errors are Gaussian.
 
 use faer::{Mat, MatRef};
 use serde::{Deserialize, Serialize};
@@ -155,7 +157,7 @@ pub struct RegressionFit {
     pub seed: u64,
 }
 
-/// Mean and ±2 standard deviation band of an ensemble's predictions.
+/// An ensemble's mean prediction and its predictive band (see the module documentation).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EnsemblePrediction {
     pub mean: Mat<f64>,
@@ -172,7 +174,7 @@ impl RegressionFit {
         }
     }
 
-    /// The members' mean and band, when bagged.
+    /// The members' mean and predictive band, when bagged.
     pub fn ensemble(&self, theta: MatRef<'_, f64>) -> Option<EnsemblePrediction> {
         if self.members.len() < 2 {
             return None;
@@ -183,13 +185,18 @@ impl RegressionFit {
         let mean = Mat::from_fn(n, m, |i, j| {
             predictions.iter().map(|p| p[(i, j)]).sum::<f64>() / count
         });
+        let residual: Vec<f64> = self
+            .selections
+            .iter()
+            .map(|s| s.scores.iter().copied().fold(f64::INFINITY, f64::min))
+            .collect();
         let deviation = Mat::from_fn(n, m, |i, j| {
             let variance = predictions
                 .iter()
                 .map(|p| (p[(i, j)] - mean[(i, j)]).powi(2))
                 .sum::<f64>()
                 / (count - 1.0);
-            2.0 * variance.sqrt()
+            2.0 * (variance + residual[j]).sqrt()
         });
         Some(EnsemblePrediction {
             lower: Mat::from_fn(n, m, |i, j| mean[(i, j)] - deviation[(i, j)]),

@@ -1,0 +1,112 @@
+//! Model selection of every variant happens inside the support segment: perturbing the query
+//! segment (states, controls and targets) changes the generalisation error but leaves every chosen
+//! hyper-parameter, the selected library and the support predictions exactly as they were.
+//! Uses one real flight and the variants of `experiments/variants.json`; the learned-basis variants
+//! get untrained networks (their meta-training never reads the evaluation flight).
+
+use std::path::{Path, PathBuf};
+
+use data::{Derivative, FlightLog, Formulation, Segment, SplitSpec};
+use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Protocol, Standardiser};
+use pipeline::{VariantsConfig, evaluate_variants};
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The real data directory, if present. Under CI (`CI=true`) a missing directory fails the test.
+fn real_data_dir() -> Option<PathBuf> {
+    let candidate = std::env::var_os("NEURAL_FLY_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace().join("data/neural-fly"));
+    if candidate.join("experiment").is_dir() {
+        return Some(candidate);
+    }
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!(
+            "CI=true but no flight data at {} (run `make data`)",
+            candidate.display()
+        );
+    }
+    eprintln!(
+        "skipping: no flight data at {} (run `make data`)",
+        candidate.display()
+    );
+    None
+}
+
+/// Scales, shifts and wiggles every column of the query segment.
+fn perturbed(query: &Segment) -> Segment {
+    let mut changed = query.clone();
+    for matrix in [
+        &mut changed.states,
+        &mut changed.controls,
+        &mut changed.targets,
+    ] {
+        for j in 0..matrix.ncols() {
+            for i in 0..matrix.nrows() {
+                matrix[(i, j)] = 1.7 * matrix[(i, j)] + 0.3 + 0.2 * ((i * (j + 3)) as f64).sin();
+            }
+        }
+    }
+    changed
+}
+
+fn untrained_model(formulation: Formulation, config: &LearnConfig) -> MetaTrainedModel {
+    let architecture = learn::architecture(formulation, config);
+    MetaTrainedModel {
+        format: CHECKPOINT_FORMAT.to_string(),
+        formulation,
+        protocol: Protocol::LeaveConditionOut,
+        held_out_condition: None,
+        seed: 1,
+        config: config.clone(),
+        parameters: architecture.initial_parameters(1),
+        standardiser: Standardiser::identity(architecture.input_dim),
+        architecture,
+        data_files: Vec::new(),
+        meta_loss_history: Vec::new(),
+    }
+}
+
+#[test]
+fn perturbing_the_query_changes_no_choice() {
+    let Some(data_dir) = real_data_dir() else {
+        return;
+    };
+    let root = workspace();
+    let config = VariantsConfig::load(&root.join("experiments/variants.json"), &root).unwrap();
+    let log =
+        FlightLog::read(&data_dir.join("experiment/custom_figure8_baseline_70wind.csv")).unwrap();
+    // The first 1200 samples, cut in halves, keep the test fast.
+    let split = SplitSpec::Halves.split(1200.min(log.len())).unwrap();
+    // Attitude: every kind of feature (inputs, sin/cos, control lags, learned basis) is present.
+    for formulation in [Formulation::Attitude] {
+        let support = formulation
+            .segment(&log, split.support.clone(), Derivative::Forward)
+            .unwrap();
+        let query = formulation
+            .segment(&log, split.query.clone(), Derivative::Forward)
+            .unwrap();
+        let changed = perturbed(&query);
+        let learn_config = config.run.learn.get().clone();
+        let model = || Ok(untrained_model(formulation, &learn_config));
+        let original = evaluate_variants(&config.raw.variants, model, &support, &query, 3).unwrap();
+        let again = evaluate_variants(&config.raw.variants, model, &support, &changed, 3).unwrap();
+        for ((spec, a), b) in config.raw.variants.iter().zip(&original).zip(&again) {
+            let what = format!("{} {}", formulation.name(), spec.name);
+            assert!(!a.chosen.is_empty(), "{what}: nothing recorded as chosen");
+            assert_eq!(a.chosen, b.chosen, "{what}: a choice moved with the query");
+            assert_eq!(a.support_cv, b.support_cv, "{what}");
+            assert_eq!(a.evaluation.support_mse, b.evaluation.support_mse, "{what}");
+            assert_eq!(
+                a.evaluation.support_prediction, b.evaluation.support_prediction,
+                "{what}"
+            );
+            assert_ne!(
+                a.evaluation.query_mse, b.evaluation.query_mse,
+                "{what}: not perturbed"
+            );
+        }
+    }
+}

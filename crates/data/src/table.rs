@@ -134,24 +134,40 @@ impl TextTable {
 }
 
 /// Parses `"1.5"`, `"[1.0, 2.0]"` or `"[[1, 2], [3, 4]]"` into its numbers, in reading order.
+///
+/// One pass over the bytes: brackets are counted, tokens end at `,`, `[` or `]`.
 pub fn parse_numbers(cell: &str, out: &mut Vec<f64>) -> std::result::Result<(), String> {
-    let trimmed = cell.trim();
-    let opened = trimmed.chars().filter(|&c| c == '[').count();
-    let closed = trimmed.chars().filter(|&c| c == ']').count();
-    if opened != closed {
-        return Err("unbalanced brackets".to_string());
-    }
-    for token in trimmed.split([',', '[', ']']) {
-        let token = token.trim();
-        if token.is_empty() {
+    let bytes = cell.as_bytes();
+    let start_len = out.len();
+    let mut depth: i64 = 0;
+    let mut token_start = 0;
+    for (i, &byte) in bytes.iter().chain(std::iter::once(&b',')).enumerate() {
+        if !matches!(byte, b',' | b'[' | b']') {
             continue;
         }
-        let value: f64 = token
-            .parse()
-            .map_err(|_| format!("'{token}' is not a number"))?;
-        out.push(value);
+        let token = cell[token_start..i.min(cell.len())].trim();
+        if !token.is_empty() {
+            let value: f64 = token
+                .parse()
+                .map_err(|_| format!("'{token}' is not a number"))?;
+            out.push(value);
+        }
+        token_start = (i + 1).min(cell.len());
+        match byte {
+            b'[' => depth += 1,
+            b']' => {
+                depth -= 1;
+                if depth < 0 {
+                    return Err("unbalanced brackets".to_string());
+                }
+            }
+            _ => {}
+        }
     }
-    if out.is_empty() {
+    if depth != 0 {
+        return Err("unbalanced brackets".to_string());
+    }
+    if out.len() == start_len {
         return Err("no number in cell".to_string());
     }
     Ok(())

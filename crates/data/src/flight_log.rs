@@ -365,10 +365,10 @@ mod tests {
             assert!((q[i] - back[i]).abs() < 1e-12);
         }
         let rrt = mat_mul(&r, &transpose(&r));
-        for i in 0..3 {
-            for j in 0..3 {
+        for (i, row) in rrt.iter().enumerate() {
+            for (j, value) in row.iter().enumerate() {
                 let expected = if i == j { 1.0 } else { 0.0 };
-                assert!((rrt[i][j] - expected).abs() < 1e-12);
+                assert!((value - expected).abs() < 1e-12);
             }
         }
     }

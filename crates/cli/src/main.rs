@@ -12,9 +12,39 @@ fn main() -> ExitCode {
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            // One line, no backtrace: the chain of causes joined by ": ".
-            eprintln!("error: {}", format!("{error:#}").replace('\n', " "));
+            eprintln!("error: {}", one_line(&error));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The chain of causes joined by ": " on one line, without repeating a cause whose text the
+/// message already shows (library errors often print their source themselves).
+fn one_line(error: &anyhow::Error) -> String {
+    let mut message = String::new();
+    for cause in error.chain() {
+        let text = cause.to_string();
+        if message.contains(&text) {
+            continue;
+        }
+        if !message.is_empty() {
+            message.push_str(": ");
+        }
+        message.push_str(&text);
+    }
+    message.replace('\n', " ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn causes_are_not_repeated() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "No such file");
+        let error = anyhow::Error::new(io).context("x.csv: No such file");
+        assert_eq!(one_line(&error), "x.csv: No such file");
+        let error = anyhow::anyhow!("inner\nline").context("outer");
+        assert_eq!(one_line(&error), "outer: inner line");
     }
 }

@@ -8,7 +8,9 @@
 
 use std::time::Instant;
 
-use learn::{Architecture, Batch, InnerLoop, MetaOrder, PAPER_HIDDEN, Task, meta_gradient};
+use learn::{
+    Architecture, Batch, InnerLoop, MetaOrder, MetaWorkspace, PAPER_HIDDEN, Task, meta_gradient_in,
+};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -52,14 +54,25 @@ fn main() {
         .collect();
     let mut parameters = architecture.initial_parameters(0);
     let inner = InnerLoop { step: 0.05, rounds };
-    let iteration = |parallel: bool, parameters: &mut Vec<f64>| {
+    // One workspace per task slot, reused across iterations, as in `meta_train`.
+    let mut workspaces = vec![MetaWorkspace::new(&architecture); tasks];
+    let mut iteration = |parallel: bool, parameters: &mut Vec<f64>| {
         let started = Instant::now();
-        let run =
-            |task: &Task| meta_gradient(&architecture, parameters, task, inner, MetaOrder::Second);
+        let run = |(task, workspace): (&Task, &mut MetaWorkspace)| {
+            meta_gradient_in(workspace, parameters, task, inner, MetaOrder::Second)
+        };
         let results: Vec<_> = if parallel {
-            task_list.par_iter().map(run).collect()
+            task_list
+                .par_iter()
+                .zip(workspaces.par_iter_mut())
+                .map(run)
+                .collect()
         } else {
-            task_list.iter().map(run).collect()
+            task_list
+                .iter()
+                .zip(workspaces.iter_mut())
+                .map(run)
+                .collect()
         };
         let mut gradient = vec![0.0; parameters.len()];
         for result in &results {

@@ -10,6 +10,7 @@
 //! constant (the paper's f(X_{t−1}; φ_{t−1}, ψ_{t−1})). The first sample of each pass has no
 //! predecessor and no regulariser. The squared error is averaged over the I outputs, as in the MSE.
 
+use crate::batched::ModelWorkspace;
 use crate::config::AdaptationConfig;
 use crate::network::Architecture;
 
@@ -24,6 +25,9 @@ pub fn adapt_online(
     let (input_dim, output_dim) = (architecture.input_dim, architecture.state_dim);
     let rows = inputs.len() / input_dim;
     let mut parameters = parameters.to_vec();
+    let mut workspace = ModelWorkspace::new(architecture);
+    let mut gradient = vec![0.0; parameters.len()];
+    let mut prediction_gradient = Vec::with_capacity(config.window * output_dim);
     for _ in 0..config.passes {
         let mut previous: Option<Vec<f64>> = None;
         let mut start = 0;
@@ -31,11 +35,10 @@ pub fn adapt_online(
             let end = (start + config.window).min(rows);
             let window_inputs = &inputs[start * input_dim..end * input_dim];
             let window_targets = &targets[start * output_dim..end * output_dim];
-            let tape = architecture.forward(&parameters, window_inputs);
+            let prediction_all = workspace.forward(&parameters, window_inputs);
             let count = (end - start) as f64;
-            let mut prediction_gradient = Vec::with_capacity(tape.prediction.len());
-            for (row, (prediction, target)) in tape
-                .prediction
+            prediction_gradient.clear();
+            for (row, (prediction, target)) in prediction_all
                 .chunks_exact(output_dim)
                 .zip(window_targets.chunks_exact(output_dim))
                 .enumerate()
@@ -43,7 +46,7 @@ pub fn adapt_online(
                 let predecessor = if row == 0 {
                     previous.as_deref()
                 } else {
-                    Some(&tape.prediction[(row - 1) * output_dim..row * output_dim])
+                    Some(&prediction_all[(row - 1) * output_dim..row * output_dim])
                 };
                 let active = predecessor.is_some_and(|before| {
                     let jump: f64 = prediction
@@ -61,11 +64,12 @@ pub fn adapt_online(
                     prediction_gradient.push(g / count);
                 }
             }
-            let gradient = architecture.backward(&parameters, &tape, &prediction_gradient);
+            let last = prediction_all[prediction_all.len() - output_dim..].to_vec();
+            workspace.backward(&parameters, &prediction_gradient, &mut gradient);
             for (p, g) in parameters.iter_mut().zip(&gradient) {
                 *p -= config.step * g;
             }
-            previous = Some(tape.prediction[tape.prediction.len() - output_dim..].to_vec());
+            previous = Some(last);
             start = end;
         }
     }

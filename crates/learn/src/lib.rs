@@ -19,8 +19,10 @@
 //!   [`Experiment::evaluate`] → [`CellResult`] (adaptation MSE, generalisation MSE, predictions on
 //!   both segments, adapted θ); [`Experiment::run_cell`] does both; [`Experiment::run_cells`] runs a
 //!   set of cells in parallel (rayon), [`Experiment::seed_spread`] repeats them over seeds.
-//! - Building blocks: [`Architecture`] (forward, gradient, prediction), [`meta_gradient`],
-//!   [`hessian_vector_product`], [`inner_updates`], [`meta_train`], [`adapt_online`], [`explain`].
+//! - Building blocks: [`Architecture`] (forward, gradient, prediction), [`meta_gradient`]
+//!   ([`meta_gradient_in`] with reusable [`MetaWorkspace`] buffers), [`hessian_vector_product`],
+//!   [`inner_updates`], [`meta_train`], [`adapt_online`], [`explain`]; [`ModelWorkspace`] for
+//!   repeated passes; `reference_*` for the generic reference implementation.
 //!
 //! # Definitions
 //!
@@ -33,13 +35,17 @@
 //!
 //! # Derivatives and speed
 //!
-//! One hand-written forward and backward pass, generic over [`Scalar`]: with `f64` it gives the
-//! loss gradient, with [`Dual`] numbers (θ + ε·v) the Hessian-vector product H·v
-//! (forward-over-reverse), which the exact meta-gradient chains as g ← g − α·H_s(θ_k)·g. Every
-//! derivative is checked against central finite differences (`tests/gradients.rs`). On x86-64 the
-//! passes run in a copy compiled for AVX2 when the CPU has it (no FMA, so results are bit-identical
-//! to the portable build). Checkpoints are written with shortest round-trip floats and read back
-//! exactly (serde_json `float_roundtrip`).
+//! The hot path ([`ModelWorkspace`], [`MetaWorkspace`]) runs each layer over the whole batch as a
+//! matrix product (register-tiled AVX-512 / AVX2+FMA kernels chosen at run time, a portable
+//! fallback), with the exact GELU and its two derivatives vectorised (Cephes' erf/erfc rational
+//! approximations, one exponential). Hessian-vector products are Pearlmutter's R-operator with
+//! separate value and tangent arrays; they reuse the forward and backward passes of the inner
+//! round. Every kernel sums each output in the same order with fused multiply-adds, so all
+//! instruction sets give bit-identical results. The generic code over [`Scalar`] (`f64` for
+//! gradients, [`Dual`] numbers for H·v, forward-over-reverse) is kept as the reference
+//! (`reference_*`): the tests hold the fast path to it (relative 1e-12) and both to central finite
+//! differences (`tests/gradients.rs`). Checkpoints are written with shortest round-trip floats and
+//! read back exactly (serde_json `float_roundtrip`).
 //!
 //! # Determinism
 //!
@@ -48,11 +54,13 @@
 //! whatever the number of threads.
 
 mod adapt;
+mod batched;
 mod config;
 mod dataset;
 mod error;
 mod experiment;
 mod explain;
+mod kernels;
 mod maml;
 mod model;
 mod network;
@@ -61,6 +69,7 @@ mod train;
 pub mod variants;
 
 pub use adapt::adapt_online;
+pub use batched::ModelWorkspace;
 pub use config::{AdaptationConfig, CheckedConfig, LearnConfig, MetaTrainingConfig, Optimizer};
 pub use dataset::{
     Protocol, Standardiser, flight_segments, from_row_major, row_major, segment_batch,
@@ -74,8 +83,9 @@ pub use explain::{
     EquationRule, Explanation, InputImportance, OutputExplanation, Term, explain, output_symbol,
 };
 pub use maml::{
-    Batch, InnerLoop, MetaGradient, MetaOrder, Task, hessian_vector_product, inner_updates,
-    meta_gradient,
+    Batch, InnerLoop, MetaGradient, MetaOrder, MetaWorkspace, Task, hessian_vector_product,
+    inner_updates, meta_gradient, meta_gradient_in, reference_hessian_vector_product,
+    reference_meta_gradient,
 };
 pub use model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel};
 pub use network::{Architecture, PAPER_HIDDEN, mean_squared_error};

@@ -6,11 +6,15 @@
 //! ∇_θ L_q(θ_n) = (I − α·H_s(θ₀)) ⋯ (I − α·H_s(θ_{n−1})) · ∇L_q(θ_n),
 //!
 //! evaluated right to left with Hessian-vector products (g ← g − α·H_s(θ_k)·g for k = n−1 … 0), each
-//! one a reverse pass run on dual numbers (forward-over-reverse). The first-order variant keeps only
-//! ∇L_q(θ_n).
+//! one Pearlmutter's R-operator on the batched passes ([`ModelWorkspace`]), which reuses the support
+//! forward and backward passes of the inner round at θ_k. The first-order variant keeps only
+//! ∇L_q(θ_n). The `reference_*` functions compute the same quantities with the generic scalar code
+//! (the Hessian-vector product as a reverse pass run on dual numbers); the tests hold the fast path
+//! to them.
 
 use serde::{Deserialize, Serialize};
 
+use crate::batched::ModelWorkspace;
 use crate::network::Architecture;
 use crate::scalar::Dual;
 
@@ -63,12 +67,28 @@ pub fn hessian_vector_product(
     direction: &[f64],
     batch: &Batch,
 ) -> (Vec<f64>, Vec<f64>) {
+    let mut workspace = ModelWorkspace::new(architecture);
+    let mut gradient = vec![0.0; parameters.len()];
+    let mut product = vec![0.0; parameters.len()];
+    workspace.mse_and_gradient(parameters, &batch.inputs, &batch.targets, &mut gradient);
+    workspace.hessian_vector_product(parameters, direction, &mut product);
+    (gradient, product)
+}
+
+/// [`hessian_vector_product`] by the generic reference code on dual numbers (forward-over-reverse).
+pub fn reference_hessian_vector_product(
+    architecture: &Architecture,
+    parameters: &[f64],
+    direction: &[f64],
+    batch: &Batch,
+) -> (Vec<f64>, Vec<f64>) {
     let dual: Vec<Dual> = parameters
         .iter()
         .zip(direction)
         .map(|(&p, &v)| Dual::new(p, v))
         .collect();
-    let (_, gradient) = architecture.loss_and_gradient(&dual, &batch.inputs, &batch.targets);
+    let (_, gradient) =
+        architecture.reference_loss_and_gradient(&dual, &batch.inputs, &batch.targets);
     gradient.into_iter().map(|d| (d.value, d.tangent)).unzip()
 }
 
@@ -79,26 +99,75 @@ pub fn inner_updates(
     support: &Batch,
     inner: InnerLoop,
 ) -> (Vec<Vec<f64>>, f64) {
-    let mut trajectory = vec![parameters.to_vec()];
-    let mut first_loss = f64::NAN;
-    for round in 0..inner.rounds {
-        let current = &trajectory[round];
-        let (loss, gradient) =
-            architecture.loss_and_gradient(current, &support.inputs, &support.targets);
-        if round == 0 {
-            first_loss = loss;
+    let mut workspace = MetaWorkspace::new(architecture);
+    let support_loss = workspace.inner_rounds(parameters, support, inner);
+    (workspace.trajectory[..=inner.rounds].to_vec(), support_loss)
+}
+
+/// Reusable buffers of [`meta_gradient_in`]: one support workspace per inner round (their passes
+/// are reused by the Hessian-vector products), one for the query batch, the trajectory θ₀ … θ_n.
+#[derive(Clone, Debug)]
+pub struct MetaWorkspace {
+    support: Vec<ModelWorkspace>,
+    query: ModelWorkspace,
+    trajectory: Vec<Vec<f64>>,
+    gradient: Vec<f64>,
+    product: Vec<f64>,
+}
+
+impl MetaWorkspace {
+    /// Empty buffers for `architecture`.
+    pub fn new(architecture: &Architecture) -> Self {
+        Self {
+            support: Vec::new(),
+            query: ModelWorkspace::new(architecture),
+            trajectory: Vec::new(),
+            gradient: Vec::new(),
+            product: Vec::new(),
         }
-        let next = current
-            .iter()
-            .zip(&gradient)
-            .map(|(p, g)| p - inner.step * g)
-            .collect();
-        trajectory.push(next);
     }
-    if inner.rounds == 0 {
-        first_loss = architecture.loss(parameters, &support.inputs, &support.targets);
+
+    /// Runs the inner rounds; `trajectory[..=rounds]` holds θ₀ … θ_n. Returns L_s(θ₀).
+    fn inner_rounds(&mut self, parameters: &[f64], support: &Batch, inner: InnerLoop) -> f64 {
+        let architecture = self.query.architecture().clone();
+        let size = parameters.len();
+        while self.support.len() < inner.rounds.max(1) {
+            self.support.push(ModelWorkspace::new(&architecture));
+        }
+        while self.trajectory.len() < inner.rounds + 1 {
+            self.trajectory.push(Vec::new());
+        }
+        self.gradient.resize(size, 0.0);
+        self.trajectory[0].clear();
+        self.trajectory[0].extend_from_slice(parameters);
+        let mut first_loss = f64::NAN;
+        for round in 0..inner.rounds {
+            let (done, rest) = self.trajectory.split_at_mut(round + 1);
+            let current = &done[round];
+            let loss = self.support[round].mse_and_gradient(
+                current,
+                &support.inputs,
+                &support.targets,
+                &mut self.gradient,
+            );
+            if round == 0 {
+                first_loss = loss;
+            }
+            let next = &mut rest[0];
+            next.clear();
+            next.extend(
+                current
+                    .iter()
+                    .zip(&self.gradient)
+                    .map(|(p, g)| p - inner.step * g),
+            );
+        }
+        if inner.rounds == 0 {
+            let prediction = self.support[0].forward(parameters, &support.inputs);
+            first_loss = crate::network::mean_squared_error(prediction, &support.targets);
+        }
+        first_loss
     }
-    (trajectory, first_loss)
 }
 
 /// The meta-gradient of one task (see the module documentation).
@@ -109,14 +178,93 @@ pub fn meta_gradient(
     inner: InnerLoop,
     order: MetaOrder,
 ) -> MetaGradient {
-    let (trajectory, support_loss) = inner_updates(architecture, parameters, &task.support, inner);
-    let adapted = trajectory.last().expect("the trajectory starts with θ");
-    let (query_loss, mut gradient) =
-        architecture.loss_and_gradient(adapted, &task.query.inputs, &task.query.targets);
+    meta_gradient_in(
+        &mut MetaWorkspace::new(architecture),
+        parameters,
+        task,
+        inner,
+        order,
+    )
+}
+
+/// [`meta_gradient`] with reusable buffers (created for the same architecture).
+pub fn meta_gradient_in(
+    workspace: &mut MetaWorkspace,
+    parameters: &[f64],
+    task: &Task,
+    inner: InnerLoop,
+    order: MetaOrder,
+) -> MetaGradient {
+    let support_loss = workspace.inner_rounds(parameters, &task.support, inner);
+    let size = parameters.len();
+    let mut gradient = vec![0.0; size];
+    let query_loss = workspace.query.mse_and_gradient(
+        &workspace.trajectory[inner.rounds],
+        &task.query.inputs,
+        &task.query.targets,
+        &mut gradient,
+    );
+    if order == MetaOrder::Second {
+        workspace.product.resize(size, 0.0);
+        for round in (0..inner.rounds).rev() {
+            workspace.support[round].hessian_vector_product(
+                &workspace.trajectory[round],
+                &gradient,
+                &mut workspace.product,
+            );
+            for (g, hv) in gradient.iter_mut().zip(&workspace.product) {
+                *g -= inner.step * hv;
+            }
+        }
+    }
+    MetaGradient {
+        support_loss,
+        query_loss,
+        gradient,
+    }
+}
+
+/// [`meta_gradient`] by the generic reference code (gradients in `f64`, Hessian-vector products
+/// on dual numbers), kept as the reference the fast path is tested against.
+pub fn reference_meta_gradient(
+    architecture: &Architecture,
+    parameters: &[f64],
+    task: &Task,
+    inner: InnerLoop,
+    order: MetaOrder,
+) -> MetaGradient {
+    let mut trajectory = vec![parameters.to_vec()];
+    let mut support_loss = f64::NAN;
+    for round in 0..inner.rounds {
+        let (loss, gradient) = architecture.reference_loss_and_gradient(
+            &trajectory[round],
+            &task.support.inputs,
+            &task.support.targets,
+        );
+        if round == 0 {
+            support_loss = loss;
+        }
+        let next = trajectory[round]
+            .iter()
+            .zip(&gradient)
+            .map(|(p, g)| p - inner.step * g)
+            .collect();
+        trajectory.push(next);
+    }
+    if inner.rounds == 0 {
+        support_loss = architecture
+            .reference_loss_and_gradient(parameters, &task.support.inputs, &task.support.targets)
+            .0;
+    }
+    let (query_loss, mut gradient) = architecture.reference_loss_and_gradient(
+        &trajectory[inner.rounds],
+        &task.query.inputs,
+        &task.query.targets,
+    );
     if order == MetaOrder::Second {
         for point in trajectory[..inner.rounds].iter().rev() {
             let (_, product) =
-                hessian_vector_product(architecture, point, &gradient, &task.support);
+                reference_hessian_vector_product(architecture, point, &gradient, &task.support);
             for (g, hv) in gradient.iter_mut().zip(product) {
                 *g -= inner.step * hv;
             }

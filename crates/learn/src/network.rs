@@ -6,8 +6,9 @@
 //!
 //! Basis index k = j·P + p stands for "basis function m_{p+1} attached to input feature j" (the
 //! analogue of SINDy's sin(x_j), cos(x_j) for P = 2). Parameters are one flat vector θ = [ψ; φ]; each
-//! layer stores its weights row-major (fan-in × fan-out) followed by its biases. Every pass is generic
-//! over [`Scalar`], so the same code yields gradients (`f64`) and Hessian-vector products ([`Dual`]).
+//! layer stores its weights row-major (fan-in × fan-out) followed by its biases. The public passes run
+//! on the batched hot path ([`crate::ModelWorkspace`]); the generic passes here (over [`Scalar`]: gradients
+//! in `f64`, Hessian-vector products on [`Dual`] numbers) are the reference they are tested against.
 //!
 //! [`Dual`]: crate::Dual
 
@@ -15,6 +16,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use crate::batched::ModelWorkspace;
 use crate::scalar::Scalar;
 
 /// Layer sizes of both networks and the dimensions of the problem.
@@ -314,42 +316,14 @@ impl Architecture {
         gradient
     }
 
-    /// Runs both networks on `inputs` (batch × (I+U), row-major) and forms y = Θ·ℰᵀ.
+    /// Runs both networks on `inputs` (batch × (I+U), row-major) and forms y = Θ·ℰᵀ (reference).
     pub(crate) fn forward<T: Scalar>(&self, parameters: &[T], inputs: &[f64]) -> ModelTape<T> {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { self.forward_avx2(parameters, inputs) };
-        }
         self.forward_portable(parameters, inputs)
     }
 
-    /// The gradient of a loss with respect to θ, given dL/dy (batch × I) at a forward pass.
+    /// The gradient of a loss with respect to θ, given dL/dy (batch × I) at a forward pass
+    /// (reference).
     pub(crate) fn backward<T: Scalar>(
-        &self,
-        parameters: &[T],
-        tape: &ModelTape<T>,
-        prediction_gradient: &[T],
-    ) -> Vec<T> {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { self.backward_avx2(parameters, tape, prediction_gradient) };
-        }
-        self.backward_portable(parameters, tape, prediction_gradient)
-    }
-
-    // The same code compiled with 256-bit vectors. No FMA: every product and sum is rounded as in
-    // the portable build, so both give bit-identical results.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn forward_avx2<T: Scalar>(&self, parameters: &[T], inputs: &[f64]) -> ModelTape<T> {
-        self.forward_portable(parameters, inputs)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn backward_avx2<T: Scalar>(
         &self,
         parameters: &[T],
         tape: &ModelTape<T>,
@@ -360,6 +334,13 @@ impl Architecture {
 
     /// Predictions y for each row of `inputs` (batch × (I+U)), batch × I row-major.
     pub fn predict(&self, parameters: &[f64], inputs: &[f64]) -> Vec<f64> {
+        ModelWorkspace::new(self)
+            .forward(parameters, inputs)
+            .to_vec()
+    }
+
+    /// [`Self::predict`] by the generic reference code.
+    pub fn reference_predict(&self, parameters: &[f64], inputs: &[f64]) -> Vec<f64> {
         self.forward(parameters, inputs).prediction
     }
 
@@ -369,12 +350,28 @@ impl Architecture {
         parameters: &[f64],
         inputs: &[f64],
     ) -> (Vec<f64>, Vec<f64>) {
-        let tape = self.forward(parameters, inputs);
-        (tape.library.output, tape.selection.output)
+        let mut workspace = ModelWorkspace::new(self);
+        workspace.forward(parameters, inputs);
+        let (library, selection) = workspace.library_and_selection();
+        (library.to_vec(), selection.to_vec())
     }
 
     /// Mean squared error over all samples and outputs, and its gradient with respect to θ.
-    pub fn loss_and_gradient<T: Scalar>(
+    pub fn loss_and_gradient(
+        &self,
+        parameters: &[f64],
+        inputs: &[f64],
+        targets: &[f64],
+    ) -> (f64, Vec<f64>) {
+        let mut gradient = vec![0.0; parameters.len()];
+        let loss =
+            ModelWorkspace::new(self).mse_and_gradient(parameters, inputs, targets, &mut gradient);
+        (loss, gradient)
+    }
+
+    /// [`Self::loss_and_gradient`] by the generic reference code: with `f64` the gradient, with
+    /// [`crate::Dual`] numbers (θ + ε·v) the Hessian-vector product in the tangents.
+    pub fn reference_loss_and_gradient<T: Scalar>(
         &self,
         parameters: &[T],
         inputs: &[f64],
@@ -440,26 +437,6 @@ mod tests {
         assert_ne!(
             architecture.initial_parameters(3),
             architecture.initial_parameters(4)
-        );
-    }
-
-    #[test]
-    fn the_vectorised_build_gives_bit_identical_results() {
-        let architecture = Architecture {
-            input_dim: 5,
-            state_dim: 3,
-            basis_per_input: 2,
-            hidden: vec![7, 9],
-        };
-        let parameters = architecture.initial_parameters(2);
-        let inputs: Vec<f64> = (0..5 * 11).map(|k| (k as f64 * 0.37).sin()).collect();
-        let fast = architecture.forward(&parameters, &inputs);
-        let portable = architecture.forward_portable(&parameters, &inputs);
-        assert_eq!(fast.prediction, portable.prediction);
-        let upstream: Vec<f64> = fast.prediction.iter().map(|y| y - 0.1).collect();
-        assert_eq!(
-            architecture.backward(&parameters, &fast, &upstream),
-            architecture.backward_portable(&parameters, &portable, &upstream)
         );
     }
 

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use crate::config::{MetaTrainingConfig, Optimizer};
 use crate::error::{LearnError, Result};
-use crate::maml::{Batch, InnerLoop, Task, meta_gradient};
+use crate::maml::{Batch, InnerLoop, MetaWorkspace, Task, meta_gradient_in};
 use crate::network::Architecture;
 
 /// The regression data of one meta-training task (one flight): its support and query segments.
@@ -181,13 +181,17 @@ pub fn meta_train_from(
     };
     let mut sampler = TaskSampler::new(seed, tasks.len());
     let mut adam = Adam::new(parameters.len());
+    let mut workspaces = vec![MetaWorkspace::new(architecture); config.task_batch];
     let mut meta_loss_history = Vec::with_capacity(config.iterations);
     let mut support_loss_history = Vec::with_capacity(config.iterations);
     for iteration in 0..config.iterations {
         let batch = sampler.draw(tasks, architecture.input_dim, config);
         let results: Vec<_> = batch
             .par_iter()
-            .map(|task| meta_gradient(architecture, &parameters, task, inner, config.order))
+            .zip(workspaces.par_iter_mut())
+            .map(|(task, workspace)| {
+                meta_gradient_in(workspace, &parameters, task, inner, config.order)
+            })
             .collect();
         let scale = 1.0 / results.len() as f64;
         let mut gradient: Vec<f64> = parameters

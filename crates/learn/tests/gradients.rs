@@ -1,8 +1,9 @@
 //! Every derivative against central finite differences in f64.
 
 use learn::{
-    Architecture, Batch, InnerLoop, MetaOrder, Task, hessian_vector_product, inner_updates,
-    meta_gradient,
+    Architecture, Batch, InnerLoop, MetaOrder, MetaWorkspace, Task, hessian_vector_product,
+    inner_updates, meta_gradient, meta_gradient_in, reference_hessian_vector_product,
+    reference_meta_gradient,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -190,4 +191,91 @@ fn second_order_meta_gradient_matches_finite_differences_and_first_order_does_no
         let loss = meta_loss(&architecture, &parameters, &task, inner);
         assert!((second.query_loss - loss).abs() < 1e-14 * loss);
     }
+}
+
+/// A task of the paper's sizes (the `full` formulation: I = 6, U = 4) on random data.
+fn paper_sized_setup() -> (Architecture, Vec<f64>, Task) {
+    let architecture = Architecture {
+        input_dim: 10,
+        state_dim: 6,
+        basis_per_input: 2,
+        hidden: learn::PAPER_HIDDEN.to_vec(),
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let parameters = architecture.initial_parameters(9);
+    let task = Task {
+        support: random_batch(&mut rng, 64, &architecture),
+        query: random_batch(&mut rng, 13, &architecture),
+    };
+    (architecture, parameters, task)
+}
+
+#[test]
+fn batched_fast_path_equals_the_generic_reference() {
+    for (architecture, parameters, task) in [setup(), paper_sized_setup()] {
+        let batch = &task.support;
+        let prediction = architecture.predict(&parameters, &batch.inputs);
+        let reference = architecture.reference_predict(&parameters, &batch.inputs);
+        assert!(relative_error(&prediction, &reference) < 1e-12);
+        let (loss, gradient) =
+            architecture.loss_and_gradient(&parameters, &batch.inputs, &batch.targets);
+        let (reference_loss, reference_gradient) =
+            architecture.reference_loss_and_gradient(&parameters, &batch.inputs, &batch.targets);
+        assert!((loss - reference_loss).abs() < 1e-12 * reference_loss);
+        let error = relative_error(&gradient, &reference_gradient);
+        assert!(error < 1e-12, "gradient: {error:e}");
+        let direction: Vec<f64> = parameters.iter().map(|p| (p * 37.0).sin()).collect();
+        let (_, product) = hessian_vector_product(&architecture, &parameters, &direction, batch);
+        let (_, reference_product) =
+            reference_hessian_vector_product(&architecture, &parameters, &direction, batch);
+        let error = relative_error(&product, &reference_product);
+        assert!(error < 1e-12, "H·v: {error:e}");
+        for rounds in [0, 1, 2] {
+            for order in [MetaOrder::Second, MetaOrder::First] {
+                let inner = InnerLoop { step: 0.3, rounds };
+                let fast = meta_gradient(&architecture, &parameters, &task, inner, order);
+                let reference =
+                    reference_meta_gradient(&architecture, &parameters, &task, inner, order);
+                let error = relative_error(&fast.gradient, &reference.gradient);
+                assert!(error < 1e-12, "meta-gradient n = {rounds}: {error:e}");
+                assert!(
+                    (fast.query_loss - reference.query_loss).abs() < 1e-12 * reference.query_loss
+                );
+                assert!(
+                    (fast.support_loss - reference.support_loss).abs()
+                        < 1e-12 * reference.support_loss
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn reused_workspaces_give_the_same_meta_gradient_as_fresh_ones() {
+    let (architecture, parameters, task) = paper_sized_setup();
+    let (_, _, other) = setup();
+    let inner = InnerLoop {
+        step: 0.2,
+        rounds: 2,
+    };
+    let mut workspace = MetaWorkspace::new(&architecture);
+    // A different batch size first, so the buffers have to be resized.
+    let small_task = Task {
+        support: Batch {
+            inputs: task.support.inputs[..30].to_vec(),
+            targets: task.support.targets[..18].to_vec(),
+        },
+        query: task.query.clone(),
+    };
+    let _ = meta_gradient_in(
+        &mut workspace,
+        &parameters,
+        &small_task,
+        inner,
+        MetaOrder::Second,
+    );
+    let reused = meta_gradient_in(&mut workspace, &parameters, &task, inner, MetaOrder::Second);
+    let fresh = meta_gradient(&architecture, &parameters, &task, inner, MetaOrder::Second);
+    assert_eq!(reused, fresh);
+    assert!(other.support.inputs.len() != task.support.inputs.len());
 }

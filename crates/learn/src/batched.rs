@@ -1,0 +1,691 @@
+//! The hot path: forward, backward and Pearlmutter's R-operator over a whole batch at once.
+//!
+//! Each layer is a matrix product over the batch (batch × width, row-major, [`crate::kernels`]);
+//! values and tangents live in separate arrays (no dual scalar); every buffer is allocated once
+//! in a [`ModelWorkspace`] and reused across calls. The generic scalar code of `network.rs` is the
+//! reference these passes are tested against (to ~1e-12) and finite differences check both.
+//!
+//! Notation for one network with layers l = 0 … L−1: h₀ = X, z_l = h_l·W_l + b_l,
+//! h_{l+1} = GELU(z_l) for hidden layers, output z_{L−1}. Backward: δ_l = ∂L/∂z_l,
+//! ∂L/∂W_l = h_lᵀ·δ_l, e_l = δ_l·W_lᵀ = ∂L/∂h_l, δ_{l−1} = e_l ⊙ GELU′(z_{l−1}).
+//! R-operator along a direction V (same layout as θ): Rz_l = Rh_l·W_l + h_l·V_l + Vb_l,
+//! Rh_{l+1} = GELU′(z_l) ⊙ Rz_l; R(∂L/∂W_l) = Rh_lᵀ·δ_l + h_lᵀ·Rδ_l,
+//! Rδ_{l−1} = (Rδ_l·W_lᵀ + δ_l·V_lᵀ) ⊙ GELU′(z_{l−1}) + e_l ⊙ GELU″(z_{l−1}) ⊙ Rz_{l−1}.
+//! The Hessian-vector product of the loss is H·V = R(∇L).
+
+use crate::kernels::{Strides, gelu_layer, matmul, matmul_with_bias, transpose};
+use crate::network::Architecture;
+
+/// Batches below this size form δ·Wᵀ without transposing W (the transposes would cost more).
+const TRANSPOSE_FROM_BATCH: usize = 8;
+
+/// Buffers of one network for one batch size.
+#[derive(Clone, Debug, Default)]
+struct NetworkWorkspace {
+    sizes: Vec<usize>,
+    /// Offset of W_l in the network's parameters (b_l follows W_l).
+    offsets: Vec<usize>,
+    /// h_1 … h_{L−1}, then the output z_{L−1}: `values[l]` is the output of layer l.
+    values: Vec<Vec<f64>>,
+    /// GELU′(z_l), GELU″(z_l) of the hidden layers.
+    first: Vec<Vec<f64>>,
+    second: Vec<Vec<f64>>,
+    /// δ_l.
+    deltas: Vec<Vec<f64>>,
+    /// e_l = δ_l·W_lᵀ for l ≥ 1 (index l − 1).
+    back: Vec<Vec<f64>>,
+    /// Rz_l and Rh_{l+1} (index l), Rδ_l.
+    r_pre: Vec<Vec<f64>>,
+    r_values: Vec<Vec<f64>>,
+    r_deltas: Vec<Vec<f64>>,
+    /// W_lᵀ and V_lᵀ for l ≥ 1 (index l).
+    weights_transposed: Vec<Vec<f64>>,
+    direction_transposed: Vec<Vec<f64>>,
+    /// Scratch for small batches (δ_lᵀ, then (δ·Wᵀ)ᵀ).
+    scratch: Vec<f64>,
+    scratch_out: Vec<f64>,
+}
+
+impl NetworkWorkspace {
+    fn new(sizes: Vec<usize>) -> Self {
+        let layers = sizes.len() - 1;
+        let mut offsets = Vec::with_capacity(layers);
+        let mut offset = 0;
+        for layer in sizes.windows(2) {
+            offsets.push(offset);
+            offset += (layer[0] + 1) * layer[1];
+        }
+        let weights_transposed: Vec<Vec<f64>> = sizes
+            .windows(2)
+            .map(|layer| vec![0.0; layer[0] * layer[1]])
+            .collect();
+        Self {
+            offsets,
+            values: vec![Vec::new(); layers],
+            first: vec![Vec::new(); layers - 1],
+            second: vec![Vec::new(); layers - 1],
+            deltas: vec![Vec::new(); layers],
+            back: vec![Vec::new(); layers - 1],
+            r_pre: vec![Vec::new(); layers],
+            r_values: vec![Vec::new(); layers - 1],
+            r_deltas: vec![Vec::new(); layers],
+            direction_transposed: weights_transposed.clone(),
+            weights_transposed,
+            scratch: Vec::new(),
+            scratch_out: Vec::new(),
+            sizes,
+        }
+    }
+
+    fn layers(&self) -> usize {
+        self.sizes.len() - 1
+    }
+
+    /// Sizes every per-batch buffer for `batch` rows.
+    fn resize(&mut self, batch: usize) {
+        let layers = self.layers();
+        for l in 0..layers {
+            let width = batch * self.sizes[l + 1];
+            for buffer in [
+                &mut self.values[l],
+                &mut self.deltas[l],
+                &mut self.r_pre[l],
+                &mut self.r_deltas[l],
+            ] {
+                buffer.resize(width, 0.0);
+            }
+            if l + 1 < layers {
+                for buffer in [
+                    &mut self.first[l],
+                    &mut self.second[l],
+                    &mut self.r_values[l],
+                ] {
+                    buffer.resize(width, 0.0);
+                }
+            }
+            if l >= 1 {
+                self.back[l - 1].resize(batch * self.sizes[l], 0.0);
+            }
+        }
+    }
+
+    fn weights<'a>(&self, parameters: &'a [f64], l: usize) -> (&'a [f64], &'a [f64]) {
+        let (fan_in, fan_out) = (self.sizes[l], self.sizes[l + 1]);
+        let start = self.offsets[l];
+        parameters[start..start + (fan_in + 1) * fan_out].split_at(fan_in * fan_out)
+    }
+
+    /// The input of layer l: X for l = 0, else h_l.
+    fn input<'a>(&'a self, inputs: &'a [f64], l: usize) -> &'a [f64] {
+        if l == 0 { inputs } else { &self.values[l - 1] }
+    }
+
+    fn forward(&mut self, parameters: &[f64], inputs: &[f64], batch: usize) {
+        let layers = self.layers();
+        for l in 0..layers {
+            let (fan_in, fan_out) = (self.sizes[l], self.sizes[l + 1]);
+            let (weights, biases) = self.weights(parameters, l);
+            let mut z = std::mem::take(&mut self.values[l]);
+            let input = self.input(inputs, l);
+            matmul_with_bias(
+                batch,
+                fan_out,
+                fan_in,
+                input,
+                Strides {
+                    row: fan_in,
+                    depth: 1,
+                },
+                weights,
+                fan_out,
+                &mut z,
+                fan_out,
+                false,
+                Some(biases),
+            );
+            if l + 1 < layers {
+                gelu_layer(&mut z, &mut self.first[l], &mut self.second[l]);
+            }
+            self.values[l] = z;
+        }
+    }
+
+    /// out (batch × fan_in) = delta (batch × fan_out) · W_lᵀ, `weights_t` = W_lᵀ when available.
+    #[allow(clippy::too_many_arguments)]
+    fn times_transposed(
+        scratch: &mut Vec<f64>,
+        scratch_out: &mut Vec<f64>,
+        batch: usize,
+        fan_in: usize,
+        fan_out: usize,
+        delta: &[f64],
+        weights: &[f64],
+        weights_t: Option<&[f64]>,
+        out: &mut [f64],
+        accumulate: bool,
+    ) {
+        if let Some(weights_t) = weights_t {
+            matmul(
+                batch,
+                fan_in,
+                fan_out,
+                delta,
+                Strides {
+                    row: fan_out,
+                    depth: 1,
+                },
+                weights_t,
+                fan_in,
+                out,
+                fan_in,
+                accumulate,
+            );
+            return;
+        }
+        // outᵀ (fan_in × batch) = W_l (fan_in × fan_out) · deltaᵀ (fan_out × batch).
+        scratch.resize(fan_out * batch, 0.0);
+        transpose(batch, fan_out, delta, scratch);
+        scratch_out.resize(fan_in * batch, 0.0);
+        matmul(
+            fan_in,
+            batch,
+            fan_out,
+            weights,
+            Strides {
+                row: fan_out,
+                depth: 1,
+            },
+            scratch,
+            batch,
+            scratch_out,
+            batch,
+            false,
+        );
+        for b in 0..batch {
+            let row = &mut out[b * fan_in..(b + 1) * fan_in];
+            for (j, target) in row.iter_mut().enumerate() {
+                let value = scratch_out[j * batch + b];
+                *target = if accumulate { *target + value } else { value };
+            }
+        }
+    }
+
+    /// Writes ∂L/∂θ of this network into `gradient`, given δ_{L−1} in `deltas[L−1]`.
+    fn backward(&mut self, parameters: &[f64], inputs: &[f64], batch: usize, gradient: &mut [f64]) {
+        let layers = self.layers();
+        let transposed = batch >= TRANSPOSE_FROM_BATCH;
+        for l in (0..layers).rev() {
+            let (fan_in, fan_out) = (self.sizes[l], self.sizes[l + 1]);
+            let start = self.offsets[l];
+            let (weight_gradient, bias_gradient) =
+                gradient[start..start + (fan_in + 1) * fan_out].split_at_mut(fan_in * fan_out);
+            let delta = &self.deltas[l];
+            matmul(
+                fan_in,
+                fan_out,
+                batch,
+                self.input(inputs, l),
+                Strides {
+                    row: 1,
+                    depth: fan_in,
+                },
+                delta,
+                fan_out,
+                weight_gradient,
+                fan_out,
+                false,
+            );
+            column_sums(delta, fan_out, bias_gradient);
+            if l == 0 {
+                break;
+            }
+            let (weights, _) = self.weights(parameters, l);
+            if transposed {
+                transpose(fan_in, fan_out, weights, &mut self.weights_transposed[l]);
+            }
+            let mut back = std::mem::take(&mut self.back[l - 1]);
+            Self::times_transposed(
+                &mut self.scratch,
+                &mut self.scratch_out,
+                batch,
+                fan_in,
+                fan_out,
+                &self.deltas[l],
+                weights,
+                transposed.then_some(self.weights_transposed[l].as_slice()),
+                &mut back,
+                false,
+            );
+            for ((previous, &e), &d) in self.deltas[l - 1]
+                .iter_mut()
+                .zip(&back)
+                .zip(&self.first[l - 1])
+            {
+                *previous = e * d;
+            }
+            self.back[l - 1] = back;
+        }
+    }
+
+    /// Rz_l and Rh_l along `direction` (this network's part of V).
+    fn r_forward(&mut self, parameters: &[f64], direction: &[f64], inputs: &[f64], batch: usize) {
+        let layers = self.layers();
+        for l in 0..layers {
+            let (fan_in, fan_out) = (self.sizes[l], self.sizes[l + 1]);
+            let (weights, _) = self.weights(parameters, l);
+            let (direction_weights, direction_biases) = self.weights(direction, l);
+            let mut r_pre = std::mem::take(&mut self.r_pre[l]);
+            let row_major = Strides {
+                row: fan_in,
+                depth: 1,
+            };
+            matmul_with_bias(
+                batch,
+                fan_out,
+                fan_in,
+                self.input(inputs, l),
+                row_major,
+                direction_weights,
+                fan_out,
+                &mut r_pre,
+                fan_out,
+                false,
+                Some(direction_biases),
+            );
+            if l >= 1 {
+                matmul(
+                    batch,
+                    fan_out,
+                    fan_in,
+                    &self.r_values[l - 1],
+                    row_major,
+                    weights,
+                    fan_out,
+                    &mut r_pre,
+                    fan_out,
+                    true,
+                );
+            }
+            if l + 1 < layers {
+                for ((r_value, &r), &d) in
+                    self.r_values[l].iter_mut().zip(&r_pre).zip(&self.first[l])
+                {
+                    *r_value = d * r;
+                }
+            }
+            self.r_pre[l] = r_pre;
+        }
+    }
+
+    /// Writes R(∂L/∂θ) of this network into `product`, given Rδ_{L−1} in `r_deltas[L−1]`
+    /// (after `forward`, `backward` and `r_forward` at the same point).
+    fn r_backward(
+        &mut self,
+        parameters: &[f64],
+        direction: &[f64],
+        inputs: &[f64],
+        batch: usize,
+        product: &mut [f64],
+    ) {
+        let layers = self.layers();
+        let transposed = batch >= TRANSPOSE_FROM_BATCH;
+        for l in (0..layers).rev() {
+            let (fan_in, fan_out) = (self.sizes[l], self.sizes[l + 1]);
+            let start = self.offsets[l];
+            let (weight_product, bias_product) =
+                product[start..start + (fan_in + 1) * fan_out].split_at_mut(fan_in * fan_out);
+            let transposed_input = Strides {
+                row: 1,
+                depth: fan_in,
+            };
+            matmul(
+                fan_in,
+                fan_out,
+                batch,
+                self.input(inputs, l),
+                transposed_input,
+                &self.r_deltas[l],
+                fan_out,
+                weight_product,
+                fan_out,
+                false,
+            );
+            if l >= 1 {
+                matmul(
+                    fan_in,
+                    fan_out,
+                    batch,
+                    &self.r_values[l - 1],
+                    transposed_input,
+                    &self.deltas[l],
+                    fan_out,
+                    weight_product,
+                    fan_out,
+                    true,
+                );
+            }
+            column_sums(&self.r_deltas[l], fan_out, bias_product);
+            if l == 0 {
+                break;
+            }
+            let (weights, _) = self.weights(parameters, l);
+            let (direction_weights, _) = self.weights(direction, l);
+            if transposed {
+                transpose(
+                    fan_in,
+                    fan_out,
+                    direction_weights,
+                    &mut self.direction_transposed[l],
+                );
+            }
+            // r_back = Rδ_l·W_lᵀ + δ_l·V_lᵀ (W_lᵀ is still in place from `backward`).
+            let mut r_back = std::mem::take(&mut self.r_deltas[l - 1]);
+            Self::times_transposed(
+                &mut self.scratch,
+                &mut self.scratch_out,
+                batch,
+                fan_in,
+                fan_out,
+                &self.r_deltas[l],
+                weights,
+                transposed.then_some(self.weights_transposed[l].as_slice()),
+                &mut r_back,
+                false,
+            );
+            Self::times_transposed(
+                &mut self.scratch,
+                &mut self.scratch_out,
+                batch,
+                fan_in,
+                fan_out,
+                &self.deltas[l],
+                direction_weights,
+                transposed.then_some(self.direction_transposed[l].as_slice()),
+                &mut r_back,
+                true,
+            );
+            for ((((r, &d1), &d2), &e), &r_pre) in r_back
+                .iter_mut()
+                .zip(&self.first[l - 1])
+                .zip(&self.second[l - 1])
+                .zip(&self.back[l - 1])
+                .zip(&self.r_pre[l - 1])
+            {
+                *r = *r * d1 + e * d2 * r_pre;
+            }
+            self.r_deltas[l - 1] = r_back;
+        }
+    }
+}
+
+/// out[c] = Σ_b matrix[b·width + c], summed in row order.
+fn column_sums(matrix: &[f64], width: usize, out: &mut [f64]) {
+    out.fill(0.0);
+    for row in matrix.chunks_exact(width) {
+        for (o, &v) in out.iter_mut().zip(row) {
+            *o += v;
+        }
+    }
+}
+
+/// Reusable buffers for forward, backward and Hessian-vector passes of one [`Architecture`]
+/// on batches of any size (buffers grow to the largest batch seen).
+#[derive(Clone, Debug)]
+pub struct ModelWorkspace {
+    architecture: Architecture,
+    library: NetworkWorkspace,
+    selection: NetworkWorkspace,
+    batch: usize,
+    inputs: Vec<f64>,
+    /// y, batch × I.
+    prediction: Vec<f64>,
+    /// ∂L/∂y of the last backward pass.
+    prediction_gradient: Vec<f64>,
+    /// R(∂L/∂y) and Ry.
+    r_prediction: Vec<f64>,
+    /// Whether the stored ∂L/∂y is the mean squared error's (required by the Hessian product).
+    mse_backward: bool,
+}
+
+impl ModelWorkspace {
+    /// Empty buffers for `architecture`.
+    pub fn new(architecture: &Architecture) -> Self {
+        Self {
+            architecture: architecture.clone(),
+            library: NetworkWorkspace::new(architecture.library_sizes()),
+            selection: NetworkWorkspace::new(architecture.selection_sizes()),
+            batch: 0,
+            inputs: Vec::new(),
+            prediction: Vec::new(),
+            prediction_gradient: Vec::new(),
+            r_prediction: Vec::new(),
+            mse_backward: false,
+        }
+    }
+
+    /// The architecture these buffers serve.
+    pub fn architecture(&self) -> &Architecture {
+        &self.architecture
+    }
+
+    /// Runs both networks on `inputs` (batch × (I+U), row-major) and forms y = Θ·ℰᵀ.
+    pub fn forward(&mut self, parameters: &[f64], inputs: &[f64]) -> &[f64] {
+        let architecture = &self.architecture;
+        assert_eq!(parameters.len(), architecture.parameter_count(), "θ length");
+        assert_eq!(inputs.len() % architecture.input_dim, 0, "input width");
+        let batch = inputs.len() / architecture.input_dim;
+        self.batch = batch;
+        self.mse_backward = false;
+        self.inputs.clear();
+        self.inputs.extend_from_slice(inputs);
+        self.library.resize(batch);
+        self.selection.resize(batch);
+        let split = architecture.library_parameter_count();
+        self.library.forward(&parameters[..split], inputs, batch);
+        self.selection.forward(&parameters[split..], inputs, batch);
+        let (basis, states) = (architecture.basis_count(), architecture.state_dim);
+        self.prediction.clear();
+        let theta_all = &self.library.values[self.library.layers() - 1];
+        let selection_all = &self.selection.values[self.selection.layers() - 1];
+        for (theta, selection) in theta_all
+            .chunks_exact(basis)
+            .zip(selection_all.chunks_exact(states * basis))
+        {
+            for coefficients in selection.chunks_exact(basis) {
+                self.prediction.push(dot(theta, coefficients));
+            }
+        }
+        &self.prediction
+    }
+
+    /// The predictions of the last forward pass, batch × I.
+    pub fn prediction(&self) -> &[f64] {
+        &self.prediction
+    }
+
+    /// Θ (batch × K) and ℰ (batch × I·K) of the last forward pass.
+    pub fn library_and_selection(&self) -> (&[f64], &[f64]) {
+        (
+            &self.library.values[self.library.layers() - 1],
+            &self.selection.values[self.selection.layers() - 1],
+        )
+    }
+
+    /// ∂L/∂θ into `gradient` given ∂L/∂y (batch × I) at the last forward pass.
+    pub fn backward(
+        &mut self,
+        parameters: &[f64],
+        prediction_gradient: &[f64],
+        gradient: &mut [f64],
+    ) {
+        assert_eq!(
+            prediction_gradient.len(),
+            self.prediction.len(),
+            "∂L/∂y size"
+        );
+        assert_eq!(gradient.len(), parameters.len(), "gradient length");
+        self.prediction_gradient.clear();
+        self.prediction_gradient
+            .extend_from_slice(prediction_gradient);
+        self.mse_backward = false;
+        self.backward_stored(parameters, gradient);
+    }
+
+    fn backward_stored(&mut self, parameters: &[f64], gradient: &mut [f64]) {
+        let (basis, states) = (self.architecture.basis_count(), self.architecture.state_dim);
+        let batch = self.batch;
+        let library_layers = self.library.layers();
+        let selection_layers = self.selection.layers();
+        {
+            let theta_all = &self.library.values[library_layers - 1];
+            let selection_all = &self.selection.values[selection_layers - 1];
+            let d_theta_all = &mut self.library.deltas[library_layers - 1];
+            let d_selection_all = &mut self.selection.deltas[selection_layers - 1];
+            for b in 0..batch {
+                let theta = &theta_all[b * basis..(b + 1) * basis];
+                let selection = &selection_all[b * states * basis..(b + 1) * states * basis];
+                let d_theta = &mut d_theta_all[b * basis..(b + 1) * basis];
+                let d_selection =
+                    &mut d_selection_all[b * states * basis..(b + 1) * states * basis];
+                d_theta.fill(0.0);
+                for state in 0..states {
+                    let g = self.prediction_gradient[b * states + state];
+                    let coefficients = &selection[state * basis..(state + 1) * basis];
+                    let d_coefficients = &mut d_selection[state * basis..(state + 1) * basis];
+                    for k in 0..basis {
+                        d_theta[k] += g * coefficients[k];
+                        d_coefficients[k] = g * theta[k];
+                    }
+                }
+            }
+        }
+        let split = self.architecture.library_parameter_count();
+        let (library_gradient, selection_gradient) = gradient.split_at_mut(split);
+        self.library
+            .backward(&parameters[..split], &self.inputs, batch, library_gradient);
+        self.selection.backward(
+            &parameters[split..],
+            &self.inputs,
+            batch,
+            selection_gradient,
+        );
+    }
+
+    /// Mean squared error on (inputs, targets) and its gradient into `gradient`; keeps what
+    /// [`Self::hessian_vector_product`] needs.
+    pub fn mse_and_gradient(
+        &mut self,
+        parameters: &[f64],
+        inputs: &[f64],
+        targets: &[f64],
+        gradient: &mut [f64],
+    ) -> f64 {
+        self.forward(parameters, inputs);
+        assert_eq!(targets.len(), self.prediction.len(), "target size");
+        let scale = 2.0 / targets.len() as f64;
+        let mut loss = 0.0;
+        self.prediction_gradient.clear();
+        for (&y, &t) in self.prediction.iter().zip(targets) {
+            let residual = y - t;
+            loss += residual * residual;
+            self.prediction_gradient.push(residual * scale);
+        }
+        self.backward_stored(parameters, gradient);
+        self.mse_backward = true;
+        loss / targets.len() as f64
+    }
+
+    /// H(θ)·v of the mean squared error, into `product`, at the point and batch of the last
+    /// [`Self::mse_and_gradient`] (whose stored passes it reuses).
+    pub fn hessian_vector_product(
+        &mut self,
+        parameters: &[f64],
+        direction: &[f64],
+        product: &mut [f64],
+    ) {
+        assert!(
+            self.mse_backward,
+            "hessian_vector_product needs a preceding mse_and_gradient"
+        );
+        assert_eq!(direction.len(), parameters.len(), "direction length");
+        assert_eq!(product.len(), parameters.len(), "product length");
+        let architecture = &self.architecture;
+        let (basis, states, batch) = (
+            architecture.basis_count(),
+            architecture.state_dim,
+            self.batch,
+        );
+        let split = architecture.library_parameter_count();
+        self.library.r_forward(
+            &parameters[..split],
+            &direction[..split],
+            &self.inputs,
+            batch,
+        );
+        self.selection.r_forward(
+            &parameters[split..],
+            &direction[split..],
+            &self.inputs,
+            batch,
+        );
+        let library_last = self.library.layers() - 1;
+        let selection_last = self.selection.layers() - 1;
+        let scale = 2.0 / self.prediction.len() as f64;
+        let theta_all = &self.library.values[library_last];
+        let selection_all = &self.selection.values[selection_last];
+        let r_theta_all = &self.library.r_pre[library_last];
+        let r_selection_all = &self.selection.r_pre[selection_last];
+        let r_d_theta_all = &mut self.library.r_deltas[library_last];
+        let r_d_selection_all = &mut self.selection.r_deltas[selection_last];
+        self.r_prediction.resize(states, 0.0);
+        for b in 0..batch {
+            let theta = &theta_all[b * basis..(b + 1) * basis];
+            let r_theta = &r_theta_all[b * basis..(b + 1) * basis];
+            let row = b * states * basis..(b + 1) * states * basis;
+            let selection = &selection_all[row.clone()];
+            let r_selection = &r_selection_all[row.clone()];
+            // R(∂L/∂y) = (2/N)·Ry, Ry_i = Σ_k RΘ_k·ℰ_ik + Θ_k·Rℰ_ik.
+            for state in 0..states {
+                let cols = state * basis..(state + 1) * basis;
+                self.r_prediction[state] = scale
+                    * (dot(r_theta, &selection[cols.clone()]) + dot(theta, &r_selection[cols]));
+            }
+            let r_d_theta = &mut r_d_theta_all[b * basis..(b + 1) * basis];
+            let r_d_selection = &mut r_d_selection_all[row];
+            r_d_theta.fill(0.0);
+            for state in 0..states {
+                let g = self.prediction_gradient[b * states + state];
+                let r_g = self.r_prediction[state];
+                let cols = state * basis..(state + 1) * basis;
+                let (coefficients, r_coefficients) =
+                    (&selection[cols.clone()], &r_selection[cols.clone()]);
+                let r_d_coefficients = &mut r_d_selection[cols];
+                for k in 0..basis {
+                    r_d_theta[k] += r_g * coefficients[k] + g * r_coefficients[k];
+                    r_d_coefficients[k] = r_g * theta[k] + g * r_theta[k];
+                }
+            }
+        }
+        let (library_product, selection_product) = product.split_at_mut(split);
+        self.library.r_backward(
+            &parameters[..split],
+            &direction[..split],
+            &self.inputs,
+            batch,
+            library_product,
+        );
+        self.selection.r_backward(
+            &parameters[split..],
+            &direction[split..],
+            &self.inputs,
+            batch,
+            selection_product,
+        );
+    }
+}
+
+/// Σ a_i·b_i in index order.
+#[inline(always)]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).fold(0.0, |sum, (&x, &y)| sum + x * y)
+}

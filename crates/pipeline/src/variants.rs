@@ -777,6 +777,36 @@ pub fn ablations_markdown(ablations: &Ablations) -> String {
         config.headline,
         ablations.rows.iter().filter(|r| r.target.is_some()).count()
     ));
+    out.push_str(
+        "## Distance above the noise floor: generalisation MSE ÷ the query floor's upper estimate\n\n\
+         1.00 would mean nothing but (upper-estimate) noise is left; the lower estimate shows how \
+         much of that upper estimate may itself be fast, predictable motion.\n\n\
+         | table | condition | floor (lower–upper) | published SINDy | published LeARN | ours SINDy | headline | best variant |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    for row in &ablations.rows {
+        let floor = row.noise_floor_query.upper;
+        let ratio = |value: f64| format!("{:.2}", value / floor);
+        let (pub_sindy, pub_learn) = row
+            .published
+            .map(|p| (ratio(p.sindy.generalisation), ratio(p.learn.generalisation)))
+            .unwrap_or(("–".to_string(), "–".to_string()));
+        let best = row
+            .variants
+            .values()
+            .map(|v| v.r#gen)
+            .fold(f64::INFINITY, f64::min);
+        out.push_str(&format!(
+            "| {} | {} | {:.3}–{floor:.3} | {pub_sindy} | {pub_learn} | {} | {} | {} |\n",
+            row.table,
+            row.condition,
+            row.noise_floor_query.lower,
+            ratio(row.sindy.generalisation),
+            ratio(row.variants[&config.headline].r#gen),
+            ratio(best),
+        ));
+    }
+    out.push('\n');
     if let Some(name) = &config.figure_variant {
         out.push_str(&format!(
             "## Predictive band of `{name}` (drawn in `figures/`): share of query targets inside it\n\n\
@@ -862,4 +892,69 @@ pub fn ablations_markdown(ablations: &Ablations) -> String {
         out.push_str(&format!("- `{}`: {}\n", variant.name, variant.description));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(name: &str, text: &str) -> PathBuf {
+        let path = std::env::temp_dir().join(format!(
+            "pipeline-variants-{}-{name}.json",
+            std::process::id()
+        ));
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    fn config(variants: &str, extra: &str) -> String {
+        format!(
+            r#"{{"name": "t", "description": "d", "run": "experiments/reproduce.json",
+               "seeds": [1], "headline": "a", {extra} "variants": [{variants}]}}"#
+        )
+    }
+
+    const RIDGE: &str = r#""kind": "library", "library": {"linear": true},
+        "regression": {"penalty": {"kind": "ridge", "lambdas": [0.0]}}"#;
+    const LEARNED: &str = r#""kind": "learned_basis", "features": "basis",
+        "regression": {"penalty": {"kind": "ridge", "lambdas": [0.0]}}"#;
+
+    #[test]
+    fn the_variants_file_is_checked() {
+        let a = format!(r#"{{"name": "a", "description": "", {RIDGE}}}"#);
+        let b = format!(r#"{{"name": "b", "description": "", {LEARNED}}}"#);
+        let select = r#"{"name": "s", "description": "", "kind": "select", "candidates": ["a"]}"#;
+        let good = write(
+            "good",
+            &config(&format!("{a}, {b}, {select}"), r#""reproduce": ["s"],"#),
+        );
+        let read = VariantsConfig::read(&good).unwrap();
+        assert_eq!(read.reproduce_variants().len(), 2);
+
+        let cases = [
+            ("twice", config(&format!("{a}, {a}"), ""), "declared twice"),
+            (
+                "forward",
+                config(&format!("{select}, {a}"), ""),
+                "declared before it",
+            ),
+            (
+                "headline",
+                config(&b.replace("\"b\"", "\"c\""), ""),
+                "'a' is not",
+            ),
+            (
+                "expensive",
+                config(&format!("{a}, {b}"), r#""reproduce": ["b"],"#),
+                "meta-training",
+            ),
+        ];
+        for (name, text, expected) in cases {
+            let message = VariantsConfig::read(&write(name, &text))
+                .err()
+                .unwrap_or_else(|| panic!("{name} was accepted"))
+                .to_string();
+            assert!(message.contains(expected), "{name}: {message}");
+        }
+    }
 }

@@ -17,10 +17,25 @@ pub struct Args {
     /// The project root: relative paths in the configuration start here.
     #[arg(long, default_value = ".")]
     pub root: PathBuf,
+    /// Only rewrite `<out>/ablations.md` from an existing `ablations.json` (no fitting).
+    #[arg(long)]
+    pub render_only: bool,
 }
 
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let start = std::time::Instant::now();
+    if args.render_only {
+        let json = args.out.join("ablations.json");
+        let text = std::fs::read_to_string(&json)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
+        let ablations: pipeline::Ablations =
+            serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
+        let markdown = pipeline::ablations_markdown(&ablations);
+        let md = args.out.join("ablations.md");
+        std::fs::write(&md, &markdown).map_err(|e| anyhow::anyhow!("{}: {e}", md.display()))?;
+        println!("{markdown}");
+        return Ok(());
+    }
     let config = VariantsConfig::load(&args.config, &args.root)?;
     let data_dir = global.data_dir()?;
     let quiet = global.quiet;

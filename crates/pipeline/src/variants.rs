@@ -135,6 +135,8 @@ pub struct CheckedVariants {
     pub raw: VariantsConfig,
     pub path: PathBuf,
     pub run: CheckedRunConfig,
+    /// The project root (for the git commit of the inputs).
+    pub root: PathBuf,
 }
 
 impl VariantsConfig {
@@ -218,6 +220,7 @@ impl VariantsConfig {
             raw,
             path: path.to_path_buf(),
             run,
+            root: root.to_path_buf(),
         })
     }
 
@@ -342,8 +345,22 @@ pub struct Ablations {
     pub name: String,
     pub description: String,
     pub protocol: String,
+    pub provenance: AblationProvenance,
     pub config: VariantsConfig,
     pub rows: Vec<AblationRow>,
+}
+
+/// Where the ablation numbers come from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AblationProvenance {
+    /// The last commit that changed an input of the run (see [`crate::git_commit`]).
+    pub git_commit: String,
+    /// The evaluation flights (relative to the data directory) and their SHA-256.
+    pub data_files: Vec<learn::DataFile>,
+    /// The LeARN configuration the learned-basis variants were meta-trained with (after
+    /// `learn_overrides`), when any learned-basis variant ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub learn_config: Option<learn::LearnConfig>,
 }
 
 struct CellData<'a> {
@@ -385,9 +402,14 @@ pub fn run_variants(
                 condition,
                 &run.conditions.evaluation_controller,
             );
-            Ok(FlightLog::read(&path)?)
+            let file = learn::DataFile {
+                path: path.strip_prefix(data_dir).unwrap_or(&path).to_path_buf(),
+                sha256: data::file_sha256(&path)?,
+            };
+            Ok((FlightLog::read(&path)?, file))
         })
         .collect::<Result<Vec<_>>>()?;
+    let (logs, data_files): (Vec<FlightLog>, Vec<learn::DataFile>) = logs.into_iter().unzip();
     let mut cells = Vec::new();
     for &formulation in &run.raw.formulations {
         for (condition, log) in conditions.iter().zip(&logs) {
@@ -476,6 +498,11 @@ pub fn run_variants(
         ablations: Ablations {
             name: config.raw.name.clone(),
             description: config.raw.description.clone(),
+            provenance: AblationProvenance {
+                git_commit: crate::git_commit(&config.root),
+                data_files,
+                learn_config: experiment.as_ref().map(|e| e.config().get().clone()),
+            },
             protocol: "support = first half, query = second half, forward-difference targets on each segment; every choice by blocked cross-validation inside the support segment".to_string(),
             config: config.raw.clone(),
             rows,

@@ -337,6 +337,10 @@ pub struct AblationRow {
     pub noise_floor_support: NoiseFloor,
     pub noise_floor_query: NoiseFloor,
     pub variants: BTreeMap<String, VariantCell>,
+    /// The headline model fitted with the first seed, one equation per output, terms ordered by
+    /// their share of the prediction's variance on the support segment (largest first).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub headline_equations: Vec<String>,
 }
 
 /// The whole ablation result (`results/ablations/ablations.json`).
@@ -492,6 +496,13 @@ pub fn run_variants(
             noise_floor_support: forward_difference_noise_floor(&cell.support, dt)?,
             noise_floor_query: forward_difference_noise_floor(&cell.query, dt)?,
             variants,
+            headline_equations: config
+                .raw
+                .variants
+                .iter()
+                .position(|v| v.name == config.raw.headline)
+                .map(|index| equations(&per_seed[0][index].evaluation, cell.formulation))
+                .unwrap_or_default(),
         });
     }
     Ok(AblationsOutcome {
@@ -629,6 +640,52 @@ fn outcome_of(
         chosen,
         support_cv,
     }
+}
+
+/// `ẋ_i = b + Σ c·feature` per output: the terms with a non-zero coefficient, ordered by the size
+/// of their standardised coefficient (their share of the prediction's spread on the support
+/// segment), coefficients in the units of the raw features.
+fn equations(evaluation: &VariantEvaluation, formulation: Formulation) -> Vec<String> {
+    let fit = &evaluation.fit.full;
+    let (raw, intercepts) = fit.raw_coefficients();
+    formulation
+        .target_names()
+        .iter()
+        .enumerate()
+        .map(|(j, output)| {
+            let mut terms: Vec<usize> = (0..raw.nrows())
+                .filter(|&i| fit.coefficients[(i, j)] != 0.0)
+                .collect();
+            terms.sort_by(|&a, &b| {
+                fit.coefficients[(b, j)]
+                    .abs()
+                    .total_cmp(&fit.coefficients[(a, j)].abs())
+            });
+            let mut text = format!("{output} = {:.4}", intercepts[j]);
+            for i in terms {
+                let c = raw[(i, j)];
+                let sign = if c < 0.0 { '-' } else { '+' };
+                text.push_str(&format!(
+                    " {sign} {:.4} {}",
+                    c.abs(),
+                    evaluation.feature_names[i]
+                ));
+            }
+            text
+        })
+        .collect()
+}
+
+/// The intercept and the first `terms` terms of an equation written by [`equations`].
+fn shorten(equation: &str, terms: usize) -> String {
+    let words: Vec<&str> = equation.split(' ').collect();
+    // "out = b" then groups of three words: sign, coefficient, feature.
+    let keep = (3 + 3 * terms).min(words.len());
+    let mut text = words[..keep].join(" ");
+    if keep < words.len() {
+        text.push_str(" …");
+    }
+    text
 }
 
 /// The fraction of `targets` inside the band.
@@ -911,6 +968,26 @@ pub fn ablations_markdown(ablations: &Ablations) -> String {
                 out.push_str(&format!(" {mean:.3} ± {std:.3} |"));
             }
             out.push('\n');
+        }
+        out.push('\n');
+    }
+    if ablations
+        .rows
+        .iter()
+        .any(|r| !r.headline_equations.is_empty())
+    {
+        out.push_str(&format!(
+            "## `{}` equations (seed {}), the five largest terms\n\n\
+             Terms ordered by standardised coefficient; every term is in `ablations.json`.\n\n",
+            config.headline,
+            config.seeds.first().copied().unwrap_or_default()
+        ));
+        for row in &ablations.rows {
+            out.push_str(&format!("- {} {}:\n", row.table, row.condition));
+            for equation in &row.headline_equations {
+                let shown = shorten(equation, 5);
+                out.push_str(&format!("  - `{shown}`\n"));
+            }
         }
         out.push('\n');
     }

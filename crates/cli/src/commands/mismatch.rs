@@ -79,7 +79,11 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let names: Vec<&str> = report.effects.iter().map(|e| e.id.as_str()).collect();
     println!(
         "effects: {}; held-out MSE {:.5} -> {:.5}; wrote {}",
-        if names.is_empty() { "none".to_string() } else { names.join(", ") },
+        if names.is_empty() {
+            "none".to_string()
+        } else {
+            names.join(", ")
+        },
         report.fit.heldout.before.mse,
         report.fit.heldout.after.mse,
         args.out.display()

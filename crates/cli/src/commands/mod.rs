@@ -1,5 +1,6 @@
 //! Subcommands of `learn`.
 
+mod ablations;
 mod check_paper;
 mod conditions;
 mod explain;
@@ -8,7 +9,6 @@ mod meta_train;
 mod mismatch;
 mod reproduce;
 mod simulate;
-mod ablations;
 mod sindy;
 
 use std::path::PathBuf;

@@ -22,7 +22,10 @@ pub struct Args {
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     if args.out.exists() && !args.force {
-        bail!("{}: already exists (pass --force to overwrite)", args.out.display());
+        bail!(
+            "{}: already exists (pass --force to overwrite)",
+            args.out.display()
+        );
     }
     let (scenario, model) = physics::Scenario::load(&args.scenario)?;
     let name = args
@@ -40,7 +43,11 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         log.len(),
         scenario.duration_s,
         scenario.seed,
-        if effects.is_empty() { "none".to_string() } else { effects.join(", ") }
+        if effects.is_empty() {
+            "none".to_string()
+        } else {
+            effects.join(", ")
+        }
     );
     Ok(())
 }

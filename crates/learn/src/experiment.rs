@@ -9,13 +9,13 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::adapt::adapt_online;
-use crate::config::CheckedConfig;
+use crate::config::{AdaptationConfig, CheckedConfig, LearnConfig};
 use crate::dataset::{Protocol, Standardiser, flight_segments, from_row_major, segment_batch};
 use crate::error::{LearnError, Result};
 use crate::maml::Batch;
 use crate::model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel};
 use crate::network::{Architecture, mean_squared_error};
-use crate::train::{TaskData, meta_train};
+use crate::train::{MetaTrainingOutcome, TaskData, meta_train};
 
 /// A flight log with its file's SHA-256.
 struct LoadedFlight {
@@ -161,12 +161,44 @@ impl Experiment {
         let files =
             self.protocol
                 .training_files(&self.conditions, &self.data_dir, evaluation_condition)?;
+        let (architecture, standardiser, outcome) =
+            self.meta_train_on(formulation, &files, config, seed)?;
+        let data_files = files
+            .iter()
+            .map(|path| self.data_file(path))
+            .collect::<Result<_>>()?;
+        let held_out = self
+            .conditions
+            .condition(evaluation_condition)?
+            .name
+            .clone();
+        Ok(MetaTrainedModel {
+            format: CHECKPOINT_FORMAT.to_string(),
+            formulation,
+            protocol: self.protocol,
+            held_out_condition: (self.protocol == Protocol::LeaveConditionOut).then_some(held_out),
+            seed,
+            config: config.clone(),
+            architecture,
+            standardiser,
+            parameters: outcome.parameters,
+            data_files,
+            meta_loss_history: outcome.meta_loss_history,
+        })
+    }
+
+    /// Meta-trains on `files` with `config` (inputs standardised with these files' statistics).
+    fn meta_train_on(
+        &self,
+        formulation: Formulation,
+        files: &[PathBuf],
+        config: &LearnConfig,
+        seed: u64,
+    ) -> Result<(Architecture, Standardiser, MetaTrainingOutcome)> {
         let mut raw_tasks = Vec::with_capacity(files.len());
-        let mut data_files = Vec::with_capacity(files.len());
-        for path in &files {
+        for path in files {
             let (support, query) = flight_segments(&self.flight(path)?.log, formulation)?;
             raw_tasks.push((path, segment_batch(&support), segment_batch(&query)));
-            data_files.push(self.data_file(path)?);
         }
         let input_dim = formulation.input_names().len();
         let standardiser = if config.standardise_inputs {
@@ -189,24 +221,72 @@ impl Experiment {
             .collect();
         let architecture = architecture(formulation, config);
         let outcome = meta_train(&architecture, &tasks, &config.meta_training, seed)?;
-        let held_out = self
+        Ok((architecture, standardiser, outcome))
+    }
+
+    /// Nested validation inside the meta-training sets (leave-condition-out only). For two
+    /// evaluation conditions a and b, the flights of neither form the meta-training set of fold a
+    /// without condition b, which is also that of fold b without condition a. Meta-trains on it with
+    /// `config`, then for each of a and b adapts online on the support segment of its evaluation
+    /// flight with each of `adaptations` and returns the generalisation MSE on its query segment:
+    /// `[for a, for b]`, one value per adaptation setting. The score on b lies inside fold a's
+    /// meta-training data, so settings chosen with these scores never see fold a's evaluation flight
+    /// (and symmetrically).
+    pub fn nested_validation(
+        &self,
+        formulation: Formulation,
+        pair: [&str; 2],
+        config: &LearnConfig,
+        adaptations: &[AdaptationConfig],
+        seed: u64,
+    ) -> Result<[Vec<f64>; 2]> {
+        let first = self.conditions.condition(pair[0])?;
+        let second = self.conditions.condition(pair[1])?;
+        if self.protocol != Protocol::LeaveConditionOut || first.name == second.name {
+            return Err(LearnError::Mismatch {
+                what: format!("nested validation {}/{}", pair[0], pair[1]),
+                message: "needs leave-condition-out and two different conditions".to_string(),
+            });
+        }
+        let second_files: Vec<PathBuf> = self
             .conditions
-            .condition(evaluation_condition)?
-            .name
-            .clone();
-        Ok(MetaTrainedModel {
-            format: CHECKPOINT_FORMAT.to_string(),
-            formulation,
-            protocol: self.protocol,
-            held_out_condition: (self.protocol == Protocol::LeaveConditionOut).then_some(held_out),
-            seed,
-            config: config.clone(),
-            architecture,
-            standardiser,
-            parameters: outcome.parameters,
-            data_files,
-            meta_loss_history: outcome.meta_loss_history,
-        })
+            .flight_files(&self.data_dir)
+            .into_iter()
+            .filter(|f| f.condition == second.name)
+            .map(|f| f.path)
+            .collect();
+        let files: Vec<PathBuf> = self
+            .protocol
+            .training_files(&self.conditions, &self.data_dir, &first.name)?
+            .into_iter()
+            .filter(|path| !second_files.contains(path))
+            .collect();
+        let (architecture, standardiser, outcome) =
+            self.meta_train_on(formulation, &files, config, seed)?;
+        let score = |condition: &data::Condition| -> Result<Vec<f64>> {
+            let path = self.conditions.flight_path(
+                &self.data_dir,
+                condition,
+                &self.conditions.evaluation_controller,
+            );
+            let (support, query) = flight_segments(&self.flight(&path)?.log, formulation)?;
+            let support_batch = standardised(&standardiser, segment_batch(&support));
+            let query_batch = standardised(&standardiser, segment_batch(&query));
+            Ok(adaptations
+                .iter()
+                .map(|adaptation| {
+                    let adapted = adapt_online(
+                        &architecture,
+                        &outcome.parameters,
+                        &support_batch.inputs,
+                        &support_batch.targets,
+                        adaptation,
+                    );
+                    architecture.loss(&adapted, &query_batch.inputs, &query_batch.targets)
+                })
+                .collect())
+        };
+        Ok([score(first)?, score(second)?])
     }
 
     /// Adapts `model` online on the support segment of the evaluation flight of

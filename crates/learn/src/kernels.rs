@@ -177,14 +177,14 @@ impl MatmulCall {
     #[target_feature(enable = "avx512f,fma")]
     unsafe fn run_avx512(&self) {
         // SAFETY: forwarded from `matmul`.
-        unsafe { <x86::Avx512 as x86::Lanes>::run(self) }
+        unsafe { <x86::Avx512 as x86::Lanes>::run::<8>(self) }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     unsafe fn run_avx2(&self) {
         // SAFETY: forwarded from `matmul`.
-        unsafe { <x86::Avx2 as x86::Lanes>::run(self) }
+        unsafe { <x86::Avx2 as x86::Lanes>::run::<4>(self) }
     }
 
     unsafe fn run_portable(&self) {
@@ -298,12 +298,17 @@ mod x86 {
         unsafe fn zero() -> Self::Vector;
         unsafe fn fmadd(a: Self::Vector, b: Self::Vector, c: Self::Vector) -> Self::Vector;
 
+        /// Tiles of ROWS rows (then 4, 2, 1 at the bottom edge).
         #[inline(always)]
-        unsafe fn run(call: &MatmulCall) {
+        unsafe fn run<const ROWS: usize>(call: &MatmulCall) {
             let mut row = 0;
             // SAFETY (whole function): the tiles stay inside the ranges checked in `matmul`.
             unsafe {
-                while row + 4 <= call.rows {
+                while row + ROWS <= call.rows {
+                    Self::row_block::<ROWS>(call, row);
+                    row += ROWS;
+                }
+                if ROWS > 4 && row + 4 <= call.rows {
                     Self::row_block::<4>(call, row);
                     row += 4;
                 }
@@ -557,12 +562,22 @@ pub(crate) fn gelu_with_derivatives(z: f64) -> (f64, f64, f64) {
     let magnitude = u.abs();
     let gaussian = exp_non_positive(-0.5 * z * z);
     let square = u * u;
-    let erf_small = u * polynomial(square, &ERF_T) / monic_polynomial(square, &ERF_U);
-    let erfc_large =
-        gaussian * polynomial(magnitude, &ERFC_P) / monic_polynomial(magnitude, &ERFC_Q);
-    let tail = 0.5 * erfc_large;
-    let cdf = if magnitude < 1.0 {
-        0.5 + 0.5 * erf_small
+    // One division: erf(u) = u·T(u²)/U(u²) for |u| < 1, else erfc(|u|) = e^{−u²}·P(|u|)/Q(|u|).
+    let small = magnitude < 1.0;
+    let numerator = if small {
+        u * polynomial(square, &ERF_T)
+    } else {
+        gaussian * polynomial(magnitude, &ERFC_P)
+    };
+    let denominator = if small {
+        monic_polynomial(square, &ERF_U)
+    } else {
+        monic_polynomial(magnitude, &ERFC_Q)
+    };
+    let ratio = numerator / denominator;
+    let tail = 0.5 * ratio;
+    let cdf = if small {
+        0.5 + tail
     } else if u > 0.0 {
         1.0 - tail
     } else {

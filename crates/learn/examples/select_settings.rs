@@ -1,0 +1,184 @@
+//! Chooses LeARN settings without touching any evaluation flight of the fold they serve: nested
+//! leave-one-condition-out validation inside each fold's meta-training set
+//! ([`Experiment::nested_validation`]). For fold c, a candidate's score is the mean, over the other
+//! evaluation conditions c′, of the generalisation MSE on c′'s evaluation flight after meta-training
+//! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
+//! score and the one fold c's own validation prefers, and writes all numbers as JSON.
+//!
+//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations]
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use data::{ExperimentConditions, Formulation};
+use learn::{AdaptationConfig, Experiment, LearnConfig, Protocol};
+use rayon::prelude::*;
+use serde_json::json;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let arguments: Vec<String> = std::env::args().skip(1).collect();
+    let out = arguments
+        .first()
+        .cloned()
+        .unwrap_or_else(|| "results/.scratch/learn-selection.json".to_string());
+    let seed: u64 = arguments.get(1).map_or(Ok(1), |s| s.parse())?;
+    // `grid` (the default): the first comparison; `iterations`: how far more meta-iterations help.
+    let stage = arguments.get(2).map_or("grid", String::as_str);
+    let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
+    let base = checked.get().clone();
+    let conditions = ExperimentConditions::load(Path::new("experiments/conditions.json"))?;
+    let data_dir = data::resolve_data_dir(None)?;
+    let experiment = Experiment::load(
+        checked,
+        conditions,
+        &data_dir,
+        Some(Protocol::LeaveConditionOut),
+    )?;
+    let folds = experiment.evaluation_conditions();
+
+    // Meta-training candidates (all within the reproduce budget: iterations × tasks ≤ 3200).
+    let mut candidates: Vec<(String, LearnConfig)> = Vec::new();
+    let grid: &[(usize, usize, f64)] = match stage {
+        "iterations" => &[(800, 4, 0.1), (1600, 4, 0.1)],
+        _ => &[(200, 4, 0.1), (800, 4, 0.1), (400, 8, 0.1), (800, 4, 0.05)],
+    };
+    for &(iterations, task_batch, inner_step) in grid {
+        let mut config = base.clone();
+        config.meta_training.iterations = iterations;
+        config.meta_training.task_batch = task_batch;
+        config.meta_training.inner_step = inner_step;
+        candidates.push((
+            format!("it{iterations}_tasks{task_batch}_alpha{inner_step}"),
+            config,
+        ));
+    }
+    let mut adaptations: Vec<(String, AdaptationConfig)> = Vec::new();
+    let passes_grid: &[usize] = if stage == "iterations" { &[8] } else { &[4, 8] };
+    for step in [0.0005, 0.001] {
+        for &passes in passes_grid {
+            adaptations.push((
+                format!("step{step}_passes{passes}"),
+                AdaptationConfig {
+                    step,
+                    passes,
+                    ..base.adaptation.clone()
+                },
+            ));
+        }
+    }
+    let adaptation_settings: Vec<AdaptationConfig> =
+        adaptations.iter().map(|(_, a)| a.clone()).collect();
+
+    let mut jobs = Vec::new();
+    for formulation in [
+        Formulation::Translational,
+        Formulation::Attitude,
+        Formulation::Full,
+    ] {
+        for (i, a) in folds.iter().enumerate() {
+            for b in &folds[i + 1..] {
+                for candidate in 0..candidates.len() {
+                    jobs.push((formulation, a.clone(), b.clone(), candidate));
+                }
+            }
+        }
+    }
+    eprintln!("{} meta-trainings", jobs.len());
+    let results: Vec<[Vec<f64>; 2]> = jobs
+        .par_iter()
+        .map(|(formulation, a, b, candidate)| {
+            experiment.nested_validation(
+                *formulation,
+                [a, b],
+                &candidates[*candidate].1,
+                &adaptation_settings,
+                seed,
+            )
+        })
+        .collect::<Result<_, _>>()?;
+
+    // score[(formulation, fold, candidate, adaptation)] = scores on the other conditions.
+    let mut scores: BTreeMap<(String, String, usize, usize), Vec<f64>> = BTreeMap::new();
+    for ((formulation, a, b, candidate), [on_a, on_b]) in jobs.iter().zip(&results) {
+        for adaptation in 0..adaptations.len() {
+            // Fold a's validation scores condition b, and fold b's scores condition a.
+            scores
+                .entry((
+                    formulation.name().to_string(),
+                    a.clone(),
+                    *candidate,
+                    adaptation,
+                ))
+                .or_default()
+                .push(on_b[adaptation]);
+            scores
+                .entry((
+                    formulation.name().to_string(),
+                    b.clone(),
+                    *candidate,
+                    adaptation,
+                ))
+                .or_default()
+                .push(on_a[adaptation]);
+        }
+    }
+    let mut report = Vec::new();
+    for ((formulation, fold, candidate, adaptation), values) in &scores {
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        report.push(json!({
+            "formulation": formulation,
+            "fold": fold,
+            "meta_training": candidates[*candidate].0,
+            "adaptation": adaptations[*adaptation].0,
+            "validation_gen_mse": mean,
+            "per_condition": values,
+        }));
+    }
+    // Per formulation and fold: the preferred setting, and the ranking of the averaged score.
+    let mut best: BTreeMap<(String, String), (f64, String)> = BTreeMap::new();
+    for row in &report {
+        let key = (
+            row["formulation"].as_str().unwrap_or_default().to_string(),
+            row["fold"].as_str().unwrap_or_default().to_string(),
+        );
+        let value = row["validation_gen_mse"].as_f64().unwrap_or(f64::INFINITY);
+        let name = format!("{} {}", row["meta_training"], row["adaptation"]);
+        let entry = best.entry(key).or_insert((f64::INFINITY, String::new()));
+        if value < entry.0 {
+            *entry = (value, name);
+        }
+    }
+    for ((formulation, fold), (value, name)) in &best {
+        println!("{formulation:14} {fold:10} best {name} ({value:.4})");
+    }
+    let mut table: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for row in &report {
+        let name = format!(
+            "{} {} {}",
+            row["formulation"].as_str().unwrap_or_default(),
+            row["meta_training"],
+            row["adaptation"]
+        );
+        table
+            .entry(name)
+            .or_default()
+            .push(row["validation_gen_mse"].as_f64().unwrap_or(f64::NAN));
+    }
+    for (name, values) in &table {
+        let formatted: Vec<String> = values.iter().map(|v| format!("{v:.4}")).collect();
+        println!("{name:70} folds {}", formatted.join(" "));
+    }
+    let document = json!({
+        "protocol": "nested leave-one-condition-out inside each fold's meta-training set",
+        "seed": seed,
+        "folds": folds,
+        "scores": report,
+        "preferred": best.iter().map(|((f, c), (v, n))| json!({"formulation": f, "fold": c, "setting": n, "validation_gen_mse": v})).collect::<Vec<_>>(),
+    });
+    if let Some(parent) = Path::new(&out).parent() {
+        std::fs::create_dir_all(parent)?;
+    }
+    std::fs::write(&out, serde_json::to_string_pretty(&document)? + "\n")?;
+    eprintln!("wrote {out}");
+    Ok(())
+}

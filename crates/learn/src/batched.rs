@@ -13,7 +13,10 @@
 //! Rδ_{l−1} = (Rδ_l·W_lᵀ + δ_l·V_lᵀ) ⊙ GELU′(z_{l−1}) + e_l ⊙ GELU″(z_{l−1}) ⊙ Rz_{l−1}.
 //! The Hessian-vector product of the loss is H·V = R(∇L).
 
-use crate::kernels::{Strides, gelu_layer, matmul, matmul_with_bias, transpose};
+use crate::kernels::{
+    Strides, column_sums, dispatched, gelu_layer, hadamard, matmul, matmul_with_bias,
+    r_delta_through_gelu, transpose,
+};
 use crate::network::Architecture;
 
 /// Batches below this size form δ·Wᵀ without transposing W (the transposes would cost more).
@@ -256,13 +259,7 @@ impl NetworkWorkspace {
                 &mut back,
                 false,
             );
-            for ((previous, &e), &d) in self.deltas[l - 1]
-                .iter_mut()
-                .zip(&back)
-                .zip(&self.first[l - 1])
-            {
-                *previous = e * d;
-            }
+            hadamard(&mut self.deltas[l - 1], &back, &self.first[l - 1]);
             self.back[l - 1] = back;
         }
     }
@@ -307,11 +304,7 @@ impl NetworkWorkspace {
                 );
             }
             if l + 1 < layers {
-                for ((r_value, &r), &d) in
-                    self.r_values[l].iter_mut().zip(&r_pre).zip(&self.first[l])
-                {
-                    *r_value = d * r;
-                }
+                hadamard(&mut self.r_values[l], &self.first[l], &r_pre);
             }
             self.r_pre[l] = r_pre;
         }
@@ -404,26 +397,14 @@ impl NetworkWorkspace {
                 &mut r_back,
                 true,
             );
-            for ((((r, &d1), &d2), &e), &r_pre) in r_back
-                .iter_mut()
-                .zip(&self.first[l - 1])
-                .zip(&self.second[l - 1])
-                .zip(&self.back[l - 1])
-                .zip(&self.r_pre[l - 1])
-            {
-                *r = *r * d1 + e * d2 * r_pre;
-            }
+            r_delta_through_gelu(
+                &mut r_back,
+                &self.first[l - 1],
+                &self.second[l - 1],
+                &self.back[l - 1],
+                &self.r_pre[l - 1],
+            );
             self.r_deltas[l - 1] = r_back;
-        }
-    }
-}
-
-/// out[c] = Σ_b matrix[b·width + c], summed in row order.
-fn column_sums(matrix: &[f64], width: usize, out: &mut [f64]) {
-    out.fill(0.0);
-    for row in matrix.chunks_exact(width) {
-        for (o, &v) in out.iter_mut().zip(row) {
-            *o += v;
         }
     }
 }
@@ -441,8 +422,6 @@ pub struct ModelWorkspace {
     prediction: Vec<f64>,
     /// ∂L/∂y of the last backward pass.
     prediction_gradient: Vec<f64>,
-    /// R(∂L/∂y) and Ry.
-    r_prediction: Vec<f64>,
     /// Whether the stored ∂L/∂y is the mean squared error's (required by the Hessian product).
     mse_backward: bool,
 }
@@ -458,7 +437,6 @@ impl ModelWorkspace {
             inputs: Vec::new(),
             prediction: Vec::new(),
             prediction_gradient: Vec::new(),
-            r_prediction: Vec::new(),
             mse_backward: false,
         }
     }
@@ -484,17 +462,13 @@ impl ModelWorkspace {
         self.library.forward(&parameters[..split], inputs, batch);
         self.selection.forward(&parameters[split..], inputs, batch);
         let (basis, states) = (architecture.basis_count(), architecture.state_dim);
-        self.prediction.clear();
-        let theta_all = &self.library.values[self.library.layers() - 1];
-        let selection_all = &self.selection.values[self.selection.layers() - 1];
-        for (theta, selection) in theta_all
-            .chunks_exact(basis)
-            .zip(selection_all.chunks_exact(states * basis))
-        {
-            for coefficients in selection.chunks_exact(basis) {
-                self.prediction.push(dot(theta, coefficients));
-            }
-        }
+        self.prediction.resize(batch * states, 0.0);
+        product_forward(
+            &self.library.values[self.library.layers() - 1],
+            &self.selection.values[self.selection.layers() - 1],
+            [basis, states],
+            &mut self.prediction,
+        );
         &self.prediction
     }
 
@@ -536,29 +510,14 @@ impl ModelWorkspace {
         let batch = self.batch;
         let library_layers = self.library.layers();
         let selection_layers = self.selection.layers();
-        {
-            let theta_all = &self.library.values[library_layers - 1];
-            let selection_all = &self.selection.values[selection_layers - 1];
-            let d_theta_all = &mut self.library.deltas[library_layers - 1];
-            let d_selection_all = &mut self.selection.deltas[selection_layers - 1];
-            for b in 0..batch {
-                let theta = &theta_all[b * basis..(b + 1) * basis];
-                let selection = &selection_all[b * states * basis..(b + 1) * states * basis];
-                let d_theta = &mut d_theta_all[b * basis..(b + 1) * basis];
-                let d_selection =
-                    &mut d_selection_all[b * states * basis..(b + 1) * states * basis];
-                d_theta.fill(0.0);
-                for state in 0..states {
-                    let g = self.prediction_gradient[b * states + state];
-                    let coefficients = &selection[state * basis..(state + 1) * basis];
-                    let d_coefficients = &mut d_selection[state * basis..(state + 1) * basis];
-                    for k in 0..basis {
-                        d_theta[k] += g * coefficients[k];
-                        d_coefficients[k] = g * theta[k];
-                    }
-                }
-            }
-        }
+        product_backward(
+            &self.library.values[library_layers - 1],
+            &self.selection.values[selection_layers - 1],
+            &self.prediction_gradient,
+            [basis, states, batch],
+            &mut self.library.deltas[library_layers - 1],
+            &mut self.selection.deltas[selection_layers - 1],
+        );
         let split = self.architecture.library_parameter_count();
         let (library_gradient, selection_gradient) = gradient.split_at_mut(split);
         self.library
@@ -637,35 +596,14 @@ impl ModelWorkspace {
         let r_selection_all = &self.selection.r_pre[selection_last];
         let r_d_theta_all = &mut self.library.r_deltas[library_last];
         let r_d_selection_all = &mut self.selection.r_deltas[selection_last];
-        self.r_prediction.resize(states, 0.0);
-        for b in 0..batch {
-            let theta = &theta_all[b * basis..(b + 1) * basis];
-            let r_theta = &r_theta_all[b * basis..(b + 1) * basis];
-            let row = b * states * basis..(b + 1) * states * basis;
-            let selection = &selection_all[row.clone()];
-            let r_selection = &r_selection_all[row.clone()];
-            // R(∂L/∂y) = (2/N)·Ry, Ry_i = Σ_k RΘ_k·ℰ_ik + Θ_k·Rℰ_ik.
-            for state in 0..states {
-                let cols = state * basis..(state + 1) * basis;
-                self.r_prediction[state] = scale
-                    * (dot(r_theta, &selection[cols.clone()]) + dot(theta, &r_selection[cols]));
-            }
-            let r_d_theta = &mut r_d_theta_all[b * basis..(b + 1) * basis];
-            let r_d_selection = &mut r_d_selection_all[row];
-            r_d_theta.fill(0.0);
-            for state in 0..states {
-                let g = self.prediction_gradient[b * states + state];
-                let r_g = self.r_prediction[state];
-                let cols = state * basis..(state + 1) * basis;
-                let (coefficients, r_coefficients) =
-                    (&selection[cols.clone()], &r_selection[cols.clone()]);
-                let r_d_coefficients = &mut r_d_selection[cols];
-                for k in 0..basis {
-                    r_d_theta[k] += r_g * coefficients[k] + g * r_coefficients[k];
-                    r_d_coefficients[k] = r_g * theta[k] + g * r_theta[k];
-                }
-            }
-        }
+        product_r_backward(
+            [theta_all, selection_all, r_theta_all, r_selection_all],
+            &self.prediction_gradient,
+            [basis, states, batch],
+            scale,
+            r_d_theta_all,
+            r_d_selection_all,
+        );
         let (library_product, selection_product) = product.split_at_mut(split);
         self.library.r_backward(
             &parameters[..split],
@@ -681,6 +619,101 @@ impl ModelWorkspace {
             batch,
             selection_product,
         );
+    }
+}
+
+dispatched! {
+    /// y_bi = Σ_k Θ_bk·ℰ_b,ik.
+    fn product_forward(theta_all: &[f64], selection_all: &[f64], sizes: [usize; 2], out: &mut [f64]) {
+        let [basis, states] = sizes;
+        for ((theta, selection), y) in theta_all
+            .chunks_exact(basis)
+            .zip(selection_all.chunks_exact(states * basis))
+            .zip(out.chunks_exact_mut(states))
+        {
+            for (coefficients, value) in selection.chunks_exact(basis).zip(y) {
+                *value = dot(theta, coefficients);
+            }
+        }
+    }
+}
+
+dispatched! {
+    /// δΘ_bk = Σ_i g_bi·ℰ_b,ik and δℰ_b,ik = g_bi·Θ_bk, with `sizes` = [K, I, batch].
+    fn product_backward(
+        theta_all: &[f64],
+        selection_all: &[f64],
+        prediction_gradient: &[f64],
+        sizes: [usize; 3],
+        d_theta_all: &mut [f64],
+        d_selection_all: &mut [f64],
+    ) {
+        let [basis, states, batch] = sizes;
+        let width = states * basis;
+        for b in 0..batch {
+            let theta = &theta_all[b * basis..(b + 1) * basis];
+            let selection = &selection_all[b * width..(b + 1) * width];
+            let d_theta = &mut d_theta_all[b * basis..(b + 1) * basis];
+            let d_selection = &mut d_selection_all[b * width..(b + 1) * width];
+            d_theta.fill(0.0);
+            for ((&g, coefficients), d_coefficients) in prediction_gradient[b * states..(b + 1) * states]
+                .iter()
+                .zip(selection.chunks_exact(basis))
+                .zip(d_selection.chunks_exact_mut(basis))
+            {
+                for (((d, &c), dc), &t) in d_theta
+                    .iter_mut()
+                    .zip(coefficients)
+                    .zip(d_coefficients.iter_mut())
+                    .zip(theta)
+                {
+                    *d += g * c;
+                    *dc = g * t;
+                }
+            }
+        }
+    }
+}
+
+dispatched! {
+    /// The R-operator through y = Θ·ℰᵀ and the mean squared error: R(∂L/∂y) = scale·Ry with
+    /// Ry_bi = Σ_k RΘ_bk·ℰ_b,ik + Θ_bk·Rℰ_b,ik, then RδΘ and Rδℰ. `values` = [Θ, ℰ, RΘ, Rℰ],
+    /// `sizes` = [K, I, batch].
+    fn product_r_backward(
+        values: [&[f64]; 4],
+        prediction_gradient: &[f64],
+        sizes: [usize; 3],
+        scale: f64,
+        r_d_theta_all: &mut [f64],
+        r_d_selection_all: &mut [f64],
+    ) {
+        let [theta_all, selection_all, r_theta_all, r_selection_all] = values;
+        let [basis, states, batch] = sizes;
+        let width = states * basis;
+        for b in 0..batch {
+            let theta = &theta_all[b * basis..(b + 1) * basis];
+            let r_theta = &r_theta_all[b * basis..(b + 1) * basis];
+            let selection = &selection_all[b * width..(b + 1) * width];
+            let r_selection = &r_selection_all[b * width..(b + 1) * width];
+            let r_d_theta = &mut r_d_theta_all[b * basis..(b + 1) * basis];
+            let r_d_selection = &mut r_d_selection_all[b * width..(b + 1) * width];
+            r_d_theta.fill(0.0);
+            for (state, &g) in prediction_gradient[b * states..(b + 1) * states].iter().enumerate() {
+                let cols = state * basis..(state + 1) * basis;
+                let (coefficients, r_coefficients) = (&selection[cols.clone()], &r_selection[cols.clone()]);
+                let r_g = scale * (dot(r_theta, coefficients) + dot(theta, r_coefficients));
+                for ((((d, &c), &rc), rdc), (&t, &rt)) in r_d_theta
+                    .iter_mut()
+                    .zip(coefficients)
+                    .zip(r_coefficients)
+                    .zip(r_d_selection[cols].iter_mut())
+                    .zip(theta.iter().zip(r_theta))
+                {
+                    *d += r_g * c + g * rc;
+                    *rdc = r_g * t + g * rt;
+                }
+            }
+        }
     }
 }
 

@@ -15,7 +15,7 @@ pub(crate) struct Strides {
 
 /// The instruction set the kernels run with, detected once.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Isa {
+pub(crate) enum Isa {
     Portable,
     #[cfg(target_arch = "x86_64")]
     Avx2,
@@ -38,6 +38,80 @@ fn isa() -> Isa {
         }
         Isa::Portable
     })
+}
+
+/// Defines `fn $name(args)` that runs its body compiled for AVX-512, AVX2 or the portable
+/// baseline, as detected. For element-wise loops: no fused multiply-add is introduced, so every
+/// build computes the same roundings.
+macro_rules! dispatched {
+    ($(#[$meta:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $body:block) => {
+        $(#[$meta])*
+        $vis fn $name($($arg: $ty),*) {
+            #[inline(always)]
+            fn portable($($arg: $ty),*) $body
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx512f,fma")]
+            fn avx512($($arg: $ty),*) {
+                portable($($arg),*)
+            }
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx2,fma")]
+            fn avx2($($arg: $ty),*) {
+                portable($($arg),*)
+            }
+            match $crate::kernels::detected_isa() {
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: the instruction set was detected.
+                $crate::kernels::Isa::Avx512 => unsafe { avx512($($arg),*) },
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: the instruction set was detected.
+                $crate::kernels::Isa::Avx2 => unsafe { avx2($($arg),*) },
+                $crate::kernels::Isa::Portable => portable($($arg),*),
+            }
+        }
+    };
+}
+pub(crate) use dispatched;
+
+/// The detected instruction set (for [`dispatched`]).
+pub(crate) fn detected_isa() -> Isa {
+    isa()
+}
+
+dispatched! {
+    /// out[c] = Σ_b matrix[b·width + c], summed in row order.
+    pub(crate) fn column_sums(matrix: &[f64], width: usize, out: &mut [f64]) {
+        out.fill(0.0);
+        for row in matrix.chunks_exact(width) {
+            for (o, &v) in out.iter_mut().zip(row) {
+                *o += v;
+            }
+        }
+    }
+}
+
+dispatched! {
+    /// out[i] = a[i]·b[i].
+    pub(crate) fn hadamard(out: &mut [f64], a: &[f64], b: &[f64]) {
+        for ((o, &x), &y) in out.iter_mut().zip(a).zip(b) {
+            *o = x * y;
+        }
+    }
+}
+
+dispatched! {
+    /// r[i] ← r[i]·first[i] + back[i]·second[i]·r_pre[i] (the R-operator's δ through a GELU).
+    pub(crate) fn r_delta_through_gelu(
+        r: &mut [f64],
+        first: &[f64],
+        second: &[f64],
+        back: &[f64],
+        r_pre: &[f64],
+    ) {
+        for ((((r, &d1), &d2), &e), &z) in r.iter_mut().zip(first).zip(second).zip(back).zip(r_pre) {
+            *r = *r * d1 + e * d2 * z;
+        }
+    }
 }
 
 /// out[r·ldo + c] (= or, with `accumulate`, +=) Σ_k a[r·a.row + k·a.depth] · b[k·ldb + c]
@@ -277,7 +351,7 @@ impl MatmulCall {
     }
 }
 
-/// Explicit SIMD tiles: ROWS × (2 vectors) accumulators in registers, one broadcast of `a` per row
+/// Explicit SIMD tiles: ROWS × (up to 3 vectors) accumulators in registers, one broadcast of `a` per row
 /// and one fused multiply-add per accumulator for each k; the last columns use masked loads and
 /// stores, so every column takes the same path.
 #[cfg(target_arch = "x86_64")]
@@ -329,12 +403,15 @@ mod x86 {
             // SAFETY (whole function): as in `run`.
             unsafe {
                 let full = Self::mask(width);
-                while col + 2 * width <= call.cols {
-                    Self::tile::<ROWS, 2>(call, row, col, [full, full]);
-                    col += 2 * width;
+                while col + 3 * width <= call.cols {
+                    Self::tile::<ROWS, 3>(call, row, col, [full, full, full]);
+                    col += 3 * width;
                 }
                 let left = call.cols - col;
-                if left > width {
+                if left > 2 * width {
+                    let last = Self::mask(left - 2 * width);
+                    Self::tile::<ROWS, 3>(call, row, col, [full, full, last]);
+                } else if left > width {
                     Self::tile::<ROWS, 2>(call, row, col, [full, Self::mask(left - width)]);
                 } else if left > 0 {
                     Self::tile::<ROWS, 1>(call, row, col, [Self::mask(left)]);
@@ -651,7 +728,8 @@ fn gelu_layer_portable(values: &mut [f64], first: &mut [f64], second: &mut [f64]
     }
 }
 
-/// out (cols × rows, row-major) = source (rows × cols, row-major)ᵀ.
+/// out (cols × rows, row-major) = source (rows × cols, row-major)ᵀ: contiguous writes, strided
+/// reads (measured faster than the converse, and than the AVX-512 build of the loop).
 pub(crate) fn transpose(rows: usize, cols: usize, source: &[f64], out: &mut [f64]) {
     let (source, out) = (&source[..rows * cols], &mut out[..rows * cols]);
     for (c, out_row) in out.chunks_exact_mut(rows).enumerate() {

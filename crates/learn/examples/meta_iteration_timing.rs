@@ -9,11 +9,10 @@
 use std::time::Instant;
 
 use learn::{
-    Architecture, Batch, InnerLoop, MetaOrder, MetaWorkspace, PAPER_HIDDEN, Task, meta_gradient_in,
+    Architecture, Batch, InnerLoop, MetaOrder, MetaWorkspace, PAPER_HIDDEN, Task, meta_gradients,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 
 fn batch(rng: &mut ChaCha8Rng, rows: usize, architecture: &Architecture) -> Batch {
     Batch {
@@ -55,26 +54,18 @@ fn main() {
         .collect();
     let mut parameters = architecture.initial_parameters(0);
     let inner = InnerLoop { step: 0.05, rounds };
-    // One workspace per task slot, reused across iterations, as in `meta_train`.
-    let mut workspaces = vec![MetaWorkspace::new(&architecture); tasks];
+    // Workspaces reused across iterations, as in `meta_train`: one per thread, or one in all.
+    let mut pool_workspaces =
+        vec![MetaWorkspace::new(&architecture); rayon::current_num_threads().clamp(1, tasks)];
+    let mut single_workspace = vec![MetaWorkspace::new(&architecture)];
     let mut iteration = |parallel: bool, parameters: &mut Vec<f64>| {
         let started = Instant::now();
-        let run = |(task, workspace): (&Task, &mut MetaWorkspace)| {
-            meta_gradient_in(workspace, parameters, task, inner, MetaOrder::Second)
-        };
-        let results: Vec<_> = if parallel {
-            task_list
-                .par_iter()
-                .zip(workspaces.par_iter_mut())
-                .map(run)
-                .collect()
+        let workspaces = if parallel {
+            &mut pool_workspaces
         } else {
-            task_list
-                .iter()
-                .zip(workspaces.iter_mut())
-                .map(run)
-                .collect()
+            &mut single_workspace
         };
+        let results = meta_gradients(workspaces, parameters, &task_list, inner, MetaOrder::Second);
         let mut gradient = vec![0.0; parameters.len()];
         for result in &results {
             for (g, r) in gradient.iter_mut().zip(&result.gradient) {

@@ -224,6 +224,34 @@ pub fn meta_gradient_in(
     }
 }
 
+/// The meta-gradients of `tasks`, in task order: the tasks are cut into `workspaces.len()`
+/// contiguous chunks run in parallel (rayon), each chunk in order on its own workspace. A task's
+/// result does not depend on the workspace or the chunking, so the output is bit-identical for any
+/// number of workspaces and threads. One workspace per thread keeps each thread's buffers warm in
+/// its cache.
+pub fn meta_gradients(
+    workspaces: &mut [MetaWorkspace],
+    parameters: &[f64],
+    tasks: &[Task],
+    inner: InnerLoop,
+    order: MetaOrder,
+) -> Vec<MetaGradient> {
+    use rayon::prelude::*;
+    assert!(!workspaces.is_empty(), "at least one workspace");
+    let chunk = tasks.len().div_ceil(workspaces.len()).max(1);
+    let per_chunk: Vec<Vec<MetaGradient>> = tasks
+        .par_chunks(chunk)
+        .zip(workspaces.par_iter_mut())
+        .map(|(chunk_tasks, workspace)| {
+            chunk_tasks
+                .iter()
+                .map(|task| meta_gradient_in(workspace, parameters, task, inner, order))
+                .collect()
+        })
+        .collect();
+    per_chunk.into_iter().flatten().collect()
+}
+
 /// [`meta_gradient`] by the generic reference code (gradients in `f64`, Hessian-vector products
 /// on dual numbers), kept as the reference the fast path is tested against.
 pub fn reference_meta_gradient(

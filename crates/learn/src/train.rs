@@ -8,11 +8,10 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 
 use crate::config::{MetaTrainingConfig, Optimizer};
 use crate::error::{LearnError, Result};
-use crate::maml::{Batch, InnerLoop, MetaWorkspace, Task, meta_gradient_in};
+use crate::maml::{Batch, InnerLoop, MetaWorkspace, Task, meta_gradients};
 use crate::network::Architecture;
 
 /// The regression data of one meta-training task (one flight): its support and query segments.
@@ -181,18 +180,14 @@ pub fn meta_train_from(
     };
     let mut sampler = TaskSampler::new(seed, tasks.len());
     let mut adam = Adam::new(parameters.len());
-    let mut workspaces = vec![MetaWorkspace::new(architecture); config.task_batch];
+    // One workspace per thread (not per task): a smaller working set per cache.
+    let workspace_count = rayon::current_num_threads().clamp(1, config.task_batch.max(1));
+    let mut workspaces = vec![MetaWorkspace::new(architecture); workspace_count];
     let mut meta_loss_history = Vec::with_capacity(config.iterations);
     let mut support_loss_history = Vec::with_capacity(config.iterations);
     for iteration in 0..config.iterations {
         let batch = sampler.draw(tasks, architecture.input_dim, config);
-        let results: Vec<_> = batch
-            .par_iter()
-            .zip(workspaces.par_iter_mut())
-            .map(|(task, workspace)| {
-                meta_gradient_in(workspace, &parameters, task, inner, config.order)
-            })
-            .collect();
+        let results = meta_gradients(&mut workspaces, &parameters, &batch, inner, config.order);
         let scale = 1.0 / results.len() as f64;
         let mut gradient: Vec<f64> = parameters
             .iter()

@@ -2,8 +2,8 @@
 
 use learn::{
     Architecture, Batch, InnerLoop, MetaOrder, MetaWorkspace, Task, hessian_vector_product,
-    inner_updates, meta_gradient, meta_gradient_in, reference_hessian_vector_product,
-    reference_meta_gradient,
+    inner_updates, meta_gradient, meta_gradient_in, meta_gradients,
+    reference_hessian_vector_product, reference_meta_gradient,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -278,4 +278,35 @@ fn reused_workspaces_give_the_same_meta_gradient_as_fresh_ones() {
     let fresh = meta_gradient(&architecture, &parameters, &task, inner, MetaOrder::Second);
     assert_eq!(reused, fresh);
     assert!(other.support.inputs.len() != task.support.inputs.len());
+}
+
+#[test]
+fn meta_gradients_of_a_batch_do_not_depend_on_the_number_of_workspaces() {
+    let (architecture, parameters, _) = setup();
+    let mut rng = ChaCha8Rng::seed_from_u64(4);
+    let tasks: Vec<Task> = (0..5)
+        .map(|_| Task {
+            support: random_batch(&mut rng, 6, &architecture),
+            query: random_batch(&mut rng, 5, &architecture),
+        })
+        .collect();
+    let inner = InnerLoop {
+        step: 0.3,
+        rounds: 1,
+    };
+    let one_by_one: Vec<_> = tasks
+        .iter()
+        .map(|task| meta_gradient(&architecture, &parameters, task, inner, MetaOrder::Second))
+        .collect();
+    for count in [1, 2, 3, 7] {
+        let mut workspaces = vec![MetaWorkspace::new(&architecture); count];
+        let batch = meta_gradients(
+            &mut workspaces,
+            &parameters,
+            &tasks,
+            inner,
+            MetaOrder::Second,
+        );
+        assert_eq!(batch, one_by_one, "{count} workspaces");
+    }
 }

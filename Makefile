@@ -12,10 +12,13 @@ all: build
 data:
 	@scripts/fetch-data.sh
 
+# Binaries, tests and examples in one build: with dev-dependencies in the same feature resolution,
+# `cargo test` then reuses every artifact (building the binaries alone resolves features differently
+# and recompiles polars and faer, ~3 min on 2 cores).
 build:
-	$(CARGO) build --workspace --bins
+	$(CARGO) build --workspace --bins --tests --examples
 
-test: data
+test: data build
 	$(CARGO) test --workspace
 	$(MAKE) check-paper
 
@@ -30,7 +33,7 @@ reproduce: build
 ablations: build
 	$(LEARN) $(QUIET) ablations --config experiments/variants.json --out results/ablations
 
-# The regression against the paper: the same protocol with a smaller LeARN budget
+# The regression against the paper: the same protocol and LeARN budget without the variant columns
 # (experiments/ci.json), written to a git-ignored scratch directory, then compared with
 # paper/published.json under the tolerances of paper/tolerances.json (non-zero exit on regression).
 CI_RESULTS := results/.scratch/ci
@@ -53,7 +56,6 @@ bench: data
 
 # Sim-to-real mismatch: the tool blind on simulated flights with concealed effects, then on the real
 # baseline flights at every wind condition. Writes results/mismatch/{summary.md,summary.json,neural-fly.md}.
-mismatch-demo: data
-	$(CARGO) build $(QUIET) -p cli
+mismatch-demo: data build
 	$(LEARN) mismatch --demo experiments/mismatch/demo.json --work target/mismatch-demo --out results/mismatch --force
 	$(LEARN) mismatch --flights experiments/conditions.json --model experiments/mismatch/neural-fly.json --out results/mismatch --force

@@ -50,6 +50,32 @@ fn existing_dir(dir: &Path, origin: &str) -> Result<PathBuf> {
     }
 }
 
+/// For tests of this workspace's crates: the real flight data, if present (`$NEURAL_FLY_DIR`, else
+/// `data/neural-fly` under `workspace_root`), or `None` with a "skipping" message. Under CI
+/// (`CI=true`) missing data is an error, so a test that needs the real flights cannot silently skip.
+///
+/// # Panics
+/// When `CI=true` and no data directory with an `experiment/` folder is found.
+pub fn real_data_dir_for_tests(workspace_root: &Path) -> Option<PathBuf> {
+    let candidate = std::env::var_os(DATA_DIR_VARIABLE)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace_root.join(DEFAULT_DATA_DIR));
+    if candidate.join("experiment").is_dir() {
+        return Some(candidate);
+    }
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!(
+            "CI=true but no flight data at {} (run `make data`)",
+            candidate.display()
+        );
+    }
+    eprintln!(
+        "skipping: no flight data at {} (run `make data`)",
+        candidate.display()
+    );
+    None
+}
+
 /// SHA-256 of a file, hex encoded.
 pub fn file_sha256(path: &Path) -> Result<String> {
     let bytes = std::fs::read(path).map_err(|source| DataError::Io {

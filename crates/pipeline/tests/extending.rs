@@ -11,25 +11,9 @@ fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// The real data directory, if present. Under CI (`CI=true`) a missing directory fails the test.
+/// The real data directory (see `data::real_data_dir_for_tests`: skips locally, fails under CI).
 fn real_data_dir() -> Option<PathBuf> {
-    let candidate = std::env::var_os("NEURAL_FLY_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| workspace().join("data/neural-fly"));
-    if candidate.join("experiment").is_dir() {
-        return Some(candidate);
-    }
-    if std::env::var("CI").is_ok_and(|v| v == "true") {
-        panic!(
-            "CI=true but no flight data at {} (run `make data`)",
-            candidate.display()
-        );
-    }
-    eprintln!(
-        "skipping: no flight data at {} (run `make data`)",
-        candidate.display()
-    );
-    None
+    data::real_data_dir_for_tests(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
 }
 
 fn temp_dir(name: &str) -> PathBuf {

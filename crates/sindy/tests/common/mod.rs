@@ -28,26 +28,9 @@ pub fn matrix(value: &serde_json::Value) -> Mat<f64> {
     Mat::from_fn(rows.len(), rows[0].len(), |i, j| rows[i][j])
 }
 
-/// The real data directory, if present: `$NEURAL_FLY_DIR` or `data/neural-fly` of the workspace.
-/// Under CI (`CI=true`) a missing directory fails the test instead of skipping it.
+/// The real data directory (see `data::real_data_dir_for_tests`: skips locally, fails under CI).
 pub fn real_data_dir() -> Option<PathBuf> {
-    let candidate = std::env::var_os("NEURAL_FLY_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| workspace().join("data/neural-fly"));
-    if candidate.join("experiment").is_dir() {
-        return Some(candidate);
-    }
-    if std::env::var("CI").is_ok_and(|v| v == "true") {
-        panic!(
-            "CI=true but no flight data at {} (run `make data`)",
-            candidate.display()
-        );
-    }
-    eprintln!(
-        "skipping: no flight data at {} (run `make data`)",
-        candidate.display()
-    );
-    None
+    data::real_data_dir_for_tests(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
 }
 
 /// Fixed-step RK4 of `f` from `x0`, `steps` steps of `h`, returning every state (row per step).

@@ -365,6 +365,42 @@ fn stacked_column(top: &Mat<f64>, bottom: &Mat<f64>, j: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Every column of two stacked matrices (support rows, then query rows).
+pub(crate) fn stacked_columns(top: &Mat<f64>, bottom: &Mat<f64>) -> Vec<Vec<f64>> {
+    (0..top.ncols())
+        .map(|j| stacked_column(top, bottom, j))
+        .collect()
+}
+
+/// The qualitative figure of one cell (time and ground truth over both segments, one trace per
+/// method) and its file name.
+pub(crate) fn cell_figure(
+    formulation: Formulation,
+    condition: &Condition,
+    support: &Segment,
+    query: &Segment,
+    methods: Vec<MethodTrace>,
+) -> Result<(String, QualitativeFigure)> {
+    let figure = QualitativeFigure {
+        table: formulation.name().to_string(),
+        condition: condition.label().to_string(),
+        time: support.time.iter().chain(&query.time).copied().collect(),
+        split: support.len(),
+        outputs: formulation
+            .target_names()
+            .iter()
+            .map(|o| OutputAxis::for_target(o))
+            .collect(),
+        truth: stacked_columns(&support.targets, &query.targets),
+        methods,
+    };
+    figure.validate()?;
+    Ok((
+        figure_file_name(formulation.name(), condition.label()),
+        figure,
+    ))
+}
+
 /// The figure's file name: table and condition label, with anything unusual replaced by `-`.
 pub fn figure_file_name(table: &str, label: &str) -> String {
     let clean: String = label
@@ -381,46 +417,31 @@ pub fn figure_file_name(table: &str, label: &str) -> String {
 }
 
 fn figure(cell: &Cell, learn_result: &CellResult) -> Result<(String, QualitativeFigure)> {
-    let outputs = cell.formulation.target_names();
-    let column = |top: &Mat<f64>, bottom: &Mat<f64>| -> Vec<Vec<f64>> {
-        (0..outputs.len())
-            .map(|j| stacked_column(top, bottom, j))
-            .collect()
-    };
-    let figure = QualitativeFigure {
-        table: cell.formulation.name().to_string(),
-        condition: cell.condition.label().to_string(),
-        time: cell
-            .support
-            .time
-            .iter()
-            .chain(&cell.query.time)
-            .copied()
-            .collect(),
-        split: cell.support.len(),
-        outputs: outputs.iter().map(|o| OutputAxis::for_target(o)).collect(),
-        truth: column(&cell.support.targets, &cell.query.targets),
-        methods: vec![
-            MethodTrace {
-                method: "SINDy".to_string(),
-                prediction: column(&cell.sindy.support_prediction, &cell.sindy.query_prediction),
-                band: None,
-            },
-            MethodTrace {
-                method: "LeARN".to_string(),
-                prediction: column(
-                    &learn_result.support.predictions,
-                    &learn_result.query.predictions,
-                ),
-                band: None,
-            },
-        ],
-    };
-    figure.validate()?;
-    Ok((
-        figure_file_name(cell.formulation.name(), cell.condition.label()),
-        figure,
-    ))
+    let methods = vec![
+        MethodTrace {
+            method: "SINDy".to_string(),
+            prediction: stacked_columns(
+                &cell.sindy.support_prediction,
+                &cell.sindy.query_prediction,
+            ),
+            band: None,
+        },
+        MethodTrace {
+            method: "LeARN".to_string(),
+            prediction: stacked_columns(
+                &learn_result.support.predictions,
+                &learn_result.query.predictions,
+            ),
+            band: None,
+        },
+    ];
+    cell_figure(
+        cell.formulation,
+        cell.condition,
+        &cell.support,
+        &cell.query,
+        methods,
+    )
 }
 
 fn record(cell: &Cell, learn_results: &[Vec<CellResult>], index: usize) -> Result<CellRecord> {

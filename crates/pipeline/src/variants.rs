@@ -24,7 +24,7 @@ use data::{
 use learn::variants::{LearnedFeatures, learned_features};
 use learn::{Experiment, MetaTrainedModel};
 use rayon::prelude::*;
-use report::{MethodTrace, OutputAxis, PublishedTables, QualitativeFigure};
+use report::{MethodTrace, PublishedTables, QualitativeFigure};
 use serde::{Deserialize, Serialize};
 use sindy::{
     CausalLibrary, EnsemblePrediction, LibraryRegression, Mat, RegressionSpec, VariantEvaluation,
@@ -722,22 +722,10 @@ fn summarise(seeds: Vec<SeedCell>) -> VariantCell {
     }
 }
 
-fn stacked(top: &Mat<f64>, bottom: &Mat<f64>) -> Vec<Vec<f64>> {
-    (0..top.ncols())
-        .map(|j| {
-            top.col(j)
-                .iter()
-                .chain(bottom.col(j).iter())
-                .copied()
-                .collect()
-        })
-        .collect()
-}
-
 fn band_series(support: &EnsemblePrediction, query: &EnsemblePrediction) -> report::Band {
     report::Band {
-        lower: stacked(&support.lower, &query.lower),
-        upper: stacked(&support.upper, &query.upper),
+        lower: crate::run::stacked_columns(&support.lower, &query.lower),
+        upper: crate::run::stacked_columns(&support.upper, &query.upper),
     }
 }
 
@@ -746,35 +734,25 @@ fn figure(
     name: &str,
     evaluation: &VariantEvaluation,
 ) -> Result<(String, QualitativeFigure)> {
-    let outputs = cell.formulation.target_names();
     let band = match (&evaluation.support_band, &evaluation.query_band) {
         (Some(s), Some(q)) => Some(band_series(s, q)),
         _ => None,
     };
-    let figure = QualitativeFigure {
-        table: cell.formulation.name().to_string(),
-        condition: cell.condition.label().to_string(),
-        time: cell
-            .support
-            .time
-            .iter()
-            .chain(&cell.query.time)
-            .copied()
-            .collect(),
-        split: cell.support.len(),
-        outputs: outputs.iter().map(|o| OutputAxis::for_target(o)).collect(),
-        truth: stacked(&cell.support.targets, &cell.query.targets),
-        methods: vec![MethodTrace {
-            method: name.to_string(),
-            prediction: stacked(&evaluation.support_prediction, &evaluation.query_prediction),
-            band,
-        }],
+    let method = MethodTrace {
+        method: name.to_string(),
+        prediction: crate::run::stacked_columns(
+            &evaluation.support_prediction,
+            &evaluation.query_prediction,
+        ),
+        band,
     };
-    figure.validate()?;
-    Ok((
-        crate::run::figure_file_name(cell.formulation.name(), cell.condition.label()),
-        figure,
-    ))
+    crate::run::cell_figure(
+        cell.formulation,
+        cell.condition,
+        &cell.support,
+        &cell.query,
+        vec![method],
+    )
 }
 
 /// Writes `ablations.json`, `ablations.md` and the figures under `dir`; returns the paths.

@@ -313,10 +313,7 @@ mod tests {
     use crate::table::{MethodPair, Mse, Row};
 
     fn mse(adaptation: f64, generalisation: f64) -> Mse {
-        Mse {
-            adaptation,
-            generalisation,
-        }
+        Mse::new(adaptation, generalisation)
     }
 
     fn published() -> PublishedTables {

@@ -204,10 +204,7 @@ mod tests {
     use crate::table::{MethodPair, Mse};
 
     fn mse(adaptation: f64, generalisation: f64) -> Mse {
-        Mse {
-            adaptation,
-            generalisation,
-        }
+        Mse::new(adaptation, generalisation)
     }
 
     fn sample() -> ResultsTable {

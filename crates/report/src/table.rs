@@ -26,6 +26,14 @@ pub struct Mse {
 }
 
 impl Mse {
+    /// Adaptation and generalisation MSE.
+    pub const fn new(adaptation: f64, generalisation: f64) -> Self {
+        Self {
+            adaptation,
+            generalisation,
+        }
+    }
+
     /// The value of one metric.
     pub fn get(&self, metric: Metric) -> f64 {
         match metric {
@@ -272,10 +280,7 @@ mod tests {
     use super::*;
 
     fn mse(adaptation: f64, generalisation: f64) -> Mse {
-        Mse {
-            adaptation,
-            generalisation,
-        }
+        Mse::new(adaptation, generalisation)
     }
 
     #[test]

@@ -3,7 +3,8 @@
 //! Cholesky solver).
 
 use faer::linalg::solvers::{Qr, Solve, SolveLstsq};
-use faer::{Mat, MatRef, Side};
+use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::{Mat, MatRef, Par, Side};
 
 /// Minimum-norm least-squares solution of `a·x ≈ b` (every column of `b` a right-hand side).
 ///
@@ -30,11 +31,94 @@ pub fn full_rank_qr(a: MatRef<'_, f64>) -> Option<(Qr<f64>, Mat<f64>)> {
     let qr = a.qr();
     let r = qr.thin_R().to_owned();
     clear_upper_vector_state();
+    full_rank_triangular(a, r.as_ref()).then_some((qr, r))
+}
+
+/// A thin QR factorisation `a = Q·R` (Q: n × p with orthonormal columns, R: p × p upper
+/// triangular) of a tall, well-conditioned `a` by CholeskyQR2 (Yamamoto, Nakatsukasa, Yanagisawa
+/// and Fukaya, 2015), from its Gram matrix `aᵀa`:
+///
+/// R₁ = chol(aᵀa), Q₁ = a·R₁⁻¹, R₂ = chol(Q₁ᵀQ₁), Q = Q₁·R₂⁻¹, R = R₂·R₁.
+///
+/// The second pass restores the orthogonality the first loses (‖Q₁ᵀQ₁ − I‖ ≈ κ(a)²·ε), so Q and
+/// R are as accurate as Householder's while costing a few small matrix products instead of a
+/// column-by-column factorisation (for a 1255 × 14 library: well under 100 µs against ~400 µs
+/// for faer's Householder QR). Q is kept as Q₁ and R₂ (Qᵀb = R₂⁻ᵀ·Q₁ᵀb), one n × p matrix.
+pub(crate) struct CholeskyQr {
+    first_q: Mat<f64>,
+    second_r: Mat<f64>,
+    r: Mat<f64>,
+}
+
+impl CholeskyQr {
+    /// The factorisation of `a` given `gram = aᵀa`. `None` (use Householder) when `a` is wide, a
+    /// Cholesky factorisation fails, or R₁'s diagonal spans more than [`CHOLESKY_QR_CONDITION`]
+    /// (κ(a) large enough for the first pass to lose the orthogonality the second pass needs).
+    pub(crate) fn new(a: MatRef<'_, f64>, gram: MatRef<'_, f64>) -> Option<Self> {
+        let p = a.ncols();
+        if a.nrows() < p || p == 0 || gram.nrows() != p || gram.ncols() != p {
+            return None;
+        }
+        let factorisation = Self::factor(a, gram);
+        clear_upper_vector_state();
+        factorisation
+    }
+
+    fn factor(a: MatRef<'_, f64>, gram: MatRef<'_, f64>) -> Option<Self> {
+        let first_r = upper_cholesky(gram)?;
+        let diagonal: Vec<f64> = (0..a.ncols()).map(|i| first_r[(i, i)].abs()).collect();
+        let largest = diagonal.iter().copied().fold(0.0, f64::max);
+        let smallest = diagonal.iter().copied().fold(f64::INFINITY, f64::min);
+        if !(smallest > 0.0 && largest / smallest < CHOLESKY_QR_CONDITION) {
+            return None;
+        }
+        let first_q = a * upper_triangular_inverse(first_r.as_ref());
+        let second_r = upper_cholesky((first_q.transpose() * &first_q).as_ref())?;
+        let r = &second_r * &first_r;
+        Some(Self {
+            first_q,
+            second_r,
+            r,
+        })
+    }
+
+    /// The triangular factor R.
+    pub(crate) fn r(&self) -> MatRef<'_, f64> {
+        self.r.as_ref()
+    }
+
+    /// Qᵀ·b for every column of `b` (n rows).
+    pub(crate) fn project(&self, b: MatRef<'_, f64>) -> Mat<f64> {
+        let mut projected = self.first_q.transpose() * b;
+        solve_lower_triangular_in_place(self.second_r.transpose(), projected.as_mut(), Par::Seq);
+        clear_upper_vector_state();
+        projected
+    }
+}
+
+/// Largest ratio between R₁'s diagonal entries that [`CholeskyQr::new`] accepts (a lower bound of
+/// κ(a); CholeskyQR2 is stable for κ(a) up to about ε^(-1/2) ≈ 10⁸).
+pub const CHOLESKY_QR_CONDITION: f64 = 1e6;
+
+/// The upper triangular R with RᵀR = `gram`, if `gram` is numerically positive definite.
+fn upper_cholesky(gram: MatRef<'_, f64>) -> Option<Mat<f64>> {
+    let factor = gram.llt(Side::Lower).ok()?;
+    Some(factor.L().transpose().to_owned())
+}
+
+fn upper_triangular_inverse(r: MatRef<'_, f64>) -> Mat<f64> {
+    let mut inverse = Mat::zeros(r.nrows(), r.ncols());
+    faer::linalg::triangular_inverse::invert_upper_triangular(inverse.as_mut(), r, Par::Seq);
+    inverse
+}
+
+/// Whether the triangular factor R of a tall matrix `a` has full numerical rank: no diagonal
+/// entry `|R_ii| ≤ 1000·ε·max(m, n)·max|R_jj|`.
+pub fn full_rank_triangular(a: MatRef<'_, f64>, r: MatRef<'_, f64>) -> bool {
     let diagonal: Vec<f64> = (0..r.ncols()).map(|i| r[(i, i)].abs()).collect();
     let largest = diagonal.iter().copied().fold(0.0, f64::max);
     let tolerance = 1e3 * rank_tolerance(a) * largest;
-    clear_upper_vector_state();
-    (largest > 0.0 && diagonal.iter().all(|&d| d > tolerance)).then_some((qr, r))
+    largest > 0.0 && diagonal.iter().all(|&d| d > tolerance)
 }
 
 fn rank_tolerance(a: MatRef<'_, f64>) -> f64 {
@@ -109,6 +193,50 @@ mod tests {
         let y = Mat::from_fn(5, 1, |i, _| 2.0 * (i as f64 + 1.0));
         let x = least_squares(twin.as_ref(), y.as_ref());
         assert!((x[(0, 0)] - 1.0).abs() < 1e-10 && (x[(1, 0)] - 1.0).abs() < 1e-10);
+    }
+
+    #[test]
+    fn cholesky_qr_matches_householder_and_declines_ill_conditioned_matrices() {
+        // pseudo-random entries in [0, 1) (a multiplicative hash of the position)
+        let random = |i: usize, j: usize| {
+            ((i * 9 + j) as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) as f64 / 2f64.powi(64)
+        };
+        let a = Mat::from_fn(400, 9, random);
+        let b = Mat::from_fn(400, 2, |i, j| (i as f64 * 0.01 + j as f64).cos());
+        let gram = a.transpose() * &a;
+        let qr = CholeskyQr::new(a.as_ref(), gram.as_ref()).expect("well conditioned");
+        // QᵀQ = I through the projection of a's own columns (Qᵀa = R), and RᵀR = aᵀa.
+        let projected_a = qr.project(a.as_ref());
+        assert!((&projected_a - qr.r()).norm_max() < 1e-12 * qr.r().norm_max());
+        let product = qr.r().transpose() * qr.r();
+        assert!((&product - &gram).norm_max() < 1e-12 * gram.norm_max());
+        // The least-squares solution R⁻¹Qᵀb equals Householder's.
+        let mut solution = qr.project(b.as_ref());
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            qr.r(),
+            solution.as_mut(),
+            Par::Seq,
+        );
+        let householder = least_squares(a.as_ref(), b.as_ref());
+        assert!(
+            (&solution - &householder).norm_max() < 1e-12,
+            "{solution:?}"
+        );
+
+        // Nearly dependent columns (κ ≈ 1e9): left to Householder and the SVD.
+        let ill = Mat::from_fn(400, 3, |i, j| {
+            let t = i as f64 * 0.01;
+            if j == 2 {
+                t + 1e-9 * t.sin()
+            } else {
+                t.powi(j as i32)
+            }
+        });
+        let ill_gram = ill.transpose() * &ill;
+        assert!(CholeskyQr::new(ill.as_ref(), ill_gram.as_ref()).is_none());
+        // Wide matrices have no thin QR.
+        let wide = Mat::from_fn(2, 3, |i, j| (i + j) as f64);
+        assert!(CholeskyQr::new(wide.as_ref(), (wide.transpose() * &wide).as_ref()).is_none());
     }
 
     #[test]

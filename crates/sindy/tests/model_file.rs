@@ -95,9 +95,13 @@ fn a_saved_model_loads_and_predicts_identically() {
 fn inconsistent_files_are_rejected_naming_the_field() {
     let text = model().to_json().unwrap();
     let path = std::path::Path::new("bad.json");
+    let mut unknown_feature: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let equation = unknown_feature["equations"]["x"].as_object_mut().unwrap();
+    let coefficient = equation.remove("y").unwrap();
+    equation.insert("q".to_string(), coefficient);
     let cases = [
         (text.replace("\"sin(u)\"", "\"sin(w)\""), "features"),
-        (text.replacen("\"y\": 1.0", "\"q\": 1.0", 1), "equations.x"),
+        (unknown_feature.to_string(), "equations.x"),
         (text.replace("sindy-model/1", "sindy-model/9"), "format"),
         ("{\"state\": [".to_string(), "(document)"),
     ];

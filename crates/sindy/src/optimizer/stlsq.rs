@@ -16,9 +16,16 @@ use rayon::prelude::*;
 use crate::error::{Result, invalid};
 use faer::linalg::solvers::SolveLstsq;
 
-use crate::linalg::{clear_upper_vector_state, full_rank_qr, least_squares, ridge_from_gram};
+use crate::linalg::{
+    CholeskyQr, clear_upper_vector_state, full_rank_qr, least_squares, ridge_from_gram,
+};
+use faer::Par;
+use faer::linalg::triangular_solve::solve_upper_triangular_in_place;
 
-/// Work (samples × features²) above which targets are fitted in parallel.
+/// Work per target above which targets are fitted in parallel: features³ for the ridge steps on
+/// the Gram matrix and the refit on R (p × p), samples × features² when the refit needs Θ itself
+/// (no reduced problem). Below it, waking rayon's threads costs more than the work (measured: the
+/// paper's 14-feature fits were ~2x slower in parallel).
 const PARALLEL_WORK: usize = 100_000;
 
 /// Checked STLSQ settings.
@@ -64,7 +71,7 @@ impl Stlsq {
     pub fn fit(&self, theta: MatRef<'_, f64>, targets: MatRef<'_, f64>) -> StlsqFit {
         let gram = theta.transpose() * theta;
         let moments = theta.transpose() * targets;
-        let reduced = ReducedProblem::new(theta, targets);
+        let reduced = ReducedProblem::new(theta, targets, gram.as_ref());
         let reference = match &reduced {
             Some(reduced) => reduced.solution.clone(),
             None => least_squares(theta, targets),
@@ -86,7 +93,11 @@ impl Stlsq {
                 support.1,
             )
         };
-        let work = theta.nrows() * theta.ncols() * theta.ncols();
+        let features = theta.ncols();
+        let work = match reduced {
+            Some(_) => features * features * features,
+            None => theta.nrows() * features * features,
+        };
         let columns: Vec<(Vec<f64>, usize)> = if work >= PARALLEL_WORK && targets.ncols() > 1 {
             (0..targets.ncols())
                 .into_par_iter()
@@ -154,7 +165,9 @@ impl Stlsq {
 
 /// Θ = QR of the full library, with Qᵀy for every target: a least-squares problem on a subset S
 /// of the columns, `min ‖Θ_S ξ − y‖`, equals `min ‖R_S ξ − Qᵀy‖` (p rows instead of n), solved
-/// as stably as a QR of Θ_S. `None` when Θ is wide or rank-deficient.
+/// as stably as a QR of Θ_S. The QR comes from CholeskyQR2 on the Gram matrix already formed
+/// for the ridge steps, or from Householder when Θ is too ill-conditioned for it. `None` when Θ
+/// is wide or rank-deficient.
 struct ReducedProblem {
     triangular: Mat<f64>,
     projected: Mat<f64>,
@@ -163,7 +176,22 @@ struct ReducedProblem {
 }
 
 impl ReducedProblem {
-    fn new(theta: MatRef<'_, f64>, targets: MatRef<'_, f64>) -> Option<Self> {
+    fn new(
+        theta: MatRef<'_, f64>,
+        targets: MatRef<'_, f64>,
+        gram: MatRef<'_, f64>,
+    ) -> Option<Self> {
+        if let Some(qr) = CholeskyQr::new(theta, gram) {
+            let projected = qr.project(targets);
+            let mut solution = projected.clone();
+            solve_upper_triangular_in_place(qr.r(), solution.as_mut(), Par::Seq);
+            clear_upper_vector_state();
+            return Some(Self {
+                triangular: qr.r().to_owned(),
+                projected,
+                solution,
+            });
+        }
         let (qr, triangular) = full_rank_qr(theta)?;
         let solution = qr.solve_lstsq(targets);
         // Qᵀy = R·ξ_ls.

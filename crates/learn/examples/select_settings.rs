@@ -5,7 +5,7 @@
 //! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
 //! score and the one fold c's own validation prefers, and writes all numbers as JSON.
 //!
-//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations]
+//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging]
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -22,7 +22,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .cloned()
         .unwrap_or_else(|| "results/.scratch/learn-selection.json".to_string());
     let seed: u64 = arguments.get(1).map_or(Ok(1), |s| s.parse())?;
-    // `grid` (the default): the first comparison; `iterations`: how far more meta-iterations help.
+    // `grid` (the default): the first comparison; `iterations`: how far more meta-iterations help;
+    // `averaging`: whether averaging the last meta-iterates (Polyak–Ruppert) helps.
     let stage = arguments.get(2).map_or("grid", String::as_str);
     let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
     let base = checked.get().clone();
@@ -38,23 +39,41 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Meta-training candidates (all within the reproduce budget: iterations × tasks ≤ 3200).
     let mut candidates: Vec<(String, LearnConfig)> = Vec::new();
-    let grid: &[(usize, usize, f64)] = match stage {
-        "iterations" => &[(800, 4, 0.1), (1600, 4, 0.1)],
-        _ => &[(200, 4, 0.1), (800, 4, 0.1), (400, 8, 0.1), (800, 4, 0.05)],
+    // (iterations, tasks, α, iterates averaged)
+    let grid: &[(usize, usize, f64, usize)] = match stage {
+        "iterations" => &[(800, 4, 0.1, 0), (1600, 4, 0.1, 0)],
+        "averaging" => &[(800, 4, 0.1, 0), (800, 4, 0.1, 200), (800, 4, 0.1, 400)],
+        _ => &[
+            (200, 4, 0.1, 0),
+            (800, 4, 0.1, 0),
+            (400, 8, 0.1, 0),
+            (800, 4, 0.05, 0),
+        ],
     };
-    for &(iterations, task_batch, inner_step) in grid {
+    for &(iterations, task_batch, inner_step, average_last) in grid {
         let mut config = base.clone();
         config.meta_training.iterations = iterations;
         config.meta_training.task_batch = task_batch;
         config.meta_training.inner_step = inner_step;
+        config.meta_training.average_last = average_last;
+        let averaged = if average_last > 0 {
+            format!("_average{average_last}")
+        } else {
+            String::new()
+        };
         candidates.push((
-            format!("it{iterations}_tasks{task_batch}_alpha{inner_step}"),
+            format!("it{iterations}_tasks{task_batch}_alpha{inner_step}{averaged}"),
             config,
         ));
     }
     let mut adaptations: Vec<(String, AdaptationConfig)> = Vec::new();
-    let passes_grid: &[usize] = if stage == "iterations" { &[8] } else { &[4, 8] };
-    for step in [0.0005, 0.001] {
+    let passes_grid: &[usize] = if stage == "grid" { &[4, 8] } else { &[8] };
+    let steps: &[f64] = if stage == "averaging" {
+        &[0.0005]
+    } else {
+        &[0.0005, 0.001]
+    };
+    for &step in steps {
         for &passes in passes_grid {
             adaptations.push((
                 format!("step{step}_passes{passes}"),

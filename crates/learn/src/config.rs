@@ -40,6 +40,11 @@ pub struct MetaTrainingConfig {
     pub query_batch: usize,
     /// Number of meta-iterations.
     pub iterations: usize,
+    /// Iterate averaging (Polyak–Ruppert): the meta-trained parameters are the mean of the
+    /// parameters after each of the last `average_last` updates, instead of the last one.
+    /// 0 (the default, and the paper) keeps the final iterate.
+    #[serde(default)]
+    pub average_last: usize,
 }
 
 /// Online adaptation on the support segment (equation online_adapt of the paper).
@@ -149,6 +154,12 @@ impl LearnConfig {
             if value == 0 {
                 return Err(error(field, "must be at least 1"));
             }
+        }
+        if meta.average_last > meta.iterations {
+            return Err(error(
+                "meta_training.average_last",
+                "must not exceed meta_training.iterations",
+            ));
         }
         if !(adaptation.step.is_finite() && adaptation.step >= 0.0) {
             return Err(error("adaptation.step", "must be ≥ 0"));

@@ -72,6 +72,47 @@ impl Adam {
     }
 }
 
+/// The running mean of the iterates after the last `average_last` updates (Polyak–Ruppert).
+struct IterateAverage {
+    first_iteration: usize,
+    count: usize,
+    sum: Vec<f64>,
+}
+
+impl IterateAverage {
+    fn new(size: usize, config: &MetaTrainingConfig) -> Self {
+        let averaged = config.average_last.min(config.iterations);
+        Self {
+            first_iteration: config.iterations - averaged,
+            count: 0,
+            sum: if averaged > 0 {
+                vec![0.0; size]
+            } else {
+                Vec::new()
+            },
+        }
+    }
+
+    fn observe(&mut self, iteration: usize, parameters: &[f64]) {
+        if self.sum.is_empty() || iteration < self.first_iteration {
+            return;
+        }
+        self.count += 1;
+        for (s, p) in self.sum.iter_mut().zip(parameters) {
+            *s += p;
+        }
+    }
+
+    /// The mean of the observed iterates, or `last` when averaging is off.
+    fn finish(self, last: Vec<f64>) -> Vec<f64> {
+        if self.count == 0 {
+            return last;
+        }
+        let scale = 1.0 / self.count as f64;
+        self.sum.into_iter().map(|s| s * scale).collect()
+    }
+}
+
 fn sample_rows(rng: &mut ChaCha8Rng, source: &Batch, input_dim: usize, count: usize) -> Batch {
     let output_dim = source.targets.len() * input_dim / source.inputs.len();
     let rows = source.inputs.len() / input_dim;
@@ -183,6 +224,7 @@ pub fn meta_train_from(
     // One workspace per thread (not per task): a smaller working set per cache.
     let workspace_count = rayon::current_num_threads().clamp(1, config.task_batch.max(1));
     let mut workspaces = vec![MetaWorkspace::new(architecture); workspace_count];
+    let mut average = IterateAverage::new(parameters.len(), config);
     let mut meta_loss_history = Vec::with_capacity(config.iterations);
     let mut support_loss_history = Vec::with_capacity(config.iterations);
     for iteration in 0..config.iterations {
@@ -217,9 +259,10 @@ pub fn meta_train_from(
             }
             Optimizer::Adam => adam.update(&mut parameters, &gradient, config.outer_step),
         }
+        average.observe(iteration, &parameters);
     }
     Ok(MetaTrainingOutcome {
-        parameters,
+        parameters: average.finish(parameters),
         meta_loss_history,
         support_loss_history,
     })

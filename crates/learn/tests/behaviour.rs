@@ -20,6 +20,7 @@ fn meta_config(iterations: usize) -> MetaTrainingConfig {
         support_batch: 16,
         query_batch: 16,
         iterations,
+        average_last: 0,
     }
 }
 
@@ -126,6 +127,46 @@ fn meta_training_is_bit_identical_for_one_and_two_threads() {
     assert_eq!(one.meta_loss_history, two.meta_loss_history);
     let other_seed = meta_train(&architecture, &tasks, &config, 4).unwrap();
     assert_ne!(one.parameters, other_seed.parameters);
+}
+
+#[test]
+fn iterate_averaging_returns_the_mean_of_the_last_iterates() {
+    let architecture = small_architecture();
+    let tasks = synthetic_tasks(6);
+    // A run of n iterations passes through the final iterates of the runs of n − 2 and n − 1.
+    let finals: Vec<Vec<f64>> = [18, 19, 20]
+        .iter()
+        .map(|&n| {
+            meta_train(&architecture, &tasks, &meta_config(n), 5)
+                .unwrap()
+                .parameters
+        })
+        .collect();
+    let averaged = meta_train(
+        &architecture,
+        &tasks,
+        &MetaTrainingConfig {
+            average_last: 3,
+            ..meta_config(20)
+        },
+        5,
+    )
+    .unwrap();
+    assert_ne!(averaged.parameters, finals[2]);
+    for (j, &value) in averaged.parameters.iter().enumerate() {
+        let mean = (finals[0][j] + finals[1][j] + finals[2][j]) / 3.0;
+        assert!((value - mean).abs() <= 1e-12 * mean.abs().max(1.0), "{j}");
+    }
+    // The loss histories are those of the plain run: averaging changes only the result.
+    assert_eq!(averaged.meta_loss_history.len(), 20);
+    let too_long = LearnConfig::load(&common::workspace().join("experiments/learn.json"))
+        .unwrap()
+        .get()
+        .clone();
+    let mut bad = too_long;
+    bad.meta_training.average_last = bad.meta_training.iterations + 1;
+    let error = bad.check(std::path::Path::new("learn.json")).unwrap_err();
+    assert!(error.to_string().contains("average_last"), "{error}");
 }
 
 #[test]

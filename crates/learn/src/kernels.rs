@@ -630,26 +630,61 @@ fn exp_non_positive(x: f64) -> f64 {
     polynomial(r, &INVERSE_FACTORIALS) * scale
 }
 
+/// Which of erf's two rational approximations [`gelu_branches`] evaluates.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum ErfBranches {
+    /// Both, the lane's own selected afterwards (branch-free, for mixed chunks).
+    Both,
+    /// Only u·T(u²)/U(u²): every lane has |u| < 1.
+    Small,
+    /// Only exp(−u²)·P(|u|)/Q(|u|): no lane has |u| < 1.
+    Large,
+}
+
 /// (GELU(z), GELU′(z), GELU″(z)) = (z·Φ(z), Φ(z) + z·φ(z), φ(z)·(2 − z²)) with one exponential,
 /// branch-free so that it vectorises.
 #[inline(always)]
 pub(crate) fn gelu_with_derivatives(z: f64) -> (f64, f64, f64) {
+    gelu_branches(z, ErfBranches::Both)
+}
+
+/// [`gelu_with_derivatives`] evaluating only the rational approximation(s) `branches` names; for
+/// a lane of that kind the result is the same to the bit (the same operations in the same order).
+#[inline(always)]
+fn gelu_branches(z: f64, branches: ErfBranches) -> (f64, f64, f64) {
     const FRAC_1_SQRT_2PI: f64 = 0.398_942_280_401_432_7;
     let u = z * std::f64::consts::FRAC_1_SQRT_2;
     let magnitude = u.abs();
     let gaussian = exp_non_positive(-0.5 * z * z);
     let square = u * u;
     // One division: erf(u) = u·T(u²)/U(u²) for |u| < 1, else erfc(|u|) = e^{−u²}·P(|u|)/Q(|u|).
-    let small = magnitude < 1.0;
-    let numerator = if small {
-        u * polynomial(square, &ERF_T)
-    } else {
-        gaussian * polynomial(magnitude, &ERFC_P)
+    let small = match branches {
+        ErfBranches::Both => magnitude < 1.0,
+        ErfBranches::Small => true,
+        ErfBranches::Large => false,
     };
-    let denominator = if small {
-        monic_polynomial(square, &ERF_U)
-    } else {
-        monic_polynomial(magnitude, &ERFC_Q)
+    let (numerator, denominator) = match branches {
+        ErfBranches::Small => (
+            u * polynomial(square, &ERF_T),
+            monic_polynomial(square, &ERF_U),
+        ),
+        ErfBranches::Large => (
+            gaussian * polynomial(magnitude, &ERFC_P),
+            monic_polynomial(magnitude, &ERFC_Q),
+        ),
+        ErfBranches::Both => {
+            let numerator = if small {
+                u * polynomial(square, &ERF_T)
+            } else {
+                gaussian * polynomial(magnitude, &ERFC_P)
+            };
+            let denominator = if small {
+                monic_polynomial(square, &ERF_U)
+            } else {
+                monic_polynomial(magnitude, &ERFC_Q)
+            };
+            (numerator, denominator)
+        }
     };
     let ratio = numerator / denominator;
     let tail = 0.5 * ratio;
@@ -693,6 +728,27 @@ fn gelu_layer_avx2(values: &mut [f64], first: &mut [f64], second: &mut [f64]) {
     gelu_layer_portable(values, first, second);
 }
 
+/// One chunk of lanes with the rational approximation(s) fixed at compile time (BRANCHES: 0 both,
+/// 1 small, 2 large), so that the lane loop vectorises.
+#[inline(always)]
+fn gelu_chunk<const LANES: usize, const BRANCHES: u8>(
+    v: &mut [f64; LANES],
+    d1: &mut [f64; LANES],
+    d2: &mut [f64; LANES],
+) {
+    let branches = match BRANCHES {
+        1 => ErfBranches::Small,
+        2 => ErfBranches::Large,
+        _ => ErfBranches::Both,
+    };
+    for lane in 0..LANES {
+        let (h, g1, g2) = gelu_branches(v[lane], branches);
+        v[lane] = h;
+        d1[lane] = g1;
+        d2[lane] = g2;
+    }
+}
+
 #[inline(always)]
 fn gelu_layer_portable(values: &mut [f64], first: &mut [f64], second: &mut [f64]) {
     const LANES: usize = 8;
@@ -708,11 +764,20 @@ fn gelu_layer_portable(values: &mut [f64], first: &mut [f64], second: &mut [f64]
             d1.try_into().expect("chunk of LANES"),
             d2.try_into().expect("chunk of LANES"),
         );
-        for lane in 0..LANES {
-            let (h, g1, g2) = gelu_with_derivatives(v[lane]);
-            v[lane] = h;
-            d1[lane] = g1;
-            d2[lane] = g2;
+        // A chunk whose lanes all fall on one side of |u| = 1 evaluates one rational
+        // approximation instead of both (hidden pre-activations are mostly small).
+        let small = |z: f64| (z * std::f64::consts::FRAC_1_SQRT_2).abs() < 1.0;
+        let branches = if v.iter().all(|&z| small(z)) {
+            ErfBranches::Small
+        } else if v.iter().all(|&z| !small(z)) {
+            ErfBranches::Large
+        } else {
+            ErfBranches::Both
+        };
+        match branches {
+            ErfBranches::Small => gelu_chunk::<LANES, 1>(v, d1, d2),
+            ErfBranches::Large => gelu_chunk::<LANES, 2>(v, d1, d2),
+            ErfBranches::Both => gelu_chunk::<LANES, 0>(v, d1, d2),
         }
     }
     for ((v, d1), d2) in values_chunks
@@ -729,7 +794,8 @@ fn gelu_layer_portable(values: &mut [f64], first: &mut [f64], second: &mut [f64]
 }
 
 /// out (cols × rows, row-major) = source (rows × cols, row-major)ᵀ: contiguous writes, strided
-/// reads (measured faster than the converse, and than the AVX-512 build of the loop).
+/// reads (measured faster than the converse, than 8 × 8 blocks, and than the AVX-512 build of the
+/// loop).
 pub(crate) fn transpose(rows: usize, cols: usize, source: &[f64], out: &mut [f64]) {
     let (source, out) = (&source[..rows * cols], &mut out[..rows * cols]);
     for (c, out_row) in out.chunks_exact_mut(rows).enumerate() {
@@ -746,6 +812,8 @@ mod tests {
     #[test]
     fn vectorised_gelu_matches_libm_and_every_build_agrees() {
         let mut z: Vec<f64> = (-4000..=4000).map(|k| k as f64 * 0.004).collect();
+        // Chunks of eight mixing both sides of |u| = 1 (|z| = √2), not only the boundary chunks.
+        z.extend((0..64).map(|k| if k % 3 == 0 { 0.3 } else { -2.5 } * (1.0 + k as f64 * 0.01)));
         z.extend([-40.0, -12.0, -9.0, 9.0, 12.0, 40.0, 1e-300, -1e-300, 0.0]);
         let (mut values, mut first, mut second) =
             (z.clone(), vec![0.0; z.len()], vec![0.0; z.len()]);
@@ -758,6 +826,12 @@ mod tests {
             (&portable, &portable_first, &portable_second)
         );
         for (k, &x) in z.iter().enumerate() {
+            // Chunks evaluating one rational approximation give the bits of the branch-free code.
+            assert_eq!(
+                gelu_with_derivatives(x),
+                (values[k], first[k], second[k]),
+                "z = {x}"
+            );
             let exact = (
                 crate::gelu(x),
                 crate::gelu_derivative(x),

@@ -5,7 +5,7 @@
 //! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
 //! score and the one fold c's own validation prefers, and writes all numbers as JSON.
 //!
-//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging]
+//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging]
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -23,7 +23,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or_else(|| "results/.scratch/learn-selection.json".to_string());
     let seed: u64 = arguments.get(1).map_or(Ok(1), |s| s.parse())?;
     // `grid` (the default): the first comparison; `iterations`: how far more meta-iterations help;
-    // `averaging`: whether averaging the last meta-iterates (Polyak–Ruppert) helps.
+    // `averaging`: whether averaging the last meta-iterates (Polyak–Ruppert) helps;
+    // `adaptation-averaging`: whether averaged SGD in the online adaptation helps.
     let stage = arguments.get(2).map_or("grid", String::as_str);
     let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
     let base = checked.get().clone();
@@ -43,6 +44,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let grid: &[(usize, usize, f64, usize)] = match stage {
         "iterations" => &[(800, 4, 0.1, 0), (1600, 4, 0.1, 0)],
         "averaging" => &[(800, 4, 0.1, 0), (800, 4, 0.1, 200), (800, 4, 0.1, 400)],
+        "adaptation-averaging" => &[(800, 4, 0.1, 0)],
         _ => &[
             (200, 4, 0.1, 0),
             (800, 4, 0.1, 0),
@@ -68,18 +70,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mut adaptations: Vec<(String, AdaptationConfig)> = Vec::new();
     let passes_grid: &[usize] = if stage == "grid" { &[4, 8] } else { &[8] };
-    let steps: &[f64] = if stage == "averaging" {
-        &[0.0005]
-    } else {
-        &[0.0005, 0.001]
+    // (step, averaged SGD over the last pass)
+    let steps: &[(f64, bool)] = match stage {
+        "averaging" => &[(0.0005, false)],
+        "adaptation-averaging" => &[(0.0005, false), (0.0005, true), (0.001, true)],
+        _ => &[(0.0005, false), (0.001, false)],
     };
-    for &step in steps {
+    for &(step, average_last_pass) in steps {
         for &passes in passes_grid {
+            let averaged = if average_last_pass { "_averaged" } else { "" };
             adaptations.push((
-                format!("step{step}_passes{passes}"),
+                format!("step{step}_passes{passes}{averaged}"),
                 AdaptationConfig {
                     step,
                     passes,
+                    average_last_pass,
                     ..base.adaptation.clone()
                 },
             ));

@@ -9,6 +9,9 @@
 //! where f_{t−1} is the prediction made for the previous sample by the parameters of that time, held
 //! constant (the paper's f(X_{t−1}; φ_{t−1}, ψ_{t−1})). The first sample of each pass has no
 //! predecessor and no regulariser. The squared error is averaged over the I outputs, as in the MSE.
+//!
+//! With `average_last_pass` (averaged SGD), the result is the mean of the parameters after each
+//! update of the last pass rather than the last iterate.
 
 use crate::batched::ModelWorkspace;
 use crate::config::AdaptationConfig;
@@ -28,7 +31,17 @@ pub fn adapt_online(
     let mut workspace = ModelWorkspace::new(architecture);
     let mut gradient = vec![0.0; parameters.len()];
     let mut prediction_gradient = Vec::with_capacity(config.window * output_dim);
-    for _ in 0..config.passes {
+    let mut average = vec![
+        0.0;
+        if config.average_last_pass {
+            parameters.len()
+        } else {
+            0
+        }
+    ];
+    let mut averaged_updates = 0usize;
+    for pass in 0..config.passes {
+        let averaging = config.average_last_pass && pass + 1 == config.passes;
         let mut previous: Option<Vec<f64>> = None;
         let mut start = 0;
         while start < rows {
@@ -69,11 +82,21 @@ pub fn adapt_online(
             for (p, g) in parameters.iter_mut().zip(&gradient) {
                 *p -= config.step * g;
             }
+            if averaging {
+                averaged_updates += 1;
+                for (a, p) in average.iter_mut().zip(&parameters) {
+                    *a += p;
+                }
+            }
             previous = Some(last);
             start = end;
         }
     }
-    parameters
+    if averaged_updates == 0 {
+        return parameters;
+    }
+    let scale = 1.0 / averaged_updates as f64;
+    average.into_iter().map(|a| a * scale).collect()
 }
 
 /// The subgradient of |x| that is 0 at 0.

@@ -61,6 +61,10 @@ pub struct AdaptationConfig {
     pub lipschitz_weight: f64,
     /// L of the same regulariser.
     pub lipschitz_bound: f64,
+    /// Averaged SGD: the adapted parameters are the mean of the parameters after each update of
+    /// the last pass, instead of those after the last update. Off by default (the paper).
+    #[serde(default)]
+    pub average_last_pass: bool,
 }
 
 /// Everything in `experiments/learn.json`.

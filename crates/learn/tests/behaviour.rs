@@ -31,6 +31,7 @@ fn adaptation(step: f64) -> AdaptationConfig {
         window: 1,
         lipschitz_weight: 0.0,
         lipschitz_bound: 0.0,
+        average_last_pass: false,
     }
 }
 
@@ -60,6 +61,60 @@ fn meta_loss_decreases_and_adaptation_beats_the_meta_initialisation() {
     );
     let after = architecture.loss(&adapted, &query.inputs, &query.targets);
     assert!(after < 0.7 * before, "query MSE {before} -> {after}");
+}
+
+#[test]
+fn averaged_adaptation_is_the_mean_of_the_last_pass_iterates() {
+    let architecture = small_architecture();
+    let start = architecture.initial_parameters(3);
+    let support = synthetic_batch(1.0, 0.5, 150, 0.0);
+    // Two updates per pass (windows of 75 samples), three passes.
+    let plain_config = AdaptationConfig {
+        window: 75,
+        ..adaptation(0.05)
+    };
+    let adapt = |parameters: &[f64], rows: usize, config: &AdaptationConfig| {
+        adapt_online(
+            &architecture,
+            parameters,
+            &support.inputs[..rows * 2],
+            &support.targets[..rows],
+            config,
+        )
+    };
+    let last = adapt(&start, 150, &plain_config);
+    let before_last_pass = adapt(
+        &start,
+        150,
+        &AdaptationConfig {
+            passes: 2,
+            ..plain_config.clone()
+        },
+    );
+    let first_of_last_pass = adapt(
+        &before_last_pass,
+        75,
+        &AdaptationConfig {
+            passes: 1,
+            ..plain_config.clone()
+        },
+    );
+    let averaged = adapt(
+        &start,
+        150,
+        &AdaptationConfig {
+            average_last_pass: true,
+            ..plain_config.clone()
+        },
+    );
+    assert_ne!(averaged, last);
+    for j in 0..averaged.len() {
+        let mean = 0.5 * (first_of_last_pass[j] + last[j]);
+        assert!(
+            (averaged[j] - mean).abs() <= 1e-12 * mean.abs().max(1.0),
+            "{j}"
+        );
+    }
 }
 
 #[test]

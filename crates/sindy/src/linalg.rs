@@ -98,7 +98,7 @@ impl CholeskyQr {
 
 /// Largest ratio between R₁'s diagonal entries that [`CholeskyQr::new`] accepts (a lower bound of
 /// κ(a); CholeskyQR2 is stable for κ(a) up to about ε^(-1/2) ≈ 10⁸).
-pub const CHOLESKY_QR_CONDITION: f64 = 1e6;
+pub(crate) const CHOLESKY_QR_CONDITION: f64 = 1e6;
 
 /// The upper triangular R with RᵀR = `gram`, if `gram` is numerically positive definite.
 fn upper_cholesky(gram: MatRef<'_, f64>) -> Option<Mat<f64>> {
@@ -114,7 +114,7 @@ fn upper_triangular_inverse(r: MatRef<'_, f64>) -> Mat<f64> {
 
 /// Whether the triangular factor R of a tall matrix `a` has full numerical rank: no diagonal
 /// entry `|R_ii| ≤ 1000·ε·max(m, n)·max|R_jj|`.
-pub fn full_rank_triangular(a: MatRef<'_, f64>, r: MatRef<'_, f64>) -> bool {
+pub(crate) fn full_rank_triangular(a: MatRef<'_, f64>, r: MatRef<'_, f64>) -> bool {
     let diagonal: Vec<f64> = (0..r.ncols()).map(|i| r[(i, i)].abs()).collect();
     let largest = diagonal.iter().copied().fold(0.0, f64::max);
     let tolerance = 1e3 * rank_tolerance(a) * largest;

@@ -13,6 +13,7 @@
 //! With `average_last_pass` (averaged SGD), the result is the mean of the parameters after each
 //! update of the last pass rather than the last iterate.
 
+use crate::averaging::IterateMean;
 use crate::batched::ModelWorkspace;
 use crate::config::AdaptationConfig;
 use crate::network::Architecture;
@@ -31,17 +32,9 @@ pub fn adapt_online(
     let mut workspace = ModelWorkspace::new(architecture);
     let mut gradient = vec![0.0; parameters.len()];
     let mut prediction_gradient = Vec::with_capacity(config.window * output_dim);
-    let mut average = vec![
-        0.0;
-        if config.average_last_pass {
-            parameters.len()
-        } else {
-            0
-        }
-    ];
-    let mut averaged_updates = 0usize;
+    let mut average = IterateMean::new(parameters.len(), config.average_last_pass);
     for pass in 0..config.passes {
-        let averaging = config.average_last_pass && pass + 1 == config.passes;
+        let last_pass = pass + 1 == config.passes;
         let mut previous: Option<Vec<f64>> = None;
         let mut start = 0;
         while start < rows {
@@ -82,21 +75,14 @@ pub fn adapt_online(
             for (p, g) in parameters.iter_mut().zip(&gradient) {
                 *p -= config.step * g;
             }
-            if averaging {
-                averaged_updates += 1;
-                for (a, p) in average.iter_mut().zip(&parameters) {
-                    *a += p;
-                }
+            if last_pass {
+                average.add(&parameters);
             }
             previous = Some(last);
             start = end;
         }
     }
-    if averaged_updates == 0 {
-        return parameters;
-    }
-    let scale = 1.0 / averaged_updates as f64;
-    average.into_iter().map(|a| a * scale).collect()
+    average.finish(parameters)
 }
 
 /// The subgradient of |x| that is 0 at 0.

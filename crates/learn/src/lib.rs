@@ -54,6 +54,7 @@
 //! whatever the number of threads.
 
 mod adapt;
+mod averaging;
 mod batched;
 mod config;
 mod dataset;

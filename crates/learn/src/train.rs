@@ -9,6 +9,7 @@
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use crate::averaging::IterateMean;
 use crate::config::{MetaTrainingConfig, Optimizer};
 use crate::error::{LearnError, Result};
 use crate::maml::{Batch, InnerLoop, MetaWorkspace, Task, meta_gradients};
@@ -69,47 +70,6 @@ impl Adam {
             let v_hat = *v / correction_second;
             *p -= rate * m_hat / (v_hat.sqrt() + EPSILON);
         }
-    }
-}
-
-/// The running mean of the iterates after the last `average_last` updates (Polyak–Ruppert).
-struct IterateAverage {
-    first_iteration: usize,
-    count: usize,
-    sum: Vec<f64>,
-}
-
-impl IterateAverage {
-    fn new(size: usize, config: &MetaTrainingConfig) -> Self {
-        let averaged = config.average_last.min(config.iterations);
-        Self {
-            first_iteration: config.iterations - averaged,
-            count: 0,
-            sum: if averaged > 0 {
-                vec![0.0; size]
-            } else {
-                Vec::new()
-            },
-        }
-    }
-
-    fn observe(&mut self, iteration: usize, parameters: &[f64]) {
-        if self.sum.is_empty() || iteration < self.first_iteration {
-            return;
-        }
-        self.count += 1;
-        for (s, p) in self.sum.iter_mut().zip(parameters) {
-            *s += p;
-        }
-    }
-
-    /// The mean of the observed iterates, or `last` when averaging is off.
-    fn finish(self, last: Vec<f64>) -> Vec<f64> {
-        if self.count == 0 {
-            return last;
-        }
-        let scale = 1.0 / self.count as f64;
-        self.sum.into_iter().map(|s| s * scale).collect()
     }
 }
 
@@ -224,7 +184,9 @@ pub fn meta_train_from(
     // One workspace per thread (not per task): a smaller working set per cache.
     let workspace_count = rayon::current_num_threads().clamp(1, config.task_batch.max(1));
     let mut workspaces = vec![MetaWorkspace::new(architecture); workspace_count];
-    let mut average = IterateAverage::new(parameters.len(), config);
+    // The mean of the iterates after the last `average_last` updates.
+    let first_averaged = config.iterations - config.average_last.min(config.iterations);
+    let mut average = IterateMean::new(parameters.len(), config.average_last > 0);
     let mut meta_loss_history = Vec::with_capacity(config.iterations);
     let mut support_loss_history = Vec::with_capacity(config.iterations);
     for iteration in 0..config.iterations {
@@ -259,7 +221,9 @@ pub fn meta_train_from(
             }
             Optimizer::Adam => adam.update(&mut parameters, &gradient, config.outer_step),
         }
-        average.observe(iteration, &parameters);
+        if iteration >= first_averaged {
+            average.add(&parameters);
+        }
     }
     Ok(MetaTrainingOutcome {
         parameters: average.finish(parameters),

@@ -630,6 +630,12 @@ fn exp_non_positive(x: f64) -> f64 {
     polynomial(r, &INVERSE_FACTORIALS) * scale
 }
 
+/// Whether GELU(z) takes erf's small-argument approximation: |u| < 1 with u = z/√2.
+#[inline(always)]
+fn erf_small_branch(z: f64) -> bool {
+    (z * std::f64::consts::FRAC_1_SQRT_2).abs() < 1.0
+}
+
 /// Which of erf's two rational approximations [`gelu_branches`] evaluates.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum ErfBranches {
@@ -658,32 +664,25 @@ fn gelu_branches(z: f64, branches: ErfBranches) -> (f64, f64, f64) {
     let gaussian = exp_non_positive(-0.5 * z * z);
     let square = u * u;
     // One division: erf(u) = u·T(u²)/U(u²) for |u| < 1, else erfc(|u|) = e^{−u²}·P(|u|)/Q(|u|).
-    let small = match branches {
-        ErfBranches::Both => magnitude < 1.0,
-        ErfBranches::Small => true,
-        ErfBranches::Large => false,
-    };
-    let (numerator, denominator) = match branches {
-        ErfBranches::Small => (
+    let small_ratio = || {
+        (
             u * polynomial(square, &ERF_T),
             monic_polynomial(square, &ERF_U),
-        ),
-        ErfBranches::Large => (
+        )
+    };
+    let large_ratio = || {
+        (
             gaussian * polynomial(magnitude, &ERFC_P),
             monic_polynomial(magnitude, &ERFC_Q),
-        ),
+        )
+    };
+    let (small, (numerator, denominator)) = match branches {
+        ErfBranches::Small => (true, small_ratio()),
+        ErfBranches::Large => (false, large_ratio()),
         ErfBranches::Both => {
-            let numerator = if small {
-                u * polynomial(square, &ERF_T)
-            } else {
-                gaussian * polynomial(magnitude, &ERFC_P)
-            };
-            let denominator = if small {
-                monic_polynomial(square, &ERF_U)
-            } else {
-                monic_polynomial(magnitude, &ERFC_Q)
-            };
-            (numerator, denominator)
+            let small = erf_small_branch(z);
+            let (small_part, large_part) = (small_ratio(), large_ratio());
+            (small, if small { small_part } else { large_part })
         }
     };
     let ratio = numerator / denominator;
@@ -766,10 +765,9 @@ fn gelu_layer_portable(values: &mut [f64], first: &mut [f64], second: &mut [f64]
         );
         // A chunk whose lanes all fall on one side of |u| = 1 evaluates one rational
         // approximation instead of both (hidden pre-activations are mostly small).
-        let small = |z: f64| (z * std::f64::consts::FRAC_1_SQRT_2).abs() < 1.0;
-        let branches = if v.iter().all(|&z| small(z)) {
+        let branches = if v.iter().all(|&z| erf_small_branch(z)) {
             ErfBranches::Small
-        } else if v.iter().all(|&z| !small(z)) {
+        } else if v.iter().all(|&z| !erf_small_branch(z)) {
             ErfBranches::Large
         } else {
             ErfBranches::Both

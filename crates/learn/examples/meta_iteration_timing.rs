@@ -9,7 +9,8 @@
 use std::time::Instant;
 
 use learn::{
-    Architecture, Batch, InnerLoop, MetaOrder, MetaWorkspace, PAPER_HIDDEN, Task, meta_gradients,
+    Architecture, Batch, InnerLoop, MetaOrder, MetaWorkspace, PAPER_HIDDEN, Task,
+    meta_gradients_into,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -58,6 +59,9 @@ fn main() {
     let mut pool_workspaces =
         vec![MetaWorkspace::new(&architecture); rayon::current_num_threads().clamp(1, tasks)];
     let mut single_workspace = vec![MetaWorkspace::new(&architecture)];
+    // Per-task results and their mean reused across iterations, as in `meta_train`.
+    let mut results = Vec::new();
+    let mut gradient = vec![0.0; parameters.len()];
     let mut iteration = |parallel: bool, parameters: &mut Vec<f64>| {
         let started = Instant::now();
         let workspaces = if parallel {
@@ -65,11 +69,20 @@ fn main() {
         } else {
             &mut single_workspace
         };
-        let results = meta_gradients(workspaces, parameters, &task_list, inner, MetaOrder::Second);
-        let mut gradient = vec![0.0; parameters.len()];
+        meta_gradients_into(
+            workspaces,
+            parameters,
+            &task_list,
+            inner,
+            MetaOrder::Second,
+            &mut results,
+        );
+        // The mean over tasks, as `meta_train` forms it.
+        let scale = 1.0 / tasks as f64;
+        gradient.fill(0.0);
         for result in &results {
             for (g, r) in gradient.iter_mut().zip(&result.gradient) {
-                *g += r / tasks as f64;
+                *g += r * scale;
             }
         }
         for (p, g) in parameters.iter_mut().zip(&gradient) {

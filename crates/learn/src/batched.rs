@@ -123,7 +123,8 @@ impl NetworkWorkspace {
         if l == 0 { inputs } else { &self.values[l - 1] }
     }
 
-    fn forward(&mut self, parameters: &[f64], inputs: &[f64], batch: usize) {
+    /// The forward pass; GELU″ is kept only `with_second` (for a later Hessian-vector product).
+    fn forward(&mut self, parameters: &[f64], inputs: &[f64], batch: usize, with_second: bool) {
         let layers = self.layers();
         for l in 0..layers {
             let (fan_in, fan_out) = (self.sizes[l], self.sizes[l + 1]);
@@ -147,7 +148,8 @@ impl NetworkWorkspace {
                 Some(biases),
             );
             if l + 1 < layers {
-                gelu_layer(&mut z, &mut self.first[l], &mut self.second[l]);
+                let second = with_second.then_some(self.second[l].as_mut_slice());
+                gelu_layer(&mut z, &mut self.first[l], second);
             }
             self.values[l] = z;
         }
@@ -424,6 +426,9 @@ pub struct ModelWorkspace {
     prediction_gradient: Vec<f64>,
     /// Whether the stored ∂L/∂y is the mean squared error's (required by the Hessian product).
     mse_backward: bool,
+    /// Whether forward passes keep GELU″ (the Hessian product needs it; a workspace that only
+    /// ever takes gradients can skip it).
+    keeps_curvature: bool,
 }
 
 impl ModelWorkspace {
@@ -438,7 +443,15 @@ impl ModelWorkspace {
             prediction: Vec::new(),
             prediction_gradient: Vec::new(),
             mse_backward: false,
+            keeps_curvature: true,
         }
+    }
+
+    /// These buffers for gradients only: forward passes skip GELU″, and
+    /// [`Self::hessian_vector_product`] panics. Values and gradients are the same to the bit.
+    pub fn for_gradients_only(mut self) -> Self {
+        self.keeps_curvature = false;
+        self
     }
 
     /// The architecture these buffers serve.
@@ -459,8 +472,11 @@ impl ModelWorkspace {
         self.library.resize(batch);
         self.selection.resize(batch);
         let split = architecture.library_parameter_count();
-        self.library.forward(&parameters[..split], inputs, batch);
-        self.selection.forward(&parameters[split..], inputs, batch);
+        let curvature = self.keeps_curvature;
+        self.library
+            .forward(&parameters[..split], inputs, batch, curvature);
+        self.selection
+            .forward(&parameters[split..], inputs, batch, curvature);
         let (basis, states) = (architecture.basis_count(), architecture.state_dim);
         self.prediction.resize(batch * states, 0.0);
         product_forward(
@@ -565,6 +581,10 @@ impl ModelWorkspace {
         assert!(
             self.mse_backward,
             "hessian_vector_product needs a preceding mse_and_gradient"
+        );
+        assert!(
+            self.keeps_curvature,
+            "hessian_vector_product on a workspace made for gradients only"
         );
         assert_eq!(direction.len(), parameters.len(), "direction length");
         assert_eq!(product.len(), parameters.len(), "product length");

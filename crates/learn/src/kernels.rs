@@ -698,42 +698,62 @@ fn gelu_branches(z: f64, branches: ErfBranches) -> (f64, f64, f64) {
     (z * cdf, cdf + z * pdf, pdf * (2.0 - z * z))
 }
 
-/// For each pre-activation z in `values`: values ← GELU(z), first ← GELU′(z), second ← GELU″(z).
-pub(crate) fn gelu_layer(values: &mut [f64], first: &mut [f64], second: &mut [f64]) {
-    assert!(first.len() >= values.len() && second.len() >= values.len());
+/// For each pre-activation z in `values`: values ← GELU(z), first ← GELU′(z), and, when `second`
+/// is given, second ← GELU″(z) (only the Hessian-vector product needs it). Every value is the
+/// same to the bit with or without `second`.
+pub(crate) fn gelu_layer(values: &mut [f64], first: &mut [f64], second: Option<&mut [f64]>) {
     let count = values.len();
-    let (first, second) = (&mut first[..count], &mut second[..count]);
+    assert!(first.len() >= count);
+    let first = &mut first[..count];
+    match second {
+        Some(second) => {
+            assert!(second.len() >= count);
+            gelu_layer_dispatched::<true>(values, first, &mut second[..count]);
+        }
+        None => gelu_layer_dispatched::<false>(values, first, &mut []),
+    }
+}
+
+fn gelu_layer_dispatched<const SECOND: bool>(
+    values: &mut [f64],
+    first: &mut [f64],
+    second: &mut [f64],
+) {
     // SAFETY: the instruction set was detected.
     unsafe {
         match isa() {
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => gelu_layer_avx512(values, first, second),
+            Isa::Avx512 => gelu_layer_avx512::<SECOND>(values, first, second),
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => gelu_layer_avx2(values, first, second),
-            Isa::Portable => gelu_layer_portable(values, first, second),
+            Isa::Avx2 => gelu_layer_avx2::<SECOND>(values, first, second),
+            Isa::Portable => gelu_layer_portable::<SECOND>(values, first, second),
         }
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,fma")]
-fn gelu_layer_avx512(values: &mut [f64], first: &mut [f64], second: &mut [f64]) {
-    gelu_layer_portable(values, first, second);
+fn gelu_layer_avx512<const SECOND: bool>(
+    values: &mut [f64],
+    first: &mut [f64],
+    second: &mut [f64],
+) {
+    gelu_layer_portable::<SECOND>(values, first, second);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn gelu_layer_avx2(values: &mut [f64], first: &mut [f64], second: &mut [f64]) {
-    gelu_layer_portable(values, first, second);
+fn gelu_layer_avx2<const SECOND: bool>(values: &mut [f64], first: &mut [f64], second: &mut [f64]) {
+    gelu_layer_portable::<SECOND>(values, first, second);
 }
 
 /// One chunk of lanes with the rational approximation(s) fixed at compile time (BRANCHES: 0 both,
-/// 1 small, 2 large), so that the lane loop vectorises.
+/// 1 small, 2 large), so that the lane loop vectorises; GELU″ is stored when SECOND.
 #[inline(always)]
-fn gelu_chunk<const LANES: usize, const BRANCHES: u8>(
+fn gelu_chunk<const LANES: usize, const BRANCHES: u8, const SECOND: bool>(
     v: &mut [f64; LANES],
     d1: &mut [f64; LANES],
-    d2: &mut [f64; LANES],
+    d2: &mut [f64],
 ) {
     let branches = match BRANCHES {
         1 => ErfBranches::Small,
@@ -744,62 +764,121 @@ fn gelu_chunk<const LANES: usize, const BRANCHES: u8>(
         let (h, g1, g2) = gelu_branches(v[lane], branches);
         v[lane] = h;
         d1[lane] = g1;
-        d2[lane] = g2;
+        if SECOND {
+            d2[lane] = g2;
+        }
     }
 }
 
 #[inline(always)]
-fn gelu_layer_portable(values: &mut [f64], first: &mut [f64], second: &mut [f64]) {
+fn gelu_layer_portable<const SECOND: bool>(
+    values: &mut [f64],
+    first: &mut [f64],
+    second: &mut [f64],
+) {
     const LANES: usize = 8;
-    let mut values_chunks = values.chunks_exact_mut(LANES);
-    let mut first_chunks = first.chunks_exact_mut(LANES);
-    let mut second_chunks = second.chunks_exact_mut(LANES);
-    for ((v, d1), d2) in (&mut values_chunks)
-        .zip(&mut first_chunks)
-        .zip(&mut second_chunks)
-    {
-        let (v, d1, d2): (&mut [f64; LANES], &mut [f64; LANES], &mut [f64; LANES]) = (
-            v.try_into().expect("chunk of LANES"),
-            d1.try_into().expect("chunk of LANES"),
-            d2.try_into().expect("chunk of LANES"),
-        );
+    let count = values.len();
+    for start in (0..count - count % LANES).step_by(LANES) {
+        let chunk = start..start + LANES;
+        let v: &mut [f64; LANES] = (&mut values[chunk.clone()]).try_into().expect("chunk");
+        let d1: &mut [f64; LANES] = (&mut first[chunk.clone()]).try_into().expect("chunk");
+        let d2: &mut [f64] = if SECOND { &mut second[chunk] } else { &mut [] };
         // A chunk whose lanes all fall on one side of |u| = 1 evaluates one rational
         // approximation instead of both (hidden pre-activations are mostly small).
-        let branches = if v.iter().all(|&z| erf_small_branch(z)) {
-            ErfBranches::Small
+        if v.iter().all(|&z| erf_small_branch(z)) {
+            gelu_chunk::<LANES, 1, SECOND>(v, d1, d2);
         } else if v.iter().all(|&z| !erf_small_branch(z)) {
-            ErfBranches::Large
+            gelu_chunk::<LANES, 2, SECOND>(v, d1, d2);
         } else {
-            ErfBranches::Both
-        };
-        match branches {
-            ErfBranches::Small => gelu_chunk::<LANES, 1>(v, d1, d2),
-            ErfBranches::Large => gelu_chunk::<LANES, 2>(v, d1, d2),
-            ErfBranches::Both => gelu_chunk::<LANES, 0>(v, d1, d2),
+            gelu_chunk::<LANES, 0, SECOND>(v, d1, d2);
         }
     }
-    for ((v, d1), d2) in values_chunks
-        .into_remainder()
-        .iter_mut()
-        .zip(first_chunks.into_remainder())
-        .zip(second_chunks.into_remainder())
-    {
-        let (h, g1, g2) = gelu_with_derivatives(*v);
-        *v = h;
-        *d1 = g1;
-        *d2 = g2;
+    for k in count - count % LANES..count {
+        let (h, g1, g2) = gelu_with_derivatives(values[k]);
+        values[k] = h;
+        first[k] = g1;
+        if SECOND {
+            second[k] = g2;
+        }
     }
 }
 
-/// out (cols × rows, row-major) = source (rows × cols, row-major)ᵀ: contiguous writes, strided
-/// reads (measured faster than the converse, than 8 × 8 blocks, and than the AVX-512 build of the
-/// loop).
+/// out (cols × rows, row-major) = source (rows × cols, row-major)ᵀ. With AVX2 (or AVX-512), 4 × 4
+/// blocks go through registers (four loads, eight shuffles, four stores); the rows and columns
+/// beyond the last whole block, and machines without AVX2, take the scalar loop.
 pub(crate) fn transpose(rows: usize, cols: usize, source: &[f64], out: &mut [f64]) {
     let (source, out) = (&source[..rows * cols], &mut out[..rows * cols]);
+    #[cfg(target_arch = "x86_64")]
+    if isa() != Isa::Portable {
+        // SAFETY: AVX2 was detected (AVX-512 machines have it too).
+        unsafe { transpose_avx2(rows, cols, source, out) };
+        return;
+    }
+    transpose_scalar(rows, cols, source, out, 0, 0);
+}
+
+/// The scalar transpose of the elements with row ≥ `from_row` or column ≥ `from_col`: contiguous
+/// writes, strided reads (measured faster than the converse and than 8 × 8 scalar blocks).
+fn transpose_scalar(
+    rows: usize,
+    cols: usize,
+    source: &[f64],
+    out: &mut [f64],
+    from_row: usize,
+    from_col: usize,
+) {
     for (c, out_row) in out.chunks_exact_mut(rows).enumerate() {
-        for (value, source_row) in out_row.iter_mut().zip(source.chunks_exact(cols)) {
+        let first_row = if c < from_col { from_row } else { 0 };
+        for (value, source_row) in out_row[first_row..]
+            .iter_mut()
+            .zip(source.chunks_exact(cols).skip(first_row))
+        {
             *value = source_row[c];
         }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn transpose_avx2(rows: usize, cols: usize, source: &[f64], out: &mut [f64]) {
+    use std::arch::x86_64::*;
+    let (block_rows, block_cols) = (rows / 4 * 4, cols / 4 * 4);
+    let (from, to) = (source.as_ptr(), out.as_mut_ptr());
+    for r in (0..block_rows).step_by(4) {
+        for c in (0..block_cols).step_by(4) {
+            // SAFETY: r + 3 < rows and c + 3 < cols, so the four loads of source rows r..r+4 at
+            // columns c..c+4 and the four stores of out rows c..c+4 at columns r..r+4 stay
+            // inside the slices (both rows × cols, row-major).
+            unsafe {
+                let first = from.add(r * cols + c);
+                let a = _mm256_loadu_pd(first);
+                let b = _mm256_loadu_pd(first.add(cols));
+                let e = _mm256_loadu_pd(first.add(2 * cols));
+                let d = _mm256_loadu_pd(first.add(3 * cols));
+                // Rows (a0 a1 a2 a3), (b…), (e…), (d…) → columns (a0 b0 e0 d0), ….
+                let low_ab = _mm256_unpacklo_pd(a, b); // a0 b0 a2 b2
+                let high_ab = _mm256_unpackhi_pd(a, b); // a1 b1 a3 b3
+                let low_ed = _mm256_unpacklo_pd(e, d); // e0 d0 e2 d2
+                let high_ed = _mm256_unpackhi_pd(e, d); // e1 d1 e3 d3
+                let target = to.add(c * rows + r);
+                _mm256_storeu_pd(target, _mm256_permute2f128_pd(low_ab, low_ed, 0x20));
+                _mm256_storeu_pd(
+                    target.add(rows),
+                    _mm256_permute2f128_pd(high_ab, high_ed, 0x20),
+                );
+                _mm256_storeu_pd(
+                    target.add(2 * rows),
+                    _mm256_permute2f128_pd(low_ab, low_ed, 0x31),
+                );
+                _mm256_storeu_pd(
+                    target.add(3 * rows),
+                    _mm256_permute2f128_pd(high_ab, high_ed, 0x31),
+                );
+            }
+        }
+    }
+    if block_rows < rows || block_cols < cols {
+        transpose_scalar(rows, cols, source, out, block_rows, block_cols);
     }
 }
 
@@ -815,14 +894,18 @@ mod tests {
         z.extend([-40.0, -12.0, -9.0, 9.0, 12.0, 40.0, 1e-300, -1e-300, 0.0]);
         let (mut values, mut first, mut second) =
             (z.clone(), vec![0.0; z.len()], vec![0.0; z.len()]);
-        gelu_layer(&mut values, &mut first, &mut second);
+        gelu_layer(&mut values, &mut first, Some(&mut second));
         let (mut portable, mut portable_first, mut portable_second) =
             (z.clone(), vec![0.0; z.len()], vec![0.0; z.len()]);
-        gelu_layer_portable(&mut portable, &mut portable_first, &mut portable_second);
+        gelu_layer_portable::<true>(&mut portable, &mut portable_first, &mut portable_second);
         assert_eq!(
             (&values, &first, &second),
             (&portable, &portable_first, &portable_second)
         );
+        // Without GELU″: the same values and GELU′ to the bit.
+        let (mut values_only, mut first_only) = (z.clone(), vec![0.0; z.len()]);
+        gelu_layer(&mut values_only, &mut first_only, None);
+        assert_eq!((&values_only, &first_only), (&values, &first));
         for (k, &x) in z.iter().enumerate() {
             // Chunks evaluating one rational approximation give the bits of the branch-free code.
             assert_eq!(
@@ -852,6 +935,27 @@ mod tests {
         (0..count)
             .map(|k| ((k as f64 + seed) * 0.731).sin())
             .collect()
+    }
+
+    #[test]
+    fn transpose_moves_every_element_in_blocks_and_at_the_edges() {
+        for &(rows, cols) in &[(1, 1), (4, 4), (12, 16), (48, 120), (5, 9), (13, 6), (3, 8)] {
+            let source = values(rows * cols, 3.0);
+            let mut out = vec![f64::NAN; rows * cols];
+            transpose(rows, cols, &source, &mut out);
+            let mut scalar = vec![f64::NAN; rows * cols];
+            transpose_scalar(rows, cols, &source, &mut scalar, 0, 0);
+            for r in 0..rows {
+                for c in 0..cols {
+                    assert_eq!(
+                        out[c * rows + r],
+                        source[r * cols + c],
+                        "{rows}x{cols} ({r}, {c})"
+                    );
+                    assert_eq!(scalar[c * rows + r], source[r * cols + c]);
+                }
+            }
+        }
     }
 
     #[test]

@@ -85,8 +85,8 @@ pub use explain::{
 };
 pub use maml::{
     Batch, InnerLoop, MetaGradient, MetaOrder, MetaWorkspace, Task, hessian_vector_product,
-    inner_updates, meta_gradient, meta_gradient_in, meta_gradients,
-    reference_hessian_vector_product, reference_meta_gradient,
+    inner_updates, meta_gradient, meta_gradient_in, meta_gradient_into, meta_gradients,
+    meta_gradients_into, reference_hessian_vector_product, reference_meta_gradient,
 };
 pub use model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel};
 pub use network::{Architecture, PAPER_HIDDEN, mean_squared_error};

@@ -50,7 +50,7 @@ pub struct InnerLoop {
 }
 
 /// The meta-gradient of one task and the losses seen on the way.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct MetaGradient {
     /// L_s(θ), the support loss before adaptation.
     pub support_loss: f64,
@@ -101,11 +101,13 @@ pub fn inner_updates(
 ) -> (Vec<Vec<f64>>, f64) {
     let mut workspace = MetaWorkspace::new(architecture);
     let support_loss = workspace.inner_rounds(parameters, support, inner);
-    (workspace.trajectory[..=inner.rounds].to_vec(), support_loss)
+    let mut trajectory = vec![parameters.to_vec()];
+    trajectory.extend_from_slice(&workspace.trajectory[..inner.rounds]);
+    (trajectory, support_loss)
 }
 
 /// Reusable buffers of [`meta_gradient_in`]: one support workspace per inner round (their passes
-/// are reused by the Hessian-vector products), one for the query batch, the trajectory θ₀ … θ_n.
+/// are reused by the Hessian-vector products), one for the query batch, the inner iterates θ₁ … θ_n (θ₀ is the caller's parameters, not copied).
 #[derive(Clone, Debug)]
 pub struct MetaWorkspace {
     support: Vec<ModelWorkspace>,
@@ -120,30 +122,27 @@ impl MetaWorkspace {
     pub fn new(architecture: &Architecture) -> Self {
         Self {
             support: Vec::new(),
-            query: ModelWorkspace::new(architecture),
+            // The query batch only ever takes a gradient (no Hessian product): no GELU″.
+            query: ModelWorkspace::new(architecture).for_gradients_only(),
             trajectory: Vec::new(),
             gradient: Vec::new(),
             product: Vec::new(),
         }
     }
 
-    /// Runs the inner rounds; `trajectory[..=rounds]` holds θ₀ … θ_n. Returns L_s(θ₀).
+    /// Runs the inner rounds; `trajectory[..rounds]` holds θ₁ … θ_n. Returns L_s(θ₀).
     fn inner_rounds(&mut self, parameters: &[f64], support: &Batch, inner: InnerLoop) -> f64 {
-        let architecture = self.query.architecture().clone();
-        let size = parameters.len();
         while self.support.len() < inner.rounds.max(1) {
+            let architecture = self.query.architecture().clone();
             self.support.push(ModelWorkspace::new(&architecture));
         }
-        while self.trajectory.len() < inner.rounds + 1 {
-            self.trajectory.push(Vec::new());
-        }
-        self.gradient.resize(size, 0.0);
-        self.trajectory[0].clear();
-        self.trajectory[0].extend_from_slice(parameters);
+        self.trajectory
+            .resize_with(self.trajectory.len().max(inner.rounds), Vec::new);
+        self.gradient.resize(parameters.len(), 0.0);
         let mut first_loss = f64::NAN;
         for round in 0..inner.rounds {
-            let (done, rest) = self.trajectory.split_at_mut(round + 1);
-            let current = &done[round];
+            let (done, rest) = self.trajectory.split_at_mut(round);
+            let current = inner_point(done, parameters, round);
             let loss = self.support[round].mse_and_gradient(
                 current,
                 &support.inputs,
@@ -187,6 +186,15 @@ pub fn meta_gradient(
     )
 }
 
+/// θ_round of the inner loop: the meta-parameters for round 0, else the stored inner iterate.
+fn inner_point<'a>(trajectory: &'a [Vec<f64>], parameters: &'a [f64], round: usize) -> &'a [f64] {
+    if round == 0 {
+        parameters
+    } else {
+        &trajectory[round - 1]
+    }
+}
+
 /// [`meta_gradient`] with reusable buffers (created for the same architecture).
 pub fn meta_gradient_in(
     workspace: &mut MetaWorkspace,
@@ -195,32 +203,43 @@ pub fn meta_gradient_in(
     inner: InnerLoop,
     order: MetaOrder,
 ) -> MetaGradient {
-    let support_loss = workspace.inner_rounds(parameters, &task.support, inner);
+    let mut result = MetaGradient::default();
+    meta_gradient_into(workspace, parameters, task, inner, order, &mut result);
+    result
+}
+
+/// [`meta_gradient_in`] writing into `result`, whose gradient buffer is reused (no allocation
+/// once it has the parameters' length).
+pub fn meta_gradient_into(
+    workspace: &mut MetaWorkspace,
+    parameters: &[f64],
+    task: &Task,
+    inner: InnerLoop,
+    order: MetaOrder,
+    result: &mut MetaGradient,
+) {
+    result.support_loss = workspace.inner_rounds(parameters, &task.support, inner);
     let size = parameters.len();
-    let mut gradient = vec![0.0; size];
-    let query_loss = workspace.query.mse_and_gradient(
-        &workspace.trajectory[inner.rounds],
+    let gradient = &mut result.gradient;
+    gradient.resize(size, 0.0);
+    result.query_loss = workspace.query.mse_and_gradient(
+        inner_point(&workspace.trajectory, parameters, inner.rounds),
         &task.query.inputs,
         &task.query.targets,
-        &mut gradient,
+        gradient,
     );
     if order == MetaOrder::Second {
         workspace.product.resize(size, 0.0);
         for round in (0..inner.rounds).rev() {
             workspace.support[round].hessian_vector_product(
-                &workspace.trajectory[round],
-                &gradient,
+                inner_point(&workspace.trajectory, parameters, round),
+                gradient,
                 &mut workspace.product,
             );
             for (g, hv) in gradient.iter_mut().zip(&workspace.product) {
                 *g -= inner.step * hv;
             }
         }
-    }
-    MetaGradient {
-        support_loss,
-        query_loss,
-        gradient,
     }
 }
 
@@ -236,20 +255,34 @@ pub fn meta_gradients(
     inner: InnerLoop,
     order: MetaOrder,
 ) -> Vec<MetaGradient> {
+    let mut results = Vec::new();
+    meta_gradients_into(workspaces, parameters, tasks, inner, order, &mut results);
+    results
+}
+
+/// [`meta_gradients`] into `results` (one per task, resized to `tasks.len()`), reusing the
+/// gradient buffers already there: the form a training loop calls every iteration.
+pub fn meta_gradients_into(
+    workspaces: &mut [MetaWorkspace],
+    parameters: &[f64],
+    tasks: &[Task],
+    inner: InnerLoop,
+    order: MetaOrder,
+    results: &mut Vec<MetaGradient>,
+) {
     use rayon::prelude::*;
     assert!(!workspaces.is_empty(), "at least one workspace");
+    results.resize_with(tasks.len(), MetaGradient::default);
     let chunk = tasks.len().div_ceil(workspaces.len()).max(1);
-    let per_chunk: Vec<Vec<MetaGradient>> = tasks
+    tasks
         .par_chunks(chunk)
+        .zip(results.par_chunks_mut(chunk))
         .zip(workspaces.par_iter_mut())
-        .map(|(chunk_tasks, workspace)| {
-            chunk_tasks
-                .iter()
-                .map(|task| meta_gradient_in(workspace, parameters, task, inner, order))
-                .collect()
-        })
-        .collect();
-    per_chunk.into_iter().flatten().collect()
+        .for_each(|((chunk_tasks, chunk_results), workspace)| {
+            for (task, result) in chunk_tasks.iter().zip(chunk_results) {
+                meta_gradient_into(workspace, parameters, task, inner, order, result);
+            }
+        });
 }
 
 /// [`meta_gradient`] by the generic reference code (gradients in `f64`, Hessian-vector products

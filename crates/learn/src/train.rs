@@ -12,7 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use crate::averaging::IterateMean;
 use crate::config::{MetaTrainingConfig, Optimizer};
 use crate::error::{LearnError, Result};
-use crate::maml::{Batch, InnerLoop, MetaWorkspace, Task, meta_gradients};
+use crate::maml::{Batch, InnerLoop, MetaGradient, MetaWorkspace, Task, meta_gradients_into};
 use crate::network::Architecture;
 
 /// The regression data of one meta-training task (one flight): its support and query segments.
@@ -189,14 +189,23 @@ pub fn meta_train_from(
     let mut average = IterateMean::new(parameters.len(), config.average_last > 0);
     let mut meta_loss_history = Vec::with_capacity(config.iterations);
     let mut support_loss_history = Vec::with_capacity(config.iterations);
+    // Buffers reused across iterations: the per-task meta-gradients and their mean.
+    let mut results: Vec<MetaGradient> = Vec::new();
+    let mut gradient = vec![0.0; parameters.len()];
     for iteration in 0..config.iterations {
         let batch = sampler.draw(tasks, architecture.input_dim, config);
-        let results = meta_gradients(&mut workspaces, &parameters, &batch, inner, config.order);
+        meta_gradients_into(
+            &mut workspaces,
+            &parameters,
+            &batch,
+            inner,
+            config.order,
+            &mut results,
+        );
         let scale = 1.0 / results.len() as f64;
-        let mut gradient: Vec<f64> = parameters
-            .iter()
-            .map(|p| 2.0 * config.meta_regularisation * p)
-            .collect();
+        for (g, p) in gradient.iter_mut().zip(&parameters) {
+            *g = 2.0 * config.meta_regularisation * p;
+        }
         let (mut meta_loss, mut support_loss) = (0.0, 0.0);
         for result in &results {
             meta_loss += result.query_loss * scale;

@@ -1,9 +1,9 @@
 //! Every derivative against central finite differences in f64.
 
 use learn::{
-    Architecture, Batch, InnerLoop, MetaOrder, MetaWorkspace, Task, hessian_vector_product,
-    inner_updates, meta_gradient, meta_gradient_in, meta_gradients,
-    reference_hessian_vector_product, reference_meta_gradient,
+    Architecture, Batch, InnerLoop, MetaOrder, MetaWorkspace, ModelWorkspace, Task,
+    hessian_vector_product, inner_updates, meta_gradient, meta_gradient_in, meta_gradients,
+    meta_gradients_into, reference_hessian_vector_product, reference_meta_gradient,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -309,4 +309,42 @@ fn meta_gradients_of_a_batch_do_not_depend_on_the_number_of_workspaces() {
         );
         assert_eq!(batch, one_by_one, "{count} workspaces");
     }
+    // Reused result buffers (a longer list first, so it has to shrink) give the same bits.
+    let mut workspaces = vec![MetaWorkspace::new(&architecture); 2];
+    let mut results = Vec::new();
+    let longer: Vec<Task> = tasks.iter().chain(&tasks).cloned().collect();
+    for batch in [&longer, &tasks, &tasks] {
+        meta_gradients_into(
+            &mut workspaces,
+            &parameters,
+            batch,
+            inner,
+            MetaOrder::Second,
+            &mut results,
+        );
+    }
+    assert_eq!(results, one_by_one);
+}
+
+#[test]
+fn a_workspace_for_gradients_only_gives_the_same_bits_and_refuses_hessian_products() {
+    let (architecture, parameters, task) = paper_sized_setup();
+    let batch = &task.support;
+    let mut full = ModelWorkspace::new(&architecture);
+    let mut gradients_only = ModelWorkspace::new(&architecture).for_gradients_only();
+    let mut gradient = vec![0.0; parameters.len()];
+    let mut gradient_only = vec![0.0; parameters.len()];
+    let loss = full.mse_and_gradient(&parameters, &batch.inputs, &batch.targets, &mut gradient);
+    let loss_only = gradients_only.mse_and_gradient(
+        &parameters,
+        &batch.inputs,
+        &batch.targets,
+        &mut gradient_only,
+    );
+    assert_eq!((loss, &gradient), (loss_only, &gradient_only));
+    let refused = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let mut product = vec![0.0; parameters.len()];
+        gradients_only.hessian_vector_product(&parameters, &gradient, &mut product);
+    }));
+    assert!(refused.is_err());
 }

@@ -79,15 +79,42 @@ pub(crate) fn detected_isa() -> Isa {
 }
 
 dispatched! {
-    /// out[c] = Σ_b matrix[b·width + c], summed in row order.
+    /// out[c] = Σ_b matrix[b·width + c], summed in row order. Columns go in blocks of 32, then 8,
+    /// then one at a time, each block's sums held in registers over all rows (a running sum kept
+    /// in `out` made every row a store-to-load round trip).
     pub(crate) fn column_sums(matrix: &[f64], width: usize, out: &mut [f64]) {
-        out.fill(0.0);
-        for row in matrix.chunks_exact(width) {
-            for (o, &v) in out.iter_mut().zip(row) {
-                *o += v;
-            }
+        let mut start = 0;
+        while start + 32 <= width {
+            column_block_sums::<32>(matrix, width, start, out);
+            start += 32;
+        }
+        while start + 8 <= width {
+            column_block_sums::<8>(matrix, width, start, out);
+            start += 8;
+        }
+        while start < width {
+            column_block_sums::<1>(matrix, width, start, out);
+            start += 1;
         }
     }
+}
+
+/// out[start..start + COLUMNS] of [`column_sums`].
+#[inline(always)]
+fn column_block_sums<const COLUMNS: usize>(
+    matrix: &[f64],
+    width: usize,
+    start: usize,
+    out: &mut [f64],
+) {
+    let mut sums = [0.0; COLUMNS];
+    for row in matrix.chunks_exact(width) {
+        let block: &[f64; COLUMNS] = row[start..start + COLUMNS].try_into().expect("block");
+        for (sum, &value) in sums.iter_mut().zip(block) {
+            *sum += value;
+        }
+    }
+    out[start..start + COLUMNS].copy_from_slice(&sums);
 }
 
 dispatched! {
@@ -935,6 +962,19 @@ mod tests {
         (0..count)
             .map(|k| ((k as f64 + seed) * 0.731).sin())
             .collect()
+    }
+
+    #[test]
+    fn column_sums_add_each_column_in_row_order() {
+        for &(rows, width) in &[(1, 1), (64, 120), (64, 12), (5, 41), (3, 20)] {
+            let matrix = values(rows * width, 4.0);
+            let mut out = vec![f64::NAN; width];
+            column_sums(&matrix, width, &mut out);
+            for (c, &sum) in out.iter().enumerate() {
+                let want = (0..rows).fold(0.0, |total, r| total + matrix[r * width + c]);
+                assert_eq!(sum, want, "{rows}x{width} column {c}");
+            }
+        }
     }
 
     #[test]

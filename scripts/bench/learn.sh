@@ -39,4 +39,8 @@ print(f"LeARN meta-iteration ({first['tasks']} tasks, {first['support']}/{first[
 print(f"  minimum: Rust {r_min*1e3:.2f} ms (one thread {r1_min*1e3:.2f} ms), JAX {j_min*1e3:.2f} ms; "
       f"speed-up of Rust over JAX: {j_min/r_min:.2f}x ({'Rust' if r_min < j_min else 'JAX'} faster; target >= 5x)")
 print(f"  median:  Rust {r_med*1e3:.2f} ms, JAX {j_med*1e3:.2f} ms; ratio {j_med/r_med:.2f}x")
+# Each Rust run with the JAX run that followed it (the host's speed drifts over seconds).
+pairs = sorted(j["seconds_per_iteration_min"] / r["seconds_per_iteration_min"] for r, j in zip(rust, jax))
+print(f"  run by run (minimum of each run, Rust run then JAX run): ratios {', '.join(f'{p:.2f}' for p in pairs)}; "
+      f"median {pairs[len(pairs) // 2]:.2f}x")
 PY

@@ -112,6 +112,27 @@ impl NetworkWorkspace {
         }
     }
 
+    /// Sizes the R-operator's buffers (Rz, Rh, Rδ) for `batch` rows.
+    fn resize_r(&mut self, batch: usize) {
+        let layers = self.layers();
+        for l in 0..layers {
+            let width = batch * self.sizes[l + 1];
+            self.r_pre[l].resize(width, 0.0);
+            self.r_deltas[l].resize(width, 0.0);
+            if l + 1 < layers {
+                self.r_values[l].resize(width, 0.0);
+            }
+        }
+    }
+
+    /// Swaps this network's R-operator buffers with `other`'s z/h, GELU′ and δ buffers (the same
+    /// shapes per layer).
+    fn swap_r_buffers(&mut self, other: &mut NetworkWorkspace) {
+        std::mem::swap(&mut self.r_pre, &mut other.values);
+        std::mem::swap(&mut self.r_values, &mut other.first);
+        std::mem::swap(&mut self.r_deltas, &mut other.deltas);
+    }
+
     fn weights<'a>(&self, parameters: &'a [f64], l: usize) -> (&'a [f64], &'a [f64]) {
         let (fan_in, fan_out) = (self.sizes[l], self.sizes[l + 1]);
         let start = self.offsets[l];
@@ -454,6 +475,19 @@ impl ModelWorkspace {
         self
     }
 
+    /// Exchanges this workspace's Hessian-product buffers with `other`'s forward and backward
+    /// buffers (values, GELU′, δ), for a caller that has finished with `other`'s last pass: a
+    /// Hessian-vector product between two exchanges then runs in memory the cache already holds
+    /// instead of in buffers of its own. Calling it twice restores both.
+    pub(crate) fn exchange_hessian_buffers(&mut self, other: &mut ModelWorkspace) {
+        assert_eq!(
+            self.architecture, other.architecture,
+            "exchange between workspaces of one architecture"
+        );
+        self.library.swap_r_buffers(&mut other.library);
+        self.selection.swap_r_buffers(&mut other.selection);
+    }
+
     /// The architecture these buffers serve.
     pub fn architecture(&self) -> &Architecture {
         &self.architecture
@@ -595,6 +629,9 @@ impl ModelWorkspace {
             self.batch,
         );
         let split = architecture.library_parameter_count();
+        // The R buffers may have been exchanged with a workspace of another batch size.
+        self.library.resize_r(batch);
+        self.selection.resize_r(batch);
         self.library.r_forward(
             &parameters[..split],
             &direction[..split],

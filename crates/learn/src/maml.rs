@@ -231,11 +231,16 @@ pub fn meta_gradient_into(
     if order == MetaOrder::Second {
         workspace.product.resize(size, 0.0);
         for round in (0..inner.rounds).rev() {
-            workspace.support[round].hessian_vector_product(
+            // The query pass is finished: its buffers serve as the Hessian product's scratch
+            // (a smaller working set per thread), and are handed back afterwards.
+            let support = &mut workspace.support[round];
+            support.exchange_hessian_buffers(&mut workspace.query);
+            support.hessian_vector_product(
                 inner_point(&workspace.trajectory, parameters, round),
                 gradient,
                 &mut workspace.product,
             );
+            support.exchange_hessian_buffers(&mut workspace.query);
             for (g, hv) in gradient.iter_mut().zip(&workspace.product) {
                 *g -= inner.step * hv;
             }

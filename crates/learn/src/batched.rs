@@ -125,12 +125,13 @@ impl NetworkWorkspace {
         }
     }
 
-    /// Swaps this network's R-operator buffers with `other`'s z/h, GELU′ and δ buffers (the same
-    /// shapes per layer).
+    /// Swaps this network's R-operator buffers (Rz, Rh, Rδ, Vᵀ) with `other`'s z/h, GELU′, δ and
+    /// Wᵀ buffers (the same shapes per layer).
     fn swap_r_buffers(&mut self, other: &mut NetworkWorkspace) {
         std::mem::swap(&mut self.r_pre, &mut other.values);
         std::mem::swap(&mut self.r_values, &mut other.first);
         std::mem::swap(&mut self.r_deltas, &mut other.deltas);
+        std::mem::swap(&mut self.direction_transposed, &mut other.weights_transposed);
     }
 
     fn weights<'a>(&self, parameters: &'a [f64], l: usize) -> (&'a [f64], &'a [f64]) {
@@ -476,7 +477,7 @@ impl ModelWorkspace {
     }
 
     /// Exchanges this workspace's Hessian-product buffers with `other`'s forward and backward
-    /// buffers (values, GELU′, δ), for a caller that has finished with `other`'s last pass: a
+    /// buffers (values, GELU′, δ, transposed weights), for a caller that has finished with `other`'s last pass: a
     /// Hessian-vector product between two exchanges then runs in memory the cache already holds
     /// instead of in buffers of its own. Calling it twice restores both.
     pub(crate) fn exchange_hessian_buffers(&mut self, other: &mut ModelWorkspace) {

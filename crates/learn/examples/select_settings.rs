@@ -5,7 +5,7 @@
 //! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
 //! score and the one fold c's own validation prefers, and writes all numbers as JSON.
 //!
-//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging]
+//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz]
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -24,7 +24,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let seed: u64 = arguments.get(1).map_or(Ok(1), |s| s.parse())?;
     // `grid` (the default): the first comparison; `iterations`: how far more meta-iterations help;
     // `averaging`: whether averaging the last meta-iterates (Polyak–Ruppert) helps;
-    // `adaptation-averaging`: whether averaged SGD in the online adaptation helps.
+    // `adaptation-averaging`: whether averaged SGD in the online adaptation helps;
+    // `lipschitz`: the weight λ and bound L of the adaptation's Lipschitz regulariser.
     let stage = arguments.get(2).map_or("grid", String::as_str);
     let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
     let base = checked.get().clone();
@@ -44,7 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let grid: &[(usize, usize, f64, usize)] = match stage {
         "iterations" => &[(800, 4, 0.1, 0), (1600, 4, 0.1, 0)],
         "averaging" => &[(800, 4, 0.1, 0), (800, 4, 0.1, 200), (800, 4, 0.1, 400)],
-        "adaptation-averaging" => &[(800, 4, 0.1, 0)],
+        "adaptation-averaging" | "lipschitz" => &[(800, 4, 0.1, 0)],
         _ => &[
             (200, 4, 0.1, 0),
             (800, 4, 0.1, 0),
@@ -85,6 +86,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     step,
                     passes,
                     average_last_pass,
+                    ..base.adaptation.clone()
+                },
+            ));
+        }
+    }
+    if stage == "lipschitz" {
+        // λ = 0 (no regulariser), then λ × L; the other adaptation settings as configured.
+        adaptations.clear();
+        let weights_and_bounds = [
+            (0.0, 1.0),
+            (0.01, 1.0),
+            (0.01, 0.1),
+            (0.1, 1.0),
+            (0.1, 0.1),
+            (1.0, 1.0),
+            (1.0, 0.1),
+        ];
+        for (lipschitz_weight, lipschitz_bound) in weights_and_bounds {
+            adaptations.push((
+                format!("lambda{lipschitz_weight}_bound{lipschitz_bound}"),
+                AdaptationConfig {
+                    lipschitz_weight,
+                    lipschitz_bound,
                     ..base.adaptation.clone()
                 },
             ));

@@ -5,7 +5,7 @@
 //! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
 //! score and the one fold c's own validation prefers, and writes all numbers as JSON.
 //!
-//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz]
+//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch]
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -25,7 +25,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `grid` (the default): the first comparison; `iterations`: how far more meta-iterations help;
     // `averaging`: whether averaging the last meta-iterates (Polyak–Ruppert) helps;
     // `adaptation-averaging`: whether averaged SGD in the online adaptation helps;
-    // `lipschitz`: the weight λ and bound L of the adaptation's Lipschitz regulariser.
+    // `lipschitz`: the weight λ and bound L of the adaptation's Lipschitz regulariser;
+    // `batch`: support and query batches of 128 points per task instead of 64.
     let stage = arguments.get(2).map_or("grid", String::as_str);
     let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
     let base = checked.get().clone();
@@ -45,7 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let grid: &[(usize, usize, f64, usize)] = match stage {
         "iterations" => &[(800, 4, 0.1, 0), (1600, 4, 0.1, 0)],
         "averaging" => &[(800, 4, 0.1, 0), (800, 4, 0.1, 200), (800, 4, 0.1, 400)],
-        "adaptation-averaging" | "lipschitz" => &[(800, 4, 0.1, 0)],
+        "adaptation-averaging" | "lipschitz" | "batch" => &[(800, 4, 0.1, 0)],
         _ => &[
             (200, 4, 0.1, 0),
             (800, 4, 0.1, 0),
@@ -68,6 +69,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             format!("it{iterations}_tasks{task_batch}_alpha{inner_step}{averaged}"),
             config,
         ));
+    }
+    if stage == "batch" {
+        let mut config = candidates[0].1.clone();
+        config.meta_training.support_batch = 128;
+        config.meta_training.query_batch = 128;
+        candidates.push(("it800_tasks4_alpha0.1_batch128".to_string(), config));
     }
     let mut adaptations: Vec<(String, AdaptationConfig)> = Vec::new();
     let passes_grid: &[usize] = if stage == "grid" { &[4, 8] } else { &[8] };

@@ -131,7 +131,10 @@ impl NetworkWorkspace {
         std::mem::swap(&mut self.r_pre, &mut other.values);
         std::mem::swap(&mut self.r_values, &mut other.first);
         std::mem::swap(&mut self.r_deltas, &mut other.deltas);
-        std::mem::swap(&mut self.direction_transposed, &mut other.weights_transposed);
+        std::mem::swap(
+            &mut self.direction_transposed,
+            &mut other.weights_transposed,
+        );
     }
 
     fn weights<'a>(&self, parameters: &'a [f64], l: usize) -> (&'a [f64], &'a [f64]) {

@@ -700,7 +700,8 @@ dispatched! {
 }
 
 dispatched! {
-    /// δΘ_bk = Σ_i g_bi·ℰ_b,ik and δℰ_b,ik = g_bi·Θ_bk, with `sizes` = [K, I, batch].
+    /// δΘ_bk = Σ_i g_bi·ℰ_b,ik and δℰ_b,ik = g_bi·Θ_bk, with `sizes` = [K, I, batch]. The k go
+    /// in blocks of 8 whose sums over i stay in registers (summed in i order, as one i at a time).
     fn product_backward(
         theta_all: &[f64],
         selection_all: &[f64],
@@ -712,34 +713,65 @@ dispatched! {
         let [basis, states, batch] = sizes;
         let width = states * basis;
         for b in 0..batch {
-            let theta = &theta_all[b * basis..(b + 1) * basis];
-            let selection = &selection_all[b * width..(b + 1) * width];
+            let rows = ProductRows {
+                basis,
+                theta: &theta_all[b * basis..(b + 1) * basis],
+                selection: &selection_all[b * width..(b + 1) * width],
+                gradient: &prediction_gradient[b * states..(b + 1) * states],
+            };
             let d_theta = &mut d_theta_all[b * basis..(b + 1) * basis];
             let d_selection = &mut d_selection_all[b * width..(b + 1) * width];
-            d_theta.fill(0.0);
-            for ((&g, coefficients), d_coefficients) in prediction_gradient[b * states..(b + 1) * states]
-                .iter()
-                .zip(selection.chunks_exact(basis))
-                .zip(d_selection.chunks_exact_mut(basis))
-            {
-                for (((d, &c), dc), &t) in d_theta
-                    .iter_mut()
-                    .zip(coefficients)
-                    .zip(d_coefficients.iter_mut())
-                    .zip(theta)
-                {
-                    *d += g * c;
-                    *dc = g * t;
-                }
+            let mut start = 0;
+            while start + 8 <= basis {
+                product_backward_block::<8>(&rows, start, d_theta, d_selection);
+                start += 8;
+            }
+            while start < basis {
+                product_backward_block::<1>(&rows, start, d_theta, d_selection);
+                start += 1;
             }
         }
     }
 }
 
+/// One row b of the product y = Θ·ℰᵀ: Θ_b (K), ℰ_b (I × K) and ∂L/∂y_b (I).
+struct ProductRows<'a> {
+    basis: usize,
+    theta: &'a [f64],
+    selection: &'a [f64],
+    gradient: &'a [f64],
+}
+
+/// Columns start..start + LANES of [`product_backward`] for one row.
+#[inline(always)]
+fn product_backward_block<const LANES: usize>(
+    rows: &ProductRows,
+    start: usize,
+    d_theta: &mut [f64],
+    d_selection: &mut [f64],
+) {
+    let theta: &[f64; LANES] = rows.theta[start..start + LANES].try_into().expect("block");
+    let mut sums = [0.0; LANES];
+    for (state, &g) in rows.gradient.iter().enumerate() {
+        let offset = state * rows.basis + start;
+        let coefficients: &[f64; LANES] = rows.selection[offset..offset + LANES]
+            .try_into()
+            .expect("block");
+        let d_coefficients: &mut [f64; LANES] = (&mut d_selection[offset..offset + LANES])
+            .try_into()
+            .expect("block");
+        for lane in 0..LANES {
+            sums[lane] += g * coefficients[lane];
+            d_coefficients[lane] = g * theta[lane];
+        }
+    }
+    d_theta[start..start + LANES].copy_from_slice(&sums);
+}
+
 dispatched! {
     /// The R-operator through y = Θ·ℰᵀ and the mean squared error: R(∂L/∂y) = scale·Ry with
     /// Ry_bi = Σ_k RΘ_bk·ℰ_b,ik + Θ_bk·Rℰ_b,ik, then RδΘ and Rδℰ. `values` = [Θ, ℰ, RΘ, Rℰ],
-    /// `sizes` = [K, I, batch].
+    /// `sizes` = [K, I, batch]. The updates go in blocks of 8 k, as in [`product_backward`].
     fn product_r_backward(
         values: [&[f64]; 4],
         prediction_gradient: &[f64],
@@ -751,31 +783,71 @@ dispatched! {
         let [theta_all, selection_all, r_theta_all, r_selection_all] = values;
         let [basis, states, batch] = sizes;
         let width = states * basis;
+        let mut r_gradient = vec![0.0; states];
         for b in 0..batch {
-            let theta = &theta_all[b * basis..(b + 1) * basis];
+            let rows = ProductRows {
+                basis,
+                theta: &theta_all[b * basis..(b + 1) * basis],
+                selection: &selection_all[b * width..(b + 1) * width],
+                gradient: &prediction_gradient[b * states..(b + 1) * states],
+            };
             let r_theta = &r_theta_all[b * basis..(b + 1) * basis];
-            let selection = &selection_all[b * width..(b + 1) * width];
             let r_selection = &r_selection_all[b * width..(b + 1) * width];
+            for (state, r_g) in r_gradient.iter_mut().enumerate() {
+                let cols = state * basis..(state + 1) * basis;
+                *r_g = scale
+                    * (dot(r_theta, &rows.selection[cols.clone()])
+                        + dot(rows.theta, &r_selection[cols]));
+            }
+            let r_rows = ProductRows {
+                basis,
+                theta: r_theta,
+                selection: r_selection,
+                gradient: &r_gradient,
+            };
             let r_d_theta = &mut r_d_theta_all[b * basis..(b + 1) * basis];
             let r_d_selection = &mut r_d_selection_all[b * width..(b + 1) * width];
-            r_d_theta.fill(0.0);
-            for (state, &g) in prediction_gradient[b * states..(b + 1) * states].iter().enumerate() {
-                let cols = state * basis..(state + 1) * basis;
-                let (coefficients, r_coefficients) = (&selection[cols.clone()], &r_selection[cols.clone()]);
-                let r_g = scale * (dot(r_theta, coefficients) + dot(theta, r_coefficients));
-                for ((((d, &c), &rc), rdc), (&t, &rt)) in r_d_theta
-                    .iter_mut()
-                    .zip(coefficients)
-                    .zip(r_coefficients)
-                    .zip(r_d_selection[cols].iter_mut())
-                    .zip(theta.iter().zip(r_theta))
-                {
-                    *d += r_g * c + g * rc;
-                    *rdc = r_g * t + g * rt;
-                }
+            let mut start = 0;
+            while start + 8 <= basis {
+                product_r_backward_block::<8>([&rows, &r_rows], start, r_d_theta, r_d_selection);
+                start += 8;
+            }
+            while start < basis {
+                product_r_backward_block::<1>([&rows, &r_rows], start, r_d_theta, r_d_selection);
+                start += 1;
             }
         }
     }
+}
+
+/// Columns start..start + LANES of [`product_r_backward`] for one row: `rows` = [(Θ, ℰ, g),
+/// (RΘ, Rℰ, R(∂L/∂y))].
+#[inline(always)]
+fn product_r_backward_block<const LANES: usize>(
+    rows: [&ProductRows; 2],
+    start: usize,
+    r_d_theta: &mut [f64],
+    r_d_selection: &mut [f64],
+) {
+    let [rows, r_rows] = rows;
+    let block = start..start + LANES;
+    let theta: &[f64; LANES] = rows.theta[block.clone()].try_into().expect("block");
+    let r_theta: &[f64; LANES] = r_rows.theta[block].try_into().expect("block");
+    let mut sums = [0.0; LANES];
+    for (state, (&g, &r_g)) in rows.gradient.iter().zip(r_rows.gradient).enumerate() {
+        let offset = state * rows.basis + start;
+        let block = offset..offset + LANES;
+        let coefficients: &[f64; LANES] = rows.selection[block.clone()].try_into().expect("block");
+        let r_coefficients: &[f64; LANES] =
+            r_rows.selection[block.clone()].try_into().expect("block");
+        let r_d_coefficients: &mut [f64; LANES] =
+            (&mut r_d_selection[block]).try_into().expect("block");
+        for lane in 0..LANES {
+            sums[lane] += r_g * coefficients[lane] + g * r_coefficients[lane];
+            r_d_coefficients[lane] = r_g * theta[lane] + g * r_theta[lane];
+        }
+    }
+    r_d_theta[start..start + LANES].copy_from_slice(&sums);
 }
 
 /// Σ a_i·b_i in index order.

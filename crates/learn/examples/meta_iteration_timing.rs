@@ -96,15 +96,11 @@ fn main() {
             .map(|_| iteration(false, &mut parameters))
             .collect(),
     );
-    // The loop itself runs on a pool thread (as `meta_train` does), which takes a share of the
-    // tasks instead of waiting for two other threads to be woken.
-    let (pool, pool_min) = rayon::scope(|_| {
-        median_and_min(
-            (0..repeats)
-                .map(|_| iteration(true, &mut parameters))
-                .collect(),
-        )
-    });
+    let (pool, pool_min) = median_and_min(
+        (0..repeats)
+            .map(|_| iteration(true, &mut parameters))
+            .collect(),
+    );
     println!(
         "{{\"implementation\": \"rust\", \"tasks\": {tasks}, \"support\": {support}, \"query\": {query}, \"inner_rounds\": {rounds}, \"parameters\": {}, \"threads\": {}, \"seconds_per_iteration_one_thread\": {one_thread:.6e}, \"seconds_per_iteration_one_thread_min\": {one_thread_min:.6e}, \"seconds_per_iteration\": {pool:.6e}, \"seconds_per_iteration_min\": {pool_min:.6e}}}",
         architecture.parameter_count(),

@@ -162,20 +162,7 @@ pub fn meta_train(
 }
 
 /// Meta-trains from given parameters (the task stream is still seeded by `seed`).
-///
-/// The loop runs on a thread of rayon's pool (it is moved there when called from outside), so
-/// that the calling thread takes its share of each batch of tasks instead of waking two others.
 pub fn meta_train_from(
-    architecture: &Architecture,
-    parameters: Vec<f64>,
-    tasks: &[TaskData],
-    config: &MetaTrainingConfig,
-    seed: u64,
-) -> Result<MetaTrainingOutcome> {
-    rayon::scope(|_| meta_train_in_pool(architecture, parameters, tasks, config, seed))
-}
-
-fn meta_train_in_pool(
     architecture: &Architecture,
     mut parameters: Vec<f64>,
     tasks: &[TaskData],

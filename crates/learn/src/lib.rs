@@ -20,7 +20,8 @@
 //!   both segments, adapted θ); [`Experiment::run_cell`] does both; [`Experiment::run_cells`] runs a
 //!   set of cells in parallel (rayon), [`Experiment::seed_spread`] repeats them over seeds.
 //! - Building blocks: [`Architecture`] (forward, gradient, prediction), [`meta_gradient`]
-//!   ([`meta_gradient_in`] with reusable [`MetaWorkspace`] buffers), [`hessian_vector_product`],
+//!   ([`meta_gradient_in`] with reusable [`MetaWorkspace`] buffers, [`meta_gradients_into`] for a
+//!   batch of tasks in parallel into reused results), [`hessian_vector_product`],
 //!   [`inner_updates`], [`meta_train`], [`adapt_online`], [`explain`]; [`ModelWorkspace`] for
 //!   repeated passes; `reference_*` for the generic reference implementation.
 //!
@@ -40,7 +41,7 @@
 //! fallback), with the exact GELU and its two derivatives vectorised (Cephes' erf/erfc rational
 //! approximations, one exponential). Hessian-vector products are Pearlmutter's R-operator with
 //! separate value and tangent arrays; they reuse the forward and backward passes of the inner
-//! round. Every kernel sums each output in the same order with fused multiply-adds, so all
+//! round, and run in the buffers of the finished query pass (a smaller working set per core). Every kernel sums each output in the same order with fused multiply-adds, so all
 //! instruction sets give bit-identical results. The generic code over [`Scalar`] (`f64` for
 //! gradients, [`Dual`] numbers for H·v, forward-over-reverse) is kept as the reference
 //! (`reference_*`): the tests hold the fast path to it (relative 1e-12) and both to central finite

@@ -76,32 +76,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.meta_training.query_batch = 128;
         candidates.push(("it800_tasks4_alpha0.1_batch128".to_string(), config));
     }
-    let mut adaptations: Vec<(String, AdaptationConfig)> = Vec::new();
-    let passes_grid: &[usize] = if stage == "grid" { &[4, 8] } else { &[8] };
-    // (step, averaged SGD over the last pass)
-    let steps: &[(f64, bool)] = match stage {
-        "averaging" => &[(0.0005, false)],
-        "adaptation-averaging" => &[(0.0005, false), (0.0005, true), (0.001, true)],
-        _ => &[(0.0005, false), (0.001, false)],
-    };
-    for &(step, average_last_pass) in steps {
-        for &passes in passes_grid {
-            let averaged = if average_last_pass { "_averaged" } else { "" };
-            adaptations.push((
-                format!("step{step}_passes{passes}{averaged}"),
-                AdaptationConfig {
-                    step,
-                    passes,
-                    average_last_pass,
-                    ..base.adaptation.clone()
-                },
-            ));
-        }
-    }
-    if stage == "lipschitz" {
+    let adaptations: Vec<(String, AdaptationConfig)> = if stage == "lipschitz" {
         // λ = 0 (no regulariser), then λ × L; the other adaptation settings as configured.
-        adaptations.clear();
-        let weights_and_bounds = [
+        [
             (0.0, 1.0),
             (0.01, 1.0),
             (0.01, 0.1),
@@ -109,18 +86,44 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             (0.1, 0.1),
             (1.0, 1.0),
             (1.0, 0.1),
-        ];
-        for (lipschitz_weight, lipschitz_bound) in weights_and_bounds {
-            adaptations.push((
+        ]
+        .into_iter()
+        .map(|(lipschitz_weight, lipschitz_bound)| {
+            (
                 format!("lambda{lipschitz_weight}_bound{lipschitz_bound}"),
                 AdaptationConfig {
                     lipschitz_weight,
                     lipschitz_bound,
                     ..base.adaptation.clone()
                 },
-            ));
+            )
+        })
+        .collect()
+    } else {
+        let passes_grid: &[usize] = if stage == "grid" { &[4, 8] } else { &[8] };
+        // (step, averaged SGD over the last pass)
+        let steps: &[(f64, bool)] = match stage {
+            "averaging" => &[(0.0005, false)],
+            "adaptation-averaging" => &[(0.0005, false), (0.0005, true), (0.001, true)],
+            _ => &[(0.0005, false), (0.001, false)],
+        };
+        let mut adaptations = Vec::new();
+        for &(step, average_last_pass) in steps {
+            for &passes in passes_grid {
+                let averaged = if average_last_pass { "_averaged" } else { "" };
+                adaptations.push((
+                    format!("step{step}_passes{passes}{averaged}"),
+                    AdaptationConfig {
+                        step,
+                        passes,
+                        average_last_pass,
+                        ..base.adaptation.clone()
+                    },
+                ));
+            }
         }
-    }
+        adaptations
+    };
     let adaptation_settings: Vec<AdaptationConfig> =
         adaptations.iter().map(|(_, a)| a.clone()).collect();
 

@@ -89,27 +89,17 @@ impl NetworkWorkspace {
         let layers = self.layers();
         for l in 0..layers {
             let width = batch * self.sizes[l + 1];
-            for buffer in [
-                &mut self.values[l],
-                &mut self.deltas[l],
-                &mut self.r_pre[l],
-                &mut self.r_deltas[l],
-            ] {
-                buffer.resize(width, 0.0);
-            }
+            self.values[l].resize(width, 0.0);
+            self.deltas[l].resize(width, 0.0);
             if l + 1 < layers {
-                for buffer in [
-                    &mut self.first[l],
-                    &mut self.second[l],
-                    &mut self.r_values[l],
-                ] {
-                    buffer.resize(width, 0.0);
-                }
+                self.first[l].resize(width, 0.0);
+                self.second[l].resize(width, 0.0);
             }
             if l >= 1 {
                 self.back[l - 1].resize(batch * self.sizes[l], 0.0);
             }
         }
+        self.resize_r(batch);
     }
 
     /// Sizes the R-operator's buffers (Rz, Rh, Rδ) for `batch` rows.
@@ -713,12 +703,7 @@ dispatched! {
         let [basis, states, batch] = sizes;
         let width = states * basis;
         for b in 0..batch {
-            let rows = ProductRows {
-                basis,
-                theta: &theta_all[b * basis..(b + 1) * basis],
-                selection: &selection_all[b * width..(b + 1) * width],
-                gradient: &prediction_gradient[b * states..(b + 1) * states],
-            };
+            let rows = ProductRows::of_row(b, [basis, states], [theta_all, selection_all, prediction_gradient]);
             let d_theta = &mut d_theta_all[b * basis..(b + 1) * basis];
             let d_selection = &mut d_selection_all[b * width..(b + 1) * width];
             let mut start = 0;
@@ -740,6 +725,22 @@ struct ProductRows<'a> {
     theta: &'a [f64],
     selection: &'a [f64],
     gradient: &'a [f64],
+}
+
+impl<'a> ProductRows<'a> {
+    /// Row b of Θ (batch × K), ℰ (batch × I·K) and ∂L/∂y (batch × I); `sizes` = [K, I].
+    #[inline(always)]
+    fn of_row(b: usize, sizes: [usize; 2], all: [&'a [f64]; 3]) -> Self {
+        let [basis, states] = sizes;
+        let [theta, selection, gradient] = all;
+        let width = states * basis;
+        Self {
+            basis,
+            theta: &theta[b * basis..(b + 1) * basis],
+            selection: &selection[b * width..(b + 1) * width],
+            gradient: &gradient[b * states..(b + 1) * states],
+        }
+    }
 }
 
 /// Columns start..start + LANES of [`product_backward`] for one row.
@@ -785,12 +786,7 @@ dispatched! {
         let width = states * basis;
         let mut r_gradient = vec![0.0; states];
         for b in 0..batch {
-            let rows = ProductRows {
-                basis,
-                theta: &theta_all[b * basis..(b + 1) * basis],
-                selection: &selection_all[b * width..(b + 1) * width],
-                gradient: &prediction_gradient[b * states..(b + 1) * states],
-            };
+            let rows = ProductRows::of_row(b, [basis, states], [theta_all, selection_all, prediction_gradient]);
             let r_theta = &r_theta_all[b * basis..(b + 1) * basis];
             let r_selection = &r_selection_all[b * width..(b + 1) * width];
             for (state, r_g) in r_gradient.iter_mut().enumerate() {

@@ -107,7 +107,8 @@ pub fn inner_updates(
 }
 
 /// Reusable buffers of [`meta_gradient_in`]: one support workspace per inner round (their passes
-/// are reused by the Hessian-vector products), one for the query batch, the inner iterates θ₁ … θ_n (θ₀ is the caller's parameters, not copied).
+/// are reused by the Hessian-vector products), one for the query batch, the inner iterates
+/// θ₁ … θ_n (θ₀ is the caller's parameters, not copied).
 #[derive(Clone, Debug)]
 pub struct MetaWorkspace {
     support: Vec<ModelWorkspace>,

@@ -318,15 +318,9 @@ impl Experiment {
         let support_batch = standardised(&model.standardiser, segment_batch(&support));
         let query_batch = standardised(&model.standardiser, segment_batch(&query));
         let architecture = &model.architecture;
-        let adapted = adapt_online(
-            architecture,
-            &model.parameters,
-            &support_batch.inputs,
-            &support_batch.targets,
-            &self.config.get().adaptation,
-        );
-        let support_predictions = architecture.predict(&adapted, &support_batch.inputs);
-        let query_predictions = architecture.predict(&adapted, &query_batch.inputs);
+        let adapted = model.adapt(&support, &self.config.get().adaptation);
+        let support_predictions = model.predict_segment(&adapted, &support);
+        let query_predictions = model.predict_segment(&adapted, &query);
         let state_dim = architecture.state_dim;
         let summary = CellSummary {
             formulation: model.formulation,
@@ -510,13 +504,7 @@ pub fn explain_flight(
     let support_batch = standardised(&model.standardiser, segment_batch(&support));
     let query_batch = standardised(&model.standardiser, segment_batch(&query));
     let parameters = if adapt {
-        adapt_online(
-            &model.architecture,
-            &model.parameters,
-            &support_batch.inputs,
-            &support_batch.targets,
-            &model.config.adaptation,
-        )
+        model.adapt(&support, &model.config.adaptation)
     } else {
         model.parameters.clone()
     };

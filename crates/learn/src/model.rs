@@ -2,11 +2,12 @@
 
 use std::path::{Path, PathBuf};
 
-use data::Formulation;
+use data::{Formulation, Segment};
 use serde::{Deserialize, Serialize};
 
-use crate::config::LearnConfig;
-use crate::dataset::{Protocol, Standardiser};
+use crate::adapt::adapt_online;
+use crate::config::{AdaptationConfig, LearnConfig};
+use crate::dataset::{Protocol, Standardiser, row_major, segment_batch};
 use crate::error::{LearnError, Result};
 use crate::network::Architecture;
 
@@ -49,6 +50,26 @@ impl MetaTrainedModel {
     pub fn predict(&self, raw_inputs: &[f64]) -> Vec<f64> {
         self.architecture
             .predict(&self.parameters, &self.standardiser.apply(raw_inputs))
+    }
+
+    /// θ adapted online on `support` (equation online_adapt of the paper, [`adapt_online`]),
+    /// starting from the meta-trained parameters, on the standardised inputs in time order.
+    pub fn adapt(&self, support: &Segment, adaptation: &AdaptationConfig) -> Vec<f64> {
+        let batch = segment_batch(support);
+        adapt_online(
+            &self.architecture,
+            &self.parameters,
+            &self.standardiser.apply(&batch.inputs),
+            &batch.targets,
+            adaptation,
+        )
+    }
+
+    /// Predictions (samples × I, row-major) of the networks with `parameters` (e.g. adapted by
+    /// [`Self::adapt`]) on every sample of `segment`.
+    pub fn predict_segment(&self, parameters: &[f64], segment: &Segment) -> Vec<f64> {
+        let inputs = self.standardiser.apply(&row_major(&segment.inputs()));
+        self.architecture.predict(parameters, &inputs)
     }
 
     /// Writes the checkpoint as JSON, creating parent directories.

@@ -131,14 +131,6 @@ pub fn run(
         cells
     })?;
 
-    let variant_columns = match &config.raw.variants {
-        Some(path) => stopwatch.time("variants", || {
-            let pairs: Vec<_> = cells.iter().map(|c| (&c.support, &c.query)).collect();
-            crate::variants::reproduce_columns(&root.join(path), &pairs)
-        })?,
-        None => Vec::new(),
-    };
-
     let seeds = &config.raw.learn.seeds;
     let learn_results = stopwatch.time("LeARN meta-training and adaptation", || {
         let bar = progress_bar(options.show_progress, jobs.len() * seeds.len(), "LeARN");
@@ -149,6 +141,19 @@ pub fn run(
         bar.finish_and_clear();
         Ok(per_seed)
     })?;
+
+    let variant_columns = match &config.raw.variants {
+        Some(path) => stopwatch.time("variants", || {
+            // The run's own LeARN models (first seed) serve the variants that need them.
+            let cells: Vec<_> = cells
+                .iter()
+                .zip(&learn_results[0])
+                .map(|(c, learn)| (&c.support, &c.query, &learn.model))
+                .collect();
+            crate::variants::reproduce_columns(&root.join(path), &cells)
+        })?,
+        None => Vec::new(),
+    };
 
     let (tables, figures, summary) = stopwatch.time("tables, figures and summary", || {
         let published = PublishedTables::load(&config.published_path)?;

@@ -13,7 +13,11 @@
 //!   error (mean over outputs of each output's best penalty score);
 //! - `learned_basis`: the meta-trained LeARN library Θ(X; ψ) as features, optionally beside a fixed
 //!   causal library (the hybrid), with a regression on the support segment: closed-form adaptation
-//!   of the coefficients on the learned basis instead of SGD steps ([`learn::variants`]).
+//!   of the coefficients on the learned basis instead of SGD steps ([`learn::variants`]);
+//! - `learn`: the paper's LeARN itself, the meta-trained networks adapted online on the support
+//!   segment with the model's adaptation settings (the LeARN column of the tables);
+//! - `average`: the mean of the predictions of earlier variants (equal weights: nothing is chosen,
+//!   so nothing can be chosen on the query segment).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -27,8 +31,8 @@ use rayon::prelude::*;
 use report::{MethodTrace, PublishedTables, QualitativeFigure};
 use serde::{Deserialize, Serialize};
 use sindy::{
-    CausalLibrary, EnsemblePrediction, LibraryRegression, Mat, RegressionSpec, VariantEvaluation,
-    evaluate_features,
+    CausalLibrary, EnsemblePrediction, LibraryRegression, Mat, RegressionFit, RegressionSpec,
+    VariantEvaluation, evaluate_features, mean_squared_error,
 };
 
 use crate::config::{CheckedRunConfig, RunConfig, merge_patch};
@@ -49,8 +53,27 @@ pub struct VariantSpec {
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum VariantKind {
     Library(LibraryRegression),
-    Select { candidates: Vec<String> },
+    Select {
+        candidates: Vec<String>,
+    },
     LearnedBasis(LearnedBasisSpec),
+    /// The paper's LeARN: the meta-trained networks adapted online on the support segment.
+    Learn,
+    /// The mean of the members' predictions (variants declared before it), equal weights.
+    Average {
+        members: Vec<String>,
+    },
+}
+
+impl VariantKind {
+    /// Whether the variant fits a regression (and so has a support cross-validation score and
+    /// equations).
+    fn is_regression(&self) -> bool {
+        matches!(
+            self,
+            Self::Library(_) | Self::Select { .. } | Self::LearnedBasis(_)
+        )
+    }
 }
 
 /// Closed-form adaptation over the meta-trained LeARN networks' outputs, optionally beside a fixed
@@ -124,7 +147,8 @@ pub struct VariantsConfig {
     /// A bagged variant whose band is drawn in the figures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub figure_variant: Option<String>,
-    /// Cheap variants (no meta-training) that `make reproduce` adds as extra table columns.
+    /// Variants that `make reproduce` adds as extra table columns; those that need the LeARN
+    /// networks use the run's own meta-trained model (its first seed), so they cost no training.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reproduce: Vec<String>,
     pub variants: Vec<VariantSpec>,
@@ -167,17 +191,28 @@ impl VariantsConfig {
             }
         }
         for (own, variant) in raw.variants.iter().enumerate() {
-            if let VariantKind::Select { candidates } = &variant.kind {
-                if candidates.is_empty() {
-                    return Err(error(&variant.name, "select needs candidates".to_string()));
-                }
-                for candidate in candidates {
-                    if !names[..own].contains(&candidate.as_str()) {
-                        return Err(error(
-                            &variant.name,
-                            format!("candidate '{candidate}' must be a variant declared before it"),
-                        ));
-                    }
+            let (others, what) = match &variant.kind {
+                VariantKind::Select { candidates } => (candidates, "candidate"),
+                VariantKind::Average { members } => (members, "member"),
+                _ => continue,
+            };
+            if others.is_empty() {
+                return Err(error(&variant.name, format!("name at least one {what}")));
+            }
+            for other in others {
+                let Some(index) = names[..own].iter().position(|n| n == other) else {
+                    return Err(error(
+                        &variant.name,
+                        format!("{what} '{other}' must be a variant declared before it"),
+                    ));
+                };
+                if what == "candidate" && !raw.variants[index].kind.is_regression() {
+                    return Err(error(
+                        &variant.name,
+                        format!(
+                            "candidate '{other}' has no support cross-validation score to select by"
+                        ),
+                    ));
                 }
             }
         }
@@ -192,16 +227,6 @@ impl VariantsConfig {
                 && !names.contains(&name.as_str())
             {
                 return Err(error(field, format!("'{name}' is not a declared variant")));
-            }
-        }
-        for name in &raw.reproduce {
-            if !raw.is_cheap(name) {
-                return Err(error(
-                    "reproduce",
-                    format!(
-                        "'{name}' needs LeARN meta-training: only library and select variants of them fit `make reproduce`"
-                    ),
-                ));
             }
         }
         Ok(raw)
@@ -224,28 +249,30 @@ impl VariantsConfig {
         })
     }
 
-    /// Whether the variant (and, for select, each candidate) needs no meta-training.
-    fn is_cheap(&self, name: &str) -> bool {
-        match self
-            .variants
-            .iter()
-            .find(|v| v.name == name)
-            .map(|v| &v.kind)
-        {
-            Some(VariantKind::Library(_)) => true,
-            Some(VariantKind::Select { candidates }) => candidates.iter().all(|c| self.is_cheap(c)),
-            _ => false,
+    /// The variant whose equations describe `name`: itself when it fits a regression, for an
+    /// average its first member that does (recursively), none for `learn`.
+    pub fn equations_variant<'a>(&'a self, name: &'a str) -> Option<&'a str> {
+        match &self.variants.iter().find(|v| v.name == name)?.kind {
+            kind if kind.is_regression() => Some(name),
+            VariantKind::Average { members } => {
+                members.iter().find_map(|m| self.equations_variant(m))
+            }
+            _ => None,
         }
     }
 
-    /// The `reproduce` variants (and the candidates they select from), in declaration order.
+    /// The `reproduce` variants (and the variants they select from or average), in declaration
+    /// order.
     fn reproduce_variants(&self) -> Vec<VariantSpec> {
         let mut needed: Vec<&str> = self.reproduce.iter().map(String::as_str).collect();
         for variant in self.variants.iter().rev() {
-            if needed.contains(&variant.name.as_str())
-                && let VariantKind::Select { candidates } = &variant.kind
+            if !needed.contains(&variant.name.as_str()) {
+                continue;
+            }
+            if let VariantKind::Select { candidates: others }
+            | VariantKind::Average { members: others } = &variant.kind
             {
-                needed.extend(candidates.iter().map(String::as_str));
+                needed.extend(others.iter().map(String::as_str));
             }
         }
         self.variants
@@ -257,25 +284,20 @@ impl VariantsConfig {
 }
 
 /// The extra columns `make reproduce` shows: the `reproduce` variants of the variants file at
-/// `path`, for each (support, query) pair, with the first seed of that file.
+/// `path`, for each (support, query, the run's meta-trained LeARN model) of a cell, with the first
+/// seed of that file.
 pub fn reproduce_columns(
     path: &Path,
-    cells: &[(&Segment, &Segment)],
+    cells: &[(&Segment, &Segment, &MetaTrainedModel)],
 ) -> Result<Vec<BTreeMap<String, report::Mse>>> {
     let config = VariantsConfig::read(path)?;
     let variants = config.reproduce_variants();
     let seed = config.seeds[0];
     cells
         .par_iter()
-        .map(|(support, query)| {
-            let no_meta_training = || -> Result<MetaTrainedModel> {
-                Err(PipelineError::Config {
-                    path: path.to_path_buf(),
-                    field: "reproduce".to_string(),
-                    message: "a reproduce variant asked for LeARN meta-training".to_string(),
-                })
-            };
-            let outcomes = evaluate_variants(&variants, no_meta_training, support, query, seed)?;
+        .map(|(support, query, model)| {
+            let run_model = || -> Result<MetaTrainedModel> { Ok((*model).clone()) };
+            let outcomes = evaluate_variants(&variants, run_model, support, query, seed)?;
             Ok(variants
                 .iter()
                 .zip(outcomes)
@@ -311,8 +333,10 @@ pub struct SeedCell {
     pub seed: u64,
     pub adapt: f64,
     pub r#gen: f64,
-    /// Mean over outputs of the best support cross-validation MSE.
-    pub support_cv: f64,
+    /// Mean over outputs of the best support cross-validation MSE (variants that fit a
+    /// regression).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub support_cv: Option<f64>,
     /// What was chosen inside the support segment: per output the penalty, and for `select` the
     /// candidate.
     pub chosen: BTreeMap<String, serde_json::Value>,
@@ -374,14 +398,65 @@ struct CellData<'a> {
     query: Segment,
 }
 
+/// One variant's predictions and errors on both segments.
+#[derive(Clone, Debug)]
+pub struct Evaluation {
+    /// Samples × outputs.
+    pub support_prediction: Mat<f64>,
+    pub query_prediction: Mat<f64>,
+    /// MSE on the support segment (adapt) and on the query segment (gen).
+    pub support_mse: f64,
+    pub query_mse: f64,
+    /// The predictive band on both segments, for bagged variants.
+    pub support_band: Option<EnsemblePrediction>,
+    pub query_band: Option<EnsemblePrediction>,
+    /// The feature names and the fitted regression, for variants that fit one.
+    pub regression: Option<(Vec<String>, RegressionFit)>,
+}
+
+impl Evaluation {
+    /// Predictions of a variant without a regression (no band), scored on both segments.
+    fn unfitted(
+        support_prediction: Mat<f64>,
+        query_prediction: Mat<f64>,
+        support: &Segment,
+        query: &Segment,
+    ) -> Self {
+        Self {
+            support_mse: mean_squared_error(support_prediction.as_ref(), support.targets.as_ref()),
+            query_mse: mean_squared_error(query_prediction.as_ref(), query.targets.as_ref()),
+            support_prediction,
+            query_prediction,
+            support_band: None,
+            query_band: None,
+            regression: None,
+        }
+    }
+}
+
+impl From<VariantEvaluation> for Evaluation {
+    fn from(evaluation: VariantEvaluation) -> Self {
+        Self {
+            support_prediction: evaluation.support_prediction,
+            query_prediction: evaluation.query_prediction,
+            support_mse: evaluation.support_mse,
+            query_mse: evaluation.query_mse,
+            support_band: evaluation.support_band,
+            query_band: evaluation.query_band,
+            regression: Some((evaluation.feature_names, evaluation.fit)),
+        }
+    }
+}
+
 /// One variant's outcome on one cell and seed, with its traces.
 #[derive(Clone, Debug)]
 pub struct Outcome {
-    pub evaluation: VariantEvaluation,
+    pub evaluation: Evaluation,
     /// Everything chosen inside the support segment (per output penalty; `variant` for select).
     pub chosen: BTreeMap<String, serde_json::Value>,
-    /// Mean over outputs of the best support cross-validation MSE.
-    pub support_cv: f64,
+    /// Mean over outputs of the best support cross-validation MSE (variants that fit a
+    /// regression).
+    pub support_cv: Option<f64>,
 }
 
 /// Everything `make ablations` writes.
@@ -478,6 +553,10 @@ pub fn run_variants(
                 .collect();
             variants.insert(spec.name.clone(), summarise(seeds));
         }
+        let equations_index = config
+            .raw
+            .equations_variant(&config.raw.headline)
+            .and_then(|name| config.raw.variants.iter().position(|v| v.name == name));
         if let Some(name) = &config.raw.figure_variant {
             let index = config.raw.variants.iter().position(|v| &v.name == name);
             if let Some(index) = index {
@@ -496,11 +575,7 @@ pub fn run_variants(
             noise_floor_support: forward_difference_noise_floor(&cell.support, dt)?,
             noise_floor_query: forward_difference_noise_floor(&cell.query, dt)?,
             variants,
-            headline_equations: config
-                .raw
-                .variants
-                .iter()
-                .position(|v| v.name == config.raw.headline)
+            headline_equations: equations_index
                 .map(|index| equations(&per_seed[0][index].evaluation, cell.formulation))
                 .unwrap_or_default(),
         });
@@ -579,21 +654,35 @@ pub fn evaluate_variants(
     let mut meta_train = Some(meta_train);
     let mut meta_trained = None;
     for spec in variants {
+        // The outcomes of the variants `names` (declared before this one).
+        let earlier = |names: &[String], what: &str| -> Result<Vec<&Outcome>> {
+            let found: Vec<&Outcome> = names
+                .iter()
+                .filter_map(|name| variants.iter().position(|v| &v.name == name))
+                .filter(|&index| index < outcomes.len())
+                .map(|index| &outcomes[index])
+                .collect();
+            if found.len() != names.len() || found.is_empty() {
+                return Err(PipelineError::Mismatch {
+                    what: format!("variant '{}'", spec.name),
+                    message: format!("every {what} must be declared before it"),
+                });
+            }
+            Ok(found)
+        };
         let outcome = match &spec.kind {
             VariantKind::Library(variant) => {
                 let evaluation = variant.evaluate(support, query, seed)?;
                 outcome_of(evaluation, BTreeMap::new(), &support.formulation)
             }
             VariantKind::Select { candidates } => {
+                earlier(candidates, "candidate")?;
+                let score = |index: usize| outcomes[index].support_cv.unwrap_or(f64::INFINITY);
                 let best = candidates
                     .iter()
                     .filter_map(|name| variants.iter().position(|v| &v.name == name))
-                    .filter(|&index| index < outcomes.len())
-                    .min_by(|&a, &b| outcomes[a].support_cv.total_cmp(&outcomes[b].support_cv))
-                    .ok_or_else(|| PipelineError::Mismatch {
-                        what: format!("variant '{}'", spec.name),
-                        message: "no candidate declared before it".to_string(),
-                    })?;
+                    .min_by(|&a, &b| score(a).total_cmp(&score(b)))
+                    .expect("checked above");
                 let chosen_outcome = &outcomes[best];
                 let mut chosen = chosen_outcome.chosen.clone();
                 chosen.insert(
@@ -607,18 +696,69 @@ pub fn evaluate_variants(
                 }
             }
             VariantKind::LearnedBasis(variant) => {
-                if meta_trained.is_none() {
-                    let train = meta_train.take().expect("called once");
-                    meta_trained = Some(train()?);
-                }
-                let model = meta_trained.as_ref().expect("set above");
+                let model = meta_trained_once(&mut meta_trained, &mut meta_train)?;
                 let evaluation = variant.evaluate(model, support, query, seed)?;
                 outcome_of(evaluation, BTreeMap::new(), &support.formulation)
+            }
+            VariantKind::Learn => {
+                let model = meta_trained_once(&mut meta_trained, &mut meta_train)?;
+                let adapted = model.adapt(support, &model.config.adaptation);
+                let predict = |segment: &Segment| {
+                    learn::from_row_major(
+                        &model.predict_segment(&adapted, segment),
+                        model.architecture.state_dim,
+                    )
+                };
+                Outcome {
+                    evaluation: Evaluation::unfitted(
+                        predict(support),
+                        predict(query),
+                        support,
+                        query,
+                    ),
+                    chosen: BTreeMap::new(),
+                    support_cv: None,
+                }
+            }
+            VariantKind::Average { members } => {
+                let members = earlier(members, "member")?;
+                let mean = |prediction: fn(&Evaluation) -> &Mat<f64>| {
+                    let first = prediction(&members[0].evaluation);
+                    Mat::from_fn(first.nrows(), first.ncols(), |i, j| {
+                        members
+                            .iter()
+                            .map(|m| prediction(&m.evaluation)[(i, j)])
+                            .sum::<f64>()
+                            / members.len() as f64
+                    })
+                };
+                Outcome {
+                    evaluation: Evaluation::unfitted(
+                        mean(|e| &e.support_prediction),
+                        mean(|e| &e.query_prediction),
+                        support,
+                        query,
+                    ),
+                    chosen: BTreeMap::new(),
+                    support_cv: None,
+                }
             }
         };
         outcomes.push(outcome);
     }
     Ok(outcomes)
+}
+
+/// The meta-trained model, trained by `train` on first use.
+fn meta_trained_once<'m>(
+    model: &'m mut Option<MetaTrainedModel>,
+    train: &mut Option<impl FnOnce() -> Result<MetaTrainedModel>>,
+) -> Result<&'m MetaTrainedModel> {
+    if model.is_none() {
+        let train = train.take().expect("called once");
+        *model = Some(train()?);
+    }
+    Ok(model.as_ref().expect("set above"))
 }
 
 fn outcome_of(
@@ -636,17 +776,20 @@ fn outcome_of(
         .sum::<f64>()
         / selections.len().max(1) as f64;
     Outcome {
-        evaluation,
+        evaluation: evaluation.into(),
         chosen,
-        support_cv,
+        support_cv: Some(support_cv),
     }
 }
 
 /// `ẋ_i = b + Σ c·feature` per output: the terms with a non-zero coefficient, ordered by the size
 /// of their standardised coefficient (their share of the prediction's spread on the support
 /// segment), coefficients in the units of the raw features.
-fn equations(evaluation: &VariantEvaluation, formulation: Formulation) -> Vec<String> {
-    let fit = &evaluation.fit.full;
+fn equations(evaluation: &Evaluation, formulation: Formulation) -> Vec<String> {
+    let Some((feature_names, fit)) = &evaluation.regression else {
+        return Vec::new();
+    };
+    let fit = &fit.full;
     let (raw, intercepts) = fit.raw_coefficients();
     formulation
         .target_names()
@@ -665,11 +808,7 @@ fn equations(evaluation: &VariantEvaluation, formulation: Formulation) -> Vec<St
             for i in terms {
                 let c = raw[(i, j)];
                 let sign = if c < 0.0 { '-' } else { '+' };
-                text.push_str(&format!(
-                    " {sign} {:.4} {}",
-                    c.abs(),
-                    evaluation.feature_names[i]
-                ));
+                text.push_str(&format!(" {sign} {:.4} {}", c.abs(), feature_names[i]));
             }
             text
         })
@@ -732,7 +871,7 @@ fn band_series(support: &EnsemblePrediction, query: &EnsemblePrediction) -> repo
 fn figure(
     cell: &CellData,
     name: &str,
-    evaluation: &VariantEvaluation,
+    evaluation: &Evaluation,
 ) -> Result<(String, QualitativeFigure)> {
     let band = match (&evaluation.support_band, &evaluation.query_band) {
         (Some(s), Some(q)) => Some(band_series(s, q)),
@@ -913,7 +1052,7 @@ pub fn ablations_markdown(ablations: &Ablations) -> String {
             row.table, row.condition, cell.r#gen
         ));
     }
-    out.push_str("\n(Picking the best variant per cell by its query error is itself a choice made on the query segment: this table is descriptive; the headline column above was fixed in advance.)\n\n");
+    out.push_str("\n(Picking the best variant per cell by its query error is itself a choice made on the query segment: this table is descriptive. The headline column above is declared in `experiments/variants.json`; its description says when it was chosen.)\n\n");
     for metric in ["gen", "adapt"] {
         out.push_str(&format!(
             "## Every variant, {metric} MSE (mean ± std over seeds)\n\n"
@@ -954,10 +1093,20 @@ pub fn ablations_markdown(ablations: &Ablations) -> String {
         .iter()
         .any(|r| !r.headline_equations.is_empty())
     {
+        let name = config
+            .equations_variant(&config.headline)
+            .unwrap_or(&config.headline);
+        let role = if name == config.headline {
+            String::new()
+        } else {
+            format!(
+                " (the regression member of the headline `{}`)",
+                config.headline
+            )
+        };
         out.push_str(&format!(
-            "## `{}` equations (seed {}), the five largest terms\n\n\
+            "## `{name}` equations{role} (seed {}), the five largest terms\n\n\
              Terms ordered by standardised coefficient; every term is in `ablations.json`.\n\n",
-            config.headline,
             config.seeds.first().copied().unwrap_or_default()
         ));
         for row in &ablations.rows {
@@ -979,6 +1128,86 @@ pub fn ablations_markdown(ablations: &Ablations) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use learn::{CHECKPOINT_FORMAT, Protocol, Standardiser};
+
+    /// A synthetic attitude segment of `n` samples with targets that depend on the inputs.
+    fn segment(n: usize, phase: f64) -> Segment {
+        let states = Mat::from_fn(n, 3, |i, j| (0.05 * i as f64 + j as f64 + phase).sin());
+        let controls = Mat::from_fn(n, 4, |i, j| 1.0 + 0.2 * (0.03 * i as f64 - j as f64).cos());
+        let targets = Mat::from_fn(n, 3, |i, j| {
+            0.7 * states[(i, j)] - 0.4 * controls[(i, j + 1)] + 0.05 * ((i * 7919) % 13) as f64
+        });
+        Segment {
+            formulation: Formulation::Attitude,
+            rows: 0..n,
+            time: (0..n).map(|i| i as f64 * 0.02).collect(),
+            states,
+            controls,
+            targets,
+        }
+    }
+
+    fn untrained_model() -> MetaTrainedModel {
+        let mut config: learn::LearnConfig =
+            serde_json::from_str(include_str!("../../../experiments/learn.json")).unwrap();
+        config.hidden_layers = vec![5, 4];
+        config.adaptation.passes = 2;
+        let architecture = learn::architecture(Formulation::Attitude, &config);
+        MetaTrainedModel {
+            format: CHECKPOINT_FORMAT.to_string(),
+            formulation: Formulation::Attitude,
+            protocol: Protocol::LeaveConditionOut,
+            held_out_condition: None,
+            seed: 2,
+            parameters: architecture.initial_parameters(2),
+            standardiser: Standardiser::identity(architecture.input_dim),
+            architecture,
+            config,
+            data_files: Vec::new(),
+            meta_loss_history: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn learn_is_the_adapted_network_and_average_the_mean_of_its_members() {
+        let text = config(
+            &format!(
+                r#"{{"name": "a", "description": "", {RIDGE}}},
+                   {{"name": "l", "description": "", "kind": "learn"}},
+                   {{"name": "m", "description": "", "kind": "average", "members": ["l", "a"]}}"#
+            ),
+            "",
+        );
+        let read = VariantsConfig::read(&write("evaluate", &text)).unwrap();
+        let (support, query) = (segment(60, 0.0), segment(40, 1.3));
+        let model = untrained_model();
+        let outcomes =
+            evaluate_variants(&read.variants, || Ok(model.clone()), &support, &query, 1).unwrap();
+        let adapted = model.adapt(&support, &model.config.adaptation);
+        assert_ne!(adapted, model.parameters, "adaptation moved nothing");
+        let expected = model.predict_segment(&adapted, &query);
+        let learn = &outcomes[1].evaluation;
+        for i in 0..query.len() {
+            for j in 0..3 {
+                assert_eq!(learn.query_prediction[(i, j)], expected[i * 3 + j]);
+                let mean = 0.5
+                    * (learn.query_prediction[(i, j)]
+                        + outcomes[0].evaluation.query_prediction[(i, j)]);
+                assert_eq!(outcomes[2].evaluation.query_prediction[(i, j)], mean);
+            }
+        }
+        let error = |prediction: &Mat<f64>, segment: &Segment| {
+            mean_squared_error(prediction.as_ref(), segment.targets.as_ref())
+        };
+        assert_eq!(learn.query_mse, error(&learn.query_prediction, &query));
+        let average = &outcomes[2].evaluation;
+        assert_eq!(
+            average.support_mse,
+            error(&average.support_prediction, &support)
+        );
+        assert!(outcomes[1].support_cv.is_none() && outcomes[2].chosen.is_empty());
+        assert!(outcomes[0].support_cv.is_some() && average.regression.is_none());
+    }
 
     fn write(name: &str, text: &str) -> PathBuf {
         let path = std::env::temp_dir().join(format!(
@@ -1026,11 +1255,38 @@ mod tests {
                 "'a' is not",
             ),
             (
-                "expensive",
-                config(&format!("{a}, {b}"), r#""reproduce": ["b"],"#),
-                "meta-training",
+                "member",
+                config(
+                    &format!(
+                        r#"{a}, {{"name": "m", "description": "", "kind": "average", "members": ["a", "z"]}}"#
+                    ),
+                    "",
+                ),
+                "member 'z' must be a variant declared before it",
+            ),
+            (
+                "no-score",
+                config(
+                    &format!(
+                        r#"{a}, {{"name": "l", "description": "", "kind": "learn"}}, {{"name": "s", "description": "", "kind": "select", "candidates": ["a", "l"]}}"#
+                    ),
+                    "",
+                ),
+                "no support cross-validation score",
             ),
         ];
+        let learn_average = write(
+            "learn-average",
+            &config(
+                &format!(
+                    r#"{a}, {{"name": "l", "description": "", "kind": "learn"}}, {{"name": "m", "description": "", "kind": "average", "members": ["l", "a"]}}"#
+                ),
+                "",
+            ),
+        );
+        let read = VariantsConfig::read(&learn_average).unwrap();
+        assert_eq!(read.equations_variant("m"), Some("a"));
+        assert_eq!(read.equations_variant("l"), None);
         for (name, text, expected) in cases {
             let message = VariantsConfig::read(&write(name, &text))
                 .err()

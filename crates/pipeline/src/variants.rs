@@ -414,26 +414,6 @@ pub struct Evaluation {
     pub regression: Option<(Vec<String>, RegressionFit)>,
 }
 
-impl Evaluation {
-    /// Predictions of a variant without a regression (no band), scored on both segments.
-    fn unfitted(
-        support_prediction: Mat<f64>,
-        query_prediction: Mat<f64>,
-        support: &Segment,
-        query: &Segment,
-    ) -> Self {
-        Self {
-            support_mse: mean_squared_error(support_prediction.as_ref(), support.targets.as_ref()),
-            query_mse: mean_squared_error(query_prediction.as_ref(), query.targets.as_ref()),
-            support_prediction,
-            query_prediction,
-            support_band: None,
-            query_band: None,
-            regression: None,
-        }
-    }
-}
-
 impl From<VariantEvaluation> for Evaluation {
     fn from(evaluation: VariantEvaluation) -> Self {
         Self {
@@ -457,6 +437,32 @@ pub struct Outcome {
     /// Mean over outputs of the best support cross-validation MSE (variants that fit a
     /// regression).
     pub support_cv: Option<f64>,
+}
+
+impl Outcome {
+    /// A variant without a regression (nothing chosen, no band): its predictions, scored on both
+    /// segments.
+    fn unfitted(
+        support_prediction: Mat<f64>,
+        query_prediction: Mat<f64>,
+        support: &Segment,
+        query: &Segment,
+    ) -> Self {
+        let evaluation = Evaluation {
+            support_mse: mean_squared_error(support_prediction.as_ref(), support.targets.as_ref()),
+            query_mse: mean_squared_error(query_prediction.as_ref(), query.targets.as_ref()),
+            support_prediction,
+            query_prediction,
+            support_band: None,
+            query_band: None,
+            regression: None,
+        };
+        Self {
+            evaluation,
+            chosen: BTreeMap::new(),
+            support_cv: None,
+        }
+    }
 }
 
 /// Everything `make ablations` writes.
@@ -654,13 +660,12 @@ pub fn evaluate_variants(
     let mut meta_train = Some(meta_train);
     let mut meta_trained = None;
     for spec in variants {
-        // The outcomes of the variants `names` (declared before this one).
-        let earlier = |names: &[String], what: &str| -> Result<Vec<&Outcome>> {
-            let found: Vec<&Outcome> = names
+        // The indices of the variants `names` (each declared before this one).
+        let earlier = |names: &[String], what: &str| -> Result<Vec<usize>> {
+            let found: Vec<usize> = names
                 .iter()
                 .filter_map(|name| variants.iter().position(|v| &v.name == name))
                 .filter(|&index| index < outcomes.len())
-                .map(|index| &outcomes[index])
                 .collect();
             if found.len() != names.len() || found.is_empty() {
                 return Err(PipelineError::Mismatch {
@@ -676,13 +681,11 @@ pub fn evaluate_variants(
                 outcome_of(evaluation, BTreeMap::new(), &support.formulation)
             }
             VariantKind::Select { candidates } => {
-                earlier(candidates, "candidate")?;
                 let score = |index: usize| outcomes[index].support_cv.unwrap_or(f64::INFINITY);
-                let best = candidates
-                    .iter()
-                    .filter_map(|name| variants.iter().position(|v| &v.name == name))
+                let best = earlier(candidates, "candidate")?
+                    .into_iter()
                     .min_by(|&a, &b| score(a).total_cmp(&score(b)))
-                    .expect("checked above");
+                    .expect("at least one candidate");
                 let chosen_outcome = &outcomes[best];
                 let mut chosen = chosen_outcome.chosen.clone();
                 chosen.insert(
@@ -709,39 +712,26 @@ pub fn evaluate_variants(
                         model.architecture.state_dim,
                     )
                 };
-                Outcome {
-                    evaluation: Evaluation::unfitted(
-                        predict(support),
-                        predict(query),
-                        support,
-                        query,
-                    ),
-                    chosen: BTreeMap::new(),
-                    support_cv: None,
-                }
+                Outcome::unfitted(predict(support), predict(query), support, query)
             }
             VariantKind::Average { members } => {
-                let members = earlier(members, "member")?;
+                let members: Vec<&Evaluation> = earlier(members, "member")?
+                    .into_iter()
+                    .map(|index| &outcomes[index].evaluation)
+                    .collect();
                 let mean = |prediction: fn(&Evaluation) -> &Mat<f64>| {
-                    let first = prediction(&members[0].evaluation);
+                    let first = prediction(members[0]);
                     Mat::from_fn(first.nrows(), first.ncols(), |i, j| {
-                        members
-                            .iter()
-                            .map(|m| prediction(&m.evaluation)[(i, j)])
-                            .sum::<f64>()
+                        members.iter().map(|m| prediction(m)[(i, j)]).sum::<f64>()
                             / members.len() as f64
                     })
                 };
-                Outcome {
-                    evaluation: Evaluation::unfitted(
-                        mean(|e| &e.support_prediction),
-                        mean(|e| &e.query_prediction),
-                        support,
-                        query,
-                    ),
-                    chosen: BTreeMap::new(),
-                    support_cv: None,
-                }
+                Outcome::unfitted(
+                    mean(|e| &e.support_prediction),
+                    mean(|e| &e.query_prediction),
+                    support,
+                    query,
+                )
             }
         };
         outcomes.push(outcome);

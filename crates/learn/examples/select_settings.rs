@@ -5,7 +5,7 @@
 //! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
 //! score and the one fold c's own validation prefers, and writes all numbers as JSON.
 //!
-//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch]
+//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation]
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -26,7 +26,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `averaging`: whether averaging the last meta-iterates (Polyak–Ruppert) helps;
     // `adaptation-averaging`: whether averaged SGD in the online adaptation helps;
     // `lipschitz`: the weight λ and bound L of the adaptation's Lipschitz regulariser;
-    // `batch`: support and query batches of 128 points per task instead of 64.
+    // `batch`: support and query batches of 128 points per task instead of 64;
+    // `passes`: more adaptation passes (8, 16, 24) at the configured and at half the step;
+    // `outer`: the outer (Adam) step β at half and twice the configured value;
+    // `regularisation`: the meta-regulariser μ from 0 to 1e-3.
     let stage = arguments.get(2).map_or("grid", String::as_str);
     let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
     let base = checked.get().clone();
@@ -46,7 +49,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let grid: &[(usize, usize, f64, usize)] = match stage {
         "iterations" => &[(800, 4, 0.1, 0), (1600, 4, 0.1, 0)],
         "averaging" => &[(800, 4, 0.1, 0), (800, 4, 0.1, 200), (800, 4, 0.1, 400)],
-        "adaptation-averaging" | "lipschitz" | "batch" => &[(800, 4, 0.1, 0)],
+        "adaptation-averaging" | "lipschitz" | "batch" | "passes" | "outer" | "regularisation" => {
+            &[(800, 4, 0.1, 0)]
+        }
         _ => &[
             (200, 4, 0.1, 0),
             (800, 4, 0.1, 0),
@@ -76,6 +81,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.meta_training.query_batch = 128;
         candidates.push(("it800_tasks4_alpha0.1_batch128".to_string(), config));
     }
+    if stage == "outer" {
+        for factor in [0.5, 2.0] {
+            let mut config = candidates[0].1.clone();
+            config.meta_training.outer_step *= factor;
+            let name = format!(
+                "it800_tasks4_alpha0.1_beta{}",
+                config.meta_training.outer_step
+            );
+            candidates.push((name, config));
+        }
+    }
+    if stage == "regularisation" {
+        for mu in [0.0, 1e-4, 1e-3] {
+            let mut config = candidates[0].1.clone();
+            config.meta_training.meta_regularisation = mu;
+            candidates.push((format!("it800_tasks4_alpha0.1_mu{mu}"), config));
+        }
+    }
     let adaptations: Vec<(String, AdaptationConfig)> = if stage == "lipschitz" {
         // λ = 0 (no regulariser), then λ × L; the other adaptation settings as configured.
         [
@@ -100,11 +123,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
         .collect()
     } else {
-        let passes_grid: &[usize] = if stage == "grid" { &[4, 8] } else { &[8] };
+        let passes_grid: &[usize] = match stage {
+            "grid" => &[4, 8],
+            "passes" => &[8, 16, 24],
+            _ => &[8],
+        };
         // (step, averaged SGD over the last pass)
         let steps: &[(f64, bool)] = match stage {
             "averaging" => &[(0.0005, false)],
             "adaptation-averaging" => &[(0.0005, false), (0.0005, true), (0.001, true)],
+            "passes" | "outer" | "regularisation" => &[(0.0005, false), (0.00025, false)],
             _ => &[(0.0005, false), (0.001, false)],
         };
         let mut adaptations = Vec::new();

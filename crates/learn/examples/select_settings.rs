@@ -5,7 +5,7 @@
 //! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
 //! score and the one fold c's own validation prefers, and writes all numbers as JSON.
 //!
-//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation]
+//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation|window]
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -29,7 +29,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `batch`: support and query batches of 128 points per task instead of 64;
     // `passes`: more adaptation passes (8, 16, 24) at the configured and at half the step;
     // `outer`: the outer (Adam) step β at half and twice the configured value;
-    // `regularisation`: the meta-regulariser μ from 0 to 1e-3.
+    // `regularisation`: the meta-regulariser μ from 0 to 1e-3;
+    // `window`: adaptation updates on windows of 2 or 4 consecutive samples (1: the paper).
     let stage = arguments.get(2).map_or("grid", String::as_str);
     let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
     let base = checked.get().clone();
@@ -49,9 +50,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let grid: &[(usize, usize, f64, usize)] = match stage {
         "iterations" => &[(800, 4, 0.1, 0), (1600, 4, 0.1, 0)],
         "averaging" => &[(800, 4, 0.1, 0), (800, 4, 0.1, 200), (800, 4, 0.1, 400)],
-        "adaptation-averaging" | "lipschitz" | "batch" | "passes" | "outer" | "regularisation" => {
-            &[(800, 4, 0.1, 0)]
-        }
+        "adaptation-averaging"
+        | "lipschitz"
+        | "batch"
+        | "passes"
+        | "outer"
+        | "regularisation"
+        | "window" => &[(800, 4, 0.1, 0)],
         _ => &[
             (200, 4, 0.1, 0),
             (800, 4, 0.1, 0),
@@ -99,7 +104,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             candidates.push((format!("it800_tasks4_alpha0.1_mu{mu}"), config));
         }
     }
-    let adaptations: Vec<(String, AdaptationConfig)> = if stage == "lipschitz" {
+    let adaptations: Vec<(String, AdaptationConfig)> = if stage == "window" {
+        // (window, step) at the configured passes: the same step, and the step scaled with the
+        // window (the same distance per pass as one-sample updates).
+        [(1, 0.0005), (2, 0.0005), (2, 0.001), (4, 0.001), (4, 0.002)]
+            .into_iter()
+            .map(|(window, step)| {
+                (
+                    format!("window{window}_step{step}_passes{}", base.adaptation.passes),
+                    AdaptationConfig {
+                        window,
+                        step,
+                        ..base.adaptation.clone()
+                    },
+                )
+            })
+            .collect()
+    } else if stage == "lipschitz" {
         // λ = 0 (no regulariser), then λ × L; the other adaptation settings as configured.
         [
             (0.0, 1.0),

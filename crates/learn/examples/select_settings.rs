@@ -5,7 +5,7 @@
 //! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
 //! score and the one fold c's own validation prefers, and writes all numbers as JSON.
 //!
-//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation|window]
+//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation|window|basis]
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -30,7 +30,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `passes`: more adaptation passes (8, 16, 24) at the configured and at half the step;
     // `outer`: the outer (Adam) step β at half and twice the configured value;
     // `regularisation`: the meta-regulariser μ from 0 to 1e-3;
-    // `window`: adaptation updates on windows of 2 or 4 consecutive samples (1: the paper).
+    // `window`: adaptation updates on windows of 2 or 4 consecutive samples (1: the paper);
+    // `basis`: P = 1 or 3 learned basis functions per input instead of the paper's 2.
     let stage = arguments.get(2).map_or("grid", String::as_str);
     let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
     let base = checked.get().clone();
@@ -56,7 +57,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         | "passes"
         | "outer"
         | "regularisation"
-        | "window" => &[(800, 4, 0.1, 0)],
+        | "window"
+        | "basis" => &[(800, 4, 0.1, 0)],
         _ => &[
             (200, 4, 0.1, 0),
             (800, 4, 0.1, 0),
@@ -95,6 +97,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 config.meta_training.outer_step
             );
             candidates.push((name, config));
+        }
+    }
+    if stage == "basis" {
+        for basis_per_input in [1, 3] {
+            let mut config = candidates[0].1.clone();
+            config.basis_per_input = basis_per_input;
+            candidates.push((format!("it800_tasks4_alpha0.1_P{basis_per_input}"), config));
         }
     }
     if stage == "regularisation" {
@@ -147,6 +156,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let passes_grid: &[usize] = match stage {
             "grid" => &[4, 8],
             "passes" => &[8, 16, 24],
+            "basis" => &[16],
             _ => &[8],
         };
         // (step, averaged SGD over the last pass)
@@ -154,6 +164,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "averaging" => &[(0.0005, false)],
             "adaptation-averaging" => &[(0.0005, false), (0.0005, true), (0.001, true)],
             "passes" | "outer" | "regularisation" => &[(0.0005, false), (0.00025, false)],
+            "basis" => &[(0.0005, false)],
             _ => &[(0.0005, false), (0.001, false)],
         };
         let mut adaptations = Vec::new();

@@ -37,7 +37,7 @@ pub use summary::{
     StageTiming, Summary, Timings,
 };
 pub use variants::{
-    AblationProvenance, AblationRow, Ablations, AblationsOutcome, CheckedVariants, Evaluation,
+    AblationProvenance, AblationRow, Ablations, AblationsOutcome, CheckedVariants,
     LearnedBasisSpec, Outcome, SeedCell, VariantCell, VariantKind, VariantSpec, VariantsConfig,
     ablations_markdown, evaluate_variants, reproduce_columns, run_variants, write_ablations,
 };

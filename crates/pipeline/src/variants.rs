@@ -32,7 +32,7 @@ use report::{MethodTrace, PublishedTables, QualitativeFigure};
 use serde::{Deserialize, Serialize};
 use sindy::{
     CausalLibrary, EnsemblePrediction, LibraryRegression, Mat, RegressionFit, RegressionSpec,
-    VariantEvaluation, evaluate_features, mean_squared_error,
+    SegmentPredictions, VariantEvaluation, evaluate_features,
 };
 
 use crate::config::{CheckedRunConfig, RunConfig, merge_patch};
@@ -306,8 +306,8 @@ pub fn reproduce_columns(
                     (
                         spec.name.clone(),
                         report::Mse {
-                            adaptation: outcome.evaluation.support_mse,
-                            generalisation: outcome.evaluation.query_mse,
+                            adaptation: outcome.predictions.support_mse,
+                            generalisation: outcome.predictions.query_mse,
                         },
                     )
                 })
@@ -398,40 +398,13 @@ struct CellData<'a> {
     query: Segment,
 }
 
-/// One variant's predictions and errors on both segments.
-#[derive(Clone, Debug)]
-pub struct Evaluation {
-    /// Samples × outputs.
-    pub support_prediction: Mat<f64>,
-    pub query_prediction: Mat<f64>,
-    /// MSE on the support segment (adapt) and on the query segment (gen).
-    pub support_mse: f64,
-    pub query_mse: f64,
-    /// The predictive band on both segments, for bagged variants.
-    pub support_band: Option<EnsemblePrediction>,
-    pub query_band: Option<EnsemblePrediction>,
-    /// The feature names and the fitted regression, for variants that fit one.
-    pub regression: Option<(Vec<String>, RegressionFit)>,
-}
-
-impl From<VariantEvaluation> for Evaluation {
-    fn from(evaluation: VariantEvaluation) -> Self {
-        Self {
-            support_prediction: evaluation.support_prediction,
-            query_prediction: evaluation.query_prediction,
-            support_mse: evaluation.support_mse,
-            query_mse: evaluation.query_mse,
-            support_band: evaluation.support_band,
-            query_band: evaluation.query_band,
-            regression: Some((evaluation.feature_names, evaluation.fit)),
-        }
-    }
-}
-
 /// One variant's outcome on one cell and seed, with its traces.
 #[derive(Clone, Debug)]
 pub struct Outcome {
-    pub evaluation: Evaluation,
+    /// Predictions and MSE on both segments (and the band of a bagged variant).
+    pub predictions: SegmentPredictions,
+    /// The feature names and the fitted regression, for variants that fit one.
+    pub regression: Option<(Vec<String>, RegressionFit)>,
     /// Everything chosen inside the support segment (per output penalty; `variant` for select).
     pub chosen: BTreeMap<String, serde_json::Value>,
     /// Mean over outputs of the best support cross-validation MSE (variants that fit a
@@ -448,17 +421,14 @@ impl Outcome {
         support: &Segment,
         query: &Segment,
     ) -> Self {
-        let evaluation = Evaluation {
-            support_mse: mean_squared_error(support_prediction.as_ref(), support.targets.as_ref()),
-            query_mse: mean_squared_error(query_prediction.as_ref(), query.targets.as_ref()),
-            support_prediction,
-            query_prediction,
-            support_band: None,
-            query_band: None,
-            regression: None,
-        };
         Self {
-            evaluation,
+            predictions: SegmentPredictions::scored(
+                support_prediction,
+                query_prediction,
+                support.targets.as_ref(),
+                query.targets.as_ref(),
+            ),
+            regression: None,
             chosen: BTreeMap::new(),
             support_cv: None,
         }
@@ -546,12 +516,12 @@ pub fn run_variants(
                 .zip(&per_seed)
                 .map(|(&seed, outcomes)| SeedCell {
                     seed,
-                    adapt: outcomes[index].evaluation.support_mse,
-                    r#gen: outcomes[index].evaluation.query_mse,
+                    adapt: outcomes[index].predictions.support_mse,
+                    r#gen: outcomes[index].predictions.query_mse,
                     support_cv: outcomes[index].support_cv,
                     chosen: outcomes[index].chosen.clone(),
                     query_band_coverage: outcomes[index]
-                        .evaluation
+                        .predictions
                         .query_band
                         .as_ref()
                         .map(|band| coverage(band, &cell.query.targets)),
@@ -566,7 +536,7 @@ pub fn run_variants(
         if let Some(name) = &config.raw.figure_variant {
             let index = config.raw.variants.iter().position(|v| &v.name == name);
             if let Some(index) = index {
-                figures.push(figure(cell, name, &per_seed[0][index].evaluation)?);
+                figures.push(figure(cell, name, &per_seed[0][index].predictions)?);
             }
         }
         rows.push(AblationRow {
@@ -582,7 +552,7 @@ pub fn run_variants(
             noise_floor_query: forward_difference_noise_floor(&cell.query, dt)?,
             variants,
             headline_equations: equations_index
-                .map(|index| equations(&per_seed[0][index].evaluation, cell.formulation))
+                .map(|index| equations(&per_seed[0][index].regression, cell.formulation))
                 .unwrap_or_default(),
         });
     }
@@ -693,9 +663,8 @@ pub fn evaluate_variants(
                     serde_json::Value::String(variants[best].name.clone()),
                 );
                 Outcome {
-                    evaluation: chosen_outcome.evaluation.clone(),
                     chosen,
-                    support_cv: chosen_outcome.support_cv,
+                    ..chosen_outcome.clone()
                 }
             }
             VariantKind::LearnedBasis(variant) => {
@@ -715,11 +684,11 @@ pub fn evaluate_variants(
                 Outcome::unfitted(predict(support), predict(query), support, query)
             }
             VariantKind::Average { members } => {
-                let members: Vec<&Evaluation> = earlier(members, "member")?
+                let members: Vec<&SegmentPredictions> = earlier(members, "member")?
                     .into_iter()
-                    .map(|index| &outcomes[index].evaluation)
+                    .map(|index| &outcomes[index].predictions)
                     .collect();
-                let mean = |prediction: fn(&Evaluation) -> &Mat<f64>| {
+                let mean = |prediction: fn(&SegmentPredictions) -> &Mat<f64>| {
                     let first = prediction(members[0]);
                     Mat::from_fn(first.nrows(), first.ncols(), |i, j| {
                         members.iter().map(|m| prediction(m)[(i, j)]).sum::<f64>()
@@ -766,7 +735,8 @@ fn outcome_of(
         .sum::<f64>()
         / selections.len().max(1) as f64;
     Outcome {
-        evaluation: evaluation.into(),
+        predictions: evaluation.predictions,
+        regression: Some((evaluation.feature_names, evaluation.fit)),
         chosen,
         support_cv: Some(support_cv),
     }
@@ -775,8 +745,11 @@ fn outcome_of(
 /// `ẋ_i = b + Σ c·feature` per output: the terms with a non-zero coefficient, ordered by the size
 /// of their standardised coefficient (their share of the prediction's spread on the support
 /// segment), coefficients in the units of the raw features.
-fn equations(evaluation: &Evaluation, formulation: Formulation) -> Vec<String> {
-    let Some((feature_names, fit)) = &evaluation.regression else {
+fn equations(
+    regression: &Option<(Vec<String>, RegressionFit)>,
+    formulation: Formulation,
+) -> Vec<String> {
+    let Some((feature_names, fit)) = regression else {
         return Vec::new();
     };
     let fit = &fit.full;
@@ -861,17 +834,17 @@ fn band_series(support: &EnsemblePrediction, query: &EnsemblePrediction) -> repo
 fn figure(
     cell: &CellData,
     name: &str,
-    evaluation: &Evaluation,
+    predictions: &SegmentPredictions,
 ) -> Result<(String, QualitativeFigure)> {
-    let band = match (&evaluation.support_band, &evaluation.query_band) {
+    let band = match (&predictions.support_band, &predictions.query_band) {
         (Some(s), Some(q)) => Some(band_series(s, q)),
         _ => None,
     };
     let method = MethodTrace {
         method: name.to_string(),
         prediction: crate::run::stacked_columns(
-            &evaluation.support_prediction,
-            &evaluation.query_prediction,
+            &predictions.support_prediction,
+            &predictions.query_prediction,
         ),
         band,
     };
@@ -1176,27 +1149,27 @@ mod tests {
         let adapted = model.adapt(&support, &model.config.adaptation);
         assert_ne!(adapted, model.parameters, "adaptation moved nothing");
         let expected = model.predict_segment(&adapted, &query);
-        let learn = &outcomes[1].evaluation;
+        let learn = &outcomes[1].predictions;
         for i in 0..query.len() {
             for j in 0..3 {
                 assert_eq!(learn.query_prediction[(i, j)], expected[i * 3 + j]);
                 let mean = 0.5
                     * (learn.query_prediction[(i, j)]
-                        + outcomes[0].evaluation.query_prediction[(i, j)]);
-                assert_eq!(outcomes[2].evaluation.query_prediction[(i, j)], mean);
+                        + outcomes[0].predictions.query_prediction[(i, j)]);
+                assert_eq!(outcomes[2].predictions.query_prediction[(i, j)], mean);
             }
         }
         let error = |prediction: &Mat<f64>, segment: &Segment| {
-            mean_squared_error(prediction.as_ref(), segment.targets.as_ref())
+            sindy::mean_squared_error(prediction.as_ref(), segment.targets.as_ref())
         };
         assert_eq!(learn.query_mse, error(&learn.query_prediction, &query));
-        let average = &outcomes[2].evaluation;
+        let average = &outcomes[2].predictions;
         assert_eq!(
             average.support_mse,
             error(&average.support_prediction, &support)
         );
         assert!(outcomes[1].support_cv.is_none() && outcomes[2].chosen.is_empty());
-        assert!(outcomes[0].support_cv.is_some() && average.regression.is_none());
+        assert!(outcomes[0].support_cv.is_some() && outcomes[2].regression.is_none());
     }
 
     fn write(name: &str, text: &str) -> PathBuf {

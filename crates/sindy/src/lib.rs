@@ -76,7 +76,7 @@ pub use regression::{
     Bagging, EnsemblePrediction, LinearFit, Penalty, RegressionFit, RegressionSpec, select_rows,
 };
 pub use selection::{BlockedFolds, Fold, Selection, cross_validate};
-pub use variant::{LibraryRegression, VariantEvaluation, evaluate_features};
+pub use variant::{LibraryRegression, SegmentPredictions, VariantEvaluation, evaluate_features};
 
 /// Re-exported so that users name the same matrix types.
 pub use faer::{Mat, MatRef};

@@ -18,11 +18,10 @@ pub struct LibraryRegression {
     pub regression: RegressionSpec,
 }
 
-/// A variant fitted on a support segment and its predictions on support and query.
+/// A model's predictions of the support and query segments (samples × outputs), scored against
+/// their targets.
 #[derive(Clone, Debug)]
-pub struct VariantEvaluation {
-    pub feature_names: Vec<String>,
-    pub fit: RegressionFit,
+pub struct SegmentPredictions {
     pub support_prediction: Mat<f64>,
     pub query_prediction: Mat<f64>,
     /// MSE on the support segment (adapt) and on the query segment (gen).
@@ -31,6 +30,33 @@ pub struct VariantEvaluation {
     /// The ensemble band on both segments, when bagged.
     pub support_band: Option<EnsemblePrediction>,
     pub query_band: Option<EnsemblePrediction>,
+}
+
+impl SegmentPredictions {
+    /// Predictions scored by their mean squared error against the targets; no band.
+    pub fn scored(
+        support_prediction: Mat<f64>,
+        query_prediction: Mat<f64>,
+        support_targets: MatRef<'_, f64>,
+        query_targets: MatRef<'_, f64>,
+    ) -> Self {
+        Self {
+            support_mse: mean_squared_error(support_prediction.as_ref(), support_targets),
+            query_mse: mean_squared_error(query_prediction.as_ref(), query_targets),
+            support_prediction,
+            query_prediction,
+            support_band: None,
+            query_band: None,
+        }
+    }
+}
+
+/// A variant fitted on a support segment and its predictions on support and query.
+#[derive(Clone, Debug)]
+pub struct VariantEvaluation {
+    pub feature_names: Vec<String>,
+    pub fit: RegressionFit,
+    pub predictions: SegmentPredictions,
 }
 
 impl LibraryRegression {
@@ -80,16 +106,19 @@ pub fn evaluate_features(
         ));
     }
     let fit = regression.fit(support_theta, support_targets, seed)?;
-    let support_prediction = fit.predict(support_theta);
-    let query_prediction = fit.predict(query_theta);
-    Ok(VariantEvaluation {
-        feature_names,
-        support_mse: mean_squared_error(support_prediction.as_ref(), support_targets),
-        query_mse: mean_squared_error(query_prediction.as_ref(), query_targets),
+    let predictions = SegmentPredictions {
         support_band: fit.ensemble(support_theta),
         query_band: fit.ensemble(query_theta),
+        ..SegmentPredictions::scored(
+            fit.predict(support_theta),
+            fit.predict(query_theta),
+            support_targets,
+            query_targets,
+        )
+    };
+    Ok(VariantEvaluation {
+        feature_names,
         fit,
-        support_prediction,
-        query_prediction,
+        predictions,
     })
 }

@@ -23,7 +23,11 @@ fn numbers(value: &Value) -> Vec<f64> {
 
 fn relative_error(ours: &[f64], theirs: &[f64]) -> f64 {
     assert_eq!(ours.len(), theirs.len());
-    let difference: f64 = ours.iter().zip(theirs).map(|(a, b)| (a - b) * (a - b)).sum();
+    let difference: f64 = ours
+        .iter()
+        .zip(theirs)
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum();
     let scale: f64 = theirs.iter().map(|b| b * b).sum();
     (difference / scale).sqrt()
 }
@@ -31,7 +35,8 @@ fn relative_error(ours: &[f64], theirs: &[f64]) -> f64 {
 #[test]
 fn meta_gradients_match_jax() {
     let golden = golden();
-    let architecture: Architecture = serde_json::from_value(golden["architecture"].clone()).unwrap();
+    let architecture: Architecture =
+        serde_json::from_value(golden["architecture"].clone()).unwrap();
     let parameters = numbers(&golden["parameters"]);
     assert_eq!(parameters.len(), architecture.parameter_count());
     let inner = InnerLoop {

@@ -77,6 +77,11 @@ pub struct LearnConfig {
     pub hidden_layers: Vec<usize>,
     /// z-score the inputs with the meta-training statistics.
     pub standardise_inputs: bool,
+    /// Clamp each raw input to the range it spans in the meta-training flights before the z-score,
+    /// so that adaptation and prediction never evaluate the networks beyond the inputs they were
+    /// meta-trained on (a GELU network extrapolates linearly, without bound). Off: the paper.
+    #[serde(default)]
+    pub clamp_inputs: bool,
     pub meta_training: MetaTrainingConfig,
     pub adaptation: AdaptationConfig,
     /// The seed of the reported run (initialisation and task sampling).

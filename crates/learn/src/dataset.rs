@@ -132,11 +132,41 @@ pub fn segment_batch(segment: &Segment) -> Batch {
     }
 }
 
-/// The z-score of each input feature: (x − mean) / std.
+/// The z-score of each input feature, (x − mean) / std, optionally of x first clamped to a range.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Standardiser {
     pub mean: Vec<f64>,
     pub std: Vec<f64>,
+    /// When present, each raw input is clamped to `[low, high]` before the z-score, so the
+    /// networks are never evaluated outside the box of inputs they were meta-trained on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range: Option<InputRange>,
+}
+
+/// Per-feature bounds of raw inputs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct InputRange {
+    pub low: Vec<f64>,
+    pub high: Vec<f64>,
+}
+
+impl InputRange {
+    /// The smallest and largest value of each feature over all rows of all batches.
+    pub fn spanned<'a>(batches: impl IntoIterator<Item = &'a [f64]>, dim: usize) -> Self {
+        let mut range = Self {
+            low: vec![f64::INFINITY; dim],
+            high: vec![f64::NEG_INFINITY; dim],
+        };
+        for inputs in batches {
+            for row in inputs.chunks_exact(dim) {
+                for (k, &x) in row.iter().enumerate() {
+                    range.low[k] = range.low[k].min(x);
+                    range.high[k] = range.high[k].max(x);
+                }
+            }
+        }
+        range
+    }
 }
 
 impl Standardiser {
@@ -145,6 +175,15 @@ impl Standardiser {
         Self {
             mean: vec![0.0; dim],
             std: vec![1.0; dim],
+            range: None,
+        }
+    }
+
+    /// The same z-score of inputs first clamped to `range`.
+    pub fn clamped_to(self, range: InputRange) -> Self {
+        Self {
+            range: Some(range),
+            ..self
         }
     }
 
@@ -177,16 +216,55 @@ impl Standardiser {
                 if s > 1e-12 { s } else { 1.0 }
             })
             .collect();
-        Self { mean, std }
+        Self {
+            mean,
+            std,
+            range: None,
+        }
     }
 
-    /// Standardised copy of row-major inputs.
+    /// Standardised copy of row-major inputs (clamped first when a range is set).
     pub fn apply(&self, inputs: &[f64]) -> Vec<f64> {
         let dim = self.mean.len();
         inputs
             .iter()
             .enumerate()
-            .map(|(k, x)| (x - self.mean[k % dim]) / self.std[k % dim])
+            .map(|(k, &x)| {
+                let j = k % dim;
+                let x = match &self.range {
+                    Some(range) => x.clamp(range.low[j], range.high[j]),
+                    None => x,
+                };
+                (x - self.mean[j]) / self.std[j]
+            })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clamping_standardiser_maps_inputs_outside_the_range_to_its_bounds() {
+        let rows = [1.0, -2.0, 3.0, 0.0, 2.0, 4.0];
+        let range = InputRange::spanned([&rows[..]], 2);
+        assert_eq!(range.low, vec![1.0, -2.0]);
+        assert_eq!(range.high, vec![3.0, 4.0]);
+        let plain = Standardiser::fit([&rows[..]], 2);
+        let clamped = plain.clone().clamped_to(range);
+        let inside = [2.5, 1.0];
+        assert_eq!(clamped.apply(&inside), plain.apply(&inside));
+        let outside = [10.0, -7.0];
+        assert_eq!(clamped.apply(&outside), plain.apply(&[3.0, -2.0]));
+        assert_ne!(plain.apply(&outside), plain.apply(&[3.0, -2.0]));
+    }
+
+    #[test]
+    fn a_checkpoint_standardiser_without_a_range_reads_and_writes_as_before() {
+        let text = r#"{"mean":[0.5],"std":[2.0]}"#;
+        let standardiser: Standardiser = serde_json::from_str(text).unwrap();
+        assert_eq!(standardiser.range, None);
+        assert_eq!(serde_json::to_string(&standardiser).unwrap(), text);
     }
 }

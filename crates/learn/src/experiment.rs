@@ -10,7 +10,9 @@ use serde::Serialize;
 
 use crate::adapt::adapt_online;
 use crate::config::{AdaptationConfig, CheckedConfig, LearnConfig};
-use crate::dataset::{Protocol, Standardiser, flight_segments, from_row_major, segment_batch};
+use crate::dataset::{
+    InputRange, Protocol, Standardiser, flight_segments, from_row_major, segment_batch,
+};
 use crate::error::{LearnError, Result};
 use crate::maml::Batch;
 use crate::model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel};
@@ -210,6 +212,16 @@ impl Experiment {
             )
         } else {
             Standardiser::identity(input_dim)
+        };
+        let standardiser = if config.clamp_inputs {
+            standardiser.clamped_to(InputRange::spanned(
+                raw_tasks
+                    .iter()
+                    .flat_map(|(_, s, q)| [s.inputs.as_slice(), q.inputs.as_slice()]),
+                input_dim,
+            ))
+        } else {
+            standardiser
         };
         let tasks: Vec<TaskData> = raw_tasks
             .into_iter()

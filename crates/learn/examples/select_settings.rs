@@ -31,7 +31,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `outer`: the outer (Adam) step β at half and twice the configured value;
     // `regularisation`: the meta-regulariser μ from 0 to 1e-3;
     // `window`: adaptation updates on windows of 2 or 4 consecutive samples (1: the paper);
-    // `basis`: P = 1 or 3 learned basis functions per input instead of the paper's 2.
+    // `basis`: P = 1 or 3 learned basis functions per input instead of the paper's 2;
+    // `clamp`: inputs clamped to the range they span in the meta-training flights.
     let stage = arguments.get(2).map_or("grid", String::as_str);
     let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
     let base = checked.get().clone();
@@ -58,7 +59,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         | "outer"
         | "regularisation"
         | "window"
-        | "basis" => &[(800, 4, 0.1, 0)],
+        | "basis"
+        | "clamp" => &[(800, 4, 0.1, 0)],
         _ => &[
             (200, 4, 0.1, 0),
             (800, 4, 0.1, 0),
@@ -105,6 +107,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             config.basis_per_input = basis_per_input;
             candidates.push((format!("it800_tasks4_alpha0.1_P{basis_per_input}"), config));
         }
+    }
+    if stage == "clamp" {
+        let mut config = candidates[0].1.clone();
+        config.clamp_inputs = true;
+        candidates.push(("it800_tasks4_alpha0.1_clamped".to_string(), config));
     }
     if stage == "regularisation" {
         for mu in [0.0, 1e-4, 1e-3] {
@@ -156,7 +163,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let passes_grid: &[usize] = match stage {
             "grid" => &[4, 8],
             "passes" => &[8, 16, 24],
-            "basis" => &[16],
+            "basis" | "clamp" => &[16],
             _ => &[8],
         };
         // (step, averaged SGD over the last pass)
@@ -164,7 +171,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "averaging" => &[(0.0005, false)],
             "adaptation-averaging" => &[(0.0005, false), (0.0005, true), (0.001, true)],
             "passes" | "outer" | "regularisation" => &[(0.0005, false), (0.00025, false)],
-            "basis" => &[(0.0005, false)],
+            "basis" | "clamp" => &[(0.0005, false)],
             _ => &[(0.0005, false), (0.001, false)],
         };
         let mut adaptations = Vec::new();

@@ -132,15 +132,19 @@ pub fn segment_batch(segment: &Segment) -> Batch {
     }
 }
 
-/// The z-score of each input feature, (x − mean) / std, optionally of x first clamped to a range.
+/// The z-score of each input feature, (x − mean) / std, optionally of x first clamped to the range
+/// the meta-training inputs span.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Standardiser {
     pub mean: Vec<f64>,
     pub std: Vec<f64>,
-    /// When present, each raw input is clamped to `[low, high]` before the z-score, so the
-    /// networks are never evaluated outside the box of inputs they were meta-trained on.
+    /// The range of the raw meta-training inputs (absent in checkpoints written before it was kept).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub range: Option<InputRange>,
+    /// Clamp each raw input to `range` before the z-score, so the networks are never evaluated
+    /// outside the box of inputs they were meta-trained on.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub clamp: bool,
 }
 
 /// Per-feature bounds of raw inputs.
@@ -148,6 +152,27 @@ pub struct Standardiser {
 pub struct InputRange {
     pub low: Vec<f64>,
     pub high: Vec<f64>,
+}
+
+/// How much of a segment lies outside the range of the meta-training inputs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RangeCoverage {
+    /// Samples (rows) of the segment.
+    pub samples: usize,
+    /// Samples with at least one input outside the range.
+    pub samples_outside: usize,
+    /// Per input, in the order of X.
+    pub inputs: Vec<InputCoverage>,
+}
+
+/// One input's part of a [`RangeCoverage`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct InputCoverage {
+    pub input: String,
+    /// Samples whose value of this input is outside its range.
+    pub samples_outside: usize,
+    /// The largest distance outside the range, in meta-training standard deviations (0 if none).
+    pub largest_excess_in_std: f64,
 }
 
 impl InputRange {
@@ -176,15 +201,52 @@ impl Standardiser {
             mean: vec![0.0; dim],
             std: vec![1.0; dim],
             range: None,
+            clamp: false,
         }
     }
 
-    /// The same z-score of inputs first clamped to `range`.
-    pub fn clamped_to(self, range: InputRange) -> Self {
+    /// The same z-score, keeping the range of the meta-training inputs; `clamp`: inputs are
+    /// clamped to it before the z-score.
+    pub fn with_range(self, range: InputRange, clamp: bool) -> Self {
         Self {
             range: Some(range),
+            clamp,
             ..self
         }
+    }
+
+    /// How many rows of raw row-major `inputs` (named `names`, in X order) lie outside the kept
+    /// range, and how far; `None` without a range.
+    pub fn coverage(&self, inputs: &[f64], names: &[&str]) -> Option<RangeCoverage> {
+        let range = self.range.as_ref()?;
+        let dim = self.mean.len();
+        let mut coverage = RangeCoverage {
+            samples: inputs.len() / dim,
+            samples_outside: 0,
+            inputs: names
+                .iter()
+                .map(|name| InputCoverage {
+                    input: name.to_string(),
+                    samples_outside: 0,
+                    largest_excess_in_std: 0.0,
+                })
+                .collect(),
+        };
+        for row in inputs.chunks_exact(dim) {
+            let mut outside = false;
+            for (j, &x) in row.iter().enumerate() {
+                let excess = (range.low[j] - x).max(x - range.high[j]);
+                if excess > 0.0 {
+                    outside = true;
+                    let input = &mut coverage.inputs[j];
+                    input.samples_outside += 1;
+                    input.largest_excess_in_std =
+                        input.largest_excess_in_std.max(excess / self.std[j]);
+                }
+            }
+            coverage.samples_outside += usize::from(outside);
+        }
+        Some(coverage)
     }
 
     /// Mean and (population) standard deviation of each feature over all rows of all batches;
@@ -220,6 +282,7 @@ impl Standardiser {
             mean,
             std,
             range: None,
+            clamp: false,
         }
     }
 
@@ -232,8 +295,8 @@ impl Standardiser {
             .map(|(k, &x)| {
                 let j = k % dim;
                 let x = match &self.range {
-                    Some(range) => x.clamp(range.low[j], range.high[j]),
-                    None => x,
+                    Some(range) if self.clamp => x.clamp(range.low[j], range.high[j]),
+                    _ => x,
                 };
                 (x - self.mean[j]) / self.std[j]
             })
@@ -252,12 +315,35 @@ mod tests {
         assert_eq!(range.low, vec![1.0, -2.0]);
         assert_eq!(range.high, vec![3.0, 4.0]);
         let plain = Standardiser::fit([&rows[..]], 2);
-        let clamped = plain.clone().clamped_to(range);
+        let kept = plain.clone().with_range(range.clone(), false);
+        let clamped = plain.clone().with_range(range, true);
         let inside = [2.5, 1.0];
         assert_eq!(clamped.apply(&inside), plain.apply(&inside));
         let outside = [10.0, -7.0];
+        assert_eq!(kept.apply(&outside), plain.apply(&outside));
         assert_eq!(clamped.apply(&outside), plain.apply(&[3.0, -2.0]));
         assert_ne!(plain.apply(&outside), plain.apply(&[3.0, -2.0]));
+    }
+
+    #[test]
+    fn coverage_counts_samples_outside_the_range_and_their_largest_excess() {
+        let training = [0.0, 0.0, 2.0, 4.0];
+        let standardiser = Standardiser::fit([&training[..]], 2)
+            .with_range(InputRange::spanned([&training[..]], 2), false);
+        assert_eq!(standardiser.std, vec![1.0, 2.0]);
+        // Rows: inside; x above by 1.5 (1.5 std); y below by 2 (1 std) and x above by 0.5.
+        let segment = [1.0, 2.0, 3.5, 1.0, 2.5, -2.0];
+        let coverage = standardiser.coverage(&segment, &["x", "y"]).unwrap();
+        assert_eq!(coverage.samples, 3);
+        assert_eq!(coverage.samples_outside, 2);
+        assert_eq!(coverage.inputs[0].samples_outside, 2);
+        assert_eq!(coverage.inputs[0].largest_excess_in_std, 1.5);
+        assert_eq!(coverage.inputs[1].samples_outside, 1);
+        assert_eq!(coverage.inputs[1].largest_excess_in_std, 1.0);
+        assert_eq!(
+            Standardiser::fit([&training[..]], 2).coverage(&segment, &["x", "y"]),
+            None
+        );
     }
 
     #[test]
@@ -265,6 +351,7 @@ mod tests {
         let text = r#"{"mean":[0.5],"std":[2.0]}"#;
         let standardiser: Standardiser = serde_json::from_str(text).unwrap();
         assert_eq!(standardiser.range, None);
+        assert!(!standardiser.clamp);
         assert_eq!(serde_json::to_string(&standardiser).unwrap(), text);
     }
 }

@@ -11,7 +11,8 @@ use serde::Serialize;
 use crate::adapt::adapt_online;
 use crate::config::{AdaptationConfig, CheckedConfig, LearnConfig};
 use crate::dataset::{
-    InputRange, Protocol, Standardiser, flight_segments, from_row_major, segment_batch,
+    InputRange, Protocol, RangeCoverage, Standardiser, flight_segments, from_row_major,
+    segment_batch,
 };
 use crate::error::{LearnError, Result};
 use crate::maml::Batch;
@@ -64,6 +65,10 @@ pub struct CellSummary {
     pub unadapted_gen_mse: f64,
     /// The evaluated flight.
     pub evaluation_file: DataFile,
+    /// How much of the support segment lies outside the range of the meta-training inputs.
+    pub support_coverage: Option<RangeCoverage>,
+    /// How much of the query segment lies outside that range (the networks extrapolate there).
+    pub query_coverage: Option<RangeCoverage>,
 }
 
 /// Everything one cell produces.
@@ -213,16 +218,13 @@ impl Experiment {
         } else {
             Standardiser::identity(input_dim)
         };
-        let standardiser = if config.clamp_inputs {
-            standardiser.clamped_to(InputRange::spanned(
-                raw_tasks
-                    .iter()
-                    .flat_map(|(_, s, q)| [s.inputs.as_slice(), q.inputs.as_slice()]),
-                input_dim,
-            ))
-        } else {
-            standardiser
-        };
+        let range = InputRange::spanned(
+            raw_tasks
+                .iter()
+                .flat_map(|(_, s, q)| [s.inputs.as_slice(), q.inputs.as_slice()]),
+            input_dim,
+        );
+        let standardiser = standardiser.with_range(range, config.clamp_inputs);
         let tasks: Vec<TaskData> = raw_tasks
             .into_iter()
             .map(|(path, support, query)| TaskData {
@@ -327,8 +329,14 @@ impl Experiment {
         );
         let log = &self.flight(&path)?.log;
         let (support, query) = flight_segments(log, model.formulation)?;
-        let support_batch = standardised(&model.standardiser, segment_batch(&support));
-        let query_batch = standardised(&model.standardiser, segment_batch(&query));
+        let (raw_support, raw_query) = (segment_batch(&support), segment_batch(&query));
+        let input_names = model.formulation.input_names();
+        let support_coverage = model
+            .standardiser
+            .coverage(&raw_support.inputs, &input_names);
+        let query_coverage = model.standardiser.coverage(&raw_query.inputs, &input_names);
+        let support_batch = standardised(&model.standardiser, raw_support);
+        let query_batch = standardised(&model.standardiser, raw_query);
         let architecture = &model.architecture;
         let adapted = model.adapt(&support, &self.config.get().adaptation);
         let support_predictions = model.predict_segment(&adapted, &support);
@@ -353,6 +361,8 @@ impl Experiment {
                 &query_batch.targets,
             ),
             evaluation_file: self.data_file(&path)?,
+            support_coverage,
+            query_coverage,
         };
         Ok(CellResult {
             summary,

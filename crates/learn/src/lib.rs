@@ -74,7 +74,8 @@ pub use adapt::adapt_online;
 pub use batched::ModelWorkspace;
 pub use config::{AdaptationConfig, CheckedConfig, LearnConfig, MetaTrainingConfig, Optimizer};
 pub use dataset::{
-    InputRange, Protocol, Standardiser, flight_segments, from_row_major, row_major, segment_batch,
+    InputCoverage, InputRange, Protocol, RangeCoverage, Standardiser, flight_segments,
+    from_row_major, row_major, segment_batch,
 };
 pub use error::{LearnError, Result};
 pub use experiment::{

@@ -357,6 +357,7 @@ mod tests {
                 Row::new("35wind", sindy, learn),
                 Row::new("extra", mse(1.0, 1.0), mse(1.0, 1.0)),
             ],
+            notes: Vec::new(),
         }]
     }
 

@@ -68,7 +68,8 @@ fn markdown_cell(row: &Row, method: Method, metric: Metric) -> String {
 
 /// The table in Markdown: a caption line, a legend line and one row per condition. Each cell holds
 /// our value (bold when it is the better method of its column) followed by the published value and
-/// the difference; variants, if any, follow as plain columns.
+/// the difference; variants, if any, follow as plain columns; the table's notes, if any, follow it
+/// as paragraphs.
 pub fn markdown(table: &ResultsTable) -> String {
     let variants = variant_names(table);
     let mut out = String::new();
@@ -119,6 +120,9 @@ pub fn markdown(table: &ResultsTable) -> String {
             }
         }
         out.push('\n');
+    }
+    for note in &table.notes {
+        let _ = write!(out, "\n{note}\n");
     }
     out
 }
@@ -215,6 +219,10 @@ mod tests {
                 Row::new("35wind", mse(0.1564, 0.1941), mse(0.150, 0.2101)),
                 Row::new("new_wind", mse(0.3, 0.4), mse(0.2, 0.5)),
             ],
+            notes: vec![
+                "LeARN query samples outside the meta-training input range: 35wind 0 of 10."
+                    .to_string(),
+            ],
         };
         let mut published = PublishedTables {
             source: "test".to_string(),
@@ -248,6 +256,12 @@ mod tests {
         let new = text.lines().find(|l| l.starts_with("| new_wind")).unwrap();
         assert_eq!(new, "| new_wind | 0.300 | **0.400** | **0.200** | 0.500 |");
         assert!(text.starts_with("**Translational Dynamics Estimation Error: SINDy vs. LeARN**"));
+        // The note is a paragraph after the last row.
+        assert!(text.ends_with(
+            "| new_wind | 0.300 | **0.400** | **0.200** | 0.500 |\n\n\
+             LeARN query samples outside the meta-training input range: 35wind 0 of 10.\n"
+        ));
+        assert!(!latex(&sample()).contains("meta-training input range"));
     }
 
     #[test]

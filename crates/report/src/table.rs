@@ -173,6 +173,9 @@ pub struct ResultsTable {
     /// The protocol that produced the numbers, e.g. `leave-condition-out`.
     pub protocol: String,
     pub rows: Vec<Row>,
+    /// Lines printed under the table (facts about the cells that the numbers alone do not show).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 impl ResultsTable {
@@ -294,6 +297,7 @@ mod tests {
             table: "translational".to_string(),
             protocol: "leave-condition-out".to_string(),
             rows: vec![row],
+            notes: Vec::new(),
         };
         let value: serde_json::Value = serde_json::from_str(&table.to_json()).unwrap();
         assert_eq!(value["rows"][0]["sindy"]["gen"], 0.2);
@@ -321,6 +325,7 @@ mod tests {
             table: "full".to_string(),
             protocol: "p".to_string(),
             rows: vec![Row::new("70wind", mse(0.1, -1.0), mse(0.3, 0.4))],
+            notes: Vec::new(),
         };
         table.save(&path).unwrap();
         let message = ResultsTable::load(&path).unwrap_err().to_string();

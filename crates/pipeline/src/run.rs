@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use data::{Condition, FlightLog, Formulation, Mat, Segment, file_sha256};
 use indicatif::{ProgressBar, ProgressStyle};
-use learn::{CellResult, DataFile, EquationRule, Experiment, explain, row_major};
+use learn::{CellResult, DataFile, EquationRule, Experiment, RangeCoverage, explain, row_major};
 use rayon::prelude::*;
 use report::{MethodTrace, Mse, OutputAxis, PublishedTables, QualitativeFigure, ResultsTable, Row};
 use sindy::SegmentEvaluation;
@@ -351,15 +351,59 @@ fn build_tables(
                     )
                 })
                 .collect();
+            let coverages = cells
+                .iter()
+                .enumerate()
+                .filter(|(_, cell)| cell.formulation == *formulation)
+                .map(|(index, cell)| {
+                    let summary = &learn_results[0][index].summary;
+                    (cell.condition.label(), summary.query_coverage.as_ref())
+                });
             let mut table = ResultsTable {
                 table: formulation.name().to_string(),
                 protocol: protocol.to_string(),
                 rows,
+                notes: coverage_note(coverages).into_iter().collect(),
             };
             table.attach_published(published);
             table
         })
         .collect()
+}
+
+/// The note under a table on how much of each query segment lies outside the range of the
+/// meta-training inputs (where the networks extrapolate), naming the input that goes farthest;
+/// `None` if no cell has a range.
+fn coverage_note<'a>(
+    coverages: impl Iterator<Item = (&'a str, Option<&'a RangeCoverage>)>,
+) -> Option<String> {
+    let parts: Vec<String> = coverages
+        .filter_map(|(label, coverage)| {
+            let coverage = coverage?;
+            let farthest = coverage
+                .inputs
+                .iter()
+                .filter(|input| input.samples_outside > 0)
+                .max_by(|a, b| a.largest_excess_in_std.total_cmp(&b.largest_excess_in_std));
+            let detail = farthest.map_or(String::new(), |input| {
+                format!(
+                    " (farthest: {} by {:.1} std)",
+                    input.input, input.largest_excess_in_std
+                )
+            });
+            Some(format!(
+                "{label} {} of {}{detail}",
+                coverage.samples_outside, coverage.samples
+            ))
+        })
+        .collect();
+    (!parts.is_empty()).then(|| {
+        format!(
+            "LeARN query samples with an input outside the range of the meta-training inputs \
+             (the networks extrapolate there): {}.",
+            parts.join("; ")
+        )
+    })
 }
 
 /// Column `j` of two stacked matrices.
@@ -491,6 +535,8 @@ fn record(cell: &Cell, learn_results: &[Vec<CellResult>], index: usize) -> Resul
                 })
                 .collect(),
             explanation,
+            support_coverage: first.summary.support_coverage.clone(),
+            query_coverage: first.summary.query_coverage.clone(),
         },
     })
 }
@@ -595,5 +641,35 @@ mod tests {
         let bottom = Mat::from_fn(1, 2, |_, j| 100.0 + j as f64);
         assert_eq!(stacked_column(&top, &bottom, 1), vec![1.0, 11.0, 101.0]);
         assert_eq!(mean([1.0, 2.0, 6.0].into_iter()), 3.0);
+    }
+
+    #[test]
+    fn the_coverage_note_names_the_input_that_goes_farthest() {
+        let input = |input: &str, samples_outside, largest_excess_in_std| learn::InputCoverage {
+            input: input.to_string(),
+            samples_outside,
+            largest_excess_in_std,
+        };
+        let inside = RangeCoverage {
+            samples: 10,
+            samples_outside: 0,
+            inputs: vec![input("w_x", 0, 0.0), input("w_z", 0, 0.0)],
+        };
+        let outside = RangeCoverage {
+            samples: 10,
+            samples_outside: 3,
+            inputs: vec![input("w_x", 2, 6.5), input("w_z", 3, 9.61)],
+        };
+        let note = coverage_note(
+            [
+                ("35wind", Some(&inside)),
+                ("100wind", Some(&outside)),
+                ("new", None),
+            ]
+            .into_iter(),
+        )
+        .unwrap();
+        assert!(note.ends_with(": 35wind 0 of 10; 100wind 3 of 10 (farthest: w_z by 9.6 std)."));
+        assert_eq!(coverage_note([("35wind", None)].into_iter()), None);
     }
 }

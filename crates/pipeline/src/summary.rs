@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use data::{Derivative, SplitSpec};
-use learn::{DataFile, Explanation, LearnConfig};
+use learn::{DataFile, Explanation, LearnConfig, RangeCoverage};
 use report::ResultsTable;
 use serde::Serialize;
 use sindy::SindyConfig;
@@ -73,6 +73,10 @@ pub struct LearnCell {
     pub seeds: Vec<LearnSeedCell>,
     /// The first seed's adapted model, explained over the support segment.
     pub explanation: Explanation,
+    /// How much of each segment lies outside the range of the meta-training inputs (the same for
+    /// every seed: it depends on the meta-training flights only).
+    pub support_coverage: Option<RangeCoverage>,
+    pub query_coverage: Option<RangeCoverage>,
 }
 
 /// One table cell row: one formulation on one evaluation flight.

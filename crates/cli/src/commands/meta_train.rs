@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long)]
     pub seed: Option<u64>,
     /// Summary JSON of the run.
-    #[arg(long, default_value = "results/learn/learn.json")]
+    #[arg(long, default_value = "results/.scratch/learn/learn.json")]
     pub out: PathBuf,
     /// Directory of the JSON checkpoints (one per formulation and fold).
     #[arg(long, default_value = "results/.scratch/learn/checkpoints")]
@@ -74,7 +74,7 @@ fn published(table: &Option<Value>, cell: &CellSummary, method: &str) -> Option<
 
 fn print_cells(cells: &[CellSummary], table: &Option<Value>) {
     println!(
-        "{:<14} {:<10} {:>8} {:>8} {:>10} | {:>15} {:>12} | {:>9}",
+        "{:<14} {:<10} {:>8} {:>8} {:>10} | {:>15} {:>12} | {:>9} | {:>13}",
         "formulation",
         "condition",
         "adapt",
@@ -82,7 +82,8 @@ fn print_cells(cells: &[CellSummary], table: &Option<Value>) {
         "gen(unadapted)",
         "published adapt",
         "gen",
-        "SINDy gen"
+        "SINDy gen",
+        "query outside"
     );
     for cell in cells {
         let learn = published(table, cell, "learn");
@@ -93,8 +94,12 @@ fn print_cells(cells: &[CellSummary], table: &Option<Value>) {
             Some(_) => "WORSE",
             None => "",
         };
+        // Query samples with an input outside the range of the meta-training inputs.
+        let outside = cell.query_coverage.as_ref().map_or("-".to_string(), |c| {
+            format!("{}/{}", c.samples_outside, c.samples)
+        });
         println!(
-            "{:<14} {:<10} {:>8.3} {:>8.3} {:>14.3} | {:>15} {:>6} {:<5} | {:>9}",
+            "{:<14} {:<10} {:>8.3} {:>8.3} {:>14.3} | {:>15} {:>6} {:<5} | {:>9} | {:>13}",
             cell.formulation.name(),
             cell.label,
             cell.adapt_mse,
@@ -104,6 +109,7 @@ fn print_cells(cells: &[CellSummary], table: &Option<Value>) {
             show(learn.map(|l| l.1)),
             verdict,
             show(sindy.map(|s| s.1)),
+            outside,
         );
     }
 }

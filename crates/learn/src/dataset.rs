@@ -286,7 +286,7 @@ impl Standardiser {
         }
     }
 
-    /// Standardised copy of row-major inputs (clamped first when a range is set).
+    /// Standardised copy of row-major inputs (clamped to the range first when `clamp` is set).
     pub fn apply(&self, inputs: &[f64]) -> Vec<f64> {
         let dim = self.mean.len();
         inputs

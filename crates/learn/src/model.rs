@@ -113,8 +113,23 @@ impl MetaTrainedModel {
             )));
         }
         let dim = model.architecture.input_dim;
-        if model.standardiser.mean.len() != dim || model.standardiser.std.len() != dim {
-            return Err(bad(format!("standardiser does not have {dim} features")));
+        let standardiser = &model.standardiser;
+        let range_fits = standardiser.range.as_ref().is_none_or(|range| {
+            range.low.len() == dim
+                && range.high.len() == dim
+                && range
+                    .low
+                    .iter()
+                    .zip(&range.high)
+                    .all(|(low, high)| low <= high)
+        });
+        if standardiser.mean.len() != dim || standardiser.std.len() != dim || !range_fits {
+            return Err(bad(format!(
+                "standardiser does not have {dim} features (with low <= high in its range)"
+            )));
+        }
+        if standardiser.clamp && standardiser.range.is_none() {
+            return Err(bad("standardiser clamps but has no range".to_string()));
         }
         if model.formulation.input_names().len() != dim
             || model.formulation.state_dim() != model.architecture.state_dim

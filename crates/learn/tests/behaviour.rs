@@ -4,7 +4,7 @@ mod common;
 
 use common::{small_architecture, synthetic_batch, synthetic_tasks};
 use learn::{
-    AdaptationConfig, CHECKPOINT_FORMAT, LearnConfig, MetaOrder, MetaTrainedModel,
+    AdaptationConfig, CHECKPOINT_FORMAT, InputRange, LearnConfig, MetaOrder, MetaTrainedModel,
     MetaTrainingConfig, Optimizer, Protocol, Standardiser, adapt_online, meta_train,
 };
 
@@ -271,6 +271,27 @@ fn checkpoints_round_trip_and_bad_ones_name_the_file() {
         message.contains("model.json") && message.contains("parameters"),
         "{message}"
     );
+
+    // A kept input range must fit the inputs; a clamping standardiser must have one.
+    let dim = model.architecture.input_dim;
+    let range = InputRange {
+        low: vec![-1.0; dim],
+        high: vec![1.0; dim],
+    };
+    let mut ranged = model.clone();
+    ranged.standardiser = ranged.standardiser.with_range(range.clone(), true);
+    ranged.save(&path).unwrap();
+    assert_eq!(MetaTrainedModel::load(&path).unwrap(), ranged);
+    let mut short_range = ranged.clone();
+    short_range.standardiser.range.as_mut().unwrap().high.pop();
+    short_range.save(&path).unwrap();
+    let message = MetaTrainedModel::load(&path).unwrap_err().to_string();
+    assert!(message.contains("standardiser"), "{message}");
+    let mut no_range = ranged;
+    no_range.standardiser.range = None;
+    no_range.save(&path).unwrap();
+    let message = MetaTrainedModel::load(&path).unwrap_err().to_string();
+    assert!(message.contains("clamps but has no range"), "{message}");
 
     std::fs::write(&path, "{\"format\": 3}").unwrap();
     let message = MetaTrainedModel::load(&path).unwrap_err().to_string();

@@ -16,8 +16,15 @@ if [ ! -x .venv/bin/python ] || ! .venv/bin/python -c "import jax" 2>/dev/null; 
     scripts/python-env.sh
 fi
 if [ "$TORCH" = 1 ] && { [ ! -x .venv-torch/bin/python ] || ! .venv-torch/bin/python -c "import torch" 2>/dev/null; }; then
-    echo "creating .venv-torch (PyTorch with its CUDA dependencies, ~2.5 GB download; BENCH_TORCH=0 skips it)"
-    scripts/python-env.sh torch
+    # PyTorch with its CUDA dependencies: ~2.5 GB to download, ~5.3 GB installed.
+    free_gb=$(( $(df --output=avail -k . | tail -1) / 1048576 ))
+    if [ "$free_gb" -lt 8 ]; then
+        echo "leaving PyTorch out: .venv-torch needs ~5.3 GB and only ${free_gb} GB are free (BENCH_TORCH=0 silences this)"
+        TORCH=0
+    else
+        echo "creating .venv-torch (PyTorch with its CUDA dependencies, ~2.5 GB download; BENCH_TORCH=0 skips it)"
+        scripts/python-env.sh torch
+    fi
 fi
 cargo build -q -p learn --example meta_iteration_timing
 echo "load before: $(uptime)"

@@ -336,11 +336,13 @@ fn build_tables(
         .formulations
         .iter()
         .map(|formulation| {
-            let rows = cells
+            let indices: Vec<usize> = (0..cells.len())
+                .filter(|&index| cells[index].formulation == *formulation)
+                .collect();
+            let rows = indices
                 .iter()
-                .enumerate()
-                .filter(|(_, cell)| cell.formulation == *formulation)
-                .map(|(index, cell)| {
+                .map(|&index| {
+                    let cell = &cells[index];
                     Row::new(
                         cell.condition.label(),
                         Mse {
@@ -351,14 +353,13 @@ fn build_tables(
                     )
                 })
                 .collect();
-            let coverages = cells
-                .iter()
-                .enumerate()
-                .filter(|(_, cell)| cell.formulation == *formulation)
-                .map(|(index, cell)| {
-                    let summary = &learn_results[0][index].summary;
-                    (cell.condition.label(), summary.query_coverage.as_ref())
-                });
+            let coverages = indices.iter().map(|&index| {
+                let summary = &learn_results[0][index].summary;
+                (
+                    cells[index].condition.label(),
+                    summary.query_coverage.as_ref(),
+                )
+            });
             let mut table = ResultsTable {
                 table: formulation.name().to_string(),
                 protocol: protocol.to_string(),

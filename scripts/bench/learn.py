@@ -10,12 +10,10 @@ SGD outer step, all in one jit-compiled function. Synthetic data of the `full` f
 usage: learn.py [TASKS] [SUPPORT] [QUERY] [ROUNDS] [REPEATS]
 """
 
-import json
-import os
 import sys
-import time
 
 import jax
+import meta_iteration_report as report
 
 jax.config.update("jax_enable_x64", True)
 import jax.numpy as jnp  # noqa: E402
@@ -79,8 +77,8 @@ def make_step(alpha, rounds, beta):
 
 
 def main():
-    args = [int(a) for a in sys.argv[1:]]
-    tasks, support, query, rounds, repeats = (args + [4, 64, 64, 1, 20][len(args):])[:5]
+    arguments = report.sizes(sys.argv[1:])
+    tasks, support, query, rounds, repeats = arguments
     key = jax.random.PRNGKey(0)
     k1, k2, k3 = jax.random.split(key, 3)
     basis = BASIS_PER_INPUT * INPUTS
@@ -95,29 +93,14 @@ def main():
     query_y = jax.random.uniform(keys[3], (tasks, query, STATES), jnp.float64, -1, 1)
     step = make_step(0.05, rounds, 1e-3)
     params = jax.block_until_ready(step(params, support_x, support_y, query_x, query_y))
-    times = []
-    for _ in range(repeats):
-        started = time.perf_counter()
+
+    def iteration():
+        nonlocal params
         params = jax.block_until_ready(step(params, support_x, support_y, query_x, query_y))
-        times.append(time.perf_counter() - started)
-    times.sort()
+
+    times = report.time_calls(iteration, repeats)
     parameters = sum(w.size + b.size for net in params for w, b in net)
-    print(
-        json.dumps(
-            {
-                "implementation": "jax",
-                "jax": jax.__version__,
-                "tasks": tasks,
-                "support": support,
-                "query": query,
-                "inner_rounds": rounds,
-                "parameters": int(parameters),
-                "cpu_count": os.cpu_count(),
-                "seconds_per_iteration": times[len(times) // 2],
-                "seconds_per_iteration_min": times[0],
-            }
-        )
-    )
+    report.print_report("jax", {"jax": jax.__version__}, arguments, parameters, times)
 
 
 if __name__ == "__main__":

@@ -16,11 +16,10 @@ Prints one JSON line with the median and the minimum seconds per meta-iteration.
 usage: learn_torch.py [TASKS] [SUPPORT] [QUERY] [ROUNDS] [REPEATS] [MODE]
 """
 
-import json
 import os
 import sys
-import time
 
+import meta_iteration_report as report
 import torch
 from torch.func import grad, vmap
 
@@ -84,8 +83,8 @@ def make_step(alpha, rounds, beta):
 
 
 def main():
-    args = [int(a) for a in sys.argv[1:6]]
-    tasks, support, query, rounds, repeats = (args + [4, 64, 64, 1, 20][len(args):])[:5]
+    arguments = report.sizes(sys.argv[1:6])
+    tasks, support, query, rounds, repeats = arguments
     mode = sys.argv[6] if len(sys.argv) > 6 else "eager"
     if mode not in ("eager", "compile"):
         sys.exit(f"learn_torch.py: unknown MODE '{mode}' (eager or compile)")
@@ -103,35 +102,21 @@ def main():
     step = make_step(0.05, rounds, 1e-3)
     if mode == "compile":
         step = torch.compile(step)
-    with torch.no_grad():
-        started = time.perf_counter()
+
+    def iteration():
+        nonlocal params
         params = step(params, support_x, support_y, query_x, query_y)
-        first_call = time.perf_counter() - started
-        times = []
-        for _ in range(repeats):
-            started = time.perf_counter()
-            params = step(params, support_x, support_y, query_x, query_y)
-            times.append(time.perf_counter() - started)
-    times.sort()
+
+    with torch.no_grad():
+        first_call = report.time_calls(iteration, 1)[0]
+        times = report.time_calls(iteration, repeats)
     parameters = sum(w.numel() + b.numel() for net in params for w, b in net)
-    print(
-        json.dumps(
-            {
-                "implementation": f"torch-{mode}",
-                "torch": torch.__version__,
-                "compile_seconds": first_call if mode == "compile" else None,
-                "threads": torch.get_num_threads(),
-                "tasks": tasks,
-                "support": support,
-                "query": query,
-                "inner_rounds": rounds,
-                "parameters": int(parameters),
-                "cpu_count": os.cpu_count(),
-                "seconds_per_iteration": times[len(times) // 2],
-                "seconds_per_iteration_min": times[0],
-            }
-        )
-    )
+    versions = {
+        "torch": torch.__version__,
+        "compile_seconds": first_call if mode == "compile" else None,
+        "threads": torch.get_num_threads(),
+    }
+    report.print_report(f"torch-{mode}", versions, arguments, parameters, times)
 
 
 if __name__ == "__main__":

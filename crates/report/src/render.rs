@@ -67,7 +67,7 @@ fn markdown_cell(row: &Row, method: Method, metric: Metric) -> String {
 }
 
 /// The table in Markdown: a caption line, a legend line and one row per condition. Each cell holds
-/// our value (bold when it is the better method of its column) followed by the published value and
+/// our value (bold when it is the better of SINDy and LeARN for that metric) followed by the published value and
 /// the difference; variants, if any, follow as plain columns; the table's notes, if any, follow it
 /// as paragraphs.
 pub fn markdown(table: &ResultsTable) -> String {
@@ -80,9 +80,13 @@ pub fn markdown(table: &ResultsTable) -> String {
         table.protocol
     );
     out.push_str(
-        "Each cell: ours (published; ours − published). Bold: the better method of the column, \
-         as in the paper.\n\n",
+        "Each cell: ours (published; ours − published). Bold: the better of SINDy and LeARN for \
+         each metric, as in the paper",
     );
+    if !variants.is_empty() {
+        out.push_str("; the variant columns after them are not compared");
+    }
+    out.push_str(".\n\n");
     out.push_str("| Condition |");
     for method in Method::ALL {
         for metric in Metric::ALL {
@@ -256,6 +260,11 @@ mod tests {
         let new = text.lines().find(|l| l.starts_with("| new_wind")).unwrap();
         assert_eq!(new, "| new_wind | 0.300 | **0.400** | **0.200** | 0.500 |");
         assert!(text.starts_with("**Translational Dynamics Estimation Error: SINDy vs. LeARN**"));
+        assert!(
+            text.contains(
+                "Bold: the better of SINDy and LeARN for each metric, as in the paper.\n"
+            )
+        );
         // The note is a paragraph after the last row.
         assert!(text.ends_with(
             "| new_wind | 0.300 | **0.400** | **0.200** | 0.500 |\n\n\
@@ -272,6 +281,7 @@ mod tests {
             .insert("first-order".to_string(), mse(0.25, 0.35));
         let text = markdown(&table);
         assert!(text.contains("| first-order Adapt. | first-order Gen. |"));
+        assert!(text.contains("as in the paper; the variant columns after them are not compared."));
         assert!(
             text.lines()
                 .any(|l| l.starts_with("| new_wind") && l.ends_with("| – | – |"))

@@ -40,12 +40,16 @@ pub struct Args {
     /// The published numbers to compare with.
     #[arg(long, default_value = "paper/published.json")]
     pub published: PathBuf,
-    /// Rerun every cell with each of the configuration's `spread_seeds` and write the spread.
-    #[arg(long)]
+    /// Rerun every cell with each of the configuration's `spread_seeds` and write the spread
+    /// (every condition: the spread is what the tolerances of paper/tolerances.json come from).
+    #[arg(long, conflicts_with = "condition")]
     pub seed_spread: bool,
     /// Where `--seed-spread` writes its result.
     #[arg(long, default_value = "experiments/learn-seed-spread.json")]
     pub spread_out: PathBuf,
+    /// Replace an existing `--spread-out` file.
+    #[arg(long)]
+    pub force: bool,
 }
 
 fn formulations(names: &[String]) -> anyhow::Result<Vec<Formulation>> {
@@ -115,6 +119,9 @@ fn print_cells(cells: &[CellSummary], table: &Option<Value>) {
 }
 
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
+    if args.seed_spread {
+        super::refuse_overwrite(&args.spread_out, args.force)?;
+    }
     let mut config = LearnConfig::load(&args.config)?;
     if let Some(seed) = args.seed {
         config = config.with_seed(seed);

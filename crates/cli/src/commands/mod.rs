@@ -11,7 +11,7 @@ mod reproduce;
 mod simulate;
 mod sindy;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
 
@@ -103,4 +103,15 @@ impl Global {
         use std::io::IsTerminal;
         !self.quiet && std::io::stderr().is_terminal()
     }
+}
+
+/// Refuses to replace an existing file the user did not ask to overwrite (`--force`).
+pub fn refuse_overwrite(path: &Path, force: bool) -> anyhow::Result<()> {
+    if path.exists() && !force {
+        anyhow::bail!(
+            "{}: already exists (pass --force to overwrite)",
+            path.display()
+        );
+    }
+    Ok(())
 }

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 
 use super::Global;
 
@@ -21,12 +21,7 @@ pub struct Args {
 }
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
-    if args.out.exists() && !args.force {
-        bail!(
-            "{}: already exists (pass --force to overwrite)",
-            args.out.display()
-        );
-    }
+    super::refuse_overwrite(&args.out, args.force)?;
     let (scenario, model) = physics::Scenario::load(&args.scenario)?;
     let name = args
         .out

@@ -87,11 +87,8 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     let optimizer = optimizer(&args)?;
     optimizer.checked()?;
     let derivative = Derivative::parse(&args.derivative)?;
-    if let Some(out) = &args.out
-        && out.exists()
-        && !args.force
-    {
-        bail!("{} exists (use --force to replace it)", out.display());
+    if let Some(out) = &args.out {
+        super::refuse_overwrite(out, args.force)?;
     }
 
     let columns: Vec<&str> = args

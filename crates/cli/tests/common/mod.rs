@@ -1,0 +1,63 @@
+//! Shared support for the `learn` command's behaviour tests: run the built binary, check that a
+//! failure is the one-line error the README promises, and make scratch directories.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// What one run of `learn` gave.
+pub struct Run {
+    pub code: Option<i32>,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+/// Runs `learn` with `args` in `dir` (quiet, no backtraces, no data directory from the environment).
+pub fn learn_in(dir: &Path, args: &[&str]) -> Run {
+    let output = Command::new(env!("CARGO_BIN_EXE_learn"))
+        .args(args)
+        .current_dir(dir)
+        .env_remove("NEURAL_FLY_DIR")
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .expect("the learn binary runs");
+    Run {
+        code: output.status.code(),
+        stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
+    }
+}
+
+impl Run {
+    /// Asserts a failure with exit code 1 and a one-line `error: …` message containing every one
+    /// of `needles` (a file, row or field name), and no panic; returns the message.
+    pub fn one_line_error(&self, needles: &[&str]) -> &str {
+        assert_eq!(self.code, Some(1), "exit code; stderr: {}", self.stderr);
+        let message = self.stderr.trim_end();
+        assert!(!message.contains("panicked"), "panic: {message}");
+        assert_eq!(message.lines().count(), 1, "not one line: {message}");
+        assert!(message.starts_with("error: "), "{message}");
+        for needle in needles {
+            assert!(
+                message.contains(needle),
+                "{needle:?} missing from {message}"
+            );
+        }
+        message
+    }
+
+    /// Asserts success and returns standard output.
+    pub fn success(&self) -> &str {
+        assert_eq!(self.code, Some(0), "stderr: {}", self.stderr);
+        &self.stdout
+    }
+}
+
+/// A fresh, empty scratch directory for one test (named after it and the process).
+pub fn scratch(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("learn-cli-{test}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    dir
+}

@@ -130,6 +130,13 @@ impl RunConfig {
                 return Err(error("learn.seeds", format!("seed {seed} is listed twice")));
             }
         }
+        // Checked now, not after the flights are loaded and LeARN is meta-trained.
+        sindy::FeatureLibrary::from_spec(&self.sindy.library)
+            .map_err(|e| error("sindy.library", e.to_string()))?;
+        self.sindy
+            .optimizer
+            .checked()
+            .map_err(|e| error("sindy.optimizer", e.to_string()))?;
         let protocol = Protocol::parse(&self.learn.protocol)?;
         let resolve = |p: &Path| {
             if p.is_absolute() {
@@ -149,6 +156,10 @@ impl RunConfig {
             ));
         }
         let learn = load_learn_config(&learn_config_path, &self.learn.overrides, path)?;
+        report::PublishedTables::load(&published_path)?;
+        if let Some(variants) = &self.variants {
+            crate::variants::VariantsConfig::read(&resolve(variants))?;
+        }
         Ok(CheckedRunConfig {
             sha256: file_sha256(path)?,
             path: path.to_path_buf(),

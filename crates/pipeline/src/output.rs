@@ -27,6 +27,24 @@ pub struct OutputPaths {
 }
 
 impl OutputPaths {
+    /// Checks, before a run, that its outputs can be written: each directory is created and
+    /// written to (a probe file, removed again), and the README, if any, has the results block.
+    /// A run then never fails at its end for a reason known at its start.
+    pub fn check(&self) -> Result<()> {
+        for dir in [&self.results_dir, &self.latex_dir] {
+            let probe = dir.join(".learn-write-check");
+            write_text(&probe, "")?;
+            std::fs::remove_file(&probe).map_err(|source| PipelineError::Io {
+                path: probe.clone(),
+                source,
+            })?;
+        }
+        if let Some(readme) = &self.readme {
+            results_block(readme, &read_readme(readme)?)?;
+        }
+        Ok(())
+    }
+
     /// `results_dir/tables`.
     pub fn tables_dir(&self) -> PathBuf {
         self.results_dir.join("tables")
@@ -142,20 +160,33 @@ fn readme_block(outcome: &RunOutcome, paths: &OutputPaths, readme: &Path) -> Str
     block
 }
 
-/// Replaces the text between [`README_BEGIN`] and [`README_END`] in `readme` by `block`.
-pub fn update_readme(readme: &Path, block: &str) -> Result<()> {
-    let text = std::fs::read_to_string(readme).map_err(|source| PipelineError::Io {
+fn read_readme(readme: &Path) -> Result<String> {
+    std::fs::read_to_string(readme).map_err(|source| PipelineError::Io {
         path: readme.to_path_buf(),
         source,
-    })?;
+    })
+}
+
+/// The byte range of the generated block in a README's `text`: from the end of [`README_BEGIN`]
+/// to the start of [`README_END`].
+fn results_block(readme: &Path, text: &str) -> Result<std::ops::Range<usize>> {
     let missing = || PipelineError::Config {
         path: readme.to_path_buf(),
         field: "results block".to_string(),
         message: format!("needs the lines `{README_BEGIN}` and `{README_END}`, in that order"),
     };
-    let begin = text.find(README_BEGIN).ok_or_else(missing)?;
-    let after_begin = begin + README_BEGIN.len();
-    let end = after_begin + text[after_begin..].find(README_END).ok_or_else(missing)?;
+    let begin = text.find(README_BEGIN).ok_or_else(missing)? + README_BEGIN.len();
+    let end = begin + text[begin..].find(README_END).ok_or_else(missing)?;
+    Ok(begin..end)
+}
+
+/// Replaces the text between [`README_BEGIN`] and [`README_END`] in `readme` by `block`.
+pub fn update_readme(readme: &Path, block: &str) -> Result<()> {
+    let text = read_readme(readme)?;
+    let std::ops::Range {
+        start: after_begin,
+        end,
+    } = results_block(readme, &text)?;
     let updated = format!(
         "{}\n\n{}\n{}",
         &text[..after_begin],
@@ -206,5 +237,21 @@ mod tests {
             message.contains("README.md") && message.contains("tables:begin"),
             "{message}"
         );
+        // The same is found before a run, and so is an output directory that cannot be made.
+        let paths = |results_dir: PathBuf| OutputPaths {
+            results_dir,
+            latex_dir: dir.join("latex"),
+            readme: Some(readme.clone()),
+        };
+        let message = paths(dir.join("results")).check().unwrap_err().to_string();
+        assert!(message.contains("tables:begin"), "{message}");
+        std::fs::write(&readme, &original).unwrap();
+        paths(dir.join("results")).check().unwrap();
+        assert!(dir.join("latex").is_dir() && !dir.join("results/.learn-write-check").exists());
+        let message = paths(readme.join("results"))
+            .check()
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("README.md/results"), "{message}");
     }
 }

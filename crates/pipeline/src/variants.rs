@@ -66,6 +66,12 @@ pub enum VariantKind {
 }
 
 impl VariantKind {
+    /// Whether the variant needs the meta-trained LeARN networks (the paper's LeARN and the
+    /// closed-form adaptations over its basis).
+    fn needs_meta_training(&self) -> bool {
+        matches!(self, Self::LearnedBasis(_) | Self::Learn)
+    }
+
     /// Whether the variant fits a regression (and so has a support cross-validation score and
     /// equations).
     fn is_regression(&self) -> bool {
@@ -184,8 +190,19 @@ impl VariantsConfig {
         if raw.seeds.is_empty() {
             return Err(error("seeds", "name at least one seed".to_string()));
         }
+        for (index, seed) in raw.seeds.iter().enumerate() {
+            if raw.seeds[..index].contains(seed) {
+                return Err(error("seeds", format!("seed {seed} is listed twice")));
+            }
+        }
         let names: Vec<&str> = raw.variants.iter().map(|v| v.name.as_str()).collect();
         for (index, name) in names.iter().enumerate() {
+            if name.trim().is_empty() {
+                return Err(error(
+                    "variants",
+                    format!("variant {} has no name", index + 1),
+                ));
+            }
             if names[..index].contains(name) {
                 return Err(error("variants", format!("'{name}' is declared twice")));
             }
@@ -481,7 +498,7 @@ pub fn run_variants(
         .raw
         .variants
         .iter()
-        .any(|v| matches!(v.kind, VariantKind::LearnedBasis(_)))
+        .any(|v| v.kind.needs_meta_training())
     {
         Some(learned_basis_experiment(config, data_dir)?)
     } else {
@@ -604,7 +621,7 @@ fn evaluate_all(
     seed: u64,
 ) -> Result<Vec<Outcome>> {
     let meta_train = || -> Result<MetaTrainedModel> {
-        let experiment = experiment.expect("loaded when a learned-basis variant exists");
+        let experiment = experiment.expect("loaded when a variant needs the LeARN networks");
         Ok(experiment.meta_train(cell.formulation, &cell.condition.name, seed)?)
     };
     evaluate_variants(
@@ -1250,6 +1267,25 @@ mod tests {
         let read = VariantsConfig::read(&learn_average).unwrap();
         assert_eq!(read.equations_variant("m"), Some("a"));
         assert_eq!(read.equations_variant("l"), None);
+        // The paper's LeARN needs the meta-trained networks as much as a learned basis does.
+        let needs: Vec<bool> = read
+            .variants
+            .iter()
+            .map(|v| v.kind.needs_meta_training())
+            .collect();
+        assert_eq!(needs, [false, true, false]);
+        let cases = cases.into_iter().chain([
+            (
+                "seeds",
+                config(&a, "").replace("[1]", "[1, 1]"),
+                "seed 1 is listed twice",
+            ),
+            (
+                "unnamed",
+                config(&a.replace("\"a\"", "\" \""), ""),
+                "variant 1 has no name",
+            ),
+        ]);
         for (name, text, expected) in cases {
             let message = VariantsConfig::read(&write(name, &text))
                 .err()

@@ -87,11 +87,33 @@ fn bad_values_name_the_file_and_field() {
     let mut config = base.clone();
     config["learn"]["protocol"] = json!("sometimes");
     assert!(load("protocol", &config).unwrap_err().contains("sometimes"));
-    let mut config = base;
+    let mut config = base.clone();
     config["conditions"] = json!("experiments/no-such-file.json");
     assert!(
         load("conditions", &config)
             .unwrap_err()
             .contains("no-such-file.json")
     );
+    // Everything the run reads later is checked when the configuration is loaded, so a bad
+    // value does not surface only after the flights are loaded and LeARN is meta-trained.
+    let mut config = base.clone();
+    config["sindy"]["optimizer"]["alpha"] = json!(-1.0);
+    let message = load("sindy-alpha", &config).unwrap_err();
+    assert!(
+        message.contains("sindy-alpha.json") && message.contains("sindy.optimizer"),
+        "{message}"
+    );
+    let mut config = base.clone();
+    config["sindy"]["library"] = json!({"kind": "fourier", "frequencies": 0});
+    let message = load("sindy-library", &config).unwrap_err();
+    assert!(message.contains("sindy.library"), "{message}");
+    for (field, missing) in [
+        ("published", "paper/no-such-published.json"),
+        ("variants", "experiments/no-such-variants.json"),
+    ] {
+        let mut config = base.clone();
+        config[field] = json!(missing);
+        let message = load(field, &config).unwrap_err();
+        assert!(message.contains(missing), "{message}");
+    }
 }

@@ -2,7 +2,7 @@
 //! for it in `paper/tolerances.json`, and whether it holds.
 
 use std::fmt::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
@@ -63,22 +63,44 @@ pub struct Tolerances {
     /// Measurements the rules rest on (free-form, kept for the reader).
     #[serde(default)]
     pub evidence: serde_json::Value,
+    /// The file the rules were read from (empty when built in code), for error messages.
+    #[serde(skip)]
+    pub path: PathBuf,
 }
 
 impl Tolerances {
     /// Reads and checks `tolerances.json`.
     pub fn load(path: &Path) -> Result<Self> {
         let tolerances: Self = read_json(path)?;
+        let error = |field: String, message: String| ReportError::Json {
+            path: path.to_path_buf(),
+            field,
+            message,
+        };
         for (index, rule) in tolerances.rules.iter().enumerate() {
             if !(rule.tolerance.is_finite() && rule.tolerance >= 0.0) {
-                return Err(ReportError::Json {
-                    path: path.to_path_buf(),
-                    field: format!("rules[{index}].tolerance"),
-                    message: format!("{} is not a finite non-negative number", rule.tolerance),
-                });
+                return Err(error(
+                    format!("rules[{index}].tolerance"),
+                    format!("{} is not a finite non-negative number", rule.tolerance),
+                ));
+            }
+            // Two rules for exactly the same cells: which one was meant is unknowable.
+            let selector =
+                |r: &ToleranceRule| (r.method, r.table.clone(), r.condition.clone(), r.metric);
+            if let Some(earlier) = tolerances.rules[..index]
+                .iter()
+                .position(|other| selector(other) == selector(rule))
+            {
+                return Err(error(
+                    format!("rules[{index}]"),
+                    format!("covers exactly the cells of rules[{earlier}]"),
+                ));
             }
         }
-        Ok(tolerances)
+        Ok(Self {
+            path: path.to_path_buf(),
+            ..tolerances
+        })
     }
 
     /// The rule that applies to one cell, if any.
@@ -149,6 +171,17 @@ impl Comparison {
         tolerances: &Tolerances,
     ) -> Result<Self> {
         let mut table_names: Vec<&str> = results.iter().map(|t| t.table.as_str()).collect();
+        // A table the paper has no numbers for would pass unchecked: the file is incomplete.
+        if let Some(name) = table_names
+            .iter()
+            .find(|name| !published.tables.contains_key(**name))
+        {
+            return Err(ReportError::Json {
+                path: published.path.clone(),
+                field: "tables".to_string(),
+                message: format!("no published numbers for the results table '{name}'"),
+            });
+        }
         for name in published.tables.keys() {
             if !table_names.contains(&name.as_str()) {
                 table_names.push(name);
@@ -177,8 +210,9 @@ impl Comparison {
                             Some(_) => Some(
                                 tolerances
                                     .rule_for(method, table_name, condition, metric)
-                                    .ok_or_else(|| ReportError::Invalid {
-                                        what: "tolerances".to_string(),
+                                    .ok_or_else(|| ReportError::Json {
+                                        path: tolerances.path.clone(),
+                                        field: "rules".to_string(),
                                         message: format!(
                                             "no rule covers {table_name} {condition} {} {}",
                                             serde_name(method),
@@ -333,6 +367,7 @@ mod tests {
         PublishedTables {
             source: "test".to_string(),
             tables,
+            path: PathBuf::from("published.json"),
         }
     }
 
@@ -456,5 +491,36 @@ mod tests {
             message.contains("translational 35wind learn adapt"),
             "{message}"
         );
+    }
+
+    #[test]
+    fn the_files_must_be_complete_and_unambiguous() {
+        // Results for a table the published file does not have: an error naming that file.
+        let mut other = results(mse(0.1, 0.1), mse(0.1, 0.1));
+        other[0].table = "attitude".to_string();
+        let message = Comparison::new(&other, &published(), &tolerances())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("published.json") && message.contains("'attitude'"),
+            "{message}"
+        );
+        // Two rules for exactly the same cells.
+        let dir = std::env::temp_dir().join(format!("report-tolerances-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("tolerances.json");
+        let mut value = serde_json::to_value(tolerances()).unwrap();
+        let first = value["rules"][0].clone();
+        value["rules"].as_array_mut().unwrap().push(first);
+        std::fs::write(&path, value.to_string()).unwrap();
+        let message = Tolerances::load(&path).unwrap_err().to_string();
+        assert!(
+            message.contains("tolerances.json: rules[3]")
+                && message.contains("exactly the cells of rules[0]"),
+            "{message}"
+        );
+        value["rules"].as_array_mut().unwrap().pop();
+        std::fs::write(&path, value.to_string()).unwrap();
+        assert_eq!(Tolerances::load(&path).unwrap().path, path);
     }
 }

@@ -1,7 +1,7 @@
 //! The paper's published numbers (`paper/published.json`).
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
@@ -16,12 +16,19 @@ pub struct PublishedTables {
     pub source: String,
     /// Table name, then the condition as the paper prints it.
     pub tables: BTreeMap<String, BTreeMap<String, MethodPair>>,
+    /// The file the numbers were read from (empty when built in code), for error messages.
+    #[serde(skip)]
+    pub path: PathBuf,
 }
 
 impl PublishedTables {
     /// Reads `published.json`.
     pub fn load(path: &Path) -> Result<Self> {
-        read_json(path)
+        let published: Self = read_json(path)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            ..published
+        })
     }
 
     /// The published numbers of one cell row, if the paper has them.

@@ -231,6 +231,7 @@ mod tests {
         let mut published = PublishedTables {
             source: "test".to_string(),
             tables: Default::default(),
+            path: Default::default(),
         };
         published
             .tables

@@ -211,6 +211,16 @@ impl ResultsTable {
 
     fn validate(&self, path: &Path) -> Result<()> {
         for (index, row) in self.rows.iter().enumerate() {
+            if let Some(earlier) = self.rows[..index]
+                .iter()
+                .position(|other| other.condition == row.condition)
+            {
+                return Err(ReportError::Json {
+                    path: path.to_path_buf(),
+                    field: format!("rows[{index}].condition"),
+                    message: format!("'{}' is also rows[{earlier}]", row.condition),
+                });
+            }
             for method in Method::ALL {
                 for metric in Metric::ALL {
                     let value = row.ours(method).get(metric);
@@ -333,6 +343,20 @@ mod tests {
             message.contains("t.json")
                 && message.contains("70wind")
                 && message.contains("sindy.gen"),
+            "{message}"
+        );
+        // A condition twice would be compared, and counted, twice.
+        let twice = ResultsTable {
+            rows: vec![
+                Row::new("70wind", mse(0.1, 0.2), mse(0.3, 0.4)),
+                Row::new("70wind", mse(0.1, 0.2), mse(0.3, 0.4)),
+            ],
+            ..table
+        };
+        twice.save(&path).unwrap();
+        let message = ResultsTable::load(&path).unwrap_err().to_string();
+        assert!(
+            message.contains("rows[1].condition") && message.contains("rows[0]"),
             "{message}"
         );
     }

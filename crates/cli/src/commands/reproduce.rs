@@ -29,6 +29,12 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let start = std::time::Instant::now();
     let config = RunConfig::load(&args.config, &args.root)?;
     let data_dir = global.data_dir()?;
+    let paths = OutputPaths {
+        results_dir: args.out,
+        latex_dir: args.latex_dir,
+        readme: args.readme,
+    };
+    paths.check()?;
     let print_stage = |timing: &StageTiming| {
         eprintln!("{:>7.2} s  {}", timing.seconds, timing.stage);
     };
@@ -43,11 +49,6 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         available_threads()
     );
     let outcome = pipeline::run(&config, &data_dir, &args.root, &options)?;
-    let paths = OutputPaths {
-        results_dir: args.out,
-        latex_dir: args.latex_dir,
-        readme: args.readme,
-    };
     let written = pipeline::write_outputs(&outcome, &paths)?;
     eprintln!(
         "{:>7.2} s  total; wrote {} files under {} and {}",

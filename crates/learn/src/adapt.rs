@@ -31,7 +31,7 @@ pub fn adapt_online(
     let mut parameters = parameters.to_vec();
     let mut workspace = ModelWorkspace::new(architecture);
     let mut gradient = vec![0.0; parameters.len()];
-    let mut prediction_gradient = Vec::with_capacity(config.window * output_dim);
+    let mut prediction_gradient = Vec::with_capacity(config.window.min(rows) * output_dim);
     let mut average = IterateMean::new(parameters.len(), config.average_last_pass);
     for pass in 0..config.passes {
         let last_pass = pass + 1 == config.passes;

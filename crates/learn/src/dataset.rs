@@ -99,11 +99,26 @@ impl Protocol {
 
 /// The support and query segments of a flight (SplitSpec::Halves, forward-difference targets on
 /// each segment separately): the same data as the SINDy columns.
+/// Errors name the flight's file.
 pub fn flight_segments(log: &FlightLog, formulation: Formulation) -> Result<(Segment, Segment)> {
-    let split = SplitSpec::Halves.split(log.len())?;
-    let support = formulation.segment(log, split.support, Derivative::Forward)?;
-    let query = formulation.segment(log, split.query, Derivative::Forward)?;
-    Ok((support, query))
+    let segments = || -> std::result::Result<(Segment, Segment), data::DataError> {
+        let split = SplitSpec::Halves.split(log.len())?;
+        let support = formulation.segment(log, split.support, Derivative::Forward)?;
+        let query = formulation.segment(log, split.query, Derivative::Forward)?;
+        Ok((support, query))
+    };
+    segments().map_err(|error| {
+        let message = error.to_string();
+        let path = log.path.display().to_string();
+        if path.is_empty() || message.contains(&path) {
+            LearnError::Data(error)
+        } else {
+            LearnError::Flight {
+                path: log.path.clone(),
+                message,
+            }
+        }
+    })
 }
 
 /// The rows of a matrix, concatenated.
@@ -135,6 +150,7 @@ pub fn segment_batch(segment: &Segment) -> Batch {
 /// The z-score of each input feature, (x − mean) / std, optionally of x first clamped to the range
 /// the meta-training inputs span.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Standardiser {
     pub mean: Vec<f64>,
     pub std: Vec<f64>,
@@ -149,6 +165,7 @@ pub struct Standardiser {
 
 /// Per-feature bounds of raw inputs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct InputRange {
     pub low: Vec<f64>,
     pub high: Vec<f64>,
@@ -353,5 +370,14 @@ mod tests {
         assert_eq!(standardiser.range, None);
         assert!(!standardiser.clamp);
         assert_eq!(serde_json::to_string(&standardiser).unwrap(), text);
+    }
+
+    #[test]
+    fn a_misspelt_standardiser_field_is_an_error_not_a_default() {
+        let text = r#"{"mean":[0.5],"std":[2.0],"clmap":true}"#;
+        let error = serde_json::from_str::<Standardiser>(text).unwrap_err();
+        assert!(error.to_string().contains("clmap"), "{error}");
+        let text = r#"{"mean":[0.5],"std":[2.0],"range":{"low":[0.0],"high":[1.0],"hi":[2.0]}}"#;
+        assert!(serde_json::from_str::<Standardiser>(text).is_err());
     }
 }

@@ -38,6 +38,13 @@ pub enum LearnError {
         "meta-training diverged at iteration {iteration} (loss {loss}); lower the outer or inner step in the configuration"
     )]
     Diverged { iteration: usize, loss: f64 },
+    /// Training or adaptation of one cell (formulation and condition, or model and flight) gave a
+    /// non-finite number: reported instead of printing NaN.
+    #[error("{cell}: {message}")]
+    NotFinite { cell: String, message: String },
+    /// A flight that cannot serve LeARN (e.g. too short to split), named by its file.
+    #[error("{}: {message}", path.display())]
+    Flight { path: PathBuf, message: String },
 }
 
 /// Result with a [`LearnError`].

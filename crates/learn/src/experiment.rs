@@ -18,7 +18,7 @@ use crate::error::{LearnError, Result};
 use crate::maml::Batch;
 use crate::model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel};
 use crate::network::{Architecture, mean_squared_error};
-use crate::train::{MetaTrainingOutcome, TaskData, meta_train};
+use crate::train::{MetaTrainingOutcome, TaskData, check_sampling, meta_train};
 
 /// A flight log with its file's SHA-256.
 struct LoadedFlight {
@@ -168,8 +168,9 @@ impl Experiment {
         let files =
             self.protocol
                 .training_files(&self.conditions, &self.data_dir, evaluation_condition)?;
+        let cell = format!("{} {evaluation_condition}", formulation.name());
         let (architecture, standardiser, outcome) =
-            self.meta_train_on(formulation, &files, config, seed)?;
+            self.meta_train_on(formulation, &files, config, seed, &cell)?;
         let data_files = files
             .iter()
             .map(|path| self.data_file(path))
@@ -194,13 +195,15 @@ impl Experiment {
         })
     }
 
-    /// Meta-trains on `files` with `config` (inputs standardised with these files' statistics).
+    /// Meta-trains on `files` with `config` (inputs standardised with these files' statistics);
+    /// `cell` names the run in errors.
     fn meta_train_on(
         &self,
         formulation: Formulation,
         files: &[PathBuf],
         config: &LearnConfig,
         seed: u64,
+        cell: &str,
     ) -> Result<(Architecture, Standardiser, MetaTrainingOutcome)> {
         let mut raw_tasks = Vec::with_capacity(files.len());
         for path in files {
@@ -234,7 +237,26 @@ impl Experiment {
             })
             .collect();
         let architecture = architecture(formulation, config);
-        let outcome = meta_train(&architecture, &tasks, &config.meta_training, seed)?;
+        let origin = self.config.origin();
+        check_sampling(&config.meta_training, &tasks, architecture.input_dim).map_err(
+            |(field, message)| LearnError::Config {
+                path: origin.to_path_buf(),
+                field: field.to_string(),
+                message,
+            },
+        )?;
+        let outcome = meta_train(&architecture, &tasks, &config.meta_training, seed).map_err(
+            |error| match error {
+                LearnError::Diverged { iteration, loss } => LearnError::NotFinite {
+                    cell: cell.to_string(),
+                    message: format!(
+                        "meta-training diverged at iteration {iteration} (loss {loss}); lower meta_training.outer_step or meta_training.inner_step in {}",
+                        origin.display()
+                    ),
+                },
+                other => other,
+            },
+        )?;
         Ok((architecture, standardiser, outcome))
     }
 
@@ -275,8 +297,25 @@ impl Experiment {
             .into_iter()
             .filter(|path| !second_files.contains(path))
             .collect();
+        // The candidate settings are checked as a configuration read from the experiment's file.
+        let origin = self.config.origin();
+        let config = config.clone().check(origin)?;
+        let config = config.get();
+        for adaptation in adaptations {
+            LearnConfig {
+                adaptation: adaptation.clone(),
+                ..config.clone()
+            }
+            .check(origin)?;
+        }
+        let cell = format!(
+            "{} nested validation {}/{}",
+            formulation.name(),
+            first.name,
+            second.name
+        );
         let (architecture, standardiser, outcome) =
-            self.meta_train_on(formulation, &files, config, seed)?;
+            self.meta_train_on(formulation, &files, config, seed, &cell)?;
         let score = |condition: &data::Condition| -> Result<Vec<f64>> {
             let path = self.conditions.flight_path(
                 &self.data_dir,
@@ -284,6 +323,9 @@ impl Experiment {
                 &self.conditions.evaluation_controller,
             );
             let (support, query) = flight_segments(&self.flight(&path)?.log, formulation)?;
+            for adaptation in adaptations {
+                check_window(adaptation, &support, &path, origin)?;
+            }
             let support_batch = standardised(&standardiser, segment_batch(&support));
             let query_batch = standardised(&standardiser, segment_batch(&query));
             Ok(adaptations
@@ -338,7 +380,16 @@ impl Experiment {
         let support_batch = standardised(&model.standardiser, raw_support);
         let query_batch = standardised(&model.standardiser, raw_query);
         let architecture = &model.architecture;
-        let adapted = model.adapt(&support, &self.config.get().adaptation);
+        let origin = self.config.origin();
+        let adaptation = &self.config.get().adaptation;
+        check_window(adaptation, &support, &path, origin)?;
+        let adapted = model.adapt(&support, adaptation);
+        let cell = format!("{} {}", model.formulation.name(), condition.name);
+        let advice = format!(
+            "lower adaptation.step or adaptation.lipschitz_weight in {}",
+            origin.display()
+        );
+        check_finite_parameters(&adapted, &cell, &advice)?;
         let support_predictions = model.predict_segment(&adapted, &support);
         let query_predictions = model.predict_segment(&adapted, &query);
         let state_dim = architecture.state_dim;
@@ -364,6 +415,19 @@ impl Experiment {
             support_coverage,
             query_coverage,
         };
+        for (name, value) in [
+            ("adaptation MSE", summary.adapt_mse),
+            ("generalisation MSE", summary.gen_mse),
+            ("unadapted adaptation MSE", summary.unadapted_adapt_mse),
+            ("unadapted generalisation MSE", summary.unadapted_gen_mse),
+        ] {
+            if !value.is_finite() {
+                return Err(LearnError::NotFinite {
+                    cell,
+                    message: format!("the {name} is not finite ({value}); {advice}"),
+                });
+            }
+        }
         Ok(CellResult {
             summary,
             support: SegmentPrediction {
@@ -505,6 +569,39 @@ pub fn architecture(formulation: Formulation, config: &crate::config::LearnConfi
     }
 }
 
+/// An adaptation window no longer than the support segment (of the flight at `path`) it walks.
+fn check_window(
+    adaptation: &AdaptationConfig,
+    support: &data::Segment,
+    path: &Path,
+    origin: &Path,
+) -> Result<()> {
+    if adaptation.window > support.len() {
+        return Err(LearnError::Config {
+            path: origin.to_path_buf(),
+            field: "adaptation.window".to_string(),
+            message: format!(
+                "{} is more than the {} samples of the support segment of {}",
+                adaptation.window,
+                support.len(),
+                path.display()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Adapted (or trained) parameters that are all finite; otherwise an error naming `cell`.
+fn check_finite_parameters(parameters: &[f64], cell: &str, advice: &str) -> Result<()> {
+    if parameters.iter().any(|p| !p.is_finite()) {
+        return Err(LearnError::NotFinite {
+            cell: cell.to_string(),
+            message: format!("online adaptation gave non-finite parameters; {advice}"),
+        });
+    }
+    Ok(())
+}
+
 fn standardised(standardiser: &Standardiser, batch: Batch) -> Batch {
     Batch {
         inputs: standardiser.apply(&batch.inputs),
@@ -525,18 +622,53 @@ pub fn explain_flight(
     let (support, query) = flight_segments(log, model.formulation)?;
     let support_batch = standardised(&model.standardiser, segment_batch(&support));
     let query_batch = standardised(&model.standardiser, segment_batch(&query));
+    let cell = format!(
+        "{} model over {}",
+        model.formulation.name(),
+        log.path.display()
+    );
     let parameters = if adapt {
-        model.adapt(&support, &model.config.adaptation)
+        let adaptation = &model.config.adaptation;
+        if adaptation.window > support.len() {
+            return Err(LearnError::Flight {
+                path: log.path.clone(),
+                message: format!(
+                    "the support segment has {} samples, fewer than the model's adaptation.window {}",
+                    support.len(),
+                    adaptation.window
+                ),
+            });
+        }
+        let adapted = model.adapt(&support, adaptation);
+        check_finite_parameters(
+            &adapted,
+            &cell,
+            "the model's adaptation.step or adaptation.lipschitz_weight is too large",
+        )?;
+        adapted
     } else {
         model.parameters.clone()
     };
     let mut inputs = support_batch.inputs;
     inputs.extend(query_batch.inputs);
-    Ok(crate::explain::explain(
+    let explanation = crate::explain::explain(
         model.formulation,
         &model.architecture,
         &parameters,
         &inputs,
         rule,
-    ))
+    );
+    let finite = explanation.outputs.iter().all(|output| {
+        output
+            .inputs
+            .iter()
+            .all(|input| input.mean_abs_coefficient.is_finite())
+    });
+    if !finite {
+        return Err(LearnError::NotFinite {
+            cell,
+            message: "the feature-selection coefficients are not finite".to_string(),
+        });
+    }
+    Ok(explanation)
 }

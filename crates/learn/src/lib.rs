@@ -72,7 +72,9 @@ pub mod variants;
 
 pub use adapt::adapt_online;
 pub use batched::ModelWorkspace;
-pub use config::{AdaptationConfig, CheckedConfig, LearnConfig, MetaTrainingConfig, Optimizer};
+pub use config::{
+    AdaptationConfig, CheckedConfig, LearnConfig, MetaTrainingConfig, Optimizer, limits,
+};
 pub use dataset::{
     InputCoverage, InputRange, Protocol, RangeCoverage, Standardiser, flight_segments,
     from_row_major, row_major, segment_batch,

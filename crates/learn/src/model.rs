@@ -105,6 +105,29 @@ impl MetaTrainedModel {
                 model.format
             )));
         }
+        // The settings the model adapts with are checked as if read from a configuration file.
+        model
+            .config
+            .clone()
+            .check(path)
+            .map_err(|error| match error {
+                LearnError::Config {
+                    path,
+                    field,
+                    message,
+                } => LearnError::Config {
+                    path,
+                    field: format!("config.{field}"),
+                    message,
+                },
+                other => other,
+            })?;
+        if model.architecture != crate::experiment::architecture(model.formulation, &model.config) {
+            return Err(bad(format!(
+                "architecture does not match the configuration's basis_per_input and hidden_layers for formulation '{}'",
+                model.formulation.name()
+            )));
+        }
         let expected = model.architecture.parameter_count();
         if model.parameters.len() != expected {
             return Err(bad(format!(
@@ -127,6 +150,27 @@ impl MetaTrainedModel {
             return Err(bad(format!(
                 "standardiser does not have {dim} features (with low <= high in its range)"
             )));
+        }
+        if let Some(j) = (0..dim).find(|&j| {
+            !(standardiser.mean[j].is_finite()
+                && standardiser.std[j].is_finite()
+                && standardiser.std[j] > 0.0)
+        }) {
+            return Err(LearnError::Config {
+                path: path.to_path_buf(),
+                field: format!("standardiser.std[{j}]"),
+                message: format!(
+                    "mean {} and std {} of input '{}': the std must be a positive number",
+                    standardiser.mean[j],
+                    standardiser.std[j],
+                    model
+                        .formulation
+                        .input_names()
+                        .get(j)
+                        .copied()
+                        .unwrap_or("?")
+                ),
+            });
         }
         if standardiser.clamp && standardiser.range.is_none() {
             return Err(bad("standardiser clamps but has no range".to_string()));

@@ -145,6 +145,56 @@ impl TaskSampler {
     }
 }
 
+/// The bounds of the batch sizes that depend on the tasks: a batch of tasks holds distinct tasks
+/// (they are drawn without replacement within a batch), and a task's support or query batch is no
+/// larger than the segment it is drawn from (with replacement: a larger batch holds no sample the
+/// segment does not, only repeats). `Err((field, message))` names the offending setting.
+pub(crate) fn check_sampling(
+    config: &MetaTrainingConfig,
+    tasks: &[TaskData],
+    input_dim: usize,
+) -> std::result::Result<(), (&'static str, String)> {
+    let bound = |value: usize, most: usize, what: String| {
+        if value == 0 {
+            Some("must be at least 1".to_string())
+        } else if value > most {
+            Some(format!("must be at most {most}, the {what}, not {value}"))
+        } else {
+            None
+        }
+    };
+    if let Some(message) = bound(
+        config.task_batch,
+        tasks.len(),
+        "meta-training tasks (flights) a batch draws from without replacement".to_string(),
+    ) {
+        return Err(("meta_training.task_batch", message));
+    }
+    for task in tasks {
+        let rows = |batch: &Batch| batch.inputs.len() / input_dim.max(1);
+        for (field, value, segment, data) in [
+            (
+                "meta_training.support_batch",
+                config.support_batch,
+                "support",
+                &task.support,
+            ),
+            (
+                "meta_training.query_batch",
+                config.query_batch,
+                "query",
+                &task.query,
+            ),
+        ] {
+            let what = format!("samples of the {segment} segment of {}", task.name);
+            if let Some(message) = bound(value, rows(data), what) {
+                return Err((field, message));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Meta-trains from the seeded initialisation on `tasks` (inputs already standardised).
 pub fn meta_train(
     architecture: &Architecture,
@@ -175,6 +225,12 @@ pub fn meta_train_from(
             message: "no tasks".to_string(),
         });
     }
+    check_sampling(config, tasks, architecture.input_dim).map_err(|(what, message)| {
+        LearnError::Mismatch {
+            what: what.to_string(),
+            message,
+        }
+    })?;
     let inner = InnerLoop {
         step: config.inner_step,
         rounds: config.inner_rounds,
@@ -234,8 +290,16 @@ pub fn meta_train_from(
             average.add(&parameters);
         }
     }
+    let parameters = average.finish(parameters);
+    // The last update can overflow although every gradient was finite.
+    if parameters.iter().any(|p| !p.is_finite()) {
+        return Err(LearnError::Diverged {
+            iteration: config.iterations.saturating_sub(1),
+            loss: meta_loss_history.last().copied().unwrap_or(f64::NAN),
+        });
+    }
     Ok(MetaTrainingOutcome {
-        parameters: average.finish(parameters),
+        parameters,
         meta_loss_history,
         support_loss_history,
     })

@@ -320,3 +320,95 @@ fn bad_configurations_name_the_file_and_field() {
         "{message}"
     );
 }
+
+#[test]
+fn meta_training_batches_are_bounded_by_the_tasks_they_are_drawn_from() {
+    let architecture = small_architecture();
+    let tasks = synthetic_tasks(3);
+    for (config, field) in [
+        (
+            MetaTrainingConfig {
+                task_batch: 4,
+                ..meta_config(2)
+            },
+            "meta_training.task_batch",
+        ),
+        (
+            MetaTrainingConfig {
+                support_batch: 201,
+                task_batch: 3,
+                ..meta_config(2)
+            },
+            "meta_training.support_batch",
+        ),
+        (
+            MetaTrainingConfig {
+                query_batch: 10_000_000,
+                task_batch: 3,
+                ..meta_config(2)
+            },
+            "meta_training.query_batch",
+        ),
+    ] {
+        let message = meta_train(&architecture, &tasks, &config, 1)
+            .unwrap_err()
+            .to_string();
+        assert!(message.starts_with(field), "{message}");
+    }
+    let full = MetaTrainingConfig {
+        task_batch: 3,
+        support_batch: 200,
+        query_batch: 200,
+        ..meta_config(2)
+    };
+    assert!(meta_train(&architecture, &tasks, &full, 1).is_ok());
+}
+
+#[test]
+fn an_overflow_in_the_last_meta_update_is_divergence_not_a_result() {
+    let architecture = small_architecture();
+    let tasks = synthetic_tasks(4);
+    let config = MetaTrainingConfig {
+        // Every gradient is finite (about 2μθ ~ 1e299); the update θ − β·g is not.
+        optimizer: Optimizer::Sgd,
+        meta_regularisation: 1e300,
+        outer_step: 1e10,
+        ..meta_config(1)
+    };
+    let error = meta_train(&architecture, &tasks, &config, 1).unwrap_err();
+    assert!(
+        matches!(error, learn::LearnError::Diverged { iteration: 0, .. }),
+        "{error}"
+    );
+}
+
+#[test]
+fn checkpoints_with_unusable_standardisers_or_settings_are_refused() {
+    let dir = std::env::temp_dir().join(format!("learn-checkpoint-check-{}", std::process::id()));
+    let path = dir.join("model.json");
+    let model = example_model();
+    let mut cases: Vec<(MetaTrainedModel, &str)> = Vec::new();
+    let mut zero_std = model.clone();
+    zero_std.standardiser.std[2] = 0.0;
+    cases.push((zero_std, "field 'standardiser.std[2]'"));
+    let mut negative_std = model.clone();
+    negative_std.standardiser.std[0] = -1.0;
+    cases.push((negative_std, "field 'standardiser.std[0]'"));
+    let mut no_step = model.clone();
+    no_step.config.adaptation.step = 0.0;
+    cases.push((no_step, "field 'config.adaptation.step'"));
+    let mut no_passes = model.clone();
+    no_passes.config.adaptation.passes = 0;
+    cases.push((no_passes, "field 'config.adaptation.passes'"));
+    let mut other_architecture = model.clone();
+    other_architecture.config.hidden_layers = vec![8, 8];
+    cases.push((other_architecture, "architecture does not match"));
+    for (bad, expected) in cases {
+        bad.save(&path).unwrap();
+        let message = MetaTrainedModel::load(&path).unwrap_err().to_string();
+        assert!(
+            message.contains("model.json") && message.contains(expected),
+            "{expected}: {message}"
+        );
+    }
+}

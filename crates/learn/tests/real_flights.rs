@@ -83,3 +83,51 @@ fn leave_condition_out_cell_runs_end_to_end() {
     assert!(explanation.outputs[0].equation.starts_with("v̇x = "));
     assert_eq!(explanation.outputs[0].inputs.len(), 6);
 }
+
+#[test]
+fn nested_validation_checks_its_candidate_settings() {
+    let Some(data_dir) = common::real_data_dir() else {
+        return;
+    };
+    let root = common::workspace();
+    let config = LearnConfig::load(&root.join("experiments/learn.json")).unwrap();
+    let conditions = ExperimentConditions::load(&root.join("experiments/conditions.json")).unwrap();
+    let experiment = Experiment::load(
+        config.clone(),
+        conditions,
+        &data_dir,
+        Some(Protocol::LeaveConditionOut),
+    )
+    .unwrap();
+    let base = config.get().clone();
+    let mut no_rounds = base.clone();
+    no_rounds.meta_training.inner_rounds = 0;
+    let mut no_passes = base.adaptation.clone();
+    no_passes.passes = 0;
+    let pair = ["35wind", "70wind"];
+    let run = |candidate: &LearnConfig, adaptation: &learn::AdaptationConfig| {
+        experiment
+            .nested_validation(
+                Formulation::Translational,
+                pair,
+                candidate,
+                std::slice::from_ref(adaptation),
+                1,
+            )
+            .unwrap_err()
+            .to_string()
+    };
+    let message = run(&no_rounds, &base.adaptation);
+    assert!(message.contains("meta_training.inner_rounds"), "{message}");
+    let message = run(&base, &no_passes);
+    assert!(message.contains("adaptation.passes"), "{message}");
+    let mut long_window = base.adaptation.clone();
+    long_window.window = 100_000;
+    let mut small = base.clone();
+    small.meta_training.iterations = 1;
+    let message = run(&small, &long_window);
+    assert!(
+        message.contains("adaptation.window") && message.contains("support segment"),
+        "{message}"
+    );
+}

@@ -1,12 +1,13 @@
 //! `learn explain`: the inputs that dominate each output through ℰ, and the learned equation.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use data::{ExperimentConditions, FlightLog};
 use learn::{EquationRule, MetaTrainedModel, explain_flight};
 
 use super::Global;
+use super::meta_train::refuse_input_as_output;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -25,15 +26,32 @@ pub struct Args {
     /// Explain the meta-trained model itself, without online adaptation on the flight.
     #[arg(long)]
     pub no_adapt: bool,
-    /// Most terms per equation.
+    /// Most terms per equation (at least 1).
     #[arg(long, default_value_t = 3)]
     pub max_terms: usize,
-    /// Also write the explanation as JSON here.
+    /// Also write the explanation as JSON here (never over the checkpoint or the flight).
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Replace an existing `--json` file.
+    #[arg(long)]
+    pub force: bool,
 }
 
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
+    if args.max_terms == 0 {
+        anyhow::bail!("--max-terms: must be at least 1");
+    }
+    if let Some(path) = &args.json {
+        let mut inputs: Vec<(&str, &Path)> = vec![
+            ("checkpoint", args.checkpoint.as_path()),
+            ("--conditions", args.conditions.as_path()),
+        ];
+        if let Some(flight) = &args.flight {
+            inputs.push(("--flight", flight.as_path()));
+        }
+        refuse_input_as_output(path, &inputs)?;
+        super::refuse_overwrite(path, args.force)?;
+    }
     let model = MetaTrainedModel::load(&args.checkpoint)?;
     let flight = match args.flight {
         Some(path) => path,
@@ -53,6 +71,9 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
             )
         }
     };
+    if let Some(path) = &args.json {
+        refuse_input_as_output(path, &[("flight", flight.as_path())])?;
+    }
     let log = FlightLog::read(&flight)?;
     // Shown and recorded relative to the working directory when it lies below it.
     let flight = std::env::current_dir()

@@ -7,6 +7,7 @@ use std::time::Instant;
 use anyhow::Context;
 use data::{ExperimentConditions, Formulation};
 use learn::{CellSummary, Experiment, LearnConfig, Protocol};
+use report::{Method, PublishedTables};
 use serde_json::{Value, json};
 
 use super::Global;
@@ -31,15 +32,19 @@ pub struct Args {
     /// Override the configuration's seed.
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Summary JSON of the run.
-    #[arg(long, default_value = "results/.scratch/learn/learn.json")]
-    pub out: PathBuf,
-    /// Directory of the JSON checkpoints (one per formulation and fold).
-    #[arg(long, default_value = "results/.scratch/learn/checkpoints")]
-    pub checkpoints: PathBuf,
-    /// The published numbers to compare with.
-    #[arg(long, default_value = "paper/published.json")]
-    pub published: PathBuf,
+    /// Summary JSON of the run [default: results/.scratch/learn/learn.json, the tool's scratch,
+    /// replaced on every run]. A file given here is not replaced without --force.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Directory of the JSON checkpoints, one per formulation and fold [default:
+    /// results/.scratch/learn/checkpoints, replaced on every run]. A checkpoint already in a
+    /// directory given here is not replaced without --force.
+    #[arg(long)]
+    pub checkpoints: Option<PathBuf>,
+    /// The published numbers to compare with [default: paper/published.json, skipped when
+    /// absent]. A file given here must exist.
+    #[arg(long)]
+    pub published: Option<PathBuf>,
     /// Rerun every cell with each of the configuration's `spread_seeds` and write the spread
     /// (every condition: the spread is what the tolerances of paper/tolerances.json come from).
     #[arg(long, conflicts_with = "condition")]
@@ -47,9 +52,65 @@ pub struct Args {
     /// Where `--seed-spread` writes its result.
     #[arg(long, default_value = "experiments/learn-seed-spread.json")]
     pub spread_out: PathBuf,
-    /// Replace an existing `--spread-out` file.
+    /// Replace an existing `--spread-out` or `--out` file, or checkpoints in `--checkpoints`.
+    /// No output may be one of the input files (--config, --conditions, --published), even
+    /// with --force.
     #[arg(long)]
     pub force: bool,
+}
+
+/// `--out` when not given: the tool's own scratch, replaced on every run.
+const DEFAULT_OUT: &str = "results/.scratch/learn/learn.json";
+/// `--checkpoints` when not given: the tool's own scratch, replaced on every run.
+const DEFAULT_CHECKPOINTS: &str = "results/.scratch/learn/checkpoints";
+/// `--published` when not given (skipped when absent).
+const DEFAULT_PUBLISHED: &str = "paper/published.json";
+
+/// Whether `a` and `b` name the same existing file (also through links or other spellings).
+pub(super) fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return a.dev() == b.dev() && a.ino() == b.ino();
+        }
+        false
+    }
+    #[cfg(not(unix))]
+    {
+        match (a.canonicalize(), b.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        }
+    }
+}
+
+/// Refuses an output that is one of the command's inputs (`inputs`: option name, path), whatever
+/// `--force` says: writing it would destroy what the run was made from.
+pub(super) fn refuse_input_as_output(
+    output: &Path,
+    inputs: &[(&str, &Path)],
+) -> anyhow::Result<()> {
+    if let Some((option, _)) = inputs.iter().find(|(_, input)| same_file(output, input)) {
+        anyhow::bail!(
+            "{}: is the {option} input, refusing to write over it (even with --force)",
+            output.display()
+        );
+    }
+    Ok(())
+}
+
+/// The published tables: from a file given with --published (which must exist and parse), or from
+/// the default file when present (which must then parse).
+fn published_tables(path: Option<&Path>) -> anyhow::Result<Option<PublishedTables>> {
+    let (path, explicit) = match path {
+        Some(path) => (path, true),
+        None => (Path::new(DEFAULT_PUBLISHED), false),
+    };
+    if !explicit && !path.exists() {
+        return Ok(None);
+    }
+    Ok(Some(PublishedTables::load(path)?))
 }
 
 fn formulations(names: &[String]) -> anyhow::Result<Vec<Formulation>> {
@@ -70,13 +131,20 @@ fn write_json(path: &Path, value: &Value) -> anyhow::Result<()> {
         .with_context(|| path.display().to_string())
 }
 
-/// The published (adapt, gen) of `method` (`learn` or `sindy`) for a cell, if the file has it.
-fn published(table: &Option<Value>, cell: &CellSummary, method: &str) -> Option<(f64, f64)> {
-    let entry = table.as_ref()?["tables"][cell.formulation.name()][&cell.label][method].clone();
-    Some((entry["adapt"].as_f64()?, entry["gen"].as_f64()?))
+/// The published (adapt, gen) of `method` for a cell, if the file has it.
+fn published(
+    table: &Option<PublishedTables>,
+    cell: &CellSummary,
+    method: Method,
+) -> Option<(f64, f64)> {
+    let mse = table
+        .as_ref()?
+        .get(cell.formulation.name(), &cell.label)?
+        .get(method);
+    Some((mse.adaptation, mse.generalisation))
 }
 
-fn print_cells(cells: &[CellSummary], table: &Option<Value>) {
+fn print_cells(cells: &[CellSummary], table: &Option<PublishedTables>) {
     println!(
         "{:<14} {:<10} {:>8} {:>8} {:>10} | {:>15} {:>12} | {:>9} | {:>13}",
         "formulation",
@@ -90,8 +158,8 @@ fn print_cells(cells: &[CellSummary], table: &Option<Value>) {
         "query outside"
     );
     for cell in cells {
-        let learn = published(table, cell, "learn");
-        let sindy = published(table, cell, "sindy");
+        let learn = published(table, cell, Method::Learn);
+        let sindy = published(table, cell, Method::Sindy);
         let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
         let verdict = match learn {
             Some((_, gen_mse)) if cell.gen_mse <= gen_mse => "ok",
@@ -119,20 +187,45 @@ fn print_cells(cells: &[CellSummary], table: &Option<Value>) {
 }
 
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
+    let published_path = args
+        .published
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_PUBLISHED));
+    let inputs: [(&str, &Path); 3] = [
+        ("--config", &args.config),
+        ("--conditions", &args.conditions),
+        ("--published", &published_path),
+    ];
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT));
+    let checkpoint_dir = args
+        .checkpoints
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_CHECKPOINTS));
     if args.seed_spread {
+        refuse_input_as_output(&args.spread_out, &inputs)?;
         super::refuse_overwrite(&args.spread_out, args.force)?;
+    } else {
+        refuse_input_as_output(&out, &inputs)?;
+        if args.out.is_some() {
+            super::refuse_overwrite(&out, args.force)?;
+        }
     }
     let mut config = LearnConfig::load(&args.config)?;
     if let Some(seed) = args.seed {
         config = config.with_seed(seed);
     }
+    let table = published_tables(args.published.as_deref())?;
     let conditions = ExperimentConditions::load(&args.conditions)?;
     let data_dir = global.data_dir()?;
     let protocol = Protocol::parse(&args.protocol)?;
     let formulations = formulations(&args.formulations)?;
-    let table = std::fs::read_to_string(&args.published)
-        .ok()
-        .and_then(|text| serde_json::from_str::<Value>(&text).ok());
+    let evaluated: Vec<String> = match &args.condition {
+        Some(condition) => vec![conditions.condition(condition)?.name.clone()],
+        None => conditions.evaluation().map(|c| c.name.clone()).collect(),
+    };
     let experiment = Experiment::load(config.clone(), conditions, &data_dir, protocol)?;
     let protocol = experiment.protocol();
     println!("protocol: {}", protocol.name());
@@ -180,6 +273,23 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     }
 
     let seed = config.get().seed;
+    // Every checkpoint this run writes, checked before any work.
+    let checkpoint_path = |formulation: Formulation, condition: &str| {
+        checkpoint_dir.join(format!(
+            "{}-{}-{condition}-seed{seed}.json",
+            protocol.name(),
+            formulation.name(),
+        ))
+    };
+    for &formulation in &formulations {
+        for condition in &evaluated {
+            let path = checkpoint_path(formulation, condition);
+            refuse_input_as_output(&path, &inputs)?;
+            if args.checkpoints.is_some() {
+                super::refuse_overwrite(&path, args.force)?;
+            }
+        }
+    }
     let started = Instant::now();
     let cells = match &args.condition {
         Some(condition) => formulations
@@ -195,21 +305,14 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     );
     let mut checkpoints = Vec::new();
     for cell in &cells {
-        let name = format!(
-            "{}-{}-{}-seed{}.json",
-            protocol.name(),
-            cell.summary.formulation.name(),
-            cell.summary.condition,
-            seed
-        );
-        let path = args.checkpoints.join(name);
+        let path = checkpoint_path(cell.summary.formulation, &cell.summary.condition);
         cell.model.save(&path)?;
         checkpoints.push(path);
     }
     let summaries: Vec<CellSummary> = cells.iter().map(|c| c.summary.clone()).collect();
     print_cells(&summaries, &table);
     write_json(
-        &args.out,
+        &out,
         &json!({
             "protocol": protocol.name(),
             "seed": seed,
@@ -220,9 +323,9 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     )?;
     println!(
         "wrote {} and {} checkpoints under {}",
-        args.out.display(),
+        out.display(),
         checkpoints.len(),
-        args.checkpoints.display()
+        checkpoint_dir.display()
     );
     Ok(())
 }

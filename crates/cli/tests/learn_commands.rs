@@ -1,0 +1,437 @@
+//! `learn meta-train` and `learn explain` on bad settings, bad checkpoints and outputs that would
+//! replace a file: a one-line error naming the file and field, exit 1, nothing replaced.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{learn_in, scratch};
+use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Protocol, Standardiser};
+use serde_json::{Value, json};
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn path_str(path: &Path) -> &str {
+    path.to_str().expect("UTF-8 path")
+}
+
+/// The real flights (skipped without them, an error under CI).
+fn real_data() -> Option<PathBuf> {
+    data::real_data_dir_for_tests(&workspace())
+}
+
+/// experiments/learn.json with a tiny budget, changed by `edit`, written as `dir/learn.json`.
+fn small_config(dir: &Path, edit: impl FnOnce(&mut Value)) -> PathBuf {
+    let text = std::fs::read_to_string(workspace().join("experiments/learn.json")).unwrap();
+    let mut value: Value = serde_json::from_str(&text).unwrap();
+    value["meta_training"]["iterations"] = json!(3);
+    value["adaptation"]["passes"] = json!(1);
+    edit(&mut value);
+    let path = dir.join("learn.json");
+    std::fs::write(&path, value.to_string()).unwrap();
+    path
+}
+
+/// `meta-train` on one cell (translational, 35wind) with the real flights and `extra` arguments.
+fn meta_train(dir: &Path, data: &Path, extra: &[&str]) -> common::Run {
+    let conditions = workspace().join("experiments/conditions.json");
+    let mut args = vec![
+        "--data",
+        path_str(data),
+        "meta-train",
+        "--conditions",
+        path_str(&conditions),
+        "--protocol",
+        "leave-condition-out",
+        "--formulation",
+        "translational",
+        "--condition",
+        "35wind",
+    ];
+    args.extend_from_slice(extra);
+    learn_in(dir, &args)
+}
+
+/// An untrained translational checkpoint (the configuration of experiments/learn.json, changed by
+/// `edit`), written as `dir/name`.
+fn checkpoint(dir: &Path, name: &str, edit: impl FnOnce(&mut MetaTrainedModel)) -> PathBuf {
+    let config = LearnConfig::load(&workspace().join("experiments/learn.json")).unwrap();
+    let formulation = data::Formulation::Translational;
+    let architecture = learn::architecture(formulation, config.get());
+    let mut model = MetaTrainedModel {
+        format: CHECKPOINT_FORMAT.to_string(),
+        formulation,
+        protocol: Protocol::LeaveConditionOut,
+        held_out_condition: Some("35wind".to_string()),
+        seed: 1,
+        config: config.get().clone(),
+        parameters: architecture.initial_parameters(1),
+        standardiser: Standardiser::identity(architecture.input_dim),
+        architecture,
+        data_files: vec![],
+        meta_loss_history: vec![],
+    };
+    edit(&mut model);
+    let path = dir.join(name);
+    model.save(&path).unwrap();
+    path
+}
+
+#[test]
+fn meta_train_rejects_settings_that_make_results_meaningless_naming_the_field() {
+    let dir = scratch("meta-train-bad-settings");
+    let cases: [(&str, Value, &str); 9] = [
+        (
+            "iterations",
+            json!({"meta_training": {"iterations": 0}}),
+            "meta_training.iterations",
+        ),
+        (
+            "rounds",
+            json!({"meta_training": {"inner_rounds": 0}}),
+            "meta_training.inner_rounds",
+        ),
+        (
+            "passes",
+            json!({"adaptation": {"passes": 0}}),
+            "adaptation.passes",
+        ),
+        (
+            "step",
+            json!({"adaptation": {"step": 0.0}}),
+            "adaptation.step",
+        ),
+        (
+            "duplicate seeds",
+            json!({"spread_seeds": [1, 1]}),
+            "spread_seeds",
+        ),
+        ("no seeds", json!({"spread_seeds": []}), "spread_seeds"),
+        (
+            "basis",
+            json!({"basis_per_input": 100000}),
+            "basis_per_input",
+        ),
+        (
+            "widths",
+            json!({"hidden_layers": [1000000000]}),
+            "hidden_layers",
+        ),
+        (
+            "iterations too many",
+            json!({"meta_training": {"iterations": 1u64 << 60}}),
+            "meta_training.iterations",
+        ),
+    ];
+    for (what, patch, field) in cases {
+        let config = small_config(&dir, |value| {
+            for (section, fields) in patch.as_object().unwrap() {
+                match fields.as_object() {
+                    Some(fields) => {
+                        for (key, v) in fields {
+                            value[section][key] = v.clone();
+                        }
+                    }
+                    None => value[section] = fields.clone(),
+                }
+            }
+        });
+        let run = learn_in(&dir, &["meta-train", "--config", path_str(&config)]);
+        let message = run.one_line_error(&["learn.json", field]);
+        assert!(!message.contains("NaN"), "{what}: {message}");
+    }
+}
+
+#[test]
+fn meta_train_bounds_batches_and_window_by_the_flights() {
+    let Some(data) = real_data() else {
+        return;
+    };
+    let dir = scratch("meta-train-batches");
+    for (section, key, value, field) in [
+        (
+            "meta_training",
+            "task_batch",
+            100_000,
+            "meta_training.task_batch",
+        ),
+        (
+            "meta_training",
+            "support_batch",
+            10_000_000,
+            "meta_training.support_batch",
+        ),
+        (
+            "meta_training",
+            "query_batch",
+            10_000_000,
+            "meta_training.query_batch",
+        ),
+        ("adaptation", "window", 100_000, "adaptation.window"),
+    ] {
+        let config = small_config(&dir, |v| v[section][key] = json!(value));
+        let run = meta_train(&dir, &data, &["--config", path_str(&config)]);
+        run.one_line_error(&["learn.json", field]);
+    }
+}
+
+#[test]
+fn meta_train_reports_non_finite_results_instead_of_printing_nan() {
+    let Some(data) = real_data() else {
+        return;
+    };
+    let dir = scratch("meta-train-non-finite");
+    let config = small_config(&dir, |v| v["adaptation"]["step"] = json!(1e308));
+    let run = meta_train(&dir, &data, &["--config", path_str(&config)]);
+    run.one_line_error(&["translational 35wind", "adaptation.step", "learn.json"]);
+    assert!(!dir.join("results").exists(), "nothing written");
+}
+
+#[test]
+fn meta_train_never_replaces_a_given_output_without_force() {
+    let dir = scratch("meta-train-out");
+    std::fs::write(dir.join("mine.json"), "mine").unwrap();
+    let config = workspace().join("experiments/learn.json");
+    let run = learn_in(
+        &dir,
+        &[
+            "meta-train",
+            "--config",
+            path_str(&config),
+            "--out",
+            "mine.json",
+        ],
+    );
+    run.one_line_error(&["mine.json", "already exists", "--force"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("mine.json")).unwrap(),
+        "mine"
+    );
+}
+
+#[test]
+fn meta_train_never_writes_over_an_input_even_with_force() {
+    let dir = scratch("meta-train-input");
+    let config = small_config(&dir, |_| {});
+    let before = std::fs::read_to_string(&config).unwrap();
+    for extra in [
+        &["--out", "learn.json"][..],
+        &["--seed-spread", "--spread-out", "learn.json"],
+    ] {
+        let mut args = vec!["meta-train", "--config", "learn.json", "--force"];
+        args.extend_from_slice(extra);
+        let run = learn_in(&dir, &args);
+        run.one_line_error(&["learn.json", "--config"]);
+    }
+    // Also under another spelling of the same file.
+    let run = learn_in(
+        &dir,
+        &[
+            "meta-train",
+            "--config",
+            "./learn.json",
+            "--out",
+            path_str(&config),
+            "--force",
+        ],
+    );
+    run.one_line_error(&["learn.json", "--config"]);
+    assert_eq!(std::fs::read_to_string(&config).unwrap(), before);
+}
+
+#[test]
+fn meta_train_refuses_to_replace_a_checkpoint_in_a_given_directory() {
+    let Some(data) = real_data() else {
+        return;
+    };
+    let dir = scratch("meta-train-checkpoints");
+    let config = small_config(&dir, |_| {});
+    std::fs::create_dir_all(dir.join("ck")).unwrap();
+    let existing = dir.join("ck/leave-condition-out-translational-35wind-seed1.json");
+    std::fs::write(&existing, "mine").unwrap();
+    let run = meta_train(
+        &dir,
+        &data,
+        &[
+            "--config",
+            path_str(&config),
+            "--checkpoints",
+            "ck",
+            "--out",
+            "a.json",
+        ],
+    );
+    run.one_line_error(&[
+        "leave-condition-out-translational-35wind-seed1.json",
+        "--force",
+    ]);
+    assert_eq!(std::fs::read_to_string(&existing).unwrap(), "mine");
+    assert!(!dir.join("a.json").exists());
+    // With --force both are written.
+    let run = meta_train(
+        &dir,
+        &data,
+        &[
+            "--config",
+            path_str(&config),
+            "--checkpoints",
+            "ck",
+            "--out",
+            "a.json",
+            "--force",
+        ],
+    );
+    run.success();
+    assert!(MetaTrainedModel::load(&existing).is_ok());
+}
+
+#[test]
+fn meta_train_published_file_given_must_exist_and_parse() {
+    let dir = scratch("meta-train-published");
+    let config = workspace().join("experiments/learn.json");
+    let config = path_str(&config);
+    let run = learn_in(
+        &dir,
+        &["meta-train", "--config", config, "--published", "nope.json"],
+    );
+    run.one_line_error(&["nope.json"]);
+    std::fs::write(dir.join("bad.json"), "{\"tables\": ").unwrap();
+    let run = learn_in(
+        &dir,
+        &["meta-train", "--config", config, "--published", "bad.json"],
+    );
+    run.one_line_error(&["bad.json", "line 1"]);
+    // The default file may be absent (the next error is about the conditions), not invalid.
+    let run = learn_in(&dir, &["meta-train", "--config", config]);
+    let message = run.one_line_error(&["conditions.json"]);
+    assert!(!message.contains("published"), "{message}");
+    std::fs::create_dir_all(dir.join("paper")).unwrap();
+    std::fs::write(dir.join("paper/published.json"), "not json").unwrap();
+    let run = learn_in(&dir, &["meta-train", "--config", config]);
+    run.one_line_error(&["paper/published.json"]);
+}
+
+#[test]
+fn explain_never_writes_json_over_an_input_or_an_existing_file() {
+    let dir = scratch("explain-json");
+    let model = checkpoint(&dir, "model.json", |_| {});
+    let before = std::fs::read(&model).unwrap();
+    let run = learn_in(
+        &dir,
+        &["explain", "model.json", "--json", "model.json", "--force"],
+    );
+    run.one_line_error(&["model.json", "checkpoint"]);
+    std::fs::write(dir.join("flight.csv"), "t\n0\n").unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "explain",
+            "model.json",
+            "--flight",
+            "flight.csv",
+            "--json",
+            "./flight.csv",
+            "--force",
+        ],
+    );
+    run.one_line_error(&["flight.csv", "--flight"]);
+    std::fs::write(dir.join("mine.json"), "mine").unwrap();
+    let run = learn_in(&dir, &["explain", "model.json", "--json", "mine.json"]);
+    run.one_line_error(&["mine.json", "already exists", "--force"]);
+    assert_eq!(std::fs::read(&model).unwrap(), before);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("mine.json")).unwrap(),
+        "mine"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("flight.csv")).unwrap(),
+        "t\n0\n"
+    );
+}
+
+#[test]
+fn explain_rejects_a_checkpoint_with_a_degenerate_standardiser_or_bad_settings() {
+    let dir = scratch("explain-checkpoint");
+    checkpoint(&dir, "zero-std.json", |model| {
+        model.standardiser.std.iter_mut().for_each(|s| *s = 0.0);
+    });
+    let run = learn_in(&dir, &["explain", "zero-std.json"]);
+    run.one_line_error(&["zero-std.json", "standardiser.std"]);
+    checkpoint(&dir, "no-passes.json", |model| {
+        model.config.adaptation.passes = 0
+    });
+    let run = learn_in(&dir, &["explain", "no-passes.json"]);
+    run.one_line_error(&["no-passes.json", "config.adaptation.passes"]);
+    let run = learn_in(&dir, &["explain", "zero-std.json", "--max-terms", "0"]);
+    run.one_line_error(&["--max-terms"]);
+}
+
+#[test]
+fn explain_names_a_flight_too_short_to_split() {
+    let Some(data) = real_data() else {
+        return;
+    };
+    let dir = scratch("explain-short-flight");
+    checkpoint(&dir, "model.json", |_| {});
+    let text = std::fs::read_to_string(data.join("experiment/custom_figure8_baseline_35wind.csv"))
+        .unwrap();
+    let head: Vec<&str> = text.lines().take(4).collect();
+    std::fs::write(dir.join("short.csv"), head.join("\n") + "\n").unwrap();
+    let run = learn_in(&dir, &["explain", "model.json", "--flight", "short.csv"]);
+    run.one_line_error(&["short.csv", "too few"]);
+}
+
+#[test]
+fn explain_reports_non_finite_adaptation_instead_of_printing_nan() {
+    let Some(data) = real_data() else {
+        return;
+    };
+    let dir = scratch("explain-non-finite");
+    checkpoint(&dir, "model.json", |model| {
+        model.config.adaptation.step = 1e308
+    });
+    let flight = data.join("experiment/custom_figure8_baseline_35wind.csv");
+    let run = learn_in(
+        &dir,
+        &["explain", "model.json", "--flight", path_str(&flight)],
+    );
+    run.one_line_error(&[
+        "translational",
+        "custom_figure8_baseline_35wind.csv",
+        "adaptation.step",
+    ]);
+}
+
+#[test]
+fn explain_rejects_a_window_longer_than_the_support_segment_and_non_finite_coefficients() {
+    let Some(data) = real_data() else {
+        return;
+    };
+    let dir = scratch("explain-window");
+    let flight = data.join("experiment/custom_figure8_baseline_35wind.csv");
+    checkpoint(&dir, "window.json", |model| {
+        model.config.adaptation.window = 100_000
+    });
+    let run = learn_in(
+        &dir,
+        &["explain", "window.json", "--flight", path_str(&flight)],
+    );
+    run.one_line_error(&["custom_figure8_baseline_35wind.csv", "adaptation.window"]);
+    // Parameters whose products overflow: the coefficients are not finite.
+    checkpoint(&dir, "huge.json", |model| {
+        model.parameters.iter_mut().for_each(|p| *p = 1e200)
+    });
+    let run = learn_in(
+        &dir,
+        &[
+            "explain",
+            "huge.json",
+            "--no-adapt",
+            "--flight",
+            path_str(&flight),
+        ],
+    );
+    run.one_line_error(&["custom_figure8_baseline_35wind.csv", "not finite"]);
+}

@@ -5,13 +5,13 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use physics::{Effects, Scenario, simulate};
+use physics::{Effects, NominalModel, Scenario, simulate};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::{AnalysisSettings, analyze};
 use crate::error::{MismatchError, Result, io_error};
-use crate::output::write_outputs;
+use crate::output::{check_directory, write_outputs};
 
 /// One case of the manifest.
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -68,28 +68,82 @@ pub struct DemoSummary {
 
 fn load_manifest(path: &Path) -> Result<DemoManifest> {
     let text = std::fs::read_to_string(path).map_err(io_error(path))?;
-    serde_json::from_str(&text).map_err(|e| MismatchError::Config {
-        path: path.to_path_buf(),
-        field: format!("line {} column {}", e.line(), e.column()),
-        message: e.to_string(),
-    })
+    let manifest: DemoManifest =
+        serde_json::from_str(&text).map_err(|e| MismatchError::Config {
+            path: path.to_path_buf(),
+            field: format!("line {} column {}", e.line(), e.column()),
+            message: e.to_string(),
+        })?;
+    manifest.validate(path)?;
+    Ok(manifest)
 }
 
-/// Runs every case and writes `out/summary.md` and `out/summary.json`.
+impl DemoManifest {
+    /// Checks the cases: at least one, and each name a distinct plain directory name (letters,
+    /// digits, `_`, `-` and `.`, not starting with `.`, without `..`), since it names the case's
+    /// directory under the work directory.
+    pub fn validate(&self, origin: &Path) -> Result<()> {
+        let bad = |field: String, message: String| MismatchError::Config {
+            path: origin.to_path_buf(),
+            field,
+            message,
+        };
+        if self.cases.is_empty() {
+            return Err(bad("cases".into(), "the manifest lists no cases".into()));
+        }
+        let mut seen = std::collections::HashSet::new();
+        for (i, case) in self.cases.iter().enumerate() {
+            let name = &case.name;
+            let field = format!("cases[{i}].name");
+            if name.is_empty() {
+                return Err(bad(field, "must not be empty".into()));
+            }
+            let plain = name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'));
+            if !plain || name.starts_with('.') || name.contains("..") {
+                return Err(bad(
+                    field,
+                    format!(
+                        "{name:?} is not a plain directory name (letters, digits, '_', '-' and '.'; no path separators, no leading '.', no '..')"
+                    ),
+                ));
+            }
+            // Case-insensitive: the directories must differ on every file system.
+            if !seen.insert(name.to_ascii_lowercase()) {
+                return Err(bad(field, format!("{name:?} is used by an earlier case")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Runs every case and writes `out/summary.md` and `out/summary.json`. Every scenario (and its
+/// model) is read and checked before any case runs.
 pub fn run_demo(manifest_path: &Path, work: &Path, out: &Path, force: bool) -> Result<DemoSummary> {
     let manifest = load_manifest(manifest_path)?;
+    check_directory(work)?;
+    check_directory(out)?;
     let summary_paths = [out.join("summary.md"), out.join("summary.json")];
     if !force && let Some(path) = summary_paths.iter().find(|p| p.exists()) {
         return Err(MismatchError::Exists { path: path.clone() });
     }
     let base = manifest_path.parent().unwrap_or(Path::new("."));
+    let loaded: Vec<(Scenario, NominalModel)> = manifest
+        .cases
+        .iter()
+        .map(|case| Scenario::load(&base.join(&case.scenario)))
+        .collect::<std::result::Result<_, _>>()?;
     let cases: Vec<CaseOutcome> = manifest
         .cases
         .par_iter()
-        .map(|case| {
-            run_case(case, &base.join(&case.scenario), work).map_err(|e| MismatchError::Recording {
-                path: PathBuf::from(&case.name),
-                message: format!("demo case failed: {e}"),
+        .zip(&loaded)
+        .enumerate()
+        .map(|(i, (case, (scenario, model)))| {
+            run_case(case, scenario, model, work).map_err(|e| MismatchError::Config {
+                path: manifest_path.to_path_buf(),
+                field: format!("cases[{i}]"),
+                message: format!("demo case {:?} failed: {e}", case.name),
             })
         })
         .collect::<Result<_>>()?;
@@ -109,17 +163,21 @@ pub fn run_demo(manifest_path: &Path, work: &Path, out: &Path, force: bool) -> R
     Ok(summary)
 }
 
-fn run_case(case: &DemoCase, scenario_path: &Path, work: &Path) -> Result<CaseOutcome> {
-    let (scenario, model) = Scenario::load(scenario_path)?;
+fn run_case(
+    case: &DemoCase,
+    scenario: &Scenario,
+    model: &NominalModel,
+    work: &Path,
+) -> Result<CaseOutcome> {
     let dir = work.join(&case.name);
     let csv = dir.join("recording.csv");
-    let log = simulate(&model, &scenario, &case.name)?;
+    let log = simulate(model, scenario, &case.name)?;
     log.write_csv(&csv)?;
     // Blind: the analysis sees only the CSV as written and the nominal model.
     let recording = data::FlightLog::read(&csv)?;
     let analysis = analyze(
         &recording,
-        &model,
+        model,
         &scenario.model.display().to_string(),
         &AnalysisSettings::default(),
     )?;
@@ -351,5 +409,93 @@ impl DemoSummary {
             "\nPer-case outputs (recording, mismatch.json/svg/md) are written under the demo's work directory (`target/mismatch-demo/<case>/`, not committed)."
         );
         md
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn manifest(names: &[&str]) -> DemoManifest {
+        DemoManifest {
+            cases: names
+                .iter()
+                .map(|name| DemoCase {
+                    name: name.to_string(),
+                    scenario: "scenarios/control.json".into(),
+                    purpose: "test".into(),
+                })
+                .collect(),
+        }
+    }
+
+    fn rejected(names: &[&str]) -> String {
+        let error = manifest(names)
+            .validate(Path::new("demo.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.starts_with("demo.json: field '") && !error.contains('\n'),
+            "{error}"
+        );
+        error
+    }
+
+    #[test]
+    fn case_names_must_be_distinct_plain_directory_names() {
+        manifest(&["control", "linear_drag", "drag-2", "v1.5"])
+            .validate(Path::new("demo.json"))
+            .unwrap();
+        assert!(rejected(&["control", ""]).contains("cases[1].name"));
+        assert!(rejected(&["/tmp/x"]).contains("cases[0].name"));
+        assert!(rejected(&["../../escape"]).contains("cases[0].name"));
+        assert!(rejected(&["a/b"]).contains("cases[0].name"));
+        assert!(rejected(&["a\\b"]).contains("cases[0].name"));
+        assert!(rejected(&[".."]).contains("cases[0].name"));
+        assert!(rejected(&["a..b"]).contains("cases[0].name"));
+        assert!(rejected(&[".hidden"]).contains("cases[0].name"));
+        let duplicate = rejected(&["control", "drag", "control"]);
+        assert!(
+            duplicate.contains("cases[2].name") && duplicate.contains("earlier case"),
+            "{duplicate}"
+        );
+        assert!(rejected(&["Control", "control"]).contains("cases[1].name"));
+        assert!(rejected(&[]).contains("field 'cases'"));
+    }
+
+    /// Every scenario is read and checked before any case is simulated: a bad second case leaves
+    /// the work directory untouched and names its own file and field.
+    #[test]
+    fn a_bad_scenario_fails_before_any_case_runs() {
+        let dir = std::env::temp_dir().join(format!("mismatch-demo-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let good =
+            std::fs::read_to_string(workspace.join("experiments/mismatch/scenarios/control.json"))
+                .unwrap();
+        let model = workspace.join("experiments/mismatch/demo-quad.json");
+        let mut scenario: serde_json::Value = serde_json::from_str(&good).unwrap();
+        scenario["model"] = serde_json::json!(model);
+        std::fs::write(dir.join("good.json"), scenario.to_string()).unwrap();
+        scenario["gains"] = serde_json::json!({"integral_limit": -1});
+        std::fs::write(dir.join("bad.json"), scenario.to_string()).unwrap();
+        std::fs::write(
+            dir.join("demo.json"),
+            r#"{"cases": [{"name": "good", "scenario": "good.json", "purpose": "p"},
+                          {"name": "bad", "scenario": "bad.json", "purpose": "p"}]}"#,
+        )
+        .unwrap();
+        let work = dir.join("work");
+        let error = run_demo(&dir.join("demo.json"), &work, &dir.join("out"), false)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("bad.json: field 'gains.integral_limit'"),
+            "{error}"
+        );
+        assert!(!work.exists(), "a case ran before the check");
+        assert!(!dir.join("out").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

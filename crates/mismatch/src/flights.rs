@@ -9,7 +9,7 @@ use physics::NominalModel;
 
 use crate::analysis::{AnalysisSettings, Report, analyze};
 use crate::error::{MismatchError, Result, io_error};
-use crate::output::{check_outputs, write_outputs};
+use crate::output::{check_directory, check_outputs, write_outputs};
 
 /// Analyses each condition's flight, writes `out/neural-fly/<condition>/mismatch.*` and
 /// `out/neural-fly.md`; returns one printed line per flight.
@@ -22,6 +22,7 @@ pub fn run_flights(
     force: bool,
 ) -> Result<Vec<String>> {
     let conditions = ExperimentConditions::load(conditions_path)?;
+    check_directory(out)?;
     let summary_path = out.join("neural-fly.md");
     if summary_path.exists() && !force {
         return Err(MismatchError::Exists { path: summary_path });

@@ -39,7 +39,9 @@ pub use analysis::{
 };
 pub use error::{MismatchError, Result};
 pub use library::{Candidate, TIMING, Term, build_library};
-pub use output::{check_outputs, markdown_text, output_paths, write_figure, write_outputs};
+pub use output::{
+    check_directory, check_outputs, markdown_text, output_paths, write_figure, write_outputs,
+};
 pub use problem::{CHANNEL_NAMES, Channels, Problem};
 pub use recording::Recording;
 pub use refine::{Parameter, effects_from, levenberg_marquardt};

@@ -15,8 +15,9 @@ pub fn output_paths(dir: &Path) -> [PathBuf; 3] {
     ["mismatch.json", "mismatch.svg", "mismatch.md"].map(|name| dir.join(name))
 }
 
-/// Fails if any output file exists and `force` is off.
+/// Fails if `dir` exists but is not a directory, or if any output file exists and `force` is off.
 pub fn check_outputs(dir: &Path, force: bool) -> Result<()> {
+    check_directory(dir)?;
     if force {
         return Ok(());
     }
@@ -24,6 +25,20 @@ pub fn check_outputs(dir: &Path, force: bool) -> Result<()> {
         Some(path) => Err(MismatchError::Exists { path }),
         None => Ok(()),
     }
+}
+
+/// Fails if `dir` exists but is not a directory (checked before any work that would write there).
+pub fn check_directory(dir: &Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(MismatchError::Io {
+            path: dir.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::NotADirectory,
+                "exists and is not a directory",
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Writes the three files.

@@ -43,13 +43,20 @@ impl Recording {
                 log.len()
             )));
         }
-        if let Some(row) = log.hover_throttle.iter().position(|h| *h <= 0.0)
-            && model.thrust_source == physics::ThrustSource::ThrustSetpoint
+        if model.thrust_source == physics::ThrustSource::ThrustSetpoint
+            && let Some(row) = log
+                .hover_throttle
+                .iter()
+                .position(|h| h.is_nan() || *h <= 0.0)
         {
-            return Err(bad(format!(
-                "row {}: hover_throttle must be positive to scale T_sp",
-                row + 2
-            )));
+            // `file:line:column`, the header being line 1.
+            return Err(MismatchError::Recording {
+                path: PathBuf::from(format!("{}:{}:hover_throttle", log.path.display(), row + 2)),
+                message: format!(
+                    "must be positive to scale T_sp (the model's thrust_source is \"T_sp\"), found {}",
+                    log.hover_throttle[row]
+                ),
+            });
         }
         let (frame, body_rms, world_rms) = log.rate_frame();
         let body_rate = match frame {

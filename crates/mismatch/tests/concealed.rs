@@ -143,3 +143,57 @@ fn a_too_short_recording_is_a_one_line_error() {
         .to_string();
     assert!(error.contains("rows") && !error.contains('\n'), "{error}");
 }
+
+#[test]
+fn a_zero_hover_throttle_names_the_file_line_and_column() {
+    let thrust_only =
+        NominalModel::load(&workspace().join("experiments/mismatch/neural-fly.json")).unwrap();
+    let mut log = flight(Effects::default(), 6);
+    log.path = "zero_hover.csv".into();
+    log.hover_throttle[10] = 0.0;
+    let error = analyze(&log, &thrust_only, "nf", &settings())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.starts_with("zero_hover.csv:12:hover_throttle: must be positive"),
+        "{error}"
+    );
+}
+
+/// The shortest flight the simulator accepts is long enough for the analysis.
+#[test]
+fn the_shortest_simulated_flight_can_be_analysed() {
+    let duration_s = (physics::MIN_LOG_ROWS - 1) as f64 / 50.0;
+    let scenario = Scenario {
+        model: "demo-quad.json".into(),
+        duration_s,
+        warmup_s: 3.0,
+        seed: 8,
+        physics_rate_hz: 500.0,
+        log_rate_hz: 50.0,
+        hover_throttle: 0.5,
+        trajectory: Trajectory::Figure8 {
+            center: [0.0, 0.0, 1.5],
+            first: [1.8, 0.0, 0.0],
+            second: [0.0, 0.9, 0.4],
+            period_s: 6.0,
+            low_passes: Vec::new(),
+            yaw_amplitude_rad: 0.3,
+            yaw_period_s: 9.0,
+        },
+        effects: Effects::default(),
+        noise: Noise {
+            position_m: 0.002,
+            velocity_m_s: 0.005,
+            attitude_rad: 0.002,
+            rate_rad_s: 0.008,
+        },
+        gains: Default::default(),
+    };
+    let log = simulate(&model(), &scenario, "short").unwrap();
+    assert_eq!(log.len(), physics::MIN_LOG_ROWS);
+    analyze(&log, &model(), "demo", &AnalysisSettings::default()).unwrap();
+    let mut shorter = scenario.clone();
+    shorter.duration_s -= 0.02;
+    assert!(simulate(&model(), &shorter, "shorter").is_err());
+}

@@ -44,6 +44,42 @@ impl Default for Gains {
     }
 }
 
+impl Gains {
+    /// Checks every gain; the error names the field (`position`, …). The proportional and
+    /// derivative gains must be positive (without them the loop cannot be stable), the integral
+    /// gains and the integral limit non-negative (0 switches the integral action off); all finite.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        let positive = [
+            ("position", self.position),
+            ("velocity", self.velocity),
+            ("attitude", self.attitude),
+            ("rate", self.rate),
+        ];
+        for (name, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err((
+                    name.to_string(),
+                    format!("must be a finite positive number, found {value}"),
+                ));
+            }
+        }
+        let non_negative = [
+            ("position_integral", self.position_integral),
+            ("attitude_integral", self.attitude_integral),
+            ("integral_limit", self.integral_limit),
+        ];
+        for (name, value) in non_negative {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err((
+                    name.to_string(),
+                    format!("must be a finite number ≥ 0, found {value}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The state the controller sees (measured, possibly noisy).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MeasuredState {
@@ -212,6 +248,41 @@ fn mat_sub(a: &Mat3, b: &Mat3) -> Mat3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn gains_are_checked_for_sign_and_finiteness() {
+        assert!(Gains::default().validate().is_ok());
+        let off = Gains {
+            position_integral: 0.0,
+            attitude_integral: 0.0,
+            integral_limit: 0.0,
+            ..Gains::default()
+        };
+        assert!(off.validate().is_ok());
+        let negative_limit = Gains {
+            integral_limit: -1.0,
+            ..Gains::default()
+        };
+        assert_eq!(negative_limit.validate().unwrap_err().0, "integral_limit");
+        let zero_position = Gains {
+            position: 0.0,
+            ..Gains::default()
+        };
+        assert_eq!(zero_position.validate().unwrap_err().0, "position");
+        let nan_rate = Gains {
+            rate: f64::NAN,
+            ..Gains::default()
+        };
+        assert_eq!(nan_rate.validate().unwrap_err().0, "rate");
+        let negative_integral = Gains {
+            attitude_integral: -150.0,
+            ..Gains::default()
+        };
+        assert_eq!(
+            negative_integral.validate().unwrap_err().0,
+            "attitude_integral"
+        );
+    }
 
     #[test]
     fn desired_rotation_points_thrust_along_the_force_with_the_heading() {

@@ -122,6 +122,7 @@ impl NominalModel {
         let object = value
             .as_object()
             .ok_or_else(|| fields.error("(top level)", "expected a JSON object"))?;
+        fields.known_keys(object, "", &MODEL_KEYS)?;
         let mass_kg = fields.positive(object, "mass_kg")?;
         let gravity_m_s2 = fields.positive(object, "gravity_m_s2")?;
         let inertia = fields.numbers(object, "inertia_kg_m2", 3)?;
@@ -268,6 +269,18 @@ pub fn angular_acceleration_with_inertia(inertia: Vec3, rate: Vec3, torque: Vec3
     ]
 }
 
+/// The fields of a model file; any other is an error (as `deny_unknown_fields` elsewhere).
+const MODEL_KEYS: [&str; 6] = [
+    "mass_kg",
+    "gravity_m_s2",
+    "inertia_kg_m2",
+    "thrust_source",
+    "mixer",
+    "ground_height_m",
+];
+/// The fields of the `mixer` object.
+const MIXER_KEYS: [&str; 3] = ["pwm_offset", "pwm_scale", "b0"];
+
 struct FieldReader {
     path: PathBuf,
 }
@@ -278,6 +291,17 @@ impl FieldReader {
             path: self.path.clone(),
             field: field.to_string(),
             message: message.to_string(),
+        }
+    }
+
+    /// Fails on the first key of `object` that is not in `known` (`prefix` names the object).
+    fn known_keys(&self, object: &Map<String, Value>, prefix: &str, known: &[&str]) -> Result<()> {
+        match object.keys().find(|key| !known.contains(&key.as_str())) {
+            Some(key) => Err(self.error(
+                &format!("{prefix}{key}"),
+                &format!("unknown field, expected one of {}", known.join(", ")),
+            )),
+            None => Ok(()),
         }
     }
 
@@ -333,6 +357,7 @@ impl FieldReader {
     }
 
     fn mixer(&self, mixer: &Map<String, Value>) -> Result<Mixer> {
+        self.known_keys(mixer, "mixer.", &MIXER_KEYS)?;
         let pwm_offset = self.finite_value(mixer.get("pwm_offset"), "mixer.pwm_offset")?;
         let pwm_scale = self.finite_value(mixer.get("pwm_scale"), "mixer.pwm_scale")?;
         if pwm_scale <= 0.0 {
@@ -347,6 +372,16 @@ impl FieldReader {
         for (i, row) in rows.iter().enumerate() {
             let values = self.numbers_of(Some(row), &format!("mixer.b0[{i}]"), 4)?;
             b0[i].copy_from_slice(&values);
+        }
+        // Row 0 maps the squared motor speeds to the collective thrust: every motor pushes up.
+        if let Some(j) = b0[0].iter().position(|v| *v <= 0.0) {
+            return Err(self.error(
+                &format!("mixer.b0[0][{j}]"),
+                &format!(
+                    "the thrust row must be positive (each motor adds thrust), found {}",
+                    b0[0][j]
+                ),
+            ));
         }
         Mixer::new(pwm_offset, pwm_scale, b0)
             .ok_or_else(|| self.error("mixer.b0", "the matrix is singular (cannot be inverted)"))
@@ -444,6 +479,29 @@ mod tests {
                 .contains("inertia_kg_m2[2]")
         );
         assert!(!parse("{").unwrap_err().to_string().contains('\n'));
+    }
+
+    #[test]
+    fn unknown_fields_are_rejected_with_their_name() {
+        let typo = MIXER_MODEL.replace("\"mass_kg\"", "\"ground_height\": 0.5, \"mass_kg\"");
+        let error = parse(&typo).unwrap_err().to_string();
+        assert!(
+            error.contains("field 'ground_height'") && error.contains("unknown"),
+            "{error}"
+        );
+        let in_mixer = MIXER_MODEL.replace("\"pwm_scale\"", "\"pwm_gain\": 2, \"pwm_scale\"");
+        let error = parse(&in_mixer).unwrap_err().to_string();
+        assert!(error.contains("field 'mixer.pwm_gain'"), "{error}");
+        let spelled_out =
+            MIXER_MODEL.replace("\"mass_kg\"", "\"ground_height_m\": 0.5, \"mass_kg\"");
+        assert_eq!(parse(&spelled_out).unwrap().ground_height_m, 0.5);
+    }
+
+    #[test]
+    fn the_thrust_row_of_the_mixer_must_be_positive() {
+        let negative = MIXER_MODEL.replace("[9.7, 9.7, 9.7, 9.7]", "[9.7, 9.7, -9.7, 9.7]");
+        let error = parse(&negative).unwrap_err().to_string();
+        assert!(error.contains("mixer.b0[0][2]"), "{error}");
     }
 
     #[test]

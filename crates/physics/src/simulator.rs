@@ -8,6 +8,7 @@
 //! Measurement noise (Gaussian, from the scenario's seed) is added to position, velocity, attitude
 //! and body rate; the controller sees the noisy values, as on a real vehicle.
 
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
 use rand::{RngExt, SeedableRng};
@@ -73,8 +74,27 @@ fn default_hover_throttle() -> f64 {
     0.5
 }
 
+/// The longest flight a scenario may record, s.
+pub const MAX_DURATION_S: f64 = 3600.0;
+/// The longest warm-up before the recording, s.
+pub const MAX_WARMUP_S: f64 = 60.0;
+/// The lowest and the highest physics rate, Hz.
+pub const MIN_PHYSICS_RATE_HZ: f64 = 500.0;
+pub const MAX_PHYSICS_RATE_HZ: f64 = 10_000.0;
+/// The fewest rows a simulated log may have (`⌊duration_s · log_rate_hz⌋ + 1`): enough for the
+/// mismatch analysis (8 Savitzky–Golay windows of 21 rows) and the data tools.
+pub const MIN_LOG_ROWS: usize = 250;
+/// The most rows a simulated log may have.
+pub const MAX_LOG_ROWS: usize = 500_000;
+/// The longest actuator delay the simulator accepts, s.
+pub const MAX_DELAY_S: f64 = 1.0;
+/// The largest reference acceleration (sampled at every control step of the flight, warm-up
+/// included) a scenario may ask for, m/s² (about 2 g).
+pub const MAX_REFERENCE_ACCELERATION_M_S2: f64 = 20.0;
+
 impl Scenario {
-    /// Reads a scenario and its model (resolved relative to the scenario file).
+    /// Reads a scenario and its model (resolved relative to the scenario file), and checks both
+    /// (together: the simulator needs a mixer, and the reference must stay above the ground).
     pub fn load(path: &Path) -> Result<(Self, NominalModel)> {
         let text = std::fs::read_to_string(path).map_err(|source| PhysicsError::Io {
             path: path.to_path_buf(),
@@ -90,10 +110,17 @@ impl Scenario {
             .unwrap_or(Path::new("."))
             .join(&scenario.model);
         let model = NominalModel::load(&model_path)?;
+        scenario.validate_with_model(&model, path)?;
         Ok((scenario, model))
     }
 
-    /// Checks the settings; errors name the field.
+    /// Checks the settings; errors name the field. Bounds: `duration_s` at most
+    /// [`MAX_DURATION_S`], giving between [`MIN_LOG_ROWS`] and [`MAX_LOG_ROWS`] rows; `warmup_s` in
+    /// [0, [`MAX_WARMUP_S`]]; `physics_rate_hz` in [[`MIN_PHYSICS_RATE_HZ`],
+    /// [`MAX_PHYSICS_RATE_HZ`]] and a whole multiple of `log_rate_hz`; `hover_throttle` in (0, 1];
+    /// gains, effects, noise and trajectory as their own checks say, a delay of at most
+    /// [`MAX_DELAY_S`], and a reference acceleration of at most
+    /// [`MAX_REFERENCE_ACCELERATION_M_S2`].
     pub fn validate(&self, origin: &Path) -> Result<()> {
         let field = |field: String, message: String| PhysicsError::Field {
             path: origin.to_path_buf(),
@@ -111,15 +138,39 @@ impl Scenario {
             }
         };
         positive("duration_s", self.duration_s)?;
-        if !(self.warmup_s.is_finite() && self.warmup_s >= 0.0) {
-            return Err(field("warmup_s".into(), "must be ≥ 0".into()));
+        if self.duration_s > MAX_DURATION_S {
+            return Err(field(
+                "duration_s".into(),
+                format!("at most {MAX_DURATION_S} s, found {}", self.duration_s),
+            ));
+        }
+        if !(self.warmup_s.is_finite() && (0.0..=MAX_WARMUP_S).contains(&self.warmup_s)) {
+            return Err(field(
+                "warmup_s".into(),
+                format!(
+                    "must be between 0 and {MAX_WARMUP_S} s, found {}",
+                    self.warmup_s
+                ),
+            ));
         }
         positive("log_rate_hz", self.log_rate_hz)?;
         positive("hover_throttle", self.hover_throttle)?;
-        if self.physics_rate_hz.is_nan() || self.physics_rate_hz < 500.0 {
+        if self.hover_throttle > 1.0 {
+            return Err(field(
+                "hover_throttle".into(),
+                format!(
+                    "a normalised throttle, must be at most 1, found {}",
+                    self.hover_throttle
+                ),
+            ));
+        }
+        if !(MIN_PHYSICS_RATE_HZ..=MAX_PHYSICS_RATE_HZ).contains(&self.physics_rate_hz) {
             return Err(field(
                 "physics_rate_hz".into(),
-                format!("must be at least 500, found {}", self.physics_rate_hz),
+                format!(
+                    "must be between {MIN_PHYSICS_RATE_HZ} and {MAX_PHYSICS_RATE_HZ}, found {}",
+                    self.physics_rate_hz
+                ),
             ));
         }
         let ratio = self.physics_rate_hz / self.log_rate_hz;
@@ -129,21 +180,106 @@ impl Scenario {
                 "must be a whole multiple of log_rate_hz".into(),
             ));
         }
+        let rows = self.rows();
+        if !(MIN_LOG_ROWS..=MAX_LOG_ROWS).contains(&rows) {
+            return Err(field(
+                "duration_s".into(),
+                format!(
+                    "duration_s · log_rate_hz gives {rows} rows, a log needs between {MIN_LOG_ROWS} and {MAX_LOG_ROWS}"
+                ),
+            ));
+        }
+        self.gains
+            .validate()
+            .map_err(|(f, m)| field(format!("gains.{f}"), m))?;
         self.effects
             .validate()
             .map_err(|(f, m)| field(format!("effects.{f}"), m))?;
-        self.trajectory.validate().map_err(|(f, m)| field(f, m))?;
-        let n = self.noise;
-        if [n.position_m, n.velocity_m_s, n.attitude_rad, n.rate_rad_s]
-            .iter()
-            .any(|v| !(v.is_finite() && *v >= 0.0))
-        {
+        if self.effects.delay_s() > MAX_DELAY_S {
             return Err(field(
-                "noise".into(),
-                "standard deviations must be ≥ 0".into(),
+                "effects.delay.delay_s".into(),
+                format!("at most {MAX_DELAY_S} s, found {}", self.effects.delay_s()),
             ));
         }
+        let n = self.noise;
+        for (name, value) in [
+            ("position_m", n.position_m),
+            ("velocity_m_s", n.velocity_m_s),
+            ("attitude_rad", n.attitude_rad),
+            ("rate_rad_s", n.rate_rad_s),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(field(
+                    format!("noise.{name}"),
+                    format!("a standard deviation, must be ≥ 0, found {value}"),
+                ));
+            }
+        }
+        self.trajectory.validate().map_err(|(f, m)| field(f, m))?;
+        let generator = self.trajectory.generator();
+        for t in self.control_times() {
+            let a = norm(generator.at(t).acceleration);
+            if a.is_nan() || a > MAX_REFERENCE_ACCELERATION_M_S2 {
+                return Err(field(
+                    "trajectory".into(),
+                    format!(
+                        "the reference accelerates at {a:.4} m/s² at t = {t:.2} s, more than the {MAX_REFERENCE_ACCELERATION_M_S2} m/s² allowed"
+                    ),
+                ));
+            }
+        }
         Ok(())
+    }
+
+    /// Checks the scenario against its model: the simulator needs a mixer, and the reference must
+    /// stay above the model's ground plane.
+    pub fn validate_with_model(&self, model: &NominalModel, origin: &Path) -> Result<()> {
+        let field = |field: &str, message: String| PhysicsError::Field {
+            path: origin.to_path_buf(),
+            field: field.to_string(),
+            message,
+        };
+        if model.mixer.is_none() || !model.predicts_torque() {
+            return Err(field(
+                "model",
+                format!(
+                    "{}: the simulator needs a model with a mixer (thrust_source \"mixer\")",
+                    self.model.display()
+                ),
+            ));
+        }
+        let generator = self.trajectory.generator();
+        for t in self.control_times() {
+            let z = generator.at(t).position[2];
+            if z.is_nan() || z <= model.ground_height_m {
+                return Err(field(
+                    "trajectory",
+                    format!(
+                        "the reference is at height {z:.3} m at t = {t:.2} s, not above the model's ground (ground_height_m = {})",
+                        model.ground_height_m
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of logged rows.
+    fn rows(&self) -> usize {
+        (self.duration_s * self.log_rate_hz).floor() as usize + 1
+    }
+
+    /// Number of control steps flown before the recording starts.
+    fn warmup_rows(&self) -> usize {
+        (self.warmup_s * self.log_rate_hz).round() as usize
+    }
+
+    /// The time of every control step, warm-up included (as [`simulate`] computes them).
+    fn control_times(&self) -> impl Iterator<Item = f64> {
+        let control_dt = 1.0 / self.log_rate_hz;
+        let warmup_rows = self.warmup_rows();
+        (0..warmup_rows + self.rows())
+            .map(move |step| (step as f64 - warmup_rows as f64) * control_dt)
     }
 }
 
@@ -298,6 +434,7 @@ impl Gaussian {
 /// Simulates a scenario with its model and returns the flight log (path set to `name.csv`).
 pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result<FlightLog> {
     scenario.validate(Path::new(name))?;
+    scenario.validate_with_model(model, Path::new(name))?;
     let mixer = model.mixer.as_ref().ok_or_else(|| {
         PhysicsError::Simulation(
             "the simulator needs a model with a mixer (thrust_source \"mixer\")".into(),
@@ -306,8 +443,8 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
     let control_dt = 1.0 / scenario.log_rate_hz;
     let substeps = (scenario.physics_rate_hz / scenario.log_rate_hz).round() as usize;
     let h = control_dt / substeps as f64;
-    let rows = (scenario.duration_s * scenario.log_rate_hz).floor() as usize + 1;
-    let warmup_rows = (scenario.warmup_s * scenario.log_rate_hz).round() as usize;
+    let rows = scenario.rows();
+    let warmup_rows = scenario.warmup_rows();
     let delay_steps = (scenario.effects.delay_s() / h).round() as usize;
     let generator = scenario.trajectory.generator();
     let mut controller = GeometricController::new(model, scenario.gains);
@@ -328,7 +465,7 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
         speeds: hover_speeds,
     };
     // Commands per physics step, so that a delay of any multiple of the physics step is exact.
-    let mut applied: Vec<[f64; 4]> = Vec::with_capacity(rows * substeps);
+    let mut applied = CommandQueue::new(delay_steps);
     let mut log = empty_log(name, rows);
     for step in 0..warmup_rows + rows {
         let t = (step as f64 - warmup_rows as f64) * control_dt;
@@ -344,8 +481,7 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
         let speeds = mixer.speeds_for(&wrench);
         if step < warmup_rows {
             for _ in 0..substeps {
-                applied.push(speeds);
-                let command = delayed(&applied, delay_steps);
+                let command = applied.push(speeds);
                 state = rk4_step(&plant, &state, command, h);
             }
             check_state(&state, &reference.position, t)?;
@@ -373,8 +509,7 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
             break;
         }
         for _ in 0..substeps {
-            applied.push(speeds);
-            let command = delayed(&applied, delay_steps);
+            let command = applied.push(speeds);
             state = rk4_step(&plant, &state, command, h);
         }
         check_state(&state, &reference.position, t)?;
@@ -382,14 +517,36 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
     Ok(log)
 }
 
-/// The command the actuators receive now: the one issued `delay_steps` physics steps ago (the first
-/// command before that).
-fn delayed(applied: &[[f64; 4]], delay_steps: usize) -> [f64; 4] {
-    let index = applied.len() - 1;
-    if index >= delay_steps {
-        applied[index - delay_steps]
-    } else {
-        applied[0]
+/// The commands issued per physics step, of which only the last `delay_steps + 1` (and the very
+/// first) are kept.
+struct CommandQueue {
+    delay_steps: usize,
+    first: Option<[f64; 4]>,
+    recent: VecDeque<[f64; 4]>,
+}
+
+impl CommandQueue {
+    fn new(delay_steps: usize) -> Self {
+        Self {
+            delay_steps,
+            first: None,
+            recent: VecDeque::with_capacity(delay_steps + 1),
+        }
+    }
+
+    /// Records a command and returns the one the actuators receive now: the one issued
+    /// `delay_steps` physics steps ago (the first command before that).
+    fn push(&mut self, command: [f64; 4]) -> [f64; 4] {
+        let first = *self.first.get_or_insert(command);
+        self.recent.push_back(command);
+        if self.recent.len() > self.delay_steps + 1 {
+            self.recent.pop_front();
+        }
+        if self.recent.len() == self.delay_steps + 1 {
+            self.recent[0]
+        } else {
+            first
+        }
     }
 }
 
@@ -442,5 +599,215 @@ fn empty_log(name: &str, rows: usize) -> FlightLog {
         velocity_desired: Some(Vec::with_capacity(rows)),
         attitude_setpoint: Some(Vec::with_capacity(rows)),
         residual_force: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MODEL: &str = r#"{"mass_kg": 1.8, "gravity_m_s2": 9.81, "inertia_kg_m2": [0.02, 0.02, 0.035],
+        "thrust_source": "mixer",
+        "mixer": {"pwm_offset": 1000.0, "pwm_scale": 1000.0,
+                  "b0": [[9.0, 9.0, 9.0, 9.0], [-1.08, 1.08, 1.08, -1.08], [1.08, -1.08, 1.08, -1.08], [0.144, 0.144, -0.144, -0.144]]}}"#;
+
+    fn model() -> NominalModel {
+        NominalModel::from_json(MODEL, Path::new("quad.json")).unwrap()
+    }
+
+    fn scenario() -> Scenario {
+        Scenario {
+            model: "quad.json".into(),
+            duration_s: 6.0,
+            warmup_s: 4.0,
+            seed: 1,
+            physics_rate_hz: 500.0,
+            log_rate_hz: 50.0,
+            hover_throttle: 0.5,
+            trajectory: Trajectory::Figure8 {
+                center: [0.0, 0.0, 1.5],
+                first: [1.8, 0.0, 0.0],
+                second: [0.0, 0.9, 0.4],
+                period_s: 6.0,
+                low_passes: Vec::new(),
+                yaw_amplitude_rad: 0.3,
+                yaw_period_s: 9.0,
+            },
+            effects: Effects::default(),
+            noise: Noise::default(),
+            gains: Gains::default(),
+        }
+    }
+
+    /// The field named by the validation error of a changed scenario.
+    fn rejected_field(change: impl FnOnce(&mut Scenario)) -> String {
+        let mut s = scenario();
+        change(&mut s);
+        let error = s
+            .validate(Path::new("s.json"))
+            .and_then(|()| s.validate_with_model(&model(), Path::new("s.json")))
+            .unwrap_err();
+        let text = error.to_string();
+        assert!(!text.contains('\n'), "{text}");
+        assert!(text.starts_with("s.json: field '"), "{text}");
+        match error {
+            PhysicsError::Field { field, .. } => field,
+            other => panic!("not a field error: {other}"),
+        }
+    }
+
+    #[test]
+    fn a_valid_scenario_passes() {
+        let s = scenario();
+        s.validate(Path::new("s.json")).unwrap();
+        s.validate_with_model(&model(), Path::new("s.json"))
+            .unwrap();
+    }
+
+    #[test]
+    fn a_negative_integral_limit_is_a_field_error_not_a_panic() {
+        assert_eq!(
+            rejected_field(|s| s.gains.integral_limit = -1.0),
+            "gains.integral_limit"
+        );
+        assert_eq!(
+            rejected_field(|s| s.gains.position = -6.0),
+            "gains.position"
+        );
+        assert_eq!(rejected_field(|s| s.gains.rate = 0.0), "gains.rate");
+        // and the simulator itself refuses it rather than panicking in f64::clamp
+        let mut s = scenario();
+        s.gains.integral_limit = -1.0;
+        assert!(simulate(&model(), &s, "x").is_err());
+    }
+
+    #[test]
+    fn sizes_are_bounded_above_and_below() {
+        assert_eq!(rejected_field(|s| s.duration_s = 1e7), "duration_s");
+        assert_eq!(rejected_field(|s| s.duration_s = 0.001), "duration_s");
+        // 4 s at 50 Hz is 201 rows: too few for the analysis
+        assert_eq!(rejected_field(|s| s.duration_s = 4.0), "duration_s");
+        assert_eq!(
+            rejected_field(|s| {
+                s.duration_s = 3000.0;
+                s.log_rate_hz = 500.0;
+            }),
+            "duration_s"
+        );
+        assert_eq!(rejected_field(|s| s.warmup_s = 1e7), "warmup_s");
+        assert_eq!(rejected_field(|s| s.warmup_s = -1.0), "warmup_s");
+        assert_eq!(
+            rejected_field(|s| s.physics_rate_hz = 5e8),
+            "physics_rate_hz"
+        );
+        assert_eq!(
+            rejected_field(|s| s.physics_rate_hz = f64::NAN),
+            "physics_rate_hz"
+        );
+        assert_eq!(rejected_field(|s| s.hover_throttle = 1.5), "hover_throttle");
+        let mut s = scenario();
+        s.duration_s = MAX_DURATION_S;
+        s.warmup_s = MAX_WARMUP_S;
+        s.validate(Path::new("s.json")).unwrap();
+    }
+
+    #[test]
+    fn trajectory_fields_are_field_errors_not_divergence() {
+        let set_yaw_period = |value: f64| {
+            move |s: &mut Scenario| {
+                if let Trajectory::Figure8 { yaw_period_s, .. } = &mut s.trajectory {
+                    *yaw_period_s = value;
+                }
+            }
+        };
+        assert_eq!(
+            rejected_field(set_yaw_period(0.0)),
+            "trajectory.yaw_period_s"
+        );
+        // a yaw rate no vehicle follows (0.3 rad amplitude every 0.1 s)
+        assert_eq!(
+            rejected_field(set_yaw_period(0.1)),
+            "trajectory.yaw_period_s"
+        );
+        assert_eq!(
+            rejected_field(|s| {
+                if let Trajectory::Figure8 { first, .. } = &mut s.trajectory {
+                    first[0] = 1e6;
+                }
+            }),
+            "trajectory"
+        );
+        assert_eq!(
+            rejected_field(|s| {
+                if let Trajectory::Figure8 { low_passes, .. } = &mut s.trajectory {
+                    low_passes.push(crate::trajectory::LowPass {
+                        start_s: 1.0,
+                        end_s: 5.0,
+                        height_m: -1.0,
+                        ramp_s: 1.0,
+                    });
+                }
+            }),
+            "trajectory"
+        );
+        assert_eq!(
+            rejected_field(|s| {
+                s.trajectory = Trajectory::RandomWaypoints {
+                    seed: 1,
+                    count: 1_000_000_000,
+                    box_min: [-1.0, -1.0, 1.0],
+                    box_max: [1.0, 1.0, 2.0],
+                    segment_s: 2.5,
+                    yaw_amplitude_rad: 0.0,
+                    yaw_period_s: 10.0,
+                };
+            }),
+            "trajectory.count"
+        );
+    }
+
+    #[test]
+    fn noise_delay_and_model_errors_name_the_field() {
+        assert_eq!(
+            rejected_field(|s| s.noise.rate_rad_s = -0.1),
+            "noise.rate_rad_s"
+        );
+        assert_eq!(
+            rejected_field(|s| {
+                s.effects.delay = Some(crate::effects::Delay { delay_s: 1e9 });
+            }),
+            "effects.delay.delay_s"
+        );
+        let thrust_only = NominalModel::from_json(
+            r#"{"mass_kg": 2.6, "gravity_m_s2": 9.81, "inertia_kg_m2": [0.03, 0.03, 0.05], "thrust_source": "T_sp"}"#,
+            Path::new("nf.json"),
+        )
+        .unwrap();
+        let error = scenario()
+            .validate_with_model(&thrust_only, Path::new("s.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("field 'model'"), "{error}");
+    }
+
+    /// The queue gives exactly what indexing the whole history gave.
+    #[test]
+    fn the_command_queue_delays_like_the_full_history() {
+        for delay_steps in [0, 1, 3, 17] {
+            let mut queue = CommandQueue::new(delay_steps);
+            let mut history: Vec<[f64; 4]> = Vec::new();
+            for k in 0..60 {
+                let command = [k as f64, 0.5 * k as f64, 1.0, -(k as f64)];
+                history.push(command);
+                let index = history.len() - 1;
+                let expected = if index >= delay_steps {
+                    history[index - delay_steps]
+                } else {
+                    history[0]
+                };
+                assert_eq!(queue.push(command), expected);
+            }
+            assert!(queue.recent.len() <= delay_steps + 1);
+        }
     }
 }

@@ -72,53 +72,112 @@ pub struct ReferenceGenerator {
     waypoints: Vec<Vec3>,
 }
 
+/// The most waypoints a random-waypoint trajectory may have (each is drawn up front).
+pub const MAX_WAYPOINTS: usize = 100_000;
+
+/// The fastest peak yaw rate `|yaw_amplitude_rad| · 2π / yaw_period_s` accepted, rad/s.
+pub const MAX_YAW_RATE_RAD_S: f64 = std::f64::consts::PI;
+
 impl Trajectory {
-    /// Checks the settings; the error names the field.
+    /// Checks the settings (finite numbers, positive periods and durations, ordered low passes,
+    /// at most [`MAX_WAYPOINTS`] waypoints, a peak yaw rate of at most [`MAX_YAW_RATE_RAD_S`]);
+    /// the error names the field.
     pub fn validate(&self) -> Result<(), (String, String)> {
-        let bad = |field: &str, message: &str| Err((field.to_string(), message.to_string()));
-        match self {
+        let bad = |field: &str, message: String| Err((format!("trajectory.{field}"), message));
+        let finite3 = |v: &Vec3| v.iter().all(|x| x.is_finite());
+        let (yaw_amplitude_rad, yaw_period_s) = match self {
             Self::Figure8 {
+                center,
+                first,
+                second,
                 period_s,
                 low_passes,
-                ..
+                yaw_amplitude_rad,
+                yaw_period_s,
             } => {
-                if !(period_s.is_finite() && *period_s > 0.0) {
-                    return bad("trajectory.period_s", "must be positive");
+                for (name, v) in [("center", center), ("first", first), ("second", second)] {
+                    if !finite3(v) {
+                        return bad(name, "must be three finite numbers".into());
+                    }
                 }
-                for pass in low_passes {
+                if !(period_s.is_finite() && *period_s > 0.0) {
+                    return bad("period_s", format!("must be positive, found {period_s}"));
+                }
+                for (i, pass) in low_passes.iter().enumerate() {
+                    let field = format!("low_passes[{i}]");
+                    let values = [pass.start_s, pass.end_s, pass.height_m, pass.ramp_s];
+                    if values.iter().any(|v| !v.is_finite()) {
+                        return bad(&field, "every number must be finite".into());
+                    }
                     if !(pass.ramp_s > 0.0 && pass.end_s - pass.start_s >= 2.0 * pass.ramp_s) {
                         return bad(
-                            "trajectory.low_passes",
-                            "each needs ramp_s > 0 and end_s − start_s ≥ 2 ramp_s",
+                            &field,
+                            "needs ramp_s > 0 and end_s − start_s ≥ 2 ramp_s".into(),
                         );
                     }
                 }
-                for pair in low_passes.windows(2) {
+                for (i, pair) in low_passes.windows(2).enumerate() {
                     if pair[1].start_s < pair[0].end_s {
                         return bad(
-                            "trajectory.low_passes",
-                            "must be in time order and not overlap",
+                            &format!("low_passes[{}]", i + 1),
+                            "low passes must be in time order and not overlap".into(),
                         );
                     }
                 }
+                (*yaw_amplitude_rad, *yaw_period_s)
             }
             Self::RandomWaypoints {
                 count,
                 segment_s,
                 box_min,
                 box_max,
+                yaw_amplitude_rad,
+                yaw_period_s,
                 ..
             } => {
                 if *count < 2 {
-                    return bad("trajectory.count", "needs at least 2 waypoints");
+                    return bad(
+                        "count",
+                        format!("needs at least 2 waypoints, found {count}"),
+                    );
+                }
+                if *count > MAX_WAYPOINTS {
+                    return bad(
+                        "count",
+                        format!("at most {MAX_WAYPOINTS} waypoints, found {count}"),
+                    );
                 }
                 if !(segment_s.is_finite() && *segment_s > 0.0) {
-                    return bad("trajectory.segment_s", "must be positive");
+                    return bad("segment_s", format!("must be positive, found {segment_s}"));
+                }
+                for (name, v) in [("box_min", box_min), ("box_max", box_max)] {
+                    if !finite3(v) {
+                        return bad(name, "must be three finite numbers".into());
+                    }
                 }
                 if (0..3).any(|i| box_max[i] < box_min[i]) {
-                    return bad("trajectory.box_max", "must not be below box_min");
+                    return bad("box_max", "must not be below box_min".into());
                 }
+                (*yaw_amplitude_rad, *yaw_period_s)
             }
+        };
+        if !yaw_amplitude_rad.is_finite() {
+            return bad("yaw_amplitude_rad", "must be a finite number".into());
+        }
+        if !(yaw_period_s.is_finite() && yaw_period_s > 0.0) {
+            return bad(
+                "yaw_period_s",
+                format!("must be positive, found {yaw_period_s}"),
+            );
+        }
+        let yaw_rate = yaw_amplitude_rad.abs() * 2.0 * std::f64::consts::PI / yaw_period_s;
+        if yaw_rate > MAX_YAW_RATE_RAD_S {
+            return bad(
+                "yaw_period_s",
+                format!(
+                    "the peak yaw rate |yaw_amplitude_rad| · 2π / yaw_period_s is {yaw_rate:.3} rad/s, more than the {MAX_YAW_RATE_RAD_S:.3} rad/s (π) allowed"
+                ),
+            );
         }
         Ok(())
     }
@@ -305,6 +364,110 @@ mod tests {
         );
         assert!((generator.at(33.0).position[2] - 0.4).abs() < 1e-12);
         assert!((generator.at(15.0).position[2] - 0.3).abs() < 1e-12);
+    }
+
+    fn figure8() -> Trajectory {
+        Trajectory::Figure8 {
+            center: [0.0, 0.0, 1.5],
+            first: [1.5, 0.0, 0.0],
+            second: [0.0, 0.8, 0.3],
+            period_s: 6.0,
+            low_passes: Vec::new(),
+            yaw_amplitude_rad: 0.3,
+            yaw_period_s: 10.0,
+        }
+    }
+
+    fn rejected_field(trajectory: Trajectory) -> String {
+        trajectory.validate().unwrap_err().0
+    }
+
+    #[test]
+    fn every_field_is_checked_and_named() {
+        assert!(figure8().validate().is_ok());
+        let Trajectory::Figure8 {
+            center,
+            first,
+            second,
+            period_s,
+            low_passes,
+            yaw_amplitude_rad,
+            yaw_period_s,
+        } = figure8()
+        else {
+            unreachable!()
+        };
+        let with = |f: &dyn Fn(&mut Trajectory)| {
+            let mut t = Trajectory::Figure8 {
+                center,
+                first,
+                second,
+                period_s,
+                low_passes: low_passes.clone(),
+                yaw_amplitude_rad,
+                yaw_period_s,
+            };
+            f(&mut t);
+            rejected_field(t)
+        };
+        let pass = |start_s, end_s, height_m, ramp_s| LowPass {
+            start_s,
+            end_s,
+            height_m,
+            ramp_s,
+        };
+        macro_rules! field_of {
+            ($name:ident, $value:expr) => {
+                with(&|t| {
+                    if let Trajectory::Figure8 { $name, .. } = t {
+                        *$name = $value;
+                    }
+                })
+            };
+        }
+        assert_eq!(field_of!(yaw_period_s, 0.0), "trajectory.yaw_period_s");
+        assert_eq!(field_of!(yaw_period_s, -3.0), "trajectory.yaw_period_s");
+        assert_eq!(field_of!(yaw_period_s, 0.01), "trajectory.yaw_period_s");
+        assert_eq!(
+            field_of!(yaw_amplitude_rad, f64::INFINITY),
+            "trajectory.yaw_amplitude_rad"
+        );
+        assert_eq!(field_of!(period_s, 0.0), "trajectory.period_s");
+        assert_eq!(field_of!(center, [0.0, f64::NAN, 1.0]), "trajectory.center");
+        assert_eq!(
+            field_of!(low_passes, vec![pass(1.0, 9.0, f64::NAN, 2.0)]),
+            "trajectory.low_passes[0]"
+        );
+        assert_eq!(
+            field_of!(
+                low_passes,
+                vec![pass(1.0, 9.0, 0.3, 2.0), pass(8.0, 20.0, 0.3, 2.0)]
+            ),
+            "trajectory.low_passes[1]"
+        );
+        let waypoints = |count, segment_s, yaw_period_s| Trajectory::RandomWaypoints {
+            seed: 1,
+            count,
+            box_min: [-1.0, -1.0, 1.0],
+            box_max: [1.0, 1.0, 2.0],
+            segment_s,
+            yaw_amplitude_rad: 0.5,
+            yaw_period_s,
+        };
+        assert!(waypoints(5, 2.5, 7.0).validate().is_ok());
+        assert_eq!(rejected_field(waypoints(1, 2.5, 7.0)), "trajectory.count");
+        assert_eq!(
+            rejected_field(waypoints(MAX_WAYPOINTS + 1, 2.5, 7.0)),
+            "trajectory.count"
+        );
+        assert_eq!(
+            rejected_field(waypoints(5, 0.0, 7.0)),
+            "trajectory.segment_s"
+        );
+        assert_eq!(
+            rejected_field(waypoints(5, 2.5, 0.0)),
+            "trajectory.yaw_period_s"
+        );
     }
 
     #[test]

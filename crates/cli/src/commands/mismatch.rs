@@ -17,8 +17,8 @@ pub struct Args {
     /// A recording in the Neural-Fly CSV layout.
     #[arg(long, conflicts_with_all = ["demo", "flights"])]
     pub recording: Option<PathBuf>,
-    /// The nominal model JSON.
-    #[arg(long)]
+    /// The nominal model JSON (not with --demo: each scenario names its own model).
+    #[arg(long, conflicts_with = "demo")]
     pub model: Option<PathBuf>,
     /// Output directory.
     #[arg(long)]

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 
 use super::Global;
 
@@ -21,6 +21,9 @@ pub struct Args {
 }
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
+    if args.out.is_dir() {
+        bail!("{}: is a directory, not a CSV file", args.out.display());
+    }
     super::refuse_overwrite(&args.out, args.force)?;
     let (scenario, model) = physics::Scenario::load(&args.scenario)?;
     let name = args

@@ -65,6 +65,9 @@ pub struct ExperimentConditions {
     pub evaluation_controller: String,
     pub conditions: Vec<Condition>,
     pub paper_training: PaperTraining,
+    /// The file this was read from (names it in errors of [`ExperimentConditions::condition`]).
+    #[serde(skip)]
+    source: Option<PathBuf>,
 }
 
 /// One flight file a configuration refers to, and whether it is present.
@@ -83,12 +86,13 @@ impl ExperimentConditions {
             path: path.to_path_buf(),
             source,
         })?;
-        let config: Self = serde_json::from_str(&text).map_err(|error| DataError::Config {
+        let mut config: Self = serde_json::from_str(&text).map_err(|error| DataError::Config {
             path: path.to_path_buf(),
             field: format!("line {} column {}", error.line(), error.column()),
             message: error.to_string(),
         })?;
         config.validate(path)?;
+        config.source = Some(path.to_path_buf());
         Ok(config)
     }
 
@@ -98,36 +102,102 @@ impl ExperimentConditions {
             field: field.to_string(),
             message,
         };
+        for (index, controller) in self.controllers.iter().enumerate() {
+            if controller.trim().is_empty() {
+                return Err(config_error(
+                    &format!("controllers[{index}]"),
+                    "empty controller name".to_string(),
+                ));
+            }
+            if self.controllers[..index].contains(controller) {
+                return Err(config_error(
+                    "controllers",
+                    format!("controller '{controller}' is listed twice"),
+                ));
+            }
+        }
         if !self.controllers.contains(&self.evaluation_controller) {
             return Err(config_error(
                 "evaluation_controller",
                 format!("'{}' is not in controllers", self.evaluation_controller),
             ));
         }
-        let mut seen = std::collections::BTreeSet::new();
-        for condition in &self.conditions {
-            if !seen.insert(&condition.name) {
-                return Err(config_error(
-                    "conditions",
-                    format!("condition '{}' is declared twice", condition.name),
-                ));
-            }
+        check_pattern(&self.file_pattern, &["controller", "condition"])
+            .map_err(|message| config_error("file_pattern", message))?;
+        if self.conditions.is_empty() {
+            return Err(config_error(
+                "conditions",
+                "no condition is declared (at least one evaluation condition is needed)"
+                    .to_string(),
+            ));
+        }
+        check_conditions(&self.conditions, "conditions", &config_error)?;
+        for (index, condition) in self.conditions.iter().enumerate() {
             if let Some(controller) = condition
                 .files
                 .keys()
                 .find(|c| !self.controllers.contains(c))
             {
                 return Err(config_error(
-                    &format!("conditions.{}.files", condition.name),
-                    format!("unknown controller '{controller}'"),
+                    &format!("conditions[{index}].files"),
+                    format!(
+                        "unknown controller '{controller}' (condition '{}')",
+                        condition.name
+                    ),
+                ));
+            }
+            if let Some((controller, file)) = condition
+                .files
+                .iter()
+                .find(|(_, file)| file.trim().is_empty() || Path::new(file).is_absolute())
+            {
+                return Err(config_error(
+                    &format!("conditions[{index}].files.{controller}"),
+                    format!("'{file}' must be a path relative to the data directory"),
                 ));
             }
         }
-        if !self.file_pattern.contains("{condition}") {
+        if self.evaluation().next().is_none() {
             return Err(config_error(
-                "file_pattern",
-                "must contain {condition}".to_string(),
+                "conditions",
+                "no condition has role \"evaluation\" (the tables would have no row)".to_string(),
             ));
+        }
+        let paper = &self.paper_training;
+        check_pattern(&paper.file_pattern, &["condition"])
+            .map_err(|message| config_error("paper_training.file_pattern", message))?;
+        if paper.conditions.is_empty() {
+            return Err(config_error(
+                "paper_training.conditions",
+                "no condition is declared (the paper's protocol needs its training flights)"
+                    .to_string(),
+            ));
+        }
+        check_conditions(
+            &paper.conditions,
+            "paper_training.conditions",
+            &config_error,
+        )?;
+        for (index, condition) in paper.conditions.iter().enumerate() {
+            let field = format!("paper_training.conditions[{index}]");
+            if condition.role != Role::MetaTraining {
+                return Err(config_error(
+                    &format!("{field}.role"),
+                    format!(
+                        "'{}': the paper's training flights are \"meta-training\"",
+                        condition.name
+                    ),
+                ));
+            }
+            if !condition.files.is_empty() {
+                return Err(config_error(
+                    &format!("{field}.files"),
+                    format!(
+                        "'{}': paper_training flights follow paper_training.file_pattern",
+                        condition.name
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -141,19 +211,30 @@ impl ExperimentConditions {
 
     /// A condition by its name or label.
     pub fn condition(&self, name: &str) -> Result<&Condition> {
-        self.conditions
+        if let Some(condition) = self
+            .conditions
             .iter()
             .find(|c| c.name == name || c.label() == name)
-            .ok_or_else(|| DataError::UnknownName {
-                kind: "condition",
-                name: name.to_string(),
-                known: self
-                    .conditions
-                    .iter()
-                    .map(|c| c.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })
+        {
+            return Ok(condition);
+        }
+        let known: Vec<&str> = self.conditions.iter().map(|c| c.name.as_str()).collect();
+        let message = if known.is_empty() {
+            format!("unknown condition '{name}': no conditions are declared")
+        } else {
+            format!("unknown condition '{name}' (known: {})", known.join(", "))
+        };
+        Err(match &self.source {
+            Some(path) => DataError::Config {
+                path: path.clone(),
+                field: "conditions".to_string(),
+                message,
+            },
+            None => DataError::Invalid {
+                what: "conditions".to_string(),
+                message,
+            },
+        })
     }
 
     /// Path of the flight of `controller` in `condition`, under `data_dir`.
@@ -209,6 +290,96 @@ impl ExperimentConditions {
             .filter(|f| f.controller == "paper-training")
             .all(|f| f.present)
     }
+}
+
+/// Checks a file pattern: braces balanced, only the `allowed` placeholders, `{condition}` present,
+/// relative to the data directory.
+fn check_pattern(pattern: &str, allowed: &[&str]) -> std::result::Result<(), String> {
+    let known = allowed
+        .iter()
+        .map(|p| format!("{{{p}}}"))
+        .collect::<Vec<_>>()
+        .join(" and ");
+    let mut rest = pattern;
+    while let Some(open) = rest.find(['{', '}']) {
+        if rest[open..].starts_with('}') {
+            return Err(format!("'{pattern}' has a '}}' without its '{{'"));
+        }
+        let after = &rest[open + 1..];
+        let close = after
+            .find(['{', '}'])
+            .filter(|&i| after[i..].starts_with('}'))
+            .ok_or_else(|| format!("'{pattern}' has a '{{' that is not closed"))?;
+        let placeholder = &after[..close];
+        if !allowed.contains(&placeholder) {
+            return Err(format!(
+                "'{pattern}': unknown placeholder {{{placeholder}}} (known: {known})"
+            ));
+        }
+        rest = &after[close + 1..];
+    }
+    if !pattern.contains("{condition}") {
+        return Err("must contain {condition}".to_string());
+    }
+    if Path::new(pattern).is_absolute() {
+        return Err(format!(
+            "'{pattern}' must be a path relative to the data directory"
+        ));
+    }
+    Ok(())
+}
+
+/// Names present and unique, labels present and unique: a name or label designates one condition.
+fn check_conditions(
+    conditions: &[Condition],
+    list: &str,
+    config_error: &dyn Fn(&str, String) -> DataError,
+) -> Result<()> {
+    for (index, condition) in conditions.iter().enumerate() {
+        let field = format!("{list}[{index}]");
+        if condition.name.trim().is_empty() {
+            return Err(config_error(
+                &format!("{field}.name"),
+                "empty condition name".to_string(),
+            ));
+        }
+        if condition
+            .label
+            .as_deref()
+            .is_some_and(|l| l.trim().is_empty())
+        {
+            return Err(config_error(
+                &format!("{field}.label"),
+                format!("empty label (condition '{}')", condition.name),
+            ));
+        }
+        for (other_index, other) in conditions[..index].iter().enumerate() {
+            if other.name == condition.name {
+                return Err(config_error(
+                    list,
+                    format!("condition '{}' is declared twice", condition.name),
+                ));
+            }
+            let ours = [condition.name.as_str(), condition.label()];
+            let theirs = [other.name.as_str(), other.label()];
+            if let Some(clash) = ours.iter().find(|n| theirs.contains(n)) {
+                // The label that repeats a name or label: this condition's, or the other's.
+                let culprit = if *clash == condition.name {
+                    other_index
+                } else {
+                    index
+                };
+                return Err(config_error(
+                    &format!("{list}[{culprit}].label"),
+                    format!(
+                        "'{clash}' names both '{}' ({list}[{other_index}]) and '{}'",
+                        other.name, condition.name
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -277,5 +448,158 @@ mod tests {
             message.contains("evaluation_controller") && message.contains("pid"),
             "{message}"
         );
+    }
+
+    /// Loads `sample()` edited by `edit`, expecting an error that names the file and `needles`.
+    fn rejected(name: &str, edit: impl Fn(&str) -> String, needles: &[&str]) {
+        let dir = std::env::temp_dir().join(format!("conditions-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("conditions.json");
+        let text = edit(sample());
+        assert_ne!(text, sample(), "{name}: the edit changed nothing");
+        std::fs::write(&path, text).unwrap();
+        let message = ExperimentConditions::load(&path).unwrap_err().to_string();
+        assert!(!message.contains('\n'), "{message}");
+        assert!(message.contains("conditions.json: "), "{message}");
+        for needle in needles {
+            assert!(
+                message.contains(needle),
+                "{name}: {needle:?} missing from {message}"
+            );
+        }
+    }
+
+    #[test]
+    fn names_and_labels_designate_one_condition_each() {
+        rejected(
+            "dup-label",
+            |s| s.replace("\"label\": \"70psin20\"", "\"label\": \"extra\""),
+            &["conditions[1].label", "'extra' names both"],
+        );
+        rejected(
+            "label-is-another-name",
+            |s| s.replace("\"label\": \"70psin20\"", "\"label\": \"nowind\""),
+            &["conditions[1].label", "'nowind'"],
+        );
+        rejected(
+            "empty-name",
+            |s| s.replace("\"name\": \"extra\"", "\"name\": \" \""),
+            &["conditions[2].name", "empty condition name"],
+        );
+        rejected(
+            "empty-label",
+            |s| s.replace("\"label\": \"70psin20\"", "\"label\": \"\""),
+            &["conditions[1].label", "empty label"],
+        );
+        rejected(
+            "dup-paper",
+            |s| {
+                s.replace(
+                    "\"conditions\": [{\"name\": \"10wind\", \"wind_speed\": \"1.3 m/s\", \"role\": \"meta-training\"}]",
+                    "\"conditions\": [{\"name\": \"10wind\", \"wind_speed\": \"1.3 m/s\", \"role\": \"meta-training\"}, {\"name\": \"10wind\", \"wind_speed\": \"1 m/s\", \"role\": \"meta-training\"}]",
+                )
+            },
+            &["paper_training.conditions", "'10wind' is declared twice"],
+        );
+        rejected(
+            "dup-controller",
+            |s| s.replace("[\"baseline\", \"NF\"]", "[\"baseline\", \"NF\", \"NF\"]"),
+            &["controllers", "'NF' is listed twice"],
+        );
+    }
+
+    #[test]
+    fn file_patterns_use_known_placeholders_only() {
+        rejected(
+            "unknown-placeholder",
+            |s| s.replace("{controller}_{condition}", "{ctrl}_{condition}"),
+            &["file_pattern", "unknown placeholder {ctrl}"],
+        );
+        rejected(
+            "unclosed",
+            |s| s.replace("{controller}_{condition}", "{controller_{condition}"),
+            &["file_pattern", "not closed"],
+        );
+        rejected(
+            "stray-brace",
+            |s| s.replace("{controller}_{condition}", "controller}_{condition}"),
+            &["file_pattern", "'}' without its '{'"],
+        );
+        rejected(
+            "absolute",
+            |s| s.replace("experiment/custom_figure8_", "/etc/"),
+            &["file_pattern", "relative to the data directory"],
+        );
+        rejected(
+            "paper-controller",
+            |s| s.replace("custom_random3_baseline_", "custom_random3_{controller}_"),
+            &[
+                "paper_training.file_pattern",
+                "unknown placeholder {controller}",
+            ],
+        );
+        rejected(
+            "absolute-file",
+            |s| s.replace("mine/extra.csv", "/mine/extra.csv"),
+            &["conditions[2].files.baseline", "relative"],
+        );
+    }
+
+    #[test]
+    fn there_is_something_to_evaluate_and_to_train_on() {
+        rejected(
+            "no-conditions",
+            |s| {
+                let start = s.find("\"conditions\": [").unwrap();
+                let end = s.find("],\n          \"paper_training\"").unwrap();
+                format!("{}\"conditions\": [{}", &s[..start], &s[end..])
+            },
+            &["conditions: no condition is declared"],
+        );
+        rejected(
+            "no-evaluation",
+            |s| s.replace("\"role\": \"evaluation\"", "\"role\": \"meta-training\""),
+            &["conditions: no condition has role \"evaluation\""],
+        );
+        rejected(
+            "no-paper-conditions",
+            |s| {
+                let start = s.rfind("\"conditions\": [").unwrap();
+                format!("{}\"conditions\": []}}\n}}", &s[..start])
+            },
+            &["paper_training.conditions", "no condition is declared"],
+        );
+        rejected(
+            "paper-evaluation",
+            |s| {
+                s.replace(
+                    "\"1.3 m/s\", \"role\": \"meta-training\"",
+                    "\"1.3 m/s\", \"role\": \"evaluation\"",
+                )
+            },
+            &["paper_training.conditions[0].role"],
+        );
+    }
+
+    #[test]
+    fn an_unknown_condition_names_the_file() {
+        let dir = std::env::temp_dir().join(format!("conditions-unknown-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("conditions.json");
+        std::fs::write(&path, sample()).unwrap();
+        let mut config = ExperimentConditions::load(&path).unwrap();
+        let message = config.condition("200wind").unwrap_err().to_string();
+        assert!(
+            message.contains("conditions.json: conditions: unknown condition '200wind' (known: nowind, 70p20sint, extra)"),
+            "{message}"
+        );
+        // Only a configuration built in code can have none (load refuses it): say so.
+        config.conditions.clear();
+        let message = config.condition("35wind").unwrap_err().to_string();
+        assert!(
+            message.contains("conditions.json") && message.contains("no conditions are declared"),
+            "{message}"
+        );
+        assert!(!message.contains("known: )"), "{message}");
     }
 }

@@ -82,7 +82,7 @@ impl Derivative {
             return Err(DataError::Invalid {
                 what: "derivative".to_string(),
                 message: format!(
-                    "{} samples, the {:?} estimator needs at least {}",
+                    "{} samples, the {} estimator needs at least {}",
                     x.len(),
                     self,
                     self.min_samples()
@@ -94,6 +94,17 @@ impl Derivative {
             Self::Central => central(x, dt),
             Self::SavitzkyGolay { window, order } => savitzky_golay(x, dt, window, order),
         })
+    }
+}
+
+impl std::fmt::Display for Derivative {
+    /// The form [`Derivative::parse`] reads: `forward`, `central` or `savgol:W:O`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Forward => write!(f, "forward"),
+            Self::Central => write!(f, "central"),
+            Self::SavitzkyGolay { window, order } => write!(f, "savgol:{window}:{order}"),
+        }
     }
 }
 
@@ -285,5 +296,23 @@ mod tests {
                 .contains("spline")
         );
         assert!(Derivative::Central.apply(&[1.0, 2.0], 0.1).is_err());
+    }
+
+    #[test]
+    fn too_few_samples_name_the_estimator_as_written() {
+        let message = Derivative::SavitzkyGolay {
+            window: 1001,
+            order: 2,
+        }
+        .apply(&[0.0; 500], 0.01)
+        .unwrap_err()
+        .to_string();
+        assert!(
+            message.contains("500 samples, the savgol:1001:2 estimator needs at least 1001"),
+            "{message}"
+        );
+        for text in ["forward", "central", "savgol:11:2"] {
+            assert_eq!(Derivative::parse(text).unwrap().to_string(), text);
+        }
     }
 }

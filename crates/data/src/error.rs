@@ -17,6 +17,31 @@ pub enum DataError {
     Csv { path: PathBuf, message: String },
     #[error("{}: the file is empty (no data rows)", path.display())]
     Empty { path: PathBuf },
+    #[error("{}: is a directory, not a CSV file", path.display())]
+    IsDirectory { path: PathBuf },
+    #[error("{}:{row}: not a CSV text file: {reason}", path.display())]
+    NotText {
+        path: PathBuf,
+        row: usize,
+        reason: String,
+    },
+    #[error(
+        "{}:{row}:{column}: column '{column}' appears twice in the header (fields {first} and {second})",
+        path.display()
+    )]
+    DuplicateColumn {
+        path: PathBuf,
+        row: usize,
+        column: String,
+        first: usize,
+        second: usize,
+    },
+    #[error("{}:{row}: {message}", path.display())]
+    BadRow {
+        path: PathBuf,
+        row: usize,
+        message: String,
+    },
     #[error("{}: missing column '{column}' (columns present: {present})", path.display())]
     MissingColumn {
         path: PathBuf,

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{DataError, Result};
-use crate::table::{TextTable, file_row};
-use crate::time::check_time_axis;
+use crate::table::TextTable;
+use crate::time::check_time_axis_at;
 
 /// `<vehicle>_<trajectory>_<method>_<condition>.csv`, as the Neural-Fly data names its files.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -87,9 +87,17 @@ pub enum RateFrame {
 impl FlightLog {
     /// Reads and validates a log. Errors name the file, row and column.
     pub fn read(path: &Path) -> Result<Self> {
+        Self::read_with_columns(path).map(|(log, _)| log)
+    }
+
+    /// [`FlightLog::read`], also returning the names of the file's columns in file order (what a
+    /// log does not keep: which of `q` and `R` were recorded, and columns it does not use).
+    pub fn read_with_columns(path: &Path) -> Result<(Self, Vec<String>)> {
         let table = TextTable::read(path)?;
         let time = table.scalars("t")?;
-        check_time_axis(path, &time, crate::time::DEFAULT_UNIFORM_TOLERANCE)?;
+        check_time_axis_at(path, &time, crate::time::DEFAULT_UNIFORM_TOLERANCE, &|k| {
+            table.line(k)
+        })?;
         let has_q = table.has_column("q");
         let has_r = table.has_column("R");
         if !has_q && !has_r {
@@ -124,7 +132,11 @@ impl FlightLog {
             (None, Some(r)) => (r.iter().map(quaternion_from_rotation).collect(), r),
             (None, None) => unreachable!("checked above"),
         };
-        check_unit_quaternions(path, &quaternion, has_q)?;
+        check_unit_quaternions(&table, &quaternion, has_q)?;
+        check_rotations(&table, &rotation, has_r)?;
+        if has_q && has_r {
+            check_agreement(&table, &quaternion, &rotation)?;
+        }
         let optional3 = |name: &str| -> Result<Option<Vec<[f64; 3]>>> {
             if table.has_column(name) {
                 table.arrays::<3>(name).map(Some)
@@ -153,7 +165,7 @@ impl FlightLog {
             quaternion,
             rotation,
         };
-        Ok(log)
+        Ok((log, table.column_names()))
     }
 
     /// Number of samples.
@@ -212,7 +224,11 @@ impl FlightLog {
     }
 }
 
-fn check_unit_quaternions(path: &Path, quaternion: &[[f64; 4]], recorded: bool) -> Result<()> {
+fn check_unit_quaternions(
+    table: &TextTable,
+    quaternion: &[[f64; 4]],
+    recorded: bool,
+) -> Result<()> {
     if !recorded {
         return Ok(());
     }
@@ -220,11 +236,71 @@ fn check_unit_quaternions(path: &Path, quaternion: &[[f64; 4]], recorded: bool) 
         let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
         if (norm - 1.0).abs() > 1e-3 {
             return Err(DataError::BadCell {
-                path: path.to_path_buf(),
-                row: file_row(index),
+                path: table.path().to_path_buf(),
+                row: table.line(index),
                 column: "q".to_string(),
                 value: format!("{q:?}"),
                 reason: format!("not a unit quaternion (norm {norm:.6})"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Largest deviation of R Rᵀ from the identity accepted for a recorded `R` (the Neural-Fly logs
+/// deviate by at most 3e-4).
+const ROTATION_TOLERANCE: f64 = 1e-2;
+
+fn check_rotations(table: &TextTable, rotation: &[[[f64; 3]; 3]], recorded: bool) -> Result<()> {
+    if !recorded {
+        return Ok(());
+    }
+    for (index, r) in rotation.iter().enumerate() {
+        let product = mat_mul(r, &transpose(r));
+        let deviation = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .map(|(i, j)| (product[i][j] - if i == j { 1.0 } else { 0.0 }).abs())
+            .fold(0.0, f64::max);
+        let determinant = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
+            - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
+            + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+        if deviation > ROTATION_TOLERANCE || determinant <= 0.0 {
+            return Err(DataError::BadCell {
+                path: table.path().to_path_buf(),
+                row: table.line(index),
+                column: "R".to_string(),
+                value: format!("{r:?}"),
+                reason: format!(
+                    "not a rotation matrix (largest |R Rᵀ − I| entry {deviation:.6}, determinant {determinant:.6})"
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// When both are recorded, `q` and `R` must describe the same attitude (the Neural-Fly logs differ
+/// by at most 2e-4 per entry).
+fn check_agreement(
+    table: &TextTable,
+    quaternion: &[[f64; 4]],
+    rotation: &[[[f64; 3]; 3]],
+) -> Result<()> {
+    for (index, (q, r)) in quaternion.iter().zip(rotation).enumerate() {
+        let from_q = rotation_from_quaternion(q);
+        let difference = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .map(|(i, j)| (from_q[i][j] - r[i][j]).abs())
+            .fold(0.0, f64::max);
+        if difference > ROTATION_TOLERANCE {
+            return Err(DataError::BadCell {
+                path: table.path().to_path_buf(),
+                row: table.line(index),
+                column: "R".to_string(),
+                value: format!("{r:?}"),
+                reason: format!(
+                    "does not match the rotation of q {q:?} (largest entry difference {difference:.6})"
+                ),
             });
         }
     }

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::Result;
 use crate::table::TextTable;
-use crate::time::check_time_axis;
+use crate::time::check_time_axis_at;
 
 /// Selected columns of a numeric CSV, validated (every cell a finite number).
 #[derive(Clone, Debug)]
@@ -12,6 +12,8 @@ pub struct NumericTable {
     pub path: PathBuf,
     pub names: Vec<String>,
     pub columns: Vec<Vec<f64>>,
+    /// The line of the file on which each row starts (the header is line 1).
+    lines: Vec<usize>,
 }
 
 impl NumericTable {
@@ -26,6 +28,7 @@ impl NumericTable {
             path: path.to_path_buf(),
             names: columns.iter().map(|s| s.to_string()).collect(),
             columns: parsed,
+            lines: table.lines().to_vec(),
         })
     }
 
@@ -36,13 +39,26 @@ impl NumericTable {
         let mut table = Self::read(path, &names)?;
         let time_values = table.columns.remove(0);
         table.names.remove(0);
-        check_time_axis(path, &time_values, crate::time::DEFAULT_UNIFORM_TOLERANCE)?;
+        check_time_axis_at(
+            path,
+            &time_values,
+            crate::time::DEFAULT_UNIFORM_TOLERANCE,
+            &|k| table.line(k),
+        )?;
         Ok((time_values, table))
     }
 
     /// Number of rows.
     pub fn rows(&self) -> usize {
         self.columns.first().map_or(0, Vec::len)
+    }
+
+    /// The line of the file on which row `index` (0-based) starts; the header is line 1.
+    pub fn line(&self, index: usize) -> usize {
+        self.lines
+            .get(index)
+            .copied()
+            .unwrap_or(crate::table::file_row(index))
     }
 
     /// A column by name.

@@ -4,6 +4,12 @@
 //! Reading every column as text (no schema inference) is deliberate: the list columns of the
 //! Neural-Fly logs are strings such as `"[1.0, 2.0]"` anyway, and parsing numbers ourselves lets a bad
 //! cell be reported at its exact row instead of silently turning a whole column into strings.
+//!
+//! Before polars parses the bytes, one pass over them checks the layout polars would otherwise
+//! accept silently or report without a line: UTF-8 text, no repeated column name (polars renames
+//! a copy `x_duplicated_0`), as many fields on every row as in the header, closed quotes, no blank
+//! or `#` line between rows. The same pass records the line each row starts on, so that errors name
+//! the right line after a quoted cell that spans lines.
 
 use std::path::{Path, PathBuf};
 
@@ -15,21 +21,38 @@ use crate::error::{DataError, Result};
 pub struct TextTable {
     path: PathBuf,
     frame: DataFrame,
+    /// The line of the file on which each data row starts (the header is line 1).
+    lines: Vec<usize>,
 }
 
-/// The line of the file that holds data row `index` (0-based); the header is line 1.
+/// The line of the file that holds data row `index` (0-based) when no cell spans lines; the header
+/// is line 1. [`TextTable::line`] gives the exact line of any row.
 pub fn file_row(index: usize) -> usize {
     index + 2
 }
 
 impl TextTable {
-    /// Reads `path` with polars; fails on a missing, empty or malformed file.
+    /// Reads `path` (a file, or a pipe: the bytes are read, whatever the length reported) and checks
+    /// its layout before polars parses it: UTF-8 text, unique column names, every row with as many
+    /// fields as the header, quotes closed. Errors name the file and the line.
     pub fn read(path: &Path) -> Result<Self> {
-        let metadata = std::fs::metadata(path).map_err(|source| DataError::Io {
+        let io = |source| DataError::Io {
             path: path.to_path_buf(),
             source,
-        })?;
-        if metadata.len() == 0 {
+        };
+        if std::fs::metadata(path).map_err(io)?.is_dir() {
+            return Err(DataError::IsDirectory {
+                path: path.to_path_buf(),
+            });
+        }
+        let bytes = std::fs::read(path).map_err(io)?;
+        if bytes.is_empty() {
+            return Err(DataError::Empty {
+                path: path.to_path_buf(),
+            });
+        }
+        let layout = Layout::scan(path, &bytes)?;
+        if layout.lines.is_empty() {
             return Err(DataError::Empty {
                 path: path.to_path_buf(),
             });
@@ -37,21 +60,45 @@ impl TextTable {
         let frame = CsvReadOptions::default()
             .with_has_header(true)
             .with_infer_schema_length(Some(0))
-            .try_into_reader_with_file_path(Some(path.to_path_buf()))
-            .and_then(|reader| reader.finish())
+            .into_reader_with_file_handle(std::io::Cursor::new(bytes))
+            .finish()
             .map_err(|error| DataError::Csv {
                 path: path.to_path_buf(),
                 message: first_line(&error.to_string()),
             })?;
-        if frame.height() == 0 {
-            return Err(DataError::Empty {
+        // polars reads each blank line at the end as a row of empty cells; the layout does not.
+        let frame = if frame.height() == layout.lines.len() + layout.trailing_blank_lines {
+            frame.head(Some(layout.lines.len()))
+        } else {
+            return Err(DataError::Csv {
                 path: path.to_path_buf(),
+                message: format!(
+                    "{} rows parsed, but the file has {} data rows",
+                    frame.height(),
+                    layout.lines.len()
+                ),
             });
-        }
+        };
         Ok(Self {
             path: path.to_path_buf(),
             frame,
+            lines: layout.lines,
         })
+    }
+
+    /// The line of the file on which data row `index` (0-based) starts; the header is line 1.
+    pub fn line(&self, index: usize) -> usize {
+        self.lines.get(index).copied().unwrap_or(file_row(index))
+    }
+
+    /// The file read.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The line of each data row, in order.
+    pub fn lines(&self) -> &[usize] {
+        &self.lines
     }
 
     /// Column names in file order.
@@ -93,7 +140,7 @@ impl TextTable {
         let mut out = Vec::with_capacity(column.len());
         let mut buffer = Vec::with_capacity(N);
         for (index, cell) in column.iter().enumerate() {
-            let row = file_row(index);
+            let row = self.line(index);
             let cell = cell.ok_or_else(|| self.bad_cell(row, name, "", "empty cell"))?;
             buffer.clear();
             parse_numbers(cell, &mut buffer)
@@ -130,6 +177,252 @@ impl TextTable {
             value: value.to_string(),
             reason: reason.to_string(),
         }
+    }
+}
+
+/// What the layout check of a CSV file found: where each data row starts.
+struct Layout {
+    /// The line on which each data row starts (1-based, the header being line 1 unless blank lines
+    /// precede it).
+    lines: Vec<usize>,
+    /// Blank lines after the last data row (accepted, not rows).
+    trailing_blank_lines: usize,
+}
+
+impl Layout {
+    /// Checks the text of a CSV file the way it is split into rows and fields (RFC 4180: `,`
+    /// separates fields, a field may be quoted with `"`, `""` inside quotes is a quote, a quoted
+    /// field may span lines; `\n` or `\r\n` ends a row).
+    fn scan(path: &Path, bytes: &[u8]) -> Result<Self> {
+        let text = std::str::from_utf8(bytes).map_err(|error| {
+            let at = error.valid_up_to();
+            DataError::NotText {
+                path: path.to_path_buf(),
+                row: line_at(bytes, at),
+                reason: format!("byte 0x{:02X} is not UTF-8 text", bytes[at]),
+            }
+        })?;
+        if let Some(at) = text
+            .bytes()
+            .position(|b| b < 0x20 && !matches!(b, b'\t' | b'\n' | b'\r'))
+        {
+            return Err(DataError::NotText {
+                path: path.to_path_buf(),
+                row: line_at(bytes, at),
+                reason: format!("control byte 0x{:02X} (binary data?)", bytes[at]),
+            });
+        }
+        let mut scanner = Scanner {
+            path,
+            bytes: text.as_bytes(),
+            position: text.strip_prefix('\u{feff}').map_or(0, |_| 3),
+            line: 1,
+        };
+        // Blank lines before the header are skipped (as polars does).
+        while scanner.at_line_end() && !scanner.at_end() {
+            scanner.skip_line_end();
+        }
+        if scanner.at_end() {
+            return Ok(Self {
+                lines: Vec::new(),
+                trailing_blank_lines: 0,
+            });
+        }
+        let header_line = scanner.line;
+        if text[scanner.position..].starts_with('#') {
+            return Err(DataError::BadRow {
+                path: path.to_path_buf(),
+                row: header_line,
+                message: "a '#' comment line: the header must come first (no comments)".to_string(),
+            });
+        }
+        let mut header = Vec::new();
+        scanner.record(Some(&mut header))?;
+        for (index, name) in header.iter().enumerate() {
+            if let Some(first) = header[..index].iter().position(|n| n == name) {
+                return Err(DataError::DuplicateColumn {
+                    path: path.to_path_buf(),
+                    row: header_line,
+                    column: name.clone(),
+                    first: first + 1,
+                    second: index + 1,
+                });
+            }
+        }
+        let mut lines = Vec::new();
+        let mut blank: Option<usize> = None;
+        let mut trailing_blank_lines = 0;
+        while !scanner.at_end() {
+            let line = scanner.line;
+            if scanner.at_line_end() {
+                scanner.skip_line_end();
+                blank.get_or_insert(line);
+                trailing_blank_lines += 1;
+                continue;
+            }
+            if let Some(blank) = blank {
+                return Err(DataError::BadRow {
+                    path: path.to_path_buf(),
+                    row: blank,
+                    message: "blank line between data rows".to_string(),
+                });
+            }
+            if text[scanner.position..].starts_with('#') {
+                return Err(DataError::BadRow {
+                    path: path.to_path_buf(),
+                    row: line,
+                    message: "a '#' comment line (comments are not allowed)".to_string(),
+                });
+            }
+            let fields = scanner.record(None)?;
+            if fields != header.len() {
+                let message = if fields > header.len() {
+                    format!(
+                        "{fields} fields, more than the {} columns of the header \
+                         (a ',' in an unquoted cell, e.g. a decimal comma?)",
+                        header.len()
+                    )
+                } else {
+                    format!(
+                        "too few fields: {fields} of the header's {}, no value for '{}'",
+                        header.len(),
+                        header[fields]
+                    )
+                };
+                return Err(DataError::BadRow {
+                    path: path.to_path_buf(),
+                    row: line,
+                    message,
+                });
+            }
+            lines.push(line);
+        }
+        Ok(Self {
+            lines,
+            trailing_blank_lines,
+        })
+    }
+}
+
+/// The line (1-based) holding byte `offset` of `bytes`.
+fn line_at(bytes: &[u8], offset: usize) -> usize {
+    1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count()
+}
+
+/// A cursor over the bytes of a CSV file that knows its line.
+struct Scanner<'a> {
+    path: &'a Path,
+    bytes: &'a [u8],
+    position: usize,
+    line: usize,
+}
+
+impl Scanner<'_> {
+    fn at_end(&self) -> bool {
+        self.position >= self.bytes.len()
+    }
+
+    fn peek(&self, ahead: usize) -> Option<u8> {
+        self.bytes.get(self.position + ahead).copied()
+    }
+
+    /// At `\n`, `\r\n`, a `\r` ending the file, or the end of the file.
+    fn at_line_end(&self) -> bool {
+        match self.peek(0) {
+            None | Some(b'\n') => true,
+            Some(b'\r') => matches!(self.peek(1), None | Some(b'\n')),
+            _ => false,
+        }
+    }
+
+    fn skip_line_end(&mut self) {
+        if self.peek(0) == Some(b'\r') {
+            self.position += 1;
+        }
+        if self.peek(0) == Some(b'\n') {
+            self.position += 1;
+            self.line += 1;
+        }
+    }
+
+    fn bad_row(&self, row: usize, message: &str) -> DataError {
+        DataError::BadRow {
+            path: self.path.to_path_buf(),
+            row,
+            message: message.to_string(),
+        }
+    }
+
+    /// Reads one row up to and including its line end; returns its number of fields and, when
+    /// `names` is given, collects the fields' text (quotes removed).
+    fn record(&mut self, mut names: Option<&mut Vec<String>>) -> Result<usize> {
+        let mut fields = 0;
+        loop {
+            fields += 1;
+            let start = self.position;
+            let mut field = String::new();
+            if self.peek(0) == Some(b'"') {
+                let opened = self.line;
+                self.position += 1;
+                let mut from = self.position;
+                loop {
+                    match self.peek(0) {
+                        None => {
+                            return Err(
+                                self.bad_row(opened, "a quoted cell opened here is never closed")
+                            );
+                        }
+                        Some(b'"') if self.peek(1) == Some(b'"') => {
+                            if names.is_some() {
+                                field.push_str(self.text(from, self.position + 1));
+                            }
+                            self.position += 2;
+                            from = self.position;
+                        }
+                        Some(b'"') => break,
+                        Some(b'\n') => {
+                            self.line += 1;
+                            self.position += 1;
+                        }
+                        Some(_) => self.position += 1,
+                    }
+                }
+                if names.is_some() {
+                    field.push_str(self.text(from, self.position));
+                }
+                self.position += 1;
+                if !(self.at_line_end() || self.peek(0) == Some(b',')) {
+                    return Err(self.bad_row(self.line, "text after the closing quote of a cell"));
+                }
+            } else {
+                while !(self.at_line_end() || self.peek(0) == Some(b',')) {
+                    if self.peek(0) == Some(b'"') {
+                        return Err(self.bad_row(
+                            self.line,
+                            "a quote inside an unquoted cell (quote the whole cell)",
+                        ));
+                    }
+                    self.position += 1;
+                }
+                if names.is_some() {
+                    field.push_str(self.text(start, self.position));
+                }
+            }
+            if let Some(names) = names.as_deref_mut() {
+                names.push(field);
+            }
+            if self.peek(0) == Some(b',') {
+                self.position += 1;
+                continue;
+            }
+            self.skip_line_end();
+            return Ok(fields);
+        }
+    }
+
+    fn text(&self, from: usize, to: usize) -> &str {
+        // Field boundaries are ASCII bytes, so they are character boundaries of the UTF-8 text.
+        std::str::from_utf8(&self.bytes[from..to]).unwrap_or_default()
     }
 }
 

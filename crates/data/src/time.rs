@@ -12,6 +12,17 @@ pub const DEFAULT_UNIFORM_TOLERANCE: f64 = 0.01;
 /// Fails unless `time` has at least two samples, is strictly increasing and uniformly sampled
 /// within `tolerance` (relative to the median interval); the error reports the worst gap.
 pub fn check_time_axis(path: &Path, time: &[f64], tolerance: f64) -> Result<()> {
+    check_time_axis_at(path, time, tolerance, &file_row)
+}
+
+/// [`check_time_axis`], with `line(k)` the line of the file that holds sample `k` (for files whose
+/// cells span lines).
+pub(crate) fn check_time_axis_at(
+    path: &Path,
+    time: &[f64],
+    tolerance: f64,
+    line: &dyn Fn(usize) -> usize,
+) -> Result<()> {
     if time.len() < 2 {
         return Err(DataError::TooShort {
             path: path.to_path_buf(),
@@ -23,7 +34,7 @@ pub fn check_time_axis(path: &Path, time: &[f64], tolerance: f64) -> Result<()> 
         if time[k] <= time[k - 1] {
             return Err(DataError::TimeNotIncreasing {
                 path: path.to_path_buf(),
-                row: file_row(k),
+                row: line(k),
                 previous: time[k - 1],
                 current: time[k],
             });
@@ -47,7 +58,7 @@ pub fn check_time_axis(path: &Path, time: &[f64], tolerance: f64) -> Result<()> 
     if (gap - median).abs() > tolerance * median {
         return Err(DataError::NonUniformSampling {
             path: path.to_path_buf(),
-            row: file_row(index + 1),
+            row: line(index + 1),
             gap,
             median,
         });

@@ -180,3 +180,26 @@ fn numeric_tables_name_missing_and_bad_columns() {
     assert_eq!(time, vec![0.0, 0.1, 0.2]);
     assert_eq!(table.column("x").unwrap(), &[1.0, 1.5, 2.0]);
 }
+
+#[test]
+fn a_recorded_rotation_that_is_not_a_rotation() {
+    let (_, text) = synthetic_csv(&temp_dir("rotation-src"), 20);
+    let column = column_index(&text, "R");
+    let scaled = "\"[[2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]]\"";
+    let message = error_of(&replace_cell(&text, 5, column, scaled), "rotation");
+    assert!(
+        message.contains("bad.csv:7:R:") && message.contains("not a rotation matrix"),
+        "{message}"
+    );
+    // A reflection keeps R Rᵀ = I but is not a rotation either.
+    let reflection = "\"[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]]\"";
+    let message = error_of(&replace_cell(&text, 5, column, reflection), "reflection");
+    assert!(message.contains("determinant -1"), "{message}");
+    // A rotation, but not the one q describes.
+    let turned = "\"[[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]\"";
+    let message = error_of(&replace_cell(&text, 5, column, turned), "disagree");
+    assert!(
+        message.contains("bad.csv:7:R:") && message.contains("does not match the rotation of q"),
+        "{message}"
+    );
+}

@@ -18,12 +18,14 @@ pub enum SindyError {
     /// Matrices or name lists whose sizes do not agree.
     #[error("{what}: {message}")]
     Shape { what: String, message: String },
-    /// A NaN or infinite value in the data.
-    #[error("{what}: non-finite value at row {row}, column {column}")]
+    /// A NaN or infinite value in the data: `row` is the sample's index (from 0) in the matrix
+    /// checked, `column` names the column (e.g. `feature 'x^2'`).
+    #[error("{what}: {column} is not finite ({value}) at sample index {row}")]
     NonFinite {
         what: String,
         row: usize,
-        column: usize,
+        column: String,
+        value: f64,
     },
     /// A solver that did not reach a solution.
     #[error("{solver} failed on target '{target}': {message}")]

@@ -269,6 +269,27 @@ impl FeatureLibrary {
         names
     }
 
+    /// [`Self::feature_names`], failing when a name repeats (e.g. `poly:1+poly:2` has `x` twice, or
+    /// an input named `x^2` next to `x`): a model's terms are identified by name, in its equations
+    /// and in its file, so two columns of one name would be merged or lost.
+    pub fn unique_feature_names(&self, inputs: &[&str]) -> Result<Vec<String>> {
+        let names = self.feature_names(inputs);
+        let mut seen = std::collections::HashSet::with_capacity(names.len());
+        if let Some(repeated) = names.iter().find(|name| !seen.insert(name.as_str())) {
+            let library = self
+                .spec()
+                .map_or_else(|| "library".to_string(), |spec| format!("library '{spec}'"));
+            return Err(invalid(
+                &library,
+                format!(
+                    "it has the feature '{repeated}' twice on inputs {} (each feature must be unique)",
+                    inputs.join(", ")
+                ),
+            ));
+        }
+        Ok(names)
+    }
+
     /// Number of features for `inputs` input variables.
     pub fn feature_count(&self, inputs: usize) -> usize {
         self.parts

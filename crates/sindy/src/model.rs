@@ -242,15 +242,20 @@ impl SindyParams {
                 ),
             ));
         }
-        check_finite("inputs", inputs)?;
-        check_finite("targets", targets)?;
         let names = self.input_names();
         let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
+        check_finite("inputs", inputs, &|j| format!("input '{}'", names[j]))?;
+        check_finite("targets", targets, &|j| {
+            format!("target {}'", self.state_names[j])
+        })?;
+        let feature_names = self.library.feature_names(&input_names);
         let theta = self.library.transform(inputs);
-        check_finite("library", theta.as_ref())?;
+        check_finite("library", theta.as_ref(), &|j| {
+            format!("feature '{}'", feature_names[j])
+        })?;
         let coefficients = optimizer.fit(theta.as_ref(), targets, &self.state_names)?;
         let model = SindyModel {
-            feature_names: self.library.feature_names(&input_names),
+            feature_names,
             state_names: self.state_names.clone(),
             control_names: self.control_names.clone(),
             library: self.library.clone(),
@@ -283,6 +288,8 @@ impl SindyParams {
                 ));
             }
         }
+        let inputs: Vec<&str> = names.iter().map(String::as_str).collect();
+        self.library.unique_feature_names(&inputs)?;
         Ok(())
     }
 }
@@ -574,7 +581,7 @@ fn stack_rows(blocks: &[Mat<f64>]) -> Mat<f64> {
     out
 }
 
-fn check_finite(what: &str, matrix: MatRef<'_, f64>) -> Result<()> {
+fn check_finite(what: &str, matrix: MatRef<'_, f64>, name: &dyn Fn(usize) -> String) -> Result<()> {
     for j in 0..matrix.ncols() {
         let column = matrix.col(j);
         // The common case first: a contiguous column checked in one vectorised pass.
@@ -587,7 +594,8 @@ fn check_finite(what: &str, matrix: MatRef<'_, f64>) -> Result<()> {
             return Err(SindyError::NonFinite {
                 what: what.to_string(),
                 row: i,
-                column: j,
+                column: name(j),
+                value: column[i],
             });
         }
     }

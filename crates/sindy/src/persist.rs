@@ -127,13 +127,33 @@ impl SindyModel {
         file.optimizer
             .checked()
             .map_err(|e| error("optimizer", e.to_string()))?;
+        file.derivative
+            .validate()
+            .map_err(|e| error("derivative", e.to_string()))?;
         let inputs: Vec<&str> = file
             .state
             .iter()
             .chain(&file.control)
             .map(String::as_str)
             .collect();
-        let expected = library.feature_names(&inputs);
+        if let Some((i, name)) = inputs
+            .iter()
+            .enumerate()
+            .find(|&(i, name)| name.is_empty() || inputs[..i].contains(name))
+        {
+            let field = if i < file.state.len() {
+                "state"
+            } else {
+                "control"
+            };
+            return Err(error(
+                field,
+                format!("'{name}' is empty or named twice among state and control"),
+            ));
+        }
+        let expected = library
+            .unique_feature_names(&inputs)
+            .map_err(|e| error("library", e.to_string()))?;
         if expected != file.features {
             return Err(error(
                 "features",

@@ -350,7 +350,8 @@ fn check_finite(matrix: MatRef<'_, f64>, what: &str) -> Result<()> {
                 return Err(crate::error::SindyError::NonFinite {
                     what: format!("regression {what}"),
                     row: i,
-                    column: j,
+                    column: format!("column {j}"),
+                    value: matrix[(i, j)],
                 });
             }
         }

@@ -104,6 +104,13 @@ fn inconsistent_files_are_rejected_naming_the_field() {
         (unknown_feature.to_string(), "equations.x"),
         (text.replace("sindy-model/1", "sindy-model/9"), "format"),
         ("{\"state\": [".to_string(), "(document)"),
+        (
+            text.replace(
+                "\"kind\": \"central\"",
+                "\"kind\": \"savitzky_golay\", \"window\": 4, \"order\": 2",
+            ),
+            "field 'derivative'",
+        ),
     ];
     for (bad, field) in cases {
         let error = SindyModel::from_json(&bad, path).unwrap_err().to_string();
@@ -138,4 +145,105 @@ fn custom_libraries_fit_but_cannot_be_saved() {
         model.to_json(),
         Err(SindyError::NotSerialisable(_))
     ));
+}
+
+/// A trajectory of `n` samples of x, y (scattered, exact derivatives ẋ = y, ẏ = −x).
+fn xy(n: usize, scale: f64) -> Trajectory {
+    let time: Vec<f64> = (0..n).map(|k| k as f64 * 0.01).collect();
+    let states = Mat::from_fn(n, 2, |i, j| scale * ((i * 7 + 3 * j) as f64).sin());
+    let derivatives = Mat::from_fn(n, 2, |i, j| {
+        if j == 0 {
+            states[(i, 1)]
+        } else {
+            -states[(i, 0)]
+        }
+    });
+    Trajectory::new(time, states)
+        .unwrap()
+        .with_derivatives(derivatives)
+        .unwrap()
+}
+
+#[test]
+fn a_library_whose_feature_names_repeat_is_refused() {
+    // poly:2+poly:2 printed `x' = 0.500 y + 0.500 y` and saved {"x": {"y": 0.5}}: half the model.
+    let library = FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2+poly:2").unwrap()).unwrap();
+    let error = SindyParams::new(&["x", "y"], &[])
+        .library(library)
+        .fit(&[xy(50, 1.0)])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("library 'poly:2+poly:2'") && error.contains("feature '1' twice"),
+        "{error}"
+    );
+    // Names can collide through the inputs too: an input called `x^2` next to `x`.
+    let library = FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap();
+    let error = library
+        .unique_feature_names(&["x", "x^2"])
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("'x^2' twice"), "{error}");
+    // Disjoint parts are fine.
+    let library =
+        FeatureLibrary::from_spec(&LibrarySpec::parse("poly:0+poly:1:noconstant").unwrap())
+            .unwrap();
+    assert_eq!(
+        library.unique_feature_names(&["x", "y"]).unwrap(),
+        ["1", "x", "y"]
+    );
+}
+
+#[test]
+fn a_model_file_with_repeated_names_is_refused() {
+    let text = model().to_json().unwrap();
+    let path = std::path::Path::new("dup.json");
+    let mut doubled: serde_json::Value = serde_json::from_str(&text).unwrap();
+    doubled["library"] = serde_json::json!({"kind": "concatenation", "parts": [
+        {"kind": "polynomial", "degree": 1, "constant": false},
+        {"kind": "polynomial", "degree": 1, "constant": false}]});
+    doubled["features"] = serde_json::json!(["x", "y", "u", "x", "y", "u"]);
+    doubled["equations"] = serde_json::json!({"x": {"y": 1.0}, "y": {"x": -1.0}});
+    let error = SindyModel::from_json(&doubled.to_string(), path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("dup.json: field 'library'") && error.contains("'x' twice"),
+        "{error}"
+    );
+    let mut same_state: serde_json::Value = serde_json::from_str(&text).unwrap();
+    same_state["control"] = serde_json::json!(["x"]);
+    let error = SindyModel::from_json(&same_state.to_string(), path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("dup.json: field 'control'") && error.contains("'x'"),
+        "{error}"
+    );
+}
+
+#[test]
+fn a_non_finite_feature_is_named_with_its_sample() {
+    let mut trajectory = xy(30, 1.0);
+    trajectory.states[(4, 0)] = 1e200;
+    let library = FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap();
+    let error = SindyParams::new(&["x", "y"], &[])
+        .library(library)
+        .fit(&[trajectory])
+        .unwrap_err();
+    match &error {
+        SindyError::NonFinite {
+            what, row, column, ..
+        } => {
+            assert_eq!(
+                (what.as_str(), *row, column.as_str()),
+                ("library", 4, "feature 'x^2'")
+            );
+        }
+        other => panic!("{other}"),
+    }
+    assert_eq!(
+        error.to_string(),
+        "library: feature 'x^2' is not finite (inf) at sample index 4"
+    );
 }

@@ -25,8 +25,62 @@ fn range3(name: &str, values: &[[f64; 3]]) -> String {
     format!("  {name:<16} {}", parts.join("  "))
 }
 
+/// The columns the log uses, as found in the file: `q` or `R` may be absent (one is derived from the
+/// other), the optional ones may be absent, and columns the log does not use are listed apart.
+fn column_summary(columns: &[String]) -> String {
+    let present = |name: &str| columns.iter().any(|c| c == name);
+    let mut used = Vec::new();
+    for name in [
+        "t",
+        "p",
+        "v",
+        "q",
+        "R",
+        "w",
+        "T_sp",
+        "hover_throttle",
+        "pwm",
+    ] {
+        used.push(match name {
+            "q" if !present("q") => "q (absent, derived from R)".to_string(),
+            "R" if !present("R") => "R (absent, derived from q)".to_string(),
+            _ => name.to_string(),
+        });
+    }
+    let optional: Vec<String> = ["p_d", "v_d", "q_sp", "fa"]
+        .iter()
+        .map(|name| format!("{name}{}", if present(name) { "" } else { " (absent)" }))
+        .collect();
+    let known = [
+        "t",
+        "p",
+        "v",
+        "q",
+        "R",
+        "w",
+        "T_sp",
+        "hover_throttle",
+        "pwm",
+        "p_d",
+        "v_d",
+        "q_sp",
+        "fa",
+    ];
+    // The unnamed first column of the Neural-Fly logs is the row index.
+    let unused: Vec<&str> = columns
+        .iter()
+        .map(String::as_str)
+        .filter(|c| !c.is_empty() && !known.contains(c))
+        .collect();
+    let mut summary = format!("{}; optional: {}", used.join(", "), optional.join(", "));
+    if !unused.is_empty() {
+        summary.push_str(&format!("; not used: {}", unused.join(", ")));
+    }
+    summary
+}
+
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
-    let log = FlightLog::read(&args.file)?;
+    let (log, columns) = FlightLog::read_with_columns(&args.file)?;
     let n = log.len();
     let dt = log.sample_interval();
     println!("file:      {}", args.file.display());
@@ -39,19 +93,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     println!("samples:   {n}");
     println!("duration:  {:.3} s", log.time[n - 1] - log.time[0]);
     println!("rate:      {:.3} Hz (dt = {dt:.6} s)", 1.0 / dt);
-    let mut optional = Vec::new();
-    for (name, present) in [
-        ("p_d", log.position_desired.is_some()),
-        ("v_d", log.velocity_desired.is_some()),
-        ("q_sp", log.attitude_setpoint.is_some()),
-        ("fa", log.residual_force.is_some()),
-    ] {
-        optional.push(format!("{name}{}", if present { "" } else { " (absent)" }));
-    }
-    println!(
-        "columns:   t, p, v, q, R, w, T_sp, hover_throttle, pwm; optional: {}",
-        optional.join(", ")
-    );
+    println!("columns:   {}", column_summary(&columns));
     println!("ranges:");
     println!("{}", range3("p [m]", &log.position));
     println!("{}", range3("v [m/s]", &log.velocity));

@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, bail};
+use anyhow::{Context, anyhow, bail};
 use data::{Derivative, NumericTable};
-use sindy::{FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, SindyParams, Trajectory};
+use sindy::{FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, SindyError, SindyParams, Trajectory};
 
 use super::Global;
 
@@ -87,18 +87,41 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     let optimizer = optimizer(&args)?;
     optimizer.checked()?;
     let derivative = Derivative::parse(&args.derivative)?;
-    if let Some(out) = &args.out {
-        super::refuse_overwrite(out, args.force)?;
-    }
-
     let columns: Vec<&str> = args
         .state
         .iter()
         .chain(&args.control)
         .map(String::as_str)
         .collect();
+    for (i, name) in columns.iter().enumerate() {
+        let flag = if i < args.state.len() {
+            "--state"
+        } else {
+            "--control"
+        };
+        if name.is_empty() {
+            bail!("{flag}: empty column name");
+        }
+        if columns[..i].contains(name) {
+            bail!("{flag}: column '{name}' is named twice among --state and --control");
+        }
+    }
+    let feature_count = library.unique_feature_names(&columns)?.len();
+    if let Some(out) = &args.out {
+        super::refuse_overwrite(out, args.force)?;
+    }
+
     let (time, table) = NumericTable::read_with_time(&args.csv, &args.time, &columns)?;
     let n = table.rows();
+    if n < feature_count {
+        bail!(
+            "{}: {n} data rows, fewer than the {feature_count} features of library {} on {}: \
+             the fit needs at least one row per feature",
+            args.csv.display(),
+            args.library,
+            columns.join(", ")
+        );
+    }
     let dim_x = args.state.len();
     let states = Mat::from_fn(n, dim_x, |i, j| table.columns[j][i]);
     let controls = Mat::from_fn(n, args.control.len(), |i, j| table.columns[dim_x + j][i]);
@@ -111,7 +134,27 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         .optimizer(optimizer)
         .derivative(derivative)
         .fit(std::slice::from_ref(&trajectory))
-        .with_context(|| format!("fitting {}", args.csv.display()))?;
+        .map_err(|error| match error {
+            // One sample is one row of the file: name its line.
+            SindyError::NonFinite {
+                what,
+                row,
+                column,
+                value,
+            } => {
+                let hint = if what == "library" {
+                    format!(" (values too large for library {}?)", args.library)
+                } else {
+                    String::new()
+                };
+                anyhow!(
+                    "{}:{}: {column} is not finite ({value}) on this row{hint}",
+                    args.csv.display(),
+                    table.line(row),
+                )
+            }
+            other => anyhow::Error::new(other).context(format!("fitting {}", args.csv.display())),
+        })?;
     for line in model.equations(args.precision) {
         println!("{line}");
     }

@@ -1,0 +1,291 @@
+//! `learn sindy`, `learn data inspect` and `learn conditions` on bad input: a one-line error naming
+//! the file, the line and the column or field, exit code 1, never a panic; and valid input that
+//! used to be refused (a pipe) or misreported (absent columns) is handled.
+
+mod common;
+
+use std::path::Path;
+
+use common::{learn_in, scratch};
+
+/// `t,x,y,u` for t = 0, 0.01, ...: a damped rotation driven by u.
+fn signal(rows: usize) -> String {
+    let mut text = String::from("t,x,y,u\n");
+    for k in 0..rows {
+        let t = k as f64 * 0.01;
+        let decay = (-0.1 * t).exp();
+        text.push_str(&format!(
+            "{t:.2},{},{},{}\n",
+            decay * t.cos(),
+            -decay * t.sin(),
+            (0.5 * t).sin()
+        ));
+    }
+    text
+}
+
+/// `text` with line `line` (1-based) replaced by `new` (which may hold several lines).
+fn with_line(text: &str, line: usize, new: &str) -> String {
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines[line - 1] = new;
+    lines.join("\n") + "\n"
+}
+
+fn sindy(dir: &Path, csv: &str, library: &str, extra: &[&str]) -> common::Run {
+    let mut args = vec![
+        "sindy",
+        "--csv",
+        csv,
+        "--state",
+        "x,y",
+        "--control",
+        "u",
+        "--library",
+        library,
+    ];
+    args.extend_from_slice(extra);
+    learn_in(dir, &args)
+}
+
+#[test]
+fn a_library_that_repeats_a_feature_is_refused_before_anything_is_written() {
+    let dir = scratch("sindy-dup-features");
+    std::fs::write(dir.join("s.csv"), signal(200)).unwrap();
+    let run = sindy(&dir, "s.csv", "poly:2+poly:2", &["--out", "model.json"]);
+    run.one_line_error(&["library 'poly:2+poly:2'", "twice"]);
+    assert!(!dir.join("model.json").exists());
+    let run = sindy(&dir, "s.csv", "poly:1:noconstant+fourier:1", &[]);
+    assert!(run.success().contains("x' ="));
+}
+
+#[test]
+fn fewer_rows_than_features_is_an_error_naming_the_counts() {
+    let dir = scratch("sindy-underdetermined");
+    std::fs::write(dir.join("short.csv"), signal(5)).unwrap();
+    let run = sindy(&dir, "short.csv", "poly:3", &[]);
+    run.one_line_error(&["short.csv", "5 data rows", "20 features", "poly:3"]);
+    // As many rows as features is enough.
+    std::fs::write(dir.join("twenty.csv"), signal(20)).unwrap();
+    sindy(&dir, "twenty.csv", "poly:3", &[]).success();
+}
+
+#[test]
+fn an_overflowing_feature_names_the_line_and_the_feature() {
+    let dir = scratch("sindy-overflow");
+    let text = with_line(&signal(100), 5, "0.03,1e200,0.5,0.1");
+    std::fs::write(dir.join("huge.csv"), text).unwrap();
+    let run = sindy(&dir, "huge.csv", "poly:2", &[]);
+    // Data row 3 (t = 0.03) is line 5 of the file.
+    let message = run.one_line_error(&["huge.csv:5:", "feature 'x^2'", "not finite"]);
+    assert!(!message.contains("row 3, column"), "{message}");
+}
+
+#[test]
+fn a_too_long_savgol_window_is_named_as_written() {
+    let dir = scratch("sindy-savgol");
+    std::fs::write(dir.join("s.csv"), signal(100)).unwrap();
+    let run = sindy(&dir, "s.csv", "poly:1", &["--derivative", "savgol:101:2"]);
+    let message = run.one_line_error(&["s.csv", "savgol:101:2 estimator needs at least 101"]);
+    assert!(!message.contains("SavitzkyGolay"), "{message}");
+}
+
+#[test]
+fn csv_layout_faults_name_the_file_and_line() {
+    let dir = scratch("sindy-layout");
+    let good = signal(50);
+    let mut noted: Vec<String> = good.lines().map(|l| format!("{l},n")).collect();
+    noted[0] = "t,x,y,u,note".to_string();
+    noted[2] = noted[2].replace(",n", ",\"two\nlines\"");
+    noted[6] = "0.05,abc,0.5,0.1,n".to_string();
+    let noted = noted.join("\n") + "\n";
+    let cases = [
+        (
+            "dup.csv",
+            with_line(&good, 1, "t,x,x,u"),
+            vec!["dup.csv:1:x:", "twice"],
+        ),
+        (
+            "extra.csv",
+            with_line(&good, 7, "0.05,1,2,3,4"),
+            vec!["extra.csv:7:", "5 fields"],
+        ),
+        (
+            "few.csv",
+            with_line(&good, 7, "0.05,1"),
+            vec!["few.csv:7:", "too few fields", "'y'"],
+        ),
+        (
+            "comment.csv",
+            with_line(&good, 7, "# note, here"),
+            vec!["comment.csv:7:", "comment"],
+        ),
+        // The note of data row 2 spans two lines: row 6 starts on line 8.
+        ("note.csv", noted, vec!["note.csv:8:x:", "abc"]),
+    ];
+    for (name, text, needles) in cases {
+        std::fs::write(dir.join(name), text).unwrap();
+        let run = sindy(&dir, name, "poly:1", &[]);
+        run.one_line_error(&needles);
+    }
+}
+
+#[test]
+fn a_directory_or_a_binary_file_is_named_as_such() {
+    let dir = scratch("sindy-not-csv");
+    std::fs::create_dir_all(dir.join("folder")).unwrap();
+    sindy(&dir, "folder", "poly:1", &[]).one_line_error(&["folder: is a directory"]);
+    std::fs::write(dir.join("blob.csv"), b"\x00\x01\x02binary\xc3\xbf\n").unwrap();
+    sindy(&dir, "blob.csv", "poly:1", &[]).one_line_error(&["blob.csv:1: not a CSV text file"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn a_pipe_is_read_like_a_file() {
+    let dir = scratch("sindy-fifo");
+    std::fs::write(dir.join("s.csv"), signal(200)).unwrap();
+    let from_file = sindy(&dir, "s.csv", "poly:2", &[]);
+    let made = std::process::Command::new("mkfifo")
+        .arg(dir.join("pipe.csv"))
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    let writer = {
+        let fifo = dir.join("pipe.csv");
+        std::thread::spawn(move || std::fs::write(fifo, signal(200)).unwrap())
+    };
+    let from_pipe = sindy(&dir, "pipe.csv", "poly:2", &[]);
+    writer.join().unwrap();
+    assert_eq!(from_pipe.success(), from_file.success());
+    assert_eq!(from_pipe.stderr, from_file.stderr);
+}
+
+/// A 5-row flight log with the given columns (`q` and/or `R`).
+fn flight(with_q: bool, with_r: bool) -> String {
+    let mut header = vec!["t", "p", "v"];
+    if with_q {
+        header.push("q");
+    }
+    if with_r {
+        header.push("R");
+    }
+    header.extend(["w", "T_sp", "hover_throttle", "pwm", "battery"]);
+    let mut text = header.join(",") + "\n";
+    for k in 0..5 {
+        let mut cells = vec![
+            format!("{:.2}", k as f64 * 0.02),
+            "\"[0.0, 0.0, 1.0]\"".to_string(),
+            "\"[0.0, 0.0, 0.0]\"".to_string(),
+        ];
+        if with_q {
+            cells.push("\"[0.0, 0.0, 0.0, 1.0]\"".to_string());
+        }
+        if with_r {
+            cells.push("\"[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\"".to_string());
+        }
+        cells.extend([
+            "\"[0.0, 0.0, 0.0]\"".to_string(),
+            "0.5".to_string(),
+            "0.5".to_string(),
+            "\"[1300.0, 1300.0, 1300.0, 1300.0]\"".to_string(),
+            "16.0".to_string(),
+        ]);
+        text.push_str(&(cells.join(",") + "\n"));
+    }
+    text
+}
+
+#[test]
+fn inspect_lists_the_columns_the_file_has() {
+    let dir = scratch("inspect-columns");
+    std::fs::write(dir.join("q_only.csv"), flight(true, false)).unwrap();
+    std::fs::write(dir.join("r_only.csv"), flight(false, true)).unwrap();
+    let q_only = learn_in(&dir, &["data", "inspect", "q_only.csv"]);
+    let line = q_only
+        .success()
+        .lines()
+        .find(|l| l.starts_with("columns:"))
+        .unwrap()
+        .to_string();
+    assert!(
+        line.contains("q, R (absent, derived from q)") && line.contains("p_d (absent)"),
+        "{line}"
+    );
+    assert!(line.contains("not used: battery"), "{line}");
+    let r_only = learn_in(&dir, &["data", "inspect", "r_only.csv"]);
+    assert!(
+        r_only.success().contains("q (absent, derived from R), R,"),
+        "{}",
+        r_only.stdout
+    );
+    std::fs::write(
+        dir.join("dup.csv"),
+        flight(true, false).replacen("battery", "pwm", 1),
+    )
+    .unwrap();
+    learn_in(&dir, &["data", "inspect", "dup.csv"])
+        .one_line_error(&["dup.csv:1:pwm:", "appears twice"]);
+}
+
+fn conditions(pattern: &str, conditions: &str) -> String {
+    format!(
+        r#"{{"file_pattern": "{pattern}", "controllers": ["baseline"], "evaluation_controller": "baseline",
+  "conditions": [{conditions}],
+  "paper_training": {{"file_pattern": "training/{{condition}}.csv",
+    "conditions": [{{"name": "10wind", "wind_speed": "1 m/s", "role": "meta-training"}}]}}}}"#
+    )
+}
+
+#[test]
+fn inconsistent_conditions_are_refused_naming_the_file_and_field() {
+    let dir = scratch("conditions-bad");
+    let pattern = "experiment/{controller}_{condition}.csv";
+    let a = r#"{"name": "35wind", "wind_speed": "4 m/s", "role": "evaluation"}"#;
+    let b =
+        r#"{"name": "70p20sint", "label": "35wind", "wind_speed": "8 m/s", "role": "evaluation"}"#;
+    let c = r#"{"name": "", "wind_speed": "8 m/s", "role": "evaluation"}"#;
+    let d = r#"{"name": "nowind", "wind_speed": "0 m/s", "role": "meta-training"}"#;
+    let cases = [
+        (
+            "label.json",
+            conditions(pattern, &format!("{a}, {b}")),
+            vec!["conditions[1].label", "'35wind'"],
+        ),
+        (
+            "name.json",
+            conditions(pattern, &format!("{a}, {c}")),
+            vec!["conditions[1].name", "empty"],
+        ),
+        (
+            "ctrl.json",
+            conditions("experiment/{ctrl}_{condition}.csv", a),
+            vec!["file_pattern", "{ctrl}"],
+        ),
+        (
+            "brace.json",
+            conditions("experiment/{controller_{condition}.csv", a),
+            vec!["file_pattern", "not closed"],
+        ),
+        (
+            "none.json",
+            conditions(pattern, ""),
+            vec!["conditions", "no condition is declared"],
+        ),
+        (
+            "train.json",
+            conditions(pattern, d),
+            vec!["conditions", "no condition has role \"evaluation\""],
+        ),
+    ];
+    for (name, text, mut needles) in cases {
+        std::fs::write(dir.join(name), text).unwrap();
+        needles.push(name);
+        learn_in(&dir, &["conditions", "--config", name]).one_line_error(&needles);
+    }
+    std::fs::write(
+        dir.join("good.json"),
+        conditions(pattern, &format!("{a}, {d}")),
+    )
+    .unwrap();
+    let listing = learn_in(&dir, &["conditions", "--config", "good.json"]);
+    assert!(listing.success().contains("35wind"), "{}", listing.stdout);
+}

@@ -1,0 +1,221 @@
+//! The layout of a CSV file (header, fields per row, quotes, encoding, what the path is) is checked
+//! on load, and each fault is a one-line error naming the file and the line.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::temp_dir;
+use data::{FlightLog, NumericTable};
+
+fn write(name: &str, text: &[u8]) -> PathBuf {
+    let path = temp_dir("layout").join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn numeric_error(path: &Path, columns: &[&str]) -> String {
+    let message = NumericTable::read_with_time(path, "t", columns)
+        .unwrap_err()
+        .to_string();
+    assert!(!message.contains('\n'), "one line: {message}");
+    assert!(
+        message.contains(&path.display().to_string()),
+        "names the file: {message}"
+    );
+    message
+}
+
+/// `t,x,y` rows for t = 0, 0.1, ... with `rows` rows.
+fn plain(rows: usize) -> String {
+    let mut text = String::from("t,x,y\n");
+    for k in 0..rows {
+        text.push_str(&format!("{:.1},{},{}\n", k as f64 * 0.1, k, 2 * k));
+    }
+    text
+}
+
+#[test]
+fn a_repeated_column_name_is_an_error_not_a_renamed_copy() {
+    let path = write("dup.csv", b"t,x,x\n0,1,2\n0.1,1,2\n");
+    let message = numeric_error(&path, &["x"]);
+    assert!(
+        message.contains("dup.csv:1:x: column 'x' appears twice in the header (fields 2 and 3)"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_row_with_an_extra_field_names_its_line() {
+    let text = plain(5).replacen("0.2,2,4\n", "0.2,2,4,9\n", 1);
+    let message = numeric_error(&write("extra.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("extra.csv:4: 4 fields, more than the 3 columns of the header"),
+        "{message}"
+    );
+    // A decimal comma gives the same fault, with the hint.
+    let text = plain(5).replacen("0.2,2,4\n", "0.2,2,4,5\n", 1);
+    let message = numeric_error(&write("comma.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("comma.csv:4:") && message.contains("decimal comma"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_row_with_too_few_fields_says_so_instead_of_an_empty_cell() {
+    let text = plain(5).replacen("0.3,3,6\n", "0.3,3\n", 1);
+    let message = numeric_error(&write("short.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("short.csv:5: too few fields: 2 of the header's 3, no value for 'y'"),
+        "{message}"
+    );
+    // An empty cell is still an empty cell.
+    let text = plain(5).replacen("0.3,3,6\n", "0.3,,6\n", 1);
+    let message = numeric_error(&write("empty-cell.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("empty-cell.csv:5:x: cannot parse \"\": empty cell"),
+        "{message}"
+    );
+}
+
+#[test]
+fn comment_lines_are_named() {
+    let text = plain(5).replacen("0.2,2,4\n", "# a note, here\n0.2,2,4\n", 1);
+    let message = numeric_error(&write("comment.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("comment.csv:4: a '#' comment line"),
+        "{message}"
+    );
+    let message = numeric_error(
+        &write(
+            "comment-first.csv",
+            format!("# made by hand\n{}", plain(3)).as_bytes(),
+        ),
+        &["x"],
+    );
+    assert!(
+        message.contains("comment-first.csv:1: a '#' comment line"),
+        "{message}"
+    );
+}
+
+#[test]
+fn line_numbers_count_the_lines_inside_quoted_cells() {
+    // The note of row 2 spans two lines: the bad cell of the next row is on line 5, not 4.
+    let text = "t,x,note\n0,1,\"one\"\n0.1,2,\"two\nlines\"\n0.2,abc,three\n";
+    let message = numeric_error(&write("note.csv", text.as_bytes()), &["x"]);
+    assert!(message.contains("note.csv:5:x: cannot parse"), "{message}");
+    // Time errors too.
+    let text = "t,x,note\n0,1,\"one\"\n0.1,2,\"two\nlines\"\n0.1,3,three\n";
+    let message = numeric_error(&write("note-time.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("note-time.csv:5:t: time is not strictly increasing"),
+        "{message}"
+    );
+    let text = "t,x,note\n0,1,\"one\"\n0.1,2,\"two\nlines\"\n0.2,3,three\n";
+    let (_, table) =
+        NumericTable::read_with_time(&write("note-ok.csv", text.as_bytes()), "t", &["x"]).unwrap();
+    assert_eq!(table.column("x").unwrap(), &[1.0, 2.0, 3.0]);
+    assert_eq!((0..3).map(|k| table.line(k)).collect::<Vec<_>>(), [2, 3, 5]);
+}
+
+#[test]
+fn a_quote_left_open_names_the_line_it_opens_on() {
+    let text = "t,x\n0,1\n0.1,\"2\n0.2,3\n";
+    let message = numeric_error(&write("open.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("open.csv:3: a quoted cell opened here is never closed"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_blank_line_between_rows_is_named_and_blank_lines_at_the_end_are_ignored() {
+    let text = plain(5).replacen("0.2,2,4\n", "0.2,2,4\n\n", 1);
+    let message = numeric_error(&write("blank.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("blank.csv:5: blank line between data rows"),
+        "{message}"
+    );
+    let path = write("trailing.csv", format!("{}\n\r\n", plain(5)).as_bytes());
+    let (time, _) = NumericTable::read_with_time(&path, "t", &["x"]).unwrap();
+    assert_eq!(time.len(), 5);
+}
+
+#[test]
+fn a_directory_is_not_a_csv_file() {
+    let dir = temp_dir("layout-dir");
+    let message = numeric_error(&dir, &["x"]);
+    assert!(
+        message.ends_with("is a directory, not a CSV file"),
+        "{message}"
+    );
+    let message = FlightLog::read(&dir).unwrap_err().to_string();
+    assert!(message.contains("is a directory"), "{message}");
+}
+
+#[test]
+fn binary_and_non_utf8_files_are_not_text() {
+    let message = numeric_error(
+        &write("binary.csv", b"\x00\x01\x02binary\xc3\xbf\n"),
+        &["x"],
+    );
+    assert!(
+        message.contains("binary.csv:1: not a CSV text file: control byte 0x00"),
+        "{message}"
+    );
+    let message = numeric_error(&write("latin1.csv", b"t,x\n0,1\n0.1,caf\xe9\n"), &["x"]);
+    assert!(
+        message.contains("latin1.csv:3: not a CSV text file: byte 0xE9 is not UTF-8"),
+        "{message}"
+    );
+}
+
+#[test]
+fn crlf_byte_order_mark_and_quotes_read_as_plain_rows() {
+    let expected =
+        NumericTable::read_with_time(&write("plain.csv", plain(6).as_bytes()), "t", &["x", "y"])
+            .unwrap();
+    let crlf = plain(6).replace('\n', "\r\n");
+    let mut bom = b"\xef\xbb\xbf".to_vec();
+    bom.extend_from_slice(plain(6).as_bytes());
+    let quoted: String = plain(6)
+        .lines()
+        .map(|line| {
+            let cells: Vec<String> = line.split(',').map(|c| format!("\"{c}\"")).collect();
+            cells.join(",") + "\n"
+        })
+        .collect();
+    for (name, bytes) in [
+        ("crlf.csv", crlf.into_bytes()),
+        ("bom.csv", bom),
+        ("quoted.csv", quoted.into_bytes()),
+    ] {
+        let read = NumericTable::read_with_time(&write(name, &bytes), "t", &["x", "y"])
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(read.0, expected.0, "{name}");
+        assert_eq!(read.1.columns, expected.1.columns, "{name}");
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn a_pipe_is_read_to_its_end() {
+    let dir = temp_dir("layout-fifo");
+    let fifo = dir.join("fifo.csv");
+    let _ = std::fs::remove_file(&fifo);
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    let writer = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::write(&fifo, plain(20)).unwrap())
+    };
+    let (time, table) = NumericTable::read_with_time(&fifo, "t", &["x"]).unwrap();
+    writer.join().unwrap();
+    assert_eq!(time.len(), 20);
+    assert_eq!(table.column("x").unwrap()[19], 19.0);
+}

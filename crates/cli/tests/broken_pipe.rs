@@ -1,0 +1,31 @@
+//! `learn … | head`: when the reader of standard output goes away, the command ends quietly (as
+//! Unix tools do, by SIGPIPE) instead of panicking on the failed write.
+
+#![cfg(unix)]
+
+use std::os::unix::process::ExitStatusExt;
+use std::process::{Command, Stdio};
+
+#[test]
+fn a_closed_output_ends_the_command_without_a_panic() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_learn"))
+        .args(["conditions", "--data", "/nonexistent-learn-data"])
+        .current_dir(root)
+        .env("RUST_BACKTRACE", "0")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the learn binary runs");
+    // Close the read end before the command writes its first line.
+    drop(child.stdout.take());
+    let output = child.wait_with_output().expect("the command ends");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    // Killed by SIGPIPE, or (if it wrote before the pipe closed) a normal success.
+    assert!(
+        output.status.signal() == Some(libc::SIGPIPE) || output.status.success(),
+        "{:?}: {stderr}",
+        output.status
+    );
+}

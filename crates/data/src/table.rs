@@ -1,19 +1,20 @@
-//! The CSV layer: polars reads the file, every column as text, and this module parses the cells into
-//! typed values with errors that name the file, the row and the column.
+//! The CSV layer: the `csv` crate splits the file into rows, which become a polars frame with every
+//! column as text, and this module parses the cells into typed values with errors that name the
+//! file, the row and the column.
 //!
 //! Reading every column as text (no schema inference) is deliberate: the list columns of the
 //! Neural-Fly logs are strings such as `"[1.0, 2.0]"` anyway, and parsing numbers ourselves lets a bad
 //! cell be reported at its exact row instead of silently turning a whole column into strings.
 //!
-//! Before polars parses the bytes, one pass over them checks the layout polars would otherwise
-//! accept silently or report without a line: UTF-8 text, no repeated column name (polars renames
-//! a copy `x_duplicated_0`), as many fields on every row as in the header, closed quotes, no blank
-//! or `#` line between rows. The same pass records the line each row starts on, so that errors name
-//! the right line after a quoted cell that spans lines.
+//! The layout faults the csv crate reads without complaint are checked on the way, each named by
+//! its line: text that is not UTF-8 or holds control bytes, a repeated column name, a row with more
+//! or fewer fields than the header, an unpaired quote, a blank or `#` line between rows. Each row
+//! keeps the line it starts on, so that errors name the right line after a cell that spans lines.
 
 use std::path::{Path, PathBuf};
 
-use polars::prelude::*;
+use csv::StringRecord;
+use polars::prelude::{Column, DataFrame, StringChunked};
 
 use crate::error::{DataError, Result};
 
@@ -33,8 +34,8 @@ pub fn file_row(index: usize) -> usize {
 
 impl TextTable {
     /// Reads `path` (a file, or a pipe: the bytes are read, whatever the length reported) and checks
-    /// its layout before polars parses it: UTF-8 text, unique column names, every row with as many
-    /// fields as the header, quotes closed. Errors name the file and the line.
+    /// its layout: UTF-8 text, unique column names, every row with as many fields as the header,
+    /// quotes paired, no blank or `#` line between rows. Errors name the file and the line.
     pub fn read(path: &Path) -> Result<Self> {
         let io = |source| DataError::Io {
             path: path.to_path_buf(),
@@ -46,43 +47,45 @@ impl TextTable {
             });
         }
         let bytes = std::fs::read(path).map_err(io)?;
-        if bytes.is_empty() {
-            return Err(DataError::Empty {
-                path: path.to_path_buf(),
-            });
-        }
-        let layout = Layout::scan(path, &bytes)?;
-        if layout.lines.is_empty() {
-            return Err(DataError::Empty {
-                path: path.to_path_buf(),
-            });
-        }
-        let frame = CsvReadOptions::default()
-            .with_has_header(true)
-            .with_infer_schema_length(Some(0))
-            .into_reader_with_file_handle(std::io::Cursor::new(bytes))
-            .finish()
+        let text = check_text(path, &bytes)?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let records = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .from_reader(text.as_bytes())
+            .into_records()
+            .collect::<Result<Vec<_>, _>>()
             .map_err(|error| DataError::Csv {
                 path: path.to_path_buf(),
                 message: first_line(&error.to_string()),
             })?;
-        // polars reads each blank line at the end as a row of empty cells; the layout does not.
-        let frame = if frame.height() == layout.lines.len() + layout.trailing_blank_lines {
-            frame.head(Some(layout.lines.len()))
-        } else {
-            return Err(DataError::Csv {
+        if records.len() < 2 {
+            return Err(DataError::Empty {
                 path: path.to_path_buf(),
-                message: format!(
-                    "{} rows parsed, but the file has {} data rows",
-                    frame.height(),
-                    layout.lines.len()
-                ),
             });
-        };
+        }
+        let lines = check_layout(path, text.as_bytes(), &records)?;
+        let (header, rows) = records.split_at(1);
+        // An empty cell is missing (null), as polars reads it.
+        let columns = header[0]
+            .iter()
+            .enumerate()
+            .map(|(index, name)| {
+                let cells: Vec<Option<&str>> = rows
+                    .iter()
+                    .map(|row| Some(&row[index]).filter(|cell| !cell.is_empty()))
+                    .collect();
+                Column::new(name.into(), cells)
+            })
+            .collect();
+        let frame = DataFrame::new(rows.len(), columns).map_err(|error| DataError::Csv {
+            path: path.to_path_buf(),
+            message: first_line(&error.to_string()),
+        })?;
         Ok(Self {
             path: path.to_path_buf(),
             frame,
-            lines: layout.lines,
+            lines,
         })
     }
 
@@ -180,250 +183,124 @@ impl TextTable {
     }
 }
 
-/// What the layout check of a CSV file found: where each data row starts.
-struct Layout {
-    /// The line on which each data row starts (1-based, the header being line 1 unless blank lines
-    /// precede it).
-    lines: Vec<usize>,
-    /// Blank lines after the last data row (accepted, not rows).
-    trailing_blank_lines: usize,
+/// Checks the text before the csv crate splits it (which accepts any bytes): UTF-8, and no control
+/// bytes other than tab and line ends (a binary file). Errors name the line of the offending byte.
+fn check_text<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str> {
+    let not_text = |at: usize, reason: String| DataError::NotText {
+        path: path.to_path_buf(),
+        row: 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count(),
+        reason,
+    };
+    let text = std::str::from_utf8(bytes).map_err(|error| {
+        let at = error.valid_up_to();
+        not_text(at, format!("byte 0x{:02X} is not UTF-8 text", bytes[at]))
+    })?;
+    match bytes
+        .iter()
+        .position(|&b| b < 0x20 && !matches!(b, b'\t' | b'\n' | b'\r'))
+    {
+        Some(at) => Err(not_text(
+            at,
+            format!("control byte 0x{:02X} (binary data?)", bytes[at]),
+        )),
+        None => Ok(text),
+    }
 }
 
-impl Layout {
-    /// Checks the text of a CSV file the way it is split into rows and fields (RFC 4180: `,`
-    /// separates fields, a field may be quoted with `"`, `""` inside quotes is a quote, a quoted
-    /// field may span lines; `\n` or `\r\n` ends a row).
-    fn scan(path: &Path, bytes: &[u8]) -> Result<Self> {
-        let text = std::str::from_utf8(bytes).map_err(|error| {
-            let at = error.valid_up_to();
-            DataError::NotText {
-                path: path.to_path_buf(),
-                row: line_at(bytes, at),
-                reason: format!("byte 0x{:02X} is not UTF-8 text", bytes[at]),
-            }
-        })?;
-        if let Some(at) = text
-            .bytes()
-            .position(|b| b < 0x20 && !matches!(b, b'\t' | b'\n' | b'\r'))
-        {
-            return Err(DataError::NotText {
-                path: path.to_path_buf(),
-                row: line_at(bytes, at),
-                reason: format!("control byte 0x{:02X} (binary data?)", bytes[at]),
-            });
+/// Checks what the csv crate reads without complaint: a `#` line, a blank line between rows (it
+/// skips them), an unpaired quote (it reads an unclosed quote to the end of the file), a repeated
+/// column name, a row with more or fewer fields than the header. Returns the line on which each
+/// data row starts.
+fn check_layout(path: &Path, bytes: &[u8], records: &[StringRecord]) -> Result<Vec<usize>> {
+    let bad_row = |row, message: &str| DataError::BadRow {
+        path: path.to_path_buf(),
+        row,
+        message: message.to_string(),
+    };
+    let newlines = |cells: &[&str]| cells.iter().map(|c| c.matches('\n').count()).sum::<usize>();
+    let header: Vec<&str> = records[0].iter().collect();
+    let mut lines = Vec::with_capacity(records.len() - 1);
+    let mut next_line = 0;
+    for (index, record) in records.iter().enumerate() {
+        // A record's position is where the previous record ended: before the blank lines the
+        // reader skipped and, after a `\r\n`, before its `\n`. Its own text starts past them.
+        let position = record
+            .position()
+            .expect("records read from a reader have a position");
+        let end = records
+            .get(index + 1)
+            .and_then(StringRecord::position)
+            .map_or(bytes.len(), |next| next.byte() as usize);
+        let raw = &bytes[position.byte() as usize..end];
+        let skipped = raw.iter().take_while(|b| matches!(b, b'\r' | b'\n'));
+        let line = position.line() as usize + skipped.clone().filter(|&&b| b == b'\n').count();
+        let raw = &raw[skipped.count()..];
+        let cells: Vec<&str> = record.iter().collect();
+        if index > 0 && line > next_line {
+            return Err(bad_row(next_line, "blank line between data rows"));
         }
-        let mut scanner = Scanner {
-            path,
-            bytes: text.as_bytes(),
-            position: text.strip_prefix('\u{feff}').map_or(0, |_| 3),
-            line: 1,
-        };
-        // Blank lines before the header are skipped (as polars does).
-        while scanner.at_line_end() && !scanner.at_end() {
-            scanner.skip_line_end();
-        }
-        if scanner.at_end() {
-            return Ok(Self {
-                lines: Vec::new(),
-                trailing_blank_lines: 0,
-            });
-        }
-        let header_line = scanner.line;
-        if text[scanner.position..].starts_with('#') {
-            return Err(DataError::BadRow {
-                path: path.to_path_buf(),
-                row: header_line,
-                message: "a '#' comment line: the header must come first (no comments)".to_string(),
-            });
-        }
-        let mut header = Vec::new();
-        scanner.record(Some(&mut header))?;
-        for (index, name) in header.iter().enumerate() {
-            if let Some(first) = header[..index].iter().position(|n| n == name) {
-                return Err(DataError::DuplicateColumn {
-                    path: path.to_path_buf(),
-                    row: header_line,
-                    column: name.clone(),
-                    first: first + 1,
-                    second: index + 1,
-                });
-            }
-        }
-        let mut lines = Vec::new();
-        let mut blank: Option<usize> = None;
-        let mut trailing_blank_lines = 0;
-        while !scanner.at_end() {
-            let line = scanner.line;
-            if scanner.at_line_end() {
-                scanner.skip_line_end();
-                blank.get_or_insert(line);
-                trailing_blank_lines += 1;
-                continue;
-            }
-            if let Some(blank) = blank {
-                return Err(DataError::BadRow {
-                    path: path.to_path_buf(),
-                    row: blank,
-                    message: "blank line between data rows".to_string(),
-                });
-            }
-            if text[scanner.position..].starts_with('#') {
-                return Err(DataError::BadRow {
-                    path: path.to_path_buf(),
-                    row: line,
-                    message: "a '#' comment line (comments are not allowed)".to_string(),
-                });
-            }
-            let fields = scanner.record(None)?;
-            if fields != header.len() {
-                let message = if fields > header.len() {
-                    format!(
-                        "{fields} fields, more than the {} columns of the header \
-                         (a ',' in an unquoted cell, e.g. a decimal comma?)",
-                        header.len()
-                    )
+        next_line = line + newlines(&cells) + 1;
+        if raw.starts_with(b"#") {
+            return Err(bad_row(
+                line,
+                if index == 0 {
+                    "a '#' comment line: the header must come first (no comments)"
                 } else {
-                    format!(
-                        "too few fields: {fields} of the header's {}, no value for '{}'",
-                        header.len(),
-                        header[fields]
-                    )
-                };
-                return Err(DataError::BadRow {
-                    path: path.to_path_buf(),
-                    row: line,
-                    message,
-                });
-            }
-            lines.push(line);
+                    "a '#' comment line (comments are not allowed)"
+                },
+            ));
         }
-        Ok(Self {
-            lines,
-            trailing_blank_lines,
-        })
-    }
-}
-
-/// The line (1-based) holding byte `offset` of `bytes`.
-fn line_at(bytes: &[u8], offset: usize) -> usize {
-    1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count()
-}
-
-/// A cursor over the bytes of a CSV file that knows its line.
-struct Scanner<'a> {
-    path: &'a Path,
-    bytes: &'a [u8],
-    position: usize,
-    line: usize,
-}
-
-impl Scanner<'_> {
-    fn at_end(&self) -> bool {
-        self.position >= self.bytes.len()
-    }
-
-    fn peek(&self, ahead: usize) -> Option<u8> {
-        self.bytes.get(self.position + ahead).copied()
-    }
-
-    /// At `\n`, `\r\n`, a `\r` ending the file, or the end of the file.
-    fn at_line_end(&self) -> bool {
-        match self.peek(0) {
-            None | Some(b'\n') => true,
-            Some(b'\r') => matches!(self.peek(1), None | Some(b'\n')),
-            _ => false,
-        }
-    }
-
-    fn skip_line_end(&mut self) {
-        if self.peek(0) == Some(b'\r') {
-            self.position += 1;
-        }
-        if self.peek(0) == Some(b'\n') {
-            self.position += 1;
-            self.line += 1;
-        }
-    }
-
-    fn bad_row(&self, row: usize, message: &str) -> DataError {
-        DataError::BadRow {
-            path: self.path.to_path_buf(),
-            row,
-            message: message.to_string(),
-        }
-    }
-
-    /// Reads one row up to and including its line end; returns its number of fields and, when
-    /// `names` is given, collects the fields' text (quotes removed).
-    fn record(&mut self, mut names: Option<&mut Vec<String>>) -> Result<usize> {
-        let mut fields = 0;
-        loop {
-            fields += 1;
-            let start = self.position;
-            let mut field = String::new();
-            if self.peek(0) == Some(b'"') {
-                let opened = self.line;
-                self.position += 1;
-                let mut from = self.position;
-                loop {
-                    match self.peek(0) {
-                        None => {
-                            return Err(
-                                self.bad_row(opened, "a quoted cell opened here is never closed")
-                            );
-                        }
-                        Some(b'"') if self.peek(1) == Some(b'"') => {
-                            if names.is_some() {
-                                field.push_str(self.text(from, self.position + 1));
-                            }
-                            self.position += 2;
-                            from = self.position;
-                        }
-                        Some(b'"') => break,
-                        Some(b'\n') => {
-                            self.line += 1;
-                            self.position += 1;
-                        }
-                        Some(_) => self.position += 1,
-                    }
-                }
-                if names.is_some() {
-                    field.push_str(self.text(from, self.position));
-                }
-                self.position += 1;
-                if !(self.at_line_end() || self.peek(0) == Some(b',')) {
-                    return Err(self.bad_row(self.line, "text after the closing quote of a cell"));
-                }
+        if raw.iter().filter(|&&b| b == b'"').count() % 2 == 1 {
+            return Err(if index + 1 == records.len() {
+                // An unclosed quote is read to the end of the file as the last cell of the last
+                // row: it opened on that cell's line.
+                let opened = line + newlines(&cells[..cells.len() - 1]);
+                bad_row(
+                    opened,
+                    "a quoted cell opened here is never closed (or a stray '\"')",
+                )
             } else {
-                while !(self.at_line_end() || self.peek(0) == Some(b',')) {
-                    if self.peek(0) == Some(b'"') {
-                        return Err(self.bad_row(
-                            self.line,
-                            "a quote inside an unquoted cell (quote the whole cell)",
-                        ));
-                    }
-                    self.position += 1;
-                }
-                if names.is_some() {
-                    field.push_str(self.text(start, self.position));
-                }
-            }
-            if let Some(names) = names.as_deref_mut() {
-                names.push(field);
-            }
-            if self.peek(0) == Some(b',') {
-                self.position += 1;
-                continue;
-            }
-            self.skip_line_end();
-            return Ok(fields);
+                bad_row(
+                    line,
+                    "a quote inside an unquoted cell (quote the whole cell)",
+                )
+            });
         }
+        if index == 0 {
+            for (second, name) in header.iter().enumerate() {
+                if let Some(first) = header[..second].iter().position(|n| n == name) {
+                    return Err(DataError::DuplicateColumn {
+                        path: path.to_path_buf(),
+                        row: line,
+                        column: name.to_string(),
+                        first: first + 1,
+                        second: second + 1,
+                    });
+                }
+            }
+            continue;
+        }
+        let (fields, columns) = (cells.len(), header.len());
+        if fields > columns {
+            return Err(bad_row(
+                line,
+                &format!(
+                    "{fields} fields, more than the {columns} columns of the header \
+                     (a ',' in an unquoted cell, e.g. a decimal comma?)"
+                ),
+            ));
+        } else if fields < columns {
+            return Err(bad_row(
+                line,
+                &format!(
+                    "too few fields: {fields} of the header's {columns}, no value for '{}'",
+                    header[fields]
+                ),
+            ));
+        }
+        lines.push(line);
     }
-
-    fn text(&self, from: usize, to: usize) -> &str {
-        // Field boundaries are ASCII bytes, so they are character boundaries of the UTF-8 text.
-        std::str::from_utf8(&self.bytes[from..to]).unwrap_or_default()
-    }
+    Ok(lines)
 }
 
 /// Parses `"1.5"`, `"[1.0, 2.0]"` or `"[[1, 2], [3, 4]]"` into its numbers, in reading order.

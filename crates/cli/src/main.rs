@@ -44,7 +44,7 @@ fn one_line(error: &anyhow::Error) -> String {
         }
         message.push_str(&text);
     }
-    message.replace('\n', " ")
+    message.replace("\r\n", " ").replace(['\n', '\r'], " ")
 }
 
 #[cfg(test)]
@@ -58,5 +58,7 @@ mod tests {
         assert_eq!(one_line(&error), "x.csv: No such file");
         let error = anyhow::anyhow!("inner\nline").context("outer");
         assert_eq!(one_line(&error), "outer: inner line");
+        let error = anyhow::anyhow!("cell \"a\r\nb\" and \"c\rd\"");
+        assert_eq!(one_line(&error), "cell \"a b\" and \"c d\"");
     }
 }

@@ -86,10 +86,10 @@ impl ExperimentConditions {
             path: path.to_path_buf(),
             source,
         })?;
-        let mut config: Self = serde_json::from_str(&text).map_err(|error| DataError::Config {
+        let mut config: Self = crate::json::from_str(&text).map_err(|error| DataError::Config {
             path: path.to_path_buf(),
-            field: format!("line {} column {}", error.line(), error.column()),
-            message: error.to_string(),
+            field: error.field,
+            message: error.message,
         })?;
         config.validate(path)?;
         config.source = Some(path.to_path_buf());

@@ -16,6 +16,7 @@ mod derivative;
 mod error;
 mod flight_log;
 mod formulation;
+pub mod json;
 mod noise_floor;
 mod numeric;
 mod source;

@@ -161,10 +161,10 @@ impl LearnConfig {
             path: path.to_path_buf(),
             cause,
         })?;
-        let config: Self = serde_json::from_str(&text).map_err(|error| LearnError::Config {
+        let config: Self = data::json::from_str(&text).map_err(|error| LearnError::Config {
             path: path.to_path_buf(),
-            field: format!("line {} column {}", error.line(), error.column()),
-            message: error.to_string(),
+            field: error.field,
+            message: error.message,
         })?;
         config.check(path)
     }

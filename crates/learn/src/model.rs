@@ -98,7 +98,7 @@ impl MetaTrainedModel {
             path: path.to_path_buf(),
             message,
         };
-        let model: Self = serde_json::from_str(&text).map_err(|error| bad(error.to_string()))?;
+        let model: Self = data::json::from_str(&text).map_err(|error| bad(error.to_string()))?;
         if model.format != CHECKPOINT_FORMAT {
             return Err(bad(format!(
                 "format '{}', expected '{CHECKPOINT_FORMAT}'",

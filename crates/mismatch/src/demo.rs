@@ -69,10 +69,10 @@ pub struct DemoSummary {
 fn load_manifest(path: &Path) -> Result<DemoManifest> {
     let text = std::fs::read_to_string(path).map_err(io_error(path))?;
     let manifest: DemoManifest =
-        serde_json::from_str(&text).map_err(|e| MismatchError::Config {
+        data::json::from_str(&text).map_err(|e| MismatchError::Config {
             path: path.to_path_buf(),
-            field: format!("line {} column {}", e.line(), e.column()),
-            message: e.to_string(),
+            field: e.field,
+            message: e.message,
         })?;
     manifest.validate(path)?;
     Ok(manifest)

@@ -81,11 +81,7 @@ impl RunConfig {
     pub fn load(path: &Path, root: &Path) -> Result<CheckedRunConfig> {
         let text = read(path)?;
         let raw: RunConfig =
-            serde_json::from_str(&text).map_err(|error| PipelineError::Config {
-                path: path.to_path_buf(),
-                field: format!("line {} column {}", error.line(), error.column()),
-                message: error.to_string(),
-            })?;
+            data::json::from_str(&text).map_err(|error| PipelineError::json(path, error))?;
         raw.check(path, root)
     }
 
@@ -196,14 +192,10 @@ fn load_learn_config(
     }
     let text = read(path)?;
     let mut value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|error| PipelineError::Config {
-            path: path.to_path_buf(),
-            field: format!("line {} column {}", error.line(), error.column()),
-            message: error.to_string(),
-        })?;
+        data::json::from_str(&text).map_err(|error| PipelineError::json(path, error))?;
     merge_patch(&mut value, overrides);
     let config: LearnConfig =
-        serde_json::from_value(value).map_err(|error| PipelineError::Config {
+        data::json::from_value(value).map_err(|error| PipelineError::Config {
             path: run_config.to_path_buf(),
             field: "learn.overrides".to_string(),
             message: format!("{} with these overrides: {error}", path.display()),

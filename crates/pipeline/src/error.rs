@@ -31,6 +31,17 @@ pub enum PipelineError {
     Mismatch { what: String, message: String },
 }
 
+impl PipelineError {
+    /// A JSON document at `path` that did not deserialise, with the failing field.
+    pub(crate) fn json(path: &std::path::Path, error: data::json::JsonError) -> Self {
+        Self::Config {
+            path: path.to_path_buf(),
+            field: error.field,
+            message: error.message,
+        }
+    }
+}
+
 /// The crate's result type.
 pub type Result<T> = std::result::Result<T, PipelineError>;
 

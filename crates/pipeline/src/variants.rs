@@ -181,12 +181,8 @@ impl VariantsConfig {
             field: field.to_string(),
             message,
         };
-        let raw: VariantsConfig = serde_json::from_str(&text).map_err(|e| {
-            error(
-                &format!("line {} column {}", e.line(), e.column()),
-                e.to_string(),
-            )
-        })?;
+        let raw: VariantsConfig =
+            data::json::from_str(&text).map_err(|e| PipelineError::json(path, e))?;
         if raw.seeds.is_empty() {
             return Err(error("seeds", "name at least one seed".to_string()));
         }
@@ -599,7 +595,7 @@ fn learned_basis_experiment(config: &CheckedVariants, data_dir: &Path) -> Result
     })?;
     merge_patch(&mut value, &config.raw.learn_overrides);
     let learn_config: learn::LearnConfig =
-        serde_json::from_value(value).map_err(|e| PipelineError::Config {
+        data::json::from_value(value).map_err(|e| PipelineError::Config {
             path: config.path.clone(),
             field: "learn_overrides".to_string(),
             message: e.to_string(),

@@ -29,16 +29,17 @@ pub enum ReportError {
 /// The crate's result type.
 pub type Result<T> = std::result::Result<T, ReportError>;
 
-/// Reads a JSON file into `T`, naming the file, line and column on error.
+/// Reads a JSON file into `T`, naming the file and the failing field (with its line and column)
+/// on error.
 pub(crate) fn read_json<T: serde::de::DeserializeOwned>(path: &std::path::Path) -> Result<T> {
     let text = std::fs::read_to_string(path).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    serde_json::from_str(&text).map_err(|error| ReportError::Json {
+    data::json::from_str(&text).map_err(|error| ReportError::Json {
         path: path.to_path_buf(),
-        field: format!("line {} column {}", error.line(), error.column()),
-        message: error.to_string(),
+        field: error.field,
+        message: error.message,
     })
 }
 

@@ -110,12 +110,7 @@ impl SindyModel {
             field: field.to_string(),
             message,
         };
-        let file: ModelFile = serde_json::from_str(text).map_err(|e| {
-            error(
-                "(document)",
-                format!("line {} column {}: {e}", e.line(), e.column()),
-            )
-        })?;
+        let file: ModelFile = data::json::from_str(text).map_err(|e| error(&e.field, e.message))?;
         if file.format != MODEL_FORMAT {
             return Err(error(
                 "format",

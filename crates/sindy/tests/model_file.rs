@@ -103,7 +103,10 @@ fn inconsistent_files_are_rejected_naming_the_field() {
         (text.replace("\"sin(u)\"", "\"sin(w)\""), "features"),
         (unknown_feature.to_string(), "equations.x"),
         (text.replace("sindy-model/1", "sindy-model/9"), "format"),
-        ("{\"state\": [".to_string(), "(document)"),
+        (
+            "{\"state\": [".to_string(),
+            "field 'state (line 1 column 11)'",
+        ),
         (
             text.replace(
                 "\"kind\": \"central\"",

@@ -29,7 +29,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         let text = std::fs::read_to_string(&json)
             .map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
         let ablations: pipeline::Ablations =
-            serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
+            data::json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
         let markdown = pipeline::ablations_markdown(&ablations);
         let md = args.out.join("ablations.md");
         std::fs::write(&md, &markdown).map_err(|e| anyhow::anyhow!("{}: {e}", md.display()))?;

@@ -1,0 +1,118 @@
+//! Reading JSON configuration files with errors that name the field: a wrong type, an unknown key
+//! or a bad value deep in a file is reported as `meta_training.average_last (line 22 column 20):
+//! invalid value: integer -1, expected usize`, not by its position alone. Every crate's loaders use
+//! this and wrap [`JsonError`] in their own error type with the file's path.
+
+use serde::de::DeserializeOwned;
+
+/// Where a JSON document failed to deserialise, and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct JsonError {
+    /// The path of the offending field (`rules[3].tolerance`) and, for text, its line and column;
+    /// only the position when the document itself is malformed.
+    pub field: String,
+    /// What is wrong, without the position (which `field` holds).
+    pub message: String,
+}
+
+impl std::fmt::Display for JsonError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.field, self.message)
+    }
+}
+
+/// Deserialises `text`, naming the field that fails.
+pub fn from_str<T: DeserializeOwned>(text: &str) -> Result<T, JsonError> {
+    let mut deserializer = serde_json::Deserializer::from_str(text);
+    let value = serde_path_to_error::deserialize(&mut deserializer).map_err(|error| {
+        let path = field_path(error.path());
+        let inner = error.into_inner();
+        let position = format!("line {} column {}", inner.line(), inner.column());
+        JsonError {
+            field: match path {
+                Some(path) => format!("{path} ({position})"),
+                None => position,
+            },
+            message: without_position(&inner),
+        }
+    })?;
+    // Trailing characters after the document are an error too (as in `serde_json::from_str`).
+    deserializer.end().map_err(|error| JsonError {
+        field: format!("line {} column {}", error.line(), error.column()),
+        message: without_position(&error),
+    })?;
+    Ok(value)
+}
+
+/// Deserialises an already parsed `value` (e.g. a configuration after a merge patch), naming the
+/// field that fails.
+pub fn from_value<T: DeserializeOwned>(value: serde_json::Value) -> Result<T, JsonError> {
+    serde_path_to_error::deserialize(value).map_err(|error| JsonError {
+        field: field_path(error.path()).unwrap_or_else(|| "the document".to_string()),
+        message: without_position(error.inner()),
+    })
+}
+
+/// The path as `a.b[2].c`, or `None` at the document's root.
+fn field_path(path: &serde_path_to_error::Path) -> Option<String> {
+    let text = path.to_string();
+    (text != ".").then_some(text)
+}
+
+/// serde_json's message without the ` at line L column C` it appends.
+fn without_position(error: &serde_json::Error) -> String {
+    let text = error.to_string();
+    let suffix = format!(" at line {} column {}", error.line(), error.column());
+    text.strip_suffix(&suffix).unwrap_or(&text).to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::Deserialize;
+
+    #[derive(Debug, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Outer {
+        #[allow(dead_code)]
+        inner: Inner,
+        #[allow(dead_code)]
+        rules: Vec<Inner>,
+    }
+
+    #[derive(Debug, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Inner {
+        #[allow(dead_code)]
+        count: usize,
+    }
+
+    #[test]
+    fn a_wrong_value_is_named_by_its_path_and_position() {
+        let text = "{\"inner\": {\"count\": 1},\n \"rules\": [{\"count\": 2}, {\"count\": -1}]}";
+        let error = from_str::<Outer>(text).unwrap_err();
+        assert_eq!(error.field, "rules[1].count (line 2 column 37)");
+        assert_eq!(error.message, "invalid value: integer `-1`, expected usize");
+    }
+
+    #[test]
+    fn an_unknown_key_and_a_syntax_error_are_named() {
+        let error = from_str::<Outer>("{\"inner\": {\"cuont\": 1}, \"rules\": []}").unwrap_err();
+        assert!(error.field.starts_with("inner.cuont"), "{error}");
+        assert!(error.message.contains("unknown field `cuont`"), "{error}");
+        let error = from_str::<Outer>("{\"inner\": ").unwrap_err();
+        assert_eq!(error.field, "inner (line 1 column 10)");
+        assert_eq!(error.message, "EOF while parsing a value");
+        assert!(!error.message.contains(" at line "), "{error}");
+        let error = from_str::<Inner>("{\"count\": 1} x").unwrap_err();
+        assert_eq!(error.field, "line 1 column 14");
+    }
+
+    #[test]
+    fn values_are_named_by_path_alone() {
+        let value = serde_json::json!({"inner": {"count": "many"}, "rules": []});
+        let error = from_value::<Outer>(value).unwrap_err();
+        assert_eq!(error.field, "inner.count");
+        assert!(error.message.starts_with("invalid type: string"), "{error}");
+    }
+}

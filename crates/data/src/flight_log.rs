@@ -247,6 +247,15 @@ fn check_unit_quaternions(
     Ok(())
 }
 
+/// The largest |a_ij − b_ij|.
+fn largest_difference(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> f64 {
+    a.iter()
+        .flatten()
+        .zip(b.iter().flatten())
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
 /// Largest deviation of R Rᵀ from the identity accepted for a recorded `R` (the Neural-Fly logs
 /// deviate by at most 3e-4).
 const ROTATION_TOLERANCE: f64 = 1e-2;
@@ -256,11 +265,8 @@ fn check_rotations(table: &TextTable, rotation: &[[[f64; 3]; 3]], recorded: bool
         return Ok(());
     }
     for (index, r) in rotation.iter().enumerate() {
-        let product = mat_mul(r, &transpose(r));
-        let deviation = (0..3)
-            .flat_map(|i| (0..3).map(move |j| (i, j)))
-            .map(|(i, j)| (product[i][j] - if i == j { 1.0 } else { 0.0 }).abs())
-            .fold(0.0, f64::max);
+        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let deviation = largest_difference(&mat_mul(r, &transpose(r)), &identity);
         let determinant = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
             - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
             + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
@@ -287,11 +293,7 @@ fn check_agreement(
     rotation: &[[[f64; 3]; 3]],
 ) -> Result<()> {
     for (index, (q, r)) in quaternion.iter().zip(rotation).enumerate() {
-        let from_q = rotation_from_quaternion(q);
-        let difference = (0..3)
-            .flat_map(|i| (0..3).map(move |j| (i, j)))
-            .map(|(i, j)| (from_q[i][j] - r[i][j]).abs())
-            .fold(0.0, f64::max);
+        let difference = largest_difference(&rotation_from_quaternion(q), r);
         if difference > ROTATION_TOLERANCE {
             return Err(DataError::BadCell {
                 path: table.path().to_path_buf(),

@@ -16,8 +16,9 @@ fn model() -> NominalModel {
     NominalModel::load(&workspace().join("experiments/mismatch/demo-quad.json")).unwrap()
 }
 
-fn flight(effects: Effects, seed: u64) -> data::FlightLog {
-    let scenario = Scenario {
+/// A 14 s figure-8 with small sensor noise and the given effects.
+fn scenario(effects: Effects, seed: u64) -> Scenario {
+    Scenario {
         model: "demo-quad.json".into(),
         duration_s: 14.0,
         warmup_s: 3.0,
@@ -42,8 +43,11 @@ fn flight(effects: Effects, seed: u64) -> data::FlightLog {
             rate_rad_s: 0.008,
         },
         gains: Default::default(),
-    };
-    simulate(&model(), &scenario, "test").unwrap()
+    }
+}
+
+fn flight(effects: Effects, seed: u64) -> data::FlightLog {
+    simulate(&model(), &scenario(effects, seed), "test").unwrap()
 }
 
 fn settings() -> AnalysisSettings {
@@ -163,32 +167,9 @@ fn a_zero_hover_throttle_names_the_file_line_and_column() {
 /// The shortest flight the simulator accepts is long enough for the analysis.
 #[test]
 fn the_shortest_simulated_flight_can_be_analysed() {
-    let duration_s = (physics::MIN_LOG_ROWS - 1) as f64 / 50.0;
     let scenario = Scenario {
-        model: "demo-quad.json".into(),
-        duration_s,
-        warmup_s: 3.0,
-        seed: 8,
-        physics_rate_hz: 500.0,
-        log_rate_hz: 50.0,
-        hover_throttle: 0.5,
-        trajectory: Trajectory::Figure8 {
-            center: [0.0, 0.0, 1.5],
-            first: [1.8, 0.0, 0.0],
-            second: [0.0, 0.9, 0.4],
-            period_s: 6.0,
-            low_passes: Vec::new(),
-            yaw_amplitude_rad: 0.3,
-            yaw_period_s: 9.0,
-        },
-        effects: Effects::default(),
-        noise: Noise {
-            position_m: 0.002,
-            velocity_m_s: 0.005,
-            attitude_rad: 0.002,
-            rate_rad_s: 0.008,
-        },
-        gains: Default::default(),
+        duration_s: (physics::MIN_LOG_ROWS - 1) as f64 / 50.0,
+        ..scenario(Effects::default(), 8)
     };
     let log = simulate(&model(), &scenario, "short").unwrap();
     assert_eq!(log.len(), physics::MIN_LOG_ROWS);

@@ -29,8 +29,7 @@ fn range3(name: &str, values: &[[f64; 3]]) -> String {
 /// other), the optional ones may be absent, and columns the log does not use are listed apart.
 fn column_summary(columns: &[String]) -> String {
     let present = |name: &str| columns.iter().any(|c| c == name);
-    let mut used = Vec::new();
-    for name in [
+    const USED: [&str; 9] = [
         "t",
         "p",
         "v",
@@ -40,37 +39,25 @@ fn column_summary(columns: &[String]) -> String {
         "T_sp",
         "hover_throttle",
         "pwm",
-    ] {
-        used.push(match name {
+    ];
+    const OPTIONAL: [&str; 4] = ["p_d", "v_d", "q_sp", "fa"];
+    let used: Vec<String> = USED
+        .iter()
+        .map(|&name| match name {
             "q" if !present("q") => "q (absent, derived from R)".to_string(),
             "R" if !present("R") => "R (absent, derived from q)".to_string(),
             _ => name.to_string(),
-        });
-    }
-    let optional: Vec<String> = ["p_d", "v_d", "q_sp", "fa"]
+        })
+        .collect();
+    let optional: Vec<String> = OPTIONAL
         .iter()
         .map(|name| format!("{name}{}", if present(name) { "" } else { " (absent)" }))
         .collect();
-    let known = [
-        "t",
-        "p",
-        "v",
-        "q",
-        "R",
-        "w",
-        "T_sp",
-        "hover_throttle",
-        "pwm",
-        "p_d",
-        "v_d",
-        "q_sp",
-        "fa",
-    ];
     // The unnamed first column of the Neural-Fly logs is the row index.
     let unused: Vec<&str> = columns
         .iter()
         .map(String::as_str)
-        .filter(|c| !c.is_empty() && !known.contains(c))
+        .filter(|c| !c.is_empty() && !USED.contains(c) && !OPTIONAL.contains(c))
         .collect();
     let mut summary = format!("{}; optional: {}", used.join(", "), optional.join(", "));
     if !unused.is_empty() {

@@ -9,6 +9,7 @@ use clap::Parser;
 
 fn main() -> ExitCode {
     restore_default_sigpipe();
+    report_output_failures();
     let cli = commands::Cli::parse();
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -28,6 +29,25 @@ fn restore_default_sigpipe() {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+}
+
+/// `println!` panics when standard output cannot be written (a full disk, a closed file); that is
+/// reported as the one-line error every other failure gets, with the usual exit code.
+fn report_output_failures() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if message.starts_with("failed printing to stdout") {
+            eprintln!("error: {message}");
+            std::process::exit(1);
+        }
+        default(info);
+    }));
 }
 
 /// The chain of causes joined by ": " on one line, without repeating a cause whose text the

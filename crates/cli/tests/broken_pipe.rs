@@ -1,5 +1,6 @@
 //! `learn … | head`: when the reader of standard output goes away, the command ends quietly (as
-//! Unix tools do, by SIGPIPE) instead of panicking on the failed write.
+//! Unix tools do, by SIGPIPE) instead of panicking on the failed write; when standard output
+//! cannot be written at all, that is a one-line error.
 
 #![cfg(unix)]
 
@@ -27,5 +28,27 @@ fn a_closed_output_ends_the_command_without_a_panic() {
         output.status.signal() == Some(libc::SIGPIPE) || output.status.success(),
         "{:?}: {stderr}",
         output.status
+    );
+}
+
+#[test]
+fn an_unwritable_output_is_a_one_line_error() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        return; // no /dev/full on this system
+    };
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let output = Command::new(env!("CARGO_BIN_EXE_learn"))
+        .args(["conditions", "--data", "/nonexistent-learn-data"])
+        .current_dir(root)
+        .env("RUST_BACKTRACE", "0")
+        .stdout(full)
+        .output()
+        .expect("the learn binary runs");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.starts_with("error: failed printing to stdout"),
+        "{stderr}"
     );
 }

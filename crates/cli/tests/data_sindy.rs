@@ -289,3 +289,48 @@ fn inconsistent_conditions_are_refused_naming_the_file_and_field() {
     let listing = learn_in(&dir, &["conditions", "--config", "good.json"]);
     assert!(listing.success().contains("35wind"), "{}", listing.stdout);
 }
+
+#[test]
+fn an_unusable_fit_or_precision_is_an_error_not_inf() {
+    let dir = scratch("sindy-tiny-steps");
+    // Time steps of 1e-300: finite values whose derivatives overflow.
+    let rows: String = (0..40)
+        .map(|i| {
+            format!(
+                "{:e},{},{}\n",
+                i as f64 * 1e-300,
+                (i as f64 * 0.1).sin(),
+                i % 3
+            )
+        })
+        .collect();
+    std::fs::write(dir.join("tiny.csv"), format!("t,x,u\n{rows}")).unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "sindy",
+            "--csv",
+            "tiny.csv",
+            "--state",
+            "x",
+            "--control",
+            "u",
+        ],
+    );
+    run.one_line_error(&["tiny.csv", "the fit is not finite"]);
+    assert!(!run.stdout.contains("inf"), "{}", run.stdout);
+    let run = learn_in(
+        &dir,
+        &[
+            "sindy",
+            "--csv",
+            "tiny.csv",
+            "--state",
+            "x",
+            "--precision",
+            "18",
+        ],
+    );
+    assert_eq!(run.code, Some(2), "{}", run.stderr);
+    assert!(run.stderr.contains("--precision"), "{}", run.stderr);
+}

@@ -60,3 +60,44 @@ fn sindy_and_simulate_refuse_to_replace_an_existing_output() {
         assert_eq!(std::fs::read_to_string(dir.join(name)).unwrap(), "mine");
     }
 }
+
+#[test]
+fn an_output_is_never_one_of_the_inputs_even_with_force() {
+    let dir = scratch("input-as-output");
+    let csv = "t,x\n0,1\n0.1,2\n0.2,3\n0.3,4\n0.4,5\n";
+    std::fs::write(dir.join("data.csv"), csv).unwrap();
+    std::fs::write(dir.join("scenario.json"), "{}").unwrap();
+    let sindy = learn_in(
+        &dir,
+        &[
+            "sindy",
+            "--csv",
+            "data.csv",
+            "--state",
+            "x",
+            "--library",
+            "poly:1",
+            "--out",
+            "./data.csv",
+            "--force",
+        ],
+    );
+    sindy.one_line_error(&["data.csv", "is the --csv input"]);
+    let simulate = learn_in(
+        &dir,
+        &[
+            "simulate",
+            "--scenario",
+            "scenario.json",
+            "--out",
+            "scenario.json",
+            "--force",
+        ],
+    );
+    simulate.one_line_error(&["scenario.json", "is the --scenario input"]);
+    assert_eq!(std::fs::read_to_string(dir.join("data.csv")).unwrap(), csv);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("scenario.json")).unwrap(),
+        "{}"
+    );
+}

@@ -343,6 +343,18 @@ fn check_conditions(
                 "empty condition name".to_string(),
             ));
         }
+        // The name becomes part of file names (checkpoints, figures, file patterns).
+        let plain = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.' | '+');
+        if !condition.name.chars().all(plain) || condition.name.starts_with('.') {
+            return Err(config_error(
+                &format!("{field}.name"),
+                format!(
+                    "'{}': use letters, digits, '-', '_', '+' and '.' (not first); the name is \
+                     part of file names (a label may be any text)",
+                    condition.name
+                ),
+            ));
+        }
         if condition
             .label
             .as_deref()
@@ -486,6 +498,17 @@ mod tests {
             |s| s.replace("\"name\": \"extra\"", "\"name\": \" \""),
             &["conditions[2].name", "empty condition name"],
         );
+        for (case, name) in [
+            ("slash", "sub/../../escape"),
+            ("dot", ".hidden"),
+            ("space", "a b"),
+        ] {
+            rejected(
+                case,
+                |s| s.replace("\"name\": \"extra\"", &format!("\"name\": \"{name}\"")),
+                &["conditions[2].name", "part of file names"],
+            );
+        }
         rejected(
             "empty-label",
             |s| s.replace("\"label\": \"70psin20\"", "\"label\": \"\""),

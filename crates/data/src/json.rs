@@ -21,8 +21,10 @@ impl std::fmt::Display for JsonError {
     }
 }
 
-/// Deserialises `text`, naming the field that fails.
+/// Deserialises `text` (a leading byte-order mark is ignored, as editors may write one), naming
+/// the field that fails.
 pub fn from_str<T: DeserializeOwned>(text: &str) -> Result<T, JsonError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut deserializer = serde_json::Deserializer::from_str(text);
     let value = serde_path_to_error::deserialize(&mut deserializer).map_err(|error| {
         let path = field_path(error.path());
@@ -83,7 +85,6 @@ mod tests {
     #[derive(Debug, Deserialize)]
     #[serde(deny_unknown_fields)]
     struct Inner {
-        #[allow(dead_code)]
         count: usize,
     }
 
@@ -106,6 +107,12 @@ mod tests {
         assert!(!error.message.contains(" at line "), "{error}");
         let error = from_str::<Inner>("{\"count\": 1} x").unwrap_err();
         assert_eq!(error.field, "line 1 column 14");
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_ignored() {
+        let parsed: Inner = from_str("\u{feff}{\"count\": 3}").unwrap();
+        assert_eq!(parsed.count, 3);
     }
 
     #[test]

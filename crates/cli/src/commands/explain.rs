@@ -7,7 +7,7 @@ use data::{ExperimentConditions, FlightLog};
 use learn::{EquationRule, MetaTrainedModel, explain_flight};
 
 use super::Global;
-use super::meta_train::refuse_input_as_output;
+use super::refuse_input_as_output;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -49,8 +49,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         if let Some(flight) = &args.flight {
             inputs.push(("--flight", flight.as_path()));
         }
-        refuse_input_as_output(path, &inputs)?;
-        super::refuse_overwrite(path, args.force)?;
+        super::check_output(path, args.force, &inputs)?;
     }
     let model = MetaTrainedModel::load(&args.checkpoint)?;
     let flight = match args.flight {

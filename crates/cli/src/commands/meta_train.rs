@@ -66,40 +66,6 @@ const DEFAULT_CHECKPOINTS: &str = "results/.scratch/learn/checkpoints";
 /// `--published` when not given (skipped when absent).
 const DEFAULT_PUBLISHED: &str = "paper/published.json";
 
-/// Whether `a` and `b` name the same existing file (also through links or other spellings).
-pub(super) fn same_file(a: &Path, b: &Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        if let (Ok(a), Ok(b)) = (std::fs::metadata(a), std::fs::metadata(b)) {
-            return a.dev() == b.dev() && a.ino() == b.ino();
-        }
-        false
-    }
-    #[cfg(not(unix))]
-    {
-        match (a.canonicalize(), b.canonicalize()) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
-        }
-    }
-}
-
-/// Refuses an output that is one of the command's inputs (`inputs`: option name, path), whatever
-/// `--force` says: writing it would destroy what the run was made from.
-pub(super) fn refuse_input_as_output(
-    output: &Path,
-    inputs: &[(&str, &Path)],
-) -> anyhow::Result<()> {
-    if let Some((option, _)) = inputs.iter().find(|(_, input)| same_file(output, input)) {
-        anyhow::bail!(
-            "{}: is the {option} input, refusing to write over it (even with --force)",
-            output.display()
-        );
-    }
-    Ok(())
-}
-
 /// The published tables: from a file given with --published (which must exist and parse), or from
 /// the default file when present (which must then parse).
 fn published_tables(path: Option<&Path>) -> anyhow::Result<Option<PublishedTables>> {
@@ -117,10 +83,15 @@ fn formulations(names: &[String]) -> anyhow::Result<Vec<Formulation>> {
     if names.is_empty() {
         return Ok(Formulation::ALL.to_vec());
     }
-    names
-        .iter()
-        .map(|n| Formulation::parse(n).map_err(Into::into))
-        .collect()
+    let mut formulations = Vec::new();
+    for name in names {
+        let formulation = Formulation::parse(name)?;
+        if formulations.contains(&formulation) {
+            anyhow::bail!("--formulation {name}: given twice");
+        }
+        formulations.push(formulation);
+    }
+    Ok(formulations)
 }
 
 fn write_json(path: &Path, value: &Value) -> anyhow::Result<()> {
@@ -205,10 +176,9 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(DEFAULT_CHECKPOINTS));
     if args.seed_spread {
-        refuse_input_as_output(&args.spread_out, &inputs)?;
-        super::refuse_overwrite(&args.spread_out, args.force)?;
+        super::check_output(&args.spread_out, args.force, &inputs)?;
     } else {
-        refuse_input_as_output(&out, &inputs)?;
+        super::refuse_input_as_output(&out, &inputs)?;
         if args.out.is_some() {
             super::refuse_overwrite(&out, args.force)?;
         }
@@ -284,7 +254,13 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     for &formulation in &formulations {
         for condition in &evaluated {
             let path = checkpoint_path(formulation, condition);
-            refuse_input_as_output(&path, &inputs)?;
+            if path == out {
+                anyhow::bail!(
+                    "{}: is both --out and a checkpoint of this run",
+                    out.display()
+                );
+            }
+            super::refuse_input_as_output(&path, &inputs)?;
             if args.checkpoints.is_some() {
                 super::refuse_overwrite(&path, args.force)?;
             }

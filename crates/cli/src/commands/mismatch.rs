@@ -6,7 +6,7 @@
 //! - `--flights CONDITIONS.json --model NOMINAL.json --out DIR`: every wind condition's evaluation
 //!   flight of the data directory → DIR/<condition>/… and DIR/neural-fly.md.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 
@@ -47,6 +47,24 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let Some(model_path) = &args.model else {
         bail!("--model is required with --recording or --flights");
     };
+    // No output file may be one of the inputs, even with --force.
+    let inputs = [
+        ("--model", model_path.as_path()),
+        (
+            "--recording",
+            args.recording.as_deref().unwrap_or(Path::new("")),
+        ),
+        (
+            "--flights",
+            args.flights.as_deref().unwrap_or(Path::new("")),
+        ),
+    ];
+    for output in mismatch::output_paths(&args.out)
+        .iter()
+        .chain([&args.out.join("neural-fly.md")])
+    {
+        super::refuse_input_as_output(output, &inputs)?;
+    }
     let model = physics::NominalModel::load(model_path)?;
     if let Some(conditions) = &args.flights {
         let data_dir = global.data_dir()?;

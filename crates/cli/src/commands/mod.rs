@@ -115,3 +115,41 @@ pub fn refuse_overwrite(path: &Path, force: bool) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+/// Checks a file the command is about to write: never one of its `inputs` (option name, path),
+/// and not an existing file unless `force`.
+pub fn check_output(output: &Path, force: bool, inputs: &[(&str, &Path)]) -> anyhow::Result<()> {
+    refuse_input_as_output(output, inputs)?;
+    refuse_overwrite(output, force)
+}
+
+/// Whether `a` and `b` name the same existing file (also through links or other spellings).
+fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return a.dev() == b.dev() && a.ino() == b.ino();
+        }
+        false
+    }
+    #[cfg(not(unix))]
+    {
+        match (a.canonicalize(), b.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        }
+    }
+}
+
+/// Refuses an output that is one of the command's inputs (`inputs`: option name, path), whatever
+/// `--force` says: writing it would destroy what the run was made from.
+pub fn refuse_input_as_output(output: &Path, inputs: &[(&str, &Path)]) -> anyhow::Result<()> {
+    if let Some((option, _)) = inputs.iter().find(|(_, input)| same_file(output, input)) {
+        anyhow::bail!(
+            "{}: is the {option} input, refusing to write over it (even with --force)",
+            output.display()
+        );
+    }
+    Ok(())
+}

@@ -52,9 +52,9 @@ pub struct Args {
     /// Derivative estimator: forward, central, savgol or savgol:WINDOW:ORDER.
     #[arg(long, default_value = "central")]
     pub derivative: String,
-    /// Decimals printed in the equations.
-    #[arg(long, default_value_t = 3)]
-    pub precision: usize,
+    /// Decimals printed in the equations (at most 17: an f64 has no more).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=17))]
+    pub precision: u8,
     /// Write the model as JSON here (never overwrites an existing file without --force).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -108,7 +108,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     }
     let feature_count = library.unique_feature_names(&columns)?.len();
     if let Some(out) = &args.out {
-        super::refuse_overwrite(out, args.force)?;
+        super::check_output(out, args.force, &[("--csv", &args.csv)])?;
     }
 
     let (time, table) = NumericTable::read_with_time(&args.csv, &args.time, &columns)?;
@@ -155,10 +155,22 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
             }
             other => anyhow::Error::new(other).context(format!("fitting {}", args.csv.display())),
         })?;
-    for line in model.equations(args.precision) {
+    let score = model.score(&trajectory)?;
+    // Finite inputs can still give an unusable fit (e.g. time steps so small that the derivative
+    // estimates overflow): an error, not equations and a score of inf or NaN.
+    if !(score.mse.is_finite() && score.r2.is_finite()) {
+        bail!(
+            "{}: the fit is not finite (MSE {}, R² {}): are the time steps of column '{}' in \
+             seconds?",
+            args.csv.display(),
+            score.mse,
+            score.r2,
+            args.time
+        );
+    }
+    for line in model.equations(usize::from(args.precision)) {
         println!("{line}");
     }
-    let score = model.score(&trajectory)?;
     eprintln!(
         "{} samples, {} features; MSE {:.6}, R² {:.6}",
         n,

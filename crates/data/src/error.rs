@@ -71,22 +71,56 @@ pub enum DataError {
         column: String,
         value: String,
     },
-    #[error("{}:{row}:t: time is not strictly increasing ({previous} then {current})", path.display())]
+    #[error(
+        "{}:{row}:{column}: time is not strictly increasing ({} then {})",
+        path.display(), Compact(*previous), Compact(*current)
+    )]
     TimeNotIncreasing {
         path: PathBuf,
         row: usize,
+        /// The name of the time column.
+        column: String,
         previous: f64,
         current: f64,
     },
     #[error(
-        "{}:{row}:t: sample interval is not uniform: worst gap {gap} s against a median of {median} s",
-        path.display()
+        "{}:{row}:{column}: sample interval is not uniform: worst gap {} s against a median of {} s",
+        path.display(), Compact(*gap), Compact(*median)
     )]
     NonUniformSampling {
         path: PathBuf,
         row: usize,
+        /// The name of the time column.
+        column: String,
         gap: f64,
         median: f64,
+    },
+    #[error(
+        "{}:{row}:{column}: sample interval {} s is outside the plausible range [{}, {}] s of a flight log (is the time in seconds?)",
+        path.display(), Compact(*interval), Compact(*min), Compact(*max)
+    )]
+    ImplausibleInterval {
+        path: PathBuf,
+        row: usize,
+        column: String,
+        interval: f64,
+        min: f64,
+        max: f64,
+    },
+    #[error(
+        "{}:{row}:{column}: {} is outside the plausible range [{}, {}]{unit} of {quantity}",
+        path.display(), Compact(*value), Compact(*min), Compact(*max)
+    )]
+    Implausible {
+        path: PathBuf,
+        row: usize,
+        column: String,
+        value: f64,
+        min: f64,
+        max: f64,
+        /// Empty, or the unit with a leading space.
+        unit: &'static str,
+        quantity: &'static str,
     },
     #[error("{}: {rows} data rows, at least {needed} are needed", path.display())]
     TooShort {
@@ -112,6 +146,22 @@ pub enum DataError {
     NoDataDir { tried: String },
     #[error("{what}: {message}")]
     Invalid { what: String, message: String },
+}
+
+/// A number as it reads best in a one-line message: plainly for ordinary magnitudes (so `0.02`
+/// stays `0.02`), in scientific notation for tiny or huge ones (`1e-302`, not 300 zeros).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Compact(pub f64);
+
+impl std::fmt::Display for Compact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let magnitude = self.0.abs();
+        if self.0 == 0.0 || !self.0.is_finite() || (1e-4..1e15).contains(&magnitude) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
 }
 
 /// Shorthand for results of this crate.

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{DataError, Result};
 use crate::table::TextTable;
-use crate::time::check_time_axis_at;
+use crate::time::{check_interval_range, check_time_axis_at};
 
 /// `<vehicle>_<trajectory>_<method>_<condition>.csv`, as the Neural-Fly data names its files.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -76,6 +76,115 @@ pub struct FlightLog {
 /// The columns a flight log must have (and `q` or `R`, at least one of them).
 pub const REQUIRED_COLUMNS: [&str; 7] = ["t", "p", "v", "w", "T_sp", "hover_throttle", "pwm"];
 
+/// A generous physically plausible range of one recorded quantity: every component of every row of
+/// its column must lie in `[min, max]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlausibleRange {
+    pub column: &'static str,
+    pub min: f64,
+    pub max: f64,
+    /// Empty, or the unit with a leading space.
+    pub unit: &'static str,
+    pub quantity: &'static str,
+}
+
+impl PlausibleRange {
+    const fn symmetric(
+        column: &'static str,
+        bound: f64,
+        unit: &'static str,
+        quantity: &'static str,
+    ) -> Self {
+        Self {
+            column,
+            min: -bound,
+            max: bound,
+            unit,
+            quantity,
+        }
+    }
+}
+
+/// A flight log is a physical recording: values far outside these ranges are corrupt (or in other
+/// units), and would only reach the analyses as overflowing or meaningless numbers. The ranges are
+/// orders of magnitude wider than anything in the 30 Neural-Fly flights, whose observed extremes
+/// are given for each. Checked per component on every row; optional columns when present.
+pub const PLAUSIBLE_RANGES: [PlausibleRange; 10] = [
+    // Observed: −1.58 to 3.09 m (a motion-capture room).
+    PlausibleRange::symmetric("p", 1e4, " m", "a position component"),
+    // Observed: −1.00 to 2.90 m.
+    PlausibleRange::symmetric("p_d", 1e4, " m", "a desired position component"),
+    // Observed: −1.69 to 1.61 m/s.
+    PlausibleRange::symmetric("v", 1e3, " m/s", "a velocity component"),
+    // Observed: −1.50 to 1.50 m/s.
+    PlausibleRange::symmetric("v_d", 1e3, " m/s", "a desired velocity component"),
+    // Observed: −1.20 to 1.35 rad/s.
+    PlausibleRange::symmetric("w", 1e3, " rad/s", "an angular rate component"),
+    // Observed: 0.215 to 1.062 (normalised throttle).
+    PlausibleRange {
+        column: "T_sp",
+        min: 0.0,
+        max: 100.0,
+        unit: "",
+        quantity: "the normalised thrust setpoint",
+    },
+    // Observed: 0.444 to 0.517 (normalised; T = m g T_sp / hover_throttle divides by it).
+    PlausibleRange {
+        column: "hover_throttle",
+        min: 1e-3,
+        max: 10.0,
+        unit: "",
+        quantity: "the normalised hover throttle",
+    },
+    // Observed: 548 to 1999 (motor commands, about 1000 to 2000).
+    PlausibleRange {
+        column: "pwm",
+        min: 0.0,
+        max: 1e5,
+        unit: "",
+        quantity: "a motor command",
+    },
+    // Observed: −27.7 to 14.2 N (a 2.6 kg vehicle weighs 26 N).
+    PlausibleRange::symmetric("fa", 1e5, " N", "a residual force component"),
+    // Observed: −1.0 to 0.12 (a quaternion: components of a unit one are within ±1).
+    PlausibleRange::symmetric("q_sp", 2.0, "", "an attitude setpoint quaternion component"),
+];
+
+/// The plausible range of a flight log's sample interval, s (observed: 0.01999999999998 to
+/// 0.02000798722045 s, i.e. 50 Hz): each interval must lie in it, which rejects times in other
+/// units (ms, µs) and corrupted time columns. The lower end, 100 kHz, leaves room for rounding
+/// at the simulator's fastest rate (10 kHz).
+pub const SAMPLE_INTERVAL_RANGE_S: (f64, f64) = (1e-5, 10.0);
+
+/// The plausible range of `column`, if it has one.
+pub fn plausible_range(column: &str) -> Option<&'static PlausibleRange> {
+    PLAUSIBLE_RANGES.iter().find(|r| r.column == column)
+}
+
+/// Fails on the first row whose value (any component) lies outside the column's plausible range.
+fn check_plausible<'a>(
+    table: &TextTable,
+    column: &str,
+    rows: impl Iterator<Item = &'a [f64]>,
+) -> Result<()> {
+    let range = plausible_range(column).expect("every checked column has a range");
+    for (index, row) in rows.enumerate() {
+        if let Some(&value) = row.iter().find(|v| !(range.min..=range.max).contains(*v)) {
+            return Err(DataError::Implausible {
+                path: table.path().to_path_buf(),
+                row: table.line(index),
+                column: column.to_string(),
+                value,
+                min: range.min,
+                max: range.max,
+                unit: range.unit,
+                quantity: range.quantity,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// The frame in which the recorded angular rate `w` is expressed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -85,7 +194,9 @@ pub enum RateFrame {
 }
 
 impl FlightLog {
-    /// Reads and validates a log. Errors name the file, row and column.
+    /// Reads and validates a log. Errors name the file, row and column. Besides the layout and the
+    /// attitude, the values must be physically plausible: every sample interval in
+    /// `SAMPLE_INTERVAL_RANGE_S` and every quantity in its `PLAUSIBLE_RANGES` (see this module).
     pub fn read(path: &Path) -> Result<Self> {
         Self::read_with_columns(path).map(|(log, _)| log)
     }
@@ -95,7 +206,14 @@ impl FlightLog {
     pub fn read_with_columns(path: &Path) -> Result<(Self, Vec<String>)> {
         let table = TextTable::read(path)?;
         let time = table.scalars("t")?;
-        check_time_axis_at(path, &time, crate::time::DEFAULT_UNIFORM_TOLERANCE, &|k| {
+        check_time_axis_at(
+            path,
+            "t",
+            &time,
+            crate::time::DEFAULT_UNIFORM_TOLERANCE,
+            &|k| table.line(k),
+        )?;
+        check_interval_range(path, "t", &time, SAMPLE_INTERVAL_RANGE_S, &|k| {
             table.line(k)
         })?;
         let has_q = table.has_column("q");
@@ -137,26 +255,41 @@ impl FlightLog {
         if has_q && has_r {
             check_agreement(&table, &quaternion, &rotation)?;
         }
+        let arrays3 = |name: &str| -> Result<Vec<[f64; 3]>> {
+            let values = table.arrays::<3>(name)?;
+            check_plausible(&table, name, values.iter().map(|v| v.as_slice()))?;
+            Ok(values)
+        };
         let optional3 = |name: &str| -> Result<Option<Vec<[f64; 3]>>> {
             if table.has_column(name) {
-                table.arrays::<3>(name).map(Some)
+                arrays3(name).map(Some)
             } else {
                 Ok(None)
             }
         };
+        let scalars = |name: &str| -> Result<Vec<f64>> {
+            let values = table.scalars(name)?;
+            check_plausible(&table, name, values.iter().map(std::slice::from_ref))?;
+            Ok(values)
+        };
+        let arrays4 = |name: &str| -> Result<Vec<[f64; 4]>> {
+            let values = table.arrays::<4>(name)?;
+            check_plausible(&table, name, values.iter().map(|v| v.as_slice()))?;
+            Ok(values)
+        };
         let log = Self {
             path: path.to_path_buf(),
             meta: FlightMeta::from_file_name(path),
-            position: table.arrays::<3>("p")?,
-            velocity: table.arrays::<3>("v")?,
-            body_rate: table.arrays::<3>("w")?,
-            thrust_setpoint: table.scalars("T_sp")?,
-            hover_throttle: table.scalars("hover_throttle")?,
-            motor_command: table.arrays::<4>("pwm")?,
+            position: arrays3("p")?,
+            velocity: arrays3("v")?,
+            body_rate: arrays3("w")?,
+            thrust_setpoint: scalars("T_sp")?,
+            hover_throttle: scalars("hover_throttle")?,
+            motor_command: arrays4("pwm")?,
             position_desired: optional3("p_d")?,
             velocity_desired: optional3("v_d")?,
             attitude_setpoint: if table.has_column("q_sp") {
-                Some(table.arrays::<4>("q_sp")?)
+                Some(arrays4("q_sp")?)
             } else {
                 None
             },

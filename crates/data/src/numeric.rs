@@ -41,6 +41,7 @@ impl NumericTable {
         table.names.remove(0);
         check_time_axis_at(
             path,
+            time,
             &time_values,
             crate::time::DEFAULT_UNIFORM_TOLERANCE,
             &|k| table.line(k),

@@ -9,16 +9,18 @@ use crate::table::file_row;
 /// uniform sampling (the Neural-Fly logs deviate by ~1e-12).
 pub const DEFAULT_UNIFORM_TOLERANCE: f64 = 0.01;
 
-/// Fails unless `time` has at least two samples, is strictly increasing and uniformly sampled
-/// within `tolerance` (relative to the median interval); the error reports the worst gap.
+/// Fails unless `time` (a column named `t`) has at least two samples, is strictly increasing and
+/// uniformly sampled within `tolerance` (relative to the median interval); the error reports the
+/// worst gap.
 pub fn check_time_axis(path: &Path, time: &[f64], tolerance: f64) -> Result<()> {
-    check_time_axis_at(path, time, tolerance, &file_row)
+    check_time_axis_at(path, "t", time, tolerance, &file_row)
 }
 
-/// [`check_time_axis`], with `line(k)` the line of the file that holds sample `k` (for files whose
-/// cells span lines).
+/// [`check_time_axis`] of the time column named `column`, with `line(k)` the line of the file that
+/// holds sample `k` (for files whose cells span lines). Errors name `column`.
 pub(crate) fn check_time_axis_at(
     path: &Path,
+    column: &str,
     time: &[f64],
     tolerance: f64,
     line: &dyn Fn(usize) -> usize,
@@ -35,6 +37,7 @@ pub(crate) fn check_time_axis_at(
             return Err(DataError::TimeNotIncreasing {
                 path: path.to_path_buf(),
                 row: line(k),
+                column: column.to_string(),
                 previous: time[k - 1],
                 current: time[k],
             });
@@ -59,9 +62,35 @@ pub(crate) fn check_time_axis_at(
         return Err(DataError::NonUniformSampling {
             path: path.to_path_buf(),
             row: line(index + 1),
+            column: column.to_string(),
             gap,
             median,
         });
+    }
+    Ok(())
+}
+
+/// Fails unless every interval of a strictly increasing `time` (the column named `column`) lies in
+/// `[min, max]` seconds; the error names the line of the first sample after an offending interval.
+pub(crate) fn check_interval_range(
+    path: &Path,
+    column: &str,
+    time: &[f64],
+    (min, max): (f64, f64),
+    line: &dyn Fn(usize) -> usize,
+) -> Result<()> {
+    for k in 1..time.len() {
+        let interval = time[k] - time[k - 1];
+        if !(min..=max).contains(&interval) {
+            return Err(DataError::ImplausibleInterval {
+                path: path.to_path_buf(),
+                row: line(k),
+                column: column.to_string(),
+                interval,
+                min,
+                max,
+            });
+        }
     }
     Ok(())
 }
@@ -103,5 +132,44 @@ mod tests {
             message.contains("f.csv:4:t: time is not strictly increasing"),
             "{message}"
         );
+    }
+
+    #[test]
+    fn errors_name_the_time_column_they_check() {
+        let t = [0.0, 0.02, 0.01, 0.06];
+        let message = check_time_axis_at(Path::new("f.csv"), "time", &t, 0.01, &file_row)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.starts_with("f.csv:4:time: time is not strictly increasing"),
+            "{message}"
+        );
+        let t = [0.0, 0.02, 0.04, 0.1];
+        let message = check_time_axis_at(Path::new("f.csv"), "time", &t, 0.01, &file_row)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.starts_with("f.csv:5:time: sample interval is not uniform"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn intervals_outside_the_range_are_named_compactly() {
+        let t: Vec<f64> = (0..5).map(|k| k as f64 * 2e-302).collect();
+        let message = check_interval_range(Path::new("f.csv"), "t", &t, (1e-4, 10.0), &file_row)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            message,
+            "f.csv:3:t: sample interval 2e-302 s is outside the plausible range [0.0001, 10] s of a flight log (is the time in seconds?)"
+        );
+        let t = [0.0, 20.0, 40.0];
+        let message = check_interval_range(Path::new("f.csv"), "t", &t, (1e-4, 10.0), &file_row)
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("sample interval 20 s"), "{message}");
+        let t: Vec<f64> = (0..5).map(|k| k as f64 * 0.02).collect();
+        check_interval_range(Path::new("f.csv"), "t", &t, (1e-4, 10.0), &file_row).unwrap();
     }
 }

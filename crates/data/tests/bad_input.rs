@@ -203,3 +203,212 @@ fn a_recorded_rotation_that_is_not_a_rotation() {
         "{message}"
     );
 }
+
+/// `error_of` for a copy of the synthetic log with one cell replaced on data row 100 (line 102).
+fn error_with_cell(column: &str, value: &str, name: &str) -> String {
+    let (_, text) = synthetic_csv(&temp_dir(&format!("{name}-src")), 150);
+    error_of(
+        &replace_cell(&text, 100, column_index(&text, column), value),
+        name,
+    )
+}
+
+#[test]
+fn physically_implausible_values_name_file_line_and_column() {
+    let cases = [
+        (
+            "p",
+            "\"[0.1, 1e308, 0.3]\"",
+            "bad.csv:102:p: 1e308 is outside the plausible range [-10000, 10000] m of a position component",
+        ),
+        (
+            "v",
+            "\"[1e308, 0.0, 0.0]\"",
+            "bad.csv:102:v: 1e308 is outside the plausible range [-1000, 1000] m/s of a velocity component",
+        ),
+        (
+            "v",
+            "\"[1e200, 0.0, 0.0]\"",
+            "bad.csv:102:v: 1e200 is outside",
+        ),
+        (
+            "v",
+            "\"[0.0, -1000.5, 0.0]\"",
+            "bad.csv:102:v: -1000.5 is outside",
+        ),
+        (
+            "w",
+            "\"[0.0, 0.0, 1e300]\"",
+            "bad.csv:102:w: 1e300 is outside the plausible range [-1000, 1000] rad/s of an angular rate component",
+        ),
+        (
+            "T_sp",
+            "[1e308]",
+            "bad.csv:102:T_sp: 1e308 is outside the plausible range [0, 100] of the normalised thrust setpoint",
+        ),
+        (
+            "T_sp",
+            "[-0.5]",
+            "bad.csv:102:T_sp: -0.5 is outside the plausible range [0, 100]",
+        ),
+        (
+            "hover_throttle",
+            "[1e-300]",
+            "bad.csv:102:hover_throttle: 1e-300 is outside the plausible range [0.001, 10] of the normalised hover throttle",
+        ),
+        (
+            "hover_throttle",
+            "[0.0]",
+            "bad.csv:102:hover_throttle: 0 is outside",
+        ),
+        (
+            "hover_throttle",
+            "[-0.47]",
+            "bad.csv:102:hover_throttle: -0.47 is outside",
+        ),
+        (
+            "pwm",
+            "\"[1300.0, 1e308, 1300.0, 1300.0]\"",
+            "bad.csv:102:pwm: 1e308 is outside the plausible range [0, 100000] of a motor command",
+        ),
+        (
+            "pwm",
+            "\"[1300.0, -1.0, 1300.0, 1300.0]\"",
+            "bad.csv:102:pwm: -1 is outside",
+        ),
+        (
+            "p_d",
+            "\"[0.0, 0.0, 2e4]\"",
+            "bad.csv:102:p_d: 20000 is outside",
+        ),
+        (
+            "v_d",
+            "\"[0.0, 5e3, 0.0]\"",
+            "bad.csv:102:v_d: 5000 is outside",
+        ),
+        (
+            "fa",
+            "\"[1e300, 0.0, 0.0]\"",
+            "bad.csv:102:fa: 1e300 is outside the plausible range [-100000, 100000] N of a residual force component",
+        ),
+        (
+            "q_sp",
+            "\"[0.0, 0.0, 0.0, 1e9]\"",
+            "bad.csv:102:q_sp: 1000000000 is outside",
+        ),
+    ];
+    for (k, (column, value, expected)) in cases.into_iter().enumerate() {
+        let message = error_with_cell(column, value, &format!("implausible-{k}"));
+        assert!(
+            message.starts_with(&std::env::temp_dir().display().to_string()),
+            "{message}"
+        );
+        assert!(message.contains(expected), "{column} = {value}: {message}");
+    }
+}
+
+#[test]
+fn values_inside_the_plausible_ranges_still_load() {
+    let (_, text) = synthetic_csv(&temp_dir("plausible-src"), 150);
+    let mut text = replace_cell(
+        &text,
+        100,
+        column_index(&text, "v"),
+        "\"[999.0, -999.0, 0.0]\"",
+    );
+    for (column, value) in [
+        ("p", "\"[9999.0, -9999.0, 0.0]\""),
+        ("w", "\"[999.0, 0.0, -999.0]\""),
+        ("T_sp", "[0.0]"),
+        ("hover_throttle", "[0.001]"),
+        ("pwm", "\"[0.0, 99999.0, 1000.0, 2000.0]\""),
+    ] {
+        text = replace_cell(&text, 100, column_index(&text, column), value);
+    }
+    let dir = temp_dir("plausible");
+    let path = dir.join("edge.csv");
+    std::fs::write(&path, text).unwrap();
+    let log = FlightLog::read(&path).unwrap();
+    assert_eq!(log.velocity[100], [999.0, -999.0, 0.0]);
+    assert_eq!(log.hover_throttle[100], 0.001);
+    assert_eq!(log.motor_command[100], [0.0, 99999.0, 1000.0, 2000.0]);
+}
+
+/// The synthetic log with every time multiplied by `factor` (written with full precision).
+fn error_with_time_scaled(factor: f64, name: &str) -> String {
+    let mut log = common::synthetic_log(150);
+    for t in &mut log.time {
+        *t *= factor;
+    }
+    let dir = temp_dir(name);
+    let path = dir.join("bad.csv");
+    log.write_csv(&path).unwrap();
+    let message = FlightLog::read(&path).unwrap_err().to_string();
+    assert!(!message.contains('\n'), "one line: {message}");
+    message
+}
+
+#[test]
+fn implausible_sample_intervals_are_rejected() {
+    // Every time × 1e-300: strictly increasing and uniform, but 2e-302 s apart.
+    let message = error_with_time_scaled(1e-300, "time-tiny");
+    assert!(
+        message.contains("bad.csv:3:t: sample interval 2"),
+        "{message}"
+    );
+    assert!(
+        message.contains(
+            "e-302 s is outside the plausible range [1e-5, 10] s of a flight log (is the time in seconds?)"
+        ),
+        "{message}"
+    );
+    // Milliseconds instead of seconds, and microseconds.
+    let message = error_with_time_scaled(1000.0, "time-ms");
+    assert!(
+        message.contains("bad.csv:3:t: sample interval 20"),
+        "{message}"
+    );
+    let message = error_with_time_scaled(1e-6, "time-us");
+    assert!(
+        message.contains("bad.csv:3:t: sample interval 2"),
+        "{message}"
+    );
+    assert!(message.contains("e-8 s is outside"), "{message}");
+    let message = error_with_time_scaled(501.0, "time-10s");
+    assert!(
+        message.contains("bad.csv:3:t: sample interval 10.02"),
+        "{message}"
+    );
+    // 10 kHz (the simulator's fastest rate) and 0.1 Hz logs are still plausible.
+    for (factor, name) in [(5e-3, "time-10khz"), (499.0, "time-slow")] {
+        let mut log = common::synthetic_log(150);
+        for t in &mut log.time {
+            *t *= factor;
+        }
+        let path = temp_dir(name).join("ok.csv");
+        log.write_csv(&path).unwrap();
+        FlightLog::read(&path).unwrap();
+    }
+}
+
+#[test]
+fn a_numeric_time_axis_error_names_its_own_column() {
+    let dir = temp_dir("numeric-time");
+    let path = dir.join("plain.csv");
+    std::fs::write(&path, "time,x\n0,1\n0.1,2\n0.05,3\n0.3,4\n").unwrap();
+    let message = NumericTable::read_with_time(&path, "time", &["x"])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("plain.csv:4:time: time is not strictly increasing (0.1 then 0.05)"),
+        "{message}"
+    );
+    std::fs::write(&path, "time,x\n0,1\n0.1,2\n0.2,3\n0.5,4\n").unwrap();
+    let message = NumericTable::read_with_time(&path, "time", &["x"])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("plain.csv:5:time: sample interval is not uniform"),
+        "{message}"
+    );
+}

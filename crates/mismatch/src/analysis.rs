@@ -4,7 +4,7 @@ use data::{Derivative, FlightLog, RateFrame};
 use physics::{Effects, NominalModel};
 use serde::Serialize;
 
-use crate::error::Result;
+use crate::error::{MismatchError, Result};
 use crate::library::{Candidate, TIMING, build_library};
 use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
@@ -213,13 +213,70 @@ pub fn analyze(
         timing_alternatives,
         wind_test,
     );
-    Ok(Analysis {
+    let analysis = Analysis {
         report,
         problem,
         before,
         after,
         fitted: effects,
-    })
+    };
+    check_finite(&analysis)?;
+    Ok(analysis)
+}
+
+/// Fails, naming the recording and the first offending quantity, unless every number of an analysis
+/// (the residuals behind the figure, the times and everything in the report) is finite: a recording
+/// whose values overflow the comparison must not give NaN or infinite results, in the report or in a
+/// figure.
+pub(crate) fn check_finite(analysis: &Analysis) -> Result<()> {
+    let problem = &analysis.problem;
+    let non_finite = |what: String| MismatchError::NonFinite {
+        path: problem.recording.path.clone(),
+        what,
+    };
+    if let Some(t) = problem.time.iter().find(|t| !t.is_finite()) {
+        return Err(non_finite(format!("time ({t})")));
+    }
+    for (name, residual) in [
+        ("residual of the nominal model", &analysis.before),
+        ("residual of the fitted model", &analysis.after),
+    ] {
+        for (row, r) in residual.iter().enumerate() {
+            if let Some(c) = (0..problem.channels).find(|&c| !r[c].is_finite()) {
+                let t = problem.time.get(row).copied().unwrap_or(f64::NAN);
+                return Err(non_finite(format!(
+                    "{name} in {} ({} at t = {t} s)",
+                    CHANNEL_NAMES[c], r[c]
+                )));
+            }
+        }
+    }
+    // serde_json writes a non-finite number as null, and the report has no other nulls.
+    let report = serde_json::to_value(&analysis.report).expect("the report serialises");
+    if let Some(field) = first_null(&report, String::new()) {
+        return Err(non_finite(format!("{field} in the report")));
+    }
+    Ok(())
+}
+
+/// The path (`fit.before.mse`, `channels[0].residual_rms`) of the first null in a JSON value.
+fn first_null(value: &serde_json::Value, path: String) -> Option<String> {
+    match value {
+        serde_json::Value::Null => Some(path),
+        serde_json::Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .find_map(|(i, item)| first_null(item, format!("{path}[{i}]"))),
+        serde_json::Value::Object(map) => map.iter().find_map(|(key, item)| {
+            let inner = if path.is_empty() {
+                key.clone()
+            } else {
+                format!("{path}.{key}")
+            };
+            first_null(item, inner)
+        }),
+        _ => None,
+    }
 }
 
 /// Replaces the screen columns of the nonlinear candidates by the exact effect at the parameters
@@ -601,8 +658,8 @@ fn locate_windows(
     residual: &[Channels],
     settings: &AnalysisSettings,
 ) -> Vec<Window> {
-    let half = ((settings.window_s / problem.recording.dt) / 2.0).round() as usize;
     let rows = residual.len();
+    let half = half_window_rows(settings.window_s, problem.recording.dt, rows);
     let mut windows = Vec::new();
     for c in 0..problem.channels {
         let threshold = (settings.window_factor * problem.noise_floor[c]).powi(2);
@@ -638,6 +695,13 @@ fn locate_windows(
         }
     }
     windows
+}
+
+/// Half the length, in rows, of a moving window of `window_s` seconds at sample interval `dt`,
+/// capped at `rows` (a window longer than the recording is the whole recording), so that the
+/// window's row arithmetic cannot overflow however small `dt` is.
+fn half_window_rows(window_s: f64, dt: f64, rows: usize) -> usize {
+    (((window_s / dt) / 2.0).round() as usize).min(rows)
 }
 
 fn rms(values: impl Iterator<Item = f64>) -> f64 {
@@ -835,5 +899,45 @@ pub fn describe(id: &str, e: &Effects) -> String {
             1000.0 * e.delay_s()
         ),
         other => other.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_moving_window_cannot_overflow() {
+        // 1 s at 50 Hz: 25 rows either side, as before.
+        assert_eq!(half_window_rows(1.0, 0.02, 2500), 25);
+        // Times × 1e-300: the window would be ~1e300 rows; capped at the recording.
+        let rows = 2000;
+        let half = half_window_rows(1.0, 2e-302, rows);
+        assert_eq!(half, rows);
+        let k = rows - 1;
+        assert_eq!(
+            (k.saturating_sub(half), (k + half + 1).min(rows)),
+            (0, rows)
+        );
+        // A NaN interval gives a zero-row window, not a panic.
+        assert_eq!(half_window_rows(1.0, f64::NAN, rows), 0);
+    }
+
+    #[test]
+    fn nulls_are_found_with_their_path() {
+        let value = serde_json::json!({"a": 1.0, "fit": {"before": {"mse": f64::INFINITY}}});
+        assert_eq!(
+            first_null(&value, String::new()).as_deref(),
+            Some("fit.before.mse")
+        );
+        let value = serde_json::json!({"channels": [{"x": 1.0}, {"x": f64::NAN}]});
+        assert_eq!(
+            first_null(&value, String::new()).as_deref(),
+            Some("channels[1].x")
+        );
+        assert_eq!(
+            first_null(&serde_json::json!({"a": [1, 2]}), String::new()),
+            None
+        );
     }
 }

@@ -18,6 +18,11 @@ pub enum MismatchError {
     Exists { path: PathBuf },
     #[error("{}: {message}", path.display())]
     Recording { path: PathBuf, message: String },
+    #[error(
+        "{}: the analysis of this recording gives a non-finite {what}: its values are outside the range the analysis can handle",
+        path.display()
+    )]
+    NonFinite { path: PathBuf, what: String },
     #[error("{}: cannot draw the figure: {message}", path.display())]
     Plot { path: PathBuf, message: String },
     #[error("{}: field '{field}': {message}", path.display())]

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
-use crate::analysis::Analysis;
+use crate::analysis::{Analysis, check_finite};
 use crate::error::{MismatchError, Result, io_error};
 use crate::problem::CHANNEL_NAMES;
 
@@ -41,9 +41,11 @@ pub fn check_directory(dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Writes the three files.
+/// Writes the three files; fails before writing any of them unless every number of the analysis is
+/// finite.
 pub fn write_outputs(analysis: &Analysis, dir: &Path, force: bool) -> Result<()> {
     check_outputs(dir, force)?;
+    check_finite(analysis)?;
     std::fs::create_dir_all(dir).map_err(io_error(dir))?;
     let [json, svg, markdown] = output_paths(dir);
     let text = serde_json::to_string_pretty(&analysis.report).expect("the report serialises");
@@ -57,7 +59,16 @@ fn units(channel: usize) -> &'static str {
     if channel < 3 { "m/s²" } else { "rad/s²" }
 }
 
-/// The figure: one panel per channel.
+/// The span of an axis drawn from `lo` to `hi`, when it can be drawn: both ends finite and `lo` below
+/// `hi` by a finite, normal (not subnormal) difference. Plotting libraries compute tick marks by
+/// dividing such spans, and loop forever on infinite ones.
+fn drawable(lo: f64, hi: f64) -> bool {
+    let span = hi - lo;
+    lo.is_finite() && hi.is_finite() && span.is_normal() && span > 0.0
+}
+
+/// The figure: one panel per channel. Fails, without drawing, unless the data are finite and every
+/// axis spans a drawable range (finite ends, a normal positive span).
 pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
     let plot_error = |e: &dyn std::fmt::Display| MismatchError::Plot {
         path: path.to_path_buf(),
@@ -65,6 +76,55 @@ pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
     };
     let problem = &analysis.problem;
     let channels = problem.channels;
+    let time = &problem.time;
+    if time.is_empty()
+        || analysis.before.len() != time.len()
+        || analysis.after.len() != time.len()
+        || channels > CHANNEL_NAMES.len()
+    {
+        return Err(plot_error(&format!(
+            "{} times, {} and {} residual rows for {channels} channels",
+            time.len(),
+            analysis.before.len(),
+            analysis.after.len()
+        )));
+    }
+    if !drawable(time[0], time[time.len() - 1]) || time.iter().any(|t| !t.is_finite()) {
+        return Err(plot_error(&format!(
+            "the time axis from {} to {} s cannot be drawn",
+            time[0],
+            time[time.len() - 1]
+        )));
+    }
+    let mut ranges = Vec::with_capacity(channels);
+    for c in 0..channels {
+        let values = analysis.before.iter().chain(&analysis.after).map(|r| r[c]);
+        let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+        let margin = 0.05 * (hi - lo).max(1e-9);
+        let (lo, hi) = (lo - margin, hi + margin);
+        let finite = analysis
+            .before
+            .iter()
+            .chain(&analysis.after)
+            .all(|r| r[c].is_finite());
+        if !finite || !drawable(lo, hi) {
+            return Err(plot_error(&format!(
+                "the residual of {} is not finite or spans no drawable range ({lo} to {hi})",
+                CHANNEL_NAMES[c]
+            )));
+        }
+        ranges.push((lo, hi));
+    }
+    let windows_drawable = analysis
+        .report
+        .windows
+        .iter()
+        .all(|w| w.t_start.is_finite() && w.t_end.is_finite());
+    if !windows_drawable {
+        return Err(plot_error(&"a located window has a non-finite time"));
+    }
     let root = SVGBackend::new(path, (1100, 60 + 190 * channels as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_error(&e))?;
     let (title, body) = root.split_vertically(50);
@@ -75,16 +135,10 @@ pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
         )
         .map_err(|e| plot_error(&e))?;
     let panels = body.split_evenly((channels, 1));
-    let time = &problem.time;
     let (t0, t1) = (time[0], time[time.len() - 1]);
     let split_time = time[problem.split.min(time.len() - 1)];
     for (c, panel) in panels.iter().enumerate() {
-        let values = analysis.before.iter().chain(&analysis.after).map(|r| r[c]);
-        let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        });
-        let margin = 0.05 * (hi - lo).max(1e-9);
-        let (lo, hi) = (lo - margin, hi + margin);
+        let (lo, hi) = ranges[c];
         let mut chart = ChartBuilder::on(panel)
             .margin(8)
             .x_label_area_size(28)

@@ -4,7 +4,7 @@
 use data::Derivative;
 use physics::{Effects, NominalModel};
 
-use crate::error::Result;
+use crate::error::{MismatchError, Result};
 use crate::filter::{MatchedSmoother, white_noise_sigma};
 use crate::forward::predict_intervals;
 use crate::recording::Recording;
@@ -54,6 +54,17 @@ impl Problem {
         let smoother = MatchedSmoother::new(derivative)?;
         let half = smoother.half_window();
         let n = recording.len();
+        // At least one analysed row to fit and one held out.
+        if n < 2 * half + 2 {
+            return Err(MismatchError::Recording {
+                path: recording.path.clone(),
+                message: format!(
+                    "{n} rows, the derivative's window of {} rows needs at least {}",
+                    2 * half + 1,
+                    2 * half + 2
+                ),
+            });
+        }
         let channels = if model.predicts_torque() { 6 } else { 3 };
         let dt = recording.dt;
         let mut target = vec![[0.0; 6]; n - 2 * half];
@@ -81,6 +92,14 @@ impl Problem {
         }
         let rows = target.len();
         let split = ((1.0 - heldout_fraction) * rows as f64).round() as usize;
+        if !(1..=rows).contains(&split) {
+            return Err(MismatchError::Recording {
+                path: recording.path.clone(),
+                message: format!(
+                    "a held-out fraction of {heldout_fraction} of {rows} analysed rows leaves no rows to fit"
+                ),
+            });
+        }
         Ok(Self {
             time: recording.time[half..n - half].to_vec(),
             recording,

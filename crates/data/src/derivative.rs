@@ -13,12 +13,38 @@ use serde::{Deserialize, Serialize};
 use crate::error::{DataError, Result};
 
 /// How a derivative is estimated from samples.
+///
+/// JSON: `{"kind": "forward"}`, `{"kind": "central"}` or
+/// `{"kind": "savitzky_golay", "window": 21, "order": 3}`; any other field is an error (also next
+/// to `forward` and `central`, which serde would otherwise ignore in a unit variant).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(tag = "kind", rename_all = "snake_case", from = "DerivativeFields")]
 pub enum Derivative {
     Forward,
     Central,
     SavitzkyGolay { window: usize, order: usize },
+}
+
+/// What a [`Derivative`] is read from: the same JSON, every variant a struct variant, so that
+/// `deny_unknown_fields` applies to all of them.
+#[derive(Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum DerivativeFields {
+    Forward {},
+    Central {},
+    SavitzkyGolay { window: usize, order: usize },
+}
+
+impl From<DerivativeFields> for Derivative {
+    fn from(fields: DerivativeFields) -> Self {
+        match fields {
+            DerivativeFields::Forward {} => Self::Forward,
+            DerivativeFields::Central {} => Self::Central,
+            DerivativeFields::SavitzkyGolay { window, order } => {
+                Self::SavitzkyGolay { window, order }
+            }
+        }
+    }
 }
 
 impl Derivative {
@@ -296,6 +322,34 @@ mod tests {
                 .contains("spline")
         );
         assert!(Derivative::Central.apply(&[1.0, 2.0], 0.1).is_err());
+    }
+
+    #[test]
+    fn unknown_fields_are_errors_in_every_kind() {
+        let read = |text: &str| crate::json::from_str::<Derivative>(text);
+        assert_eq!(read(r#"{"kind": "forward"}"#).unwrap(), Derivative::Forward);
+        assert_eq!(read(r#"{"kind": "central"}"#).unwrap(), Derivative::Central);
+        assert_eq!(
+            read(r#"{"kind": "savitzky_golay", "window": 21, "order": 3}"#).unwrap(),
+            Derivative::SMOOTH
+        );
+        for text in [
+            r#"{"kind": "forward", "window": 5}"#,
+            r#"{"kind": "central", "order": 7}"#,
+            r#"{"kind": "savitzky_golay", "window": 21, "order": 3, "mode": "interp"}"#,
+        ] {
+            let message = read(text).unwrap_err().to_string();
+            assert!(message.contains("unknown field"), "{text}: {message}");
+        }
+        // Written as before.
+        for derivative in [Derivative::Forward, Derivative::Central, Derivative::SMOOTH] {
+            let text = serde_json::to_string(&derivative).unwrap();
+            assert_eq!(read(&text).unwrap(), derivative, "{text}");
+        }
+        assert_eq!(
+            serde_json::to_string(&Derivative::Forward).unwrap(),
+            r#"{"kind":"forward"}"#
+        );
     }
 
     #[test]

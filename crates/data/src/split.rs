@@ -8,13 +8,39 @@ use crate::error::{DataError, Result};
 
 /// How a flight of n samples is cut into a support segment (fit, adapt) and a query segment
 /// (generalisation, never used to fit or choose anything).
+///
+/// JSON: `{"kind": "halves"}` or `{"kind": "fraction", "support": 0.7}`; any other field is an
+/// error (also next to `halves`, which serde would otherwise ignore in a unit variant).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(
+    tag = "kind",
+    rename_all = "snake_case",
+    deny_unknown_fields,
+    from = "SplitSpecFields"
+)]
 pub enum SplitSpec {
     /// The paper's protocol: support = rows [0, n/2), query = rows [n/2, n) (integer division).
     Halves,
     /// Contiguous: support = the first ⌊fraction·n⌋ rows, query = the rest.
     Fraction { support: f64 },
+}
+
+/// What a [`SplitSpec`] is read from: the same JSON, every variant a struct variant, so that
+/// `deny_unknown_fields` applies to `halves` too.
+#[derive(Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum SplitSpecFields {
+    Halves {},
+    Fraction { support: f64 },
+}
+
+impl From<SplitSpecFields> for SplitSpec {
+    fn from(fields: SplitSpecFields) -> Self {
+        match fields {
+            SplitSpecFields::Halves {} => Self::Halves,
+            SplitSpecFields::Fraction { support } => Self::Fraction { support },
+        }
+    }
 }
 
 /// The two contiguous segments of a split.
@@ -74,5 +100,32 @@ mod tests {
         );
         assert!(SplitSpec::Fraction { support: 1.5 }.split(100).is_err());
         assert!(SplitSpec::Halves.split(3).is_err());
+    }
+
+    #[test]
+    fn unknown_fields_are_errors_in_every_kind() {
+        let read = |text: &str| crate::json::from_str::<SplitSpec>(text);
+        assert_eq!(read(r#"{"kind": "halves"}"#).unwrap(), SplitSpec::Halves);
+        assert_eq!(
+            read(r#"{"support": 0.25, "kind": "fraction"}"#).unwrap(),
+            SplitSpec::Fraction { support: 0.25 }
+        );
+        for text in [
+            r#"{"kind": "halves", "ratio": 0.3}"#,
+            r#"{"kind": "halves", "support": 0.3}"#,
+            r#"{"kind": "fraction", "support": 0.3, "ratio": 0.3}"#,
+        ] {
+            let message = read(text).unwrap_err().to_string();
+            assert!(message.contains("unknown field"), "{text}: {message}");
+        }
+        // Written as before.
+        for spec in [SplitSpec::Halves, SplitSpec::Fraction { support: 0.5 }] {
+            let text = serde_json::to_string(&spec).unwrap();
+            assert_eq!(read(&text).unwrap(), spec, "{text}");
+        }
+        assert_eq!(
+            serde_json::to_string(&SplitSpec::Halves).unwrap(),
+            r#"{"kind":"halves"}"#
+        );
     }
 }

@@ -118,17 +118,26 @@ impl RunConfig {
                     .to_string(),
             ));
         }
-        if self.learn.seeds.is_empty() {
-            return Err(error("learn.seeds", "name at least one seed".to_string()));
-        }
-        for (index, seed) in self.learn.seeds.iter().enumerate() {
-            if self.learn.seeds[..index].contains(seed) {
-                return Err(error("learn.seeds", format!("seed {seed} is listed twice")));
-            }
-        }
-        // Checked now, not after the flights are loaded and LeARN is meta-trained.
-        sindy::FeatureLibrary::from_spec(&self.sindy.library)
+        check_seeds(&self.learn.seeds).map_err(|message| error("learn.seeds", message))?;
+        // Checked now, not after the flights are loaded and LeARN is meta-trained: the library's
+        // size on each formulation's inputs too (in closed form, nothing is enumerated).
+        let library = sindy::FeatureLibrary::from_spec(&self.sindy.library)
             .map_err(|e| error("sindy.library", e.to_string()))?;
+        for formulation in &self.formulations {
+            library
+                .checked_feature_count(formulation.input_names().len())
+                .map_err(|e| {
+                    error(
+                        "sindy.library",
+                        format!("on the {} formulation: {e}", formulation.name()),
+                    )
+                })?;
+        }
+        if let Some(derivative) = self.sindy.fit_derivative {
+            derivative
+                .validate()
+                .map_err(|e| error("sindy.fit_derivative", e.to_string()))?;
+        }
         self.sindy
             .optimizer
             .checked()
@@ -170,6 +179,29 @@ impl RunConfig {
     }
 }
 
+/// The most seeds a run (`learn.seeds`) or a variants file (`seeds`) may list: every seed is a
+/// full meta-training per cell (the committed configurations use up to 5).
+pub const MAX_SEEDS: usize = 100;
+
+/// At least one seed, at most [`MAX_SEEDS`], none twice; the message otherwise.
+pub(crate) fn check_seeds(seeds: &[u64]) -> std::result::Result<(), String> {
+    if seeds.is_empty() {
+        return Err("name at least one seed".to_string());
+    }
+    if seeds.len() > MAX_SEEDS {
+        return Err(format!(
+            "{} seeds, more than the limit of {MAX_SEEDS} (pipeline::MAX_SEEDS)",
+            seeds.len()
+        ));
+    }
+    for (index, seed) in seeds.iter().enumerate() {
+        if seeds[..index].contains(seed) {
+            return Err(format!("seed {seed} is listed twice"));
+        }
+    }
+    Ok(())
+}
+
 fn read(path: &Path) -> Result<String> {
     std::fs::read_to_string(path).map_err(|source| PipelineError::Io {
         path: path.to_path_buf(),
@@ -194,13 +226,22 @@ fn load_learn_config(
     let mut value: serde_json::Value =
         data::json::from_str(&text).map_err(|error| PipelineError::json(path, error))?;
     merge_patch(&mut value, overrides);
+    // With overrides, a bad value may be the override's: the error names both files.
+    let with_overrides = |message: String| PipelineError::Config {
+        path: run_config.to_path_buf(),
+        field: "learn.overrides".to_string(),
+        message: format!("{} with these overrides: {message}", path.display()),
+    };
     let config: LearnConfig =
-        data::json::from_value(value).map_err(|error| PipelineError::Config {
-            path: run_config.to_path_buf(),
-            field: "learn.overrides".to_string(),
-            message: format!("{} with these overrides: {error}", path.display()),
-        })?;
-    Ok(config.check(path)?)
+        data::json::from_value(value).map_err(|error| with_overrides(error.to_string()))?;
+    match config.check(path) {
+        Ok(checked) => Ok(checked),
+        Err(error) if overrides.is_null() => Err(error.into()),
+        Err(learn::LearnError::Config { field, message, .. }) => {
+            Err(with_overrides(format!("field '{field}': {message}")))
+        }
+        Err(error) => Err(with_overrides(error.to_string())),
+    }
 }
 
 /// RFC 7396: objects merge key by key, `null` removes a key, anything else replaces.

@@ -26,6 +26,9 @@ pub enum PipelineError {
         field: String,
         message: String,
     },
+    /// A flight that cannot be evaluated (e.g. too short to split), named by its file.
+    #[error("{}: {message}", path.display())]
+    Flight { path: PathBuf, message: String },
     /// Two parts of a run disagree (e.g. the targets SINDy and LeARN were scored against).
     #[error("{what}: {message}")]
     Mismatch { what: String, message: String },
@@ -38,6 +41,21 @@ impl PipelineError {
             path: path.to_path_buf(),
             field: error.field,
             message: error.message,
+        }
+    }
+}
+
+/// `error` about the flight at `path`, naming the file unless the message already does.
+pub(crate) fn in_flight(path: &std::path::Path, error: impl Into<PipelineError>) -> PipelineError {
+    let error = error.into();
+    let message = error.to_string();
+    let shown = path.display().to_string();
+    if shown.is_empty() || message.contains(&shown) {
+        error
+    } else {
+        PipelineError::Flight {
+            path: path.to_path_buf(),
+            message,
         }
     }
 }

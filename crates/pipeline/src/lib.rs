@@ -24,10 +24,11 @@ mod run;
 mod summary;
 mod variants;
 
-pub use config::{CheckedRunConfig, LearnRun, RunConfig, merge_patch};
+pub use config::{CheckedRunConfig, LearnRun, MAX_SEEDS, RunConfig, merge_patch};
 pub use error::{PipelineError, Result};
 pub use output::{
-    OutputPaths, README_BEGIN, README_END, check_paper, update_readme, write_outputs,
+    OutputPaths, README_BEGIN, README_END, check_ablations_output, check_paper, update_readme,
+    write_outputs,
 };
 pub use run::{
     GENERATED_PATHS, RunOptions, RunOutcome, figure_file_name, git_commit, run, uncommitted_inputs,
@@ -38,6 +39,7 @@ pub use summary::{
 };
 pub use variants::{
     AblationProvenance, AblationRow, Ablations, AblationsOutcome, CheckedVariants,
-    LearnedBasisSpec, Outcome, SeedCell, VariantCell, VariantKind, VariantSpec, VariantsConfig,
-    ablations_markdown, evaluate_variants, reproduce_columns, run_variants, write_ablations,
+    LearnedBasisSpec, MAX_VARIANTS, Outcome, SeedCell, VariantCell, VariantKind, VariantSpec,
+    VariantsConfig, ablations_markdown, evaluate_variants, reproduce_columns, run_variants,
+    write_ablations,
 };

@@ -32,12 +32,7 @@ impl OutputPaths {
     /// A run then never fails at its end for a reason known at its start.
     pub fn check(&self) -> Result<()> {
         for dir in [&self.results_dir, &self.latex_dir] {
-            let probe = dir.join(".learn-write-check");
-            write_text(&probe, "")?;
-            std::fs::remove_file(&probe).map_err(|source| PipelineError::Io {
-                path: probe.clone(),
-                source,
-            })?;
+            check_writable(dir)?;
         }
         if let Some(readme) = &self.readme {
             results_block(readme, &read_readme(readme)?)?;
@@ -54,6 +49,25 @@ impl OutputPaths {
     pub fn figures_dir(&self) -> PathBuf {
         self.results_dir.join("figures")
     }
+}
+
+/// Creates `dir` and writes a probe file in it (removed again): a run then never fails at its end
+/// for an output directory it could have checked at its start.
+fn check_writable(dir: &Path) -> Result<()> {
+    let probe = dir.join(".learn-write-check");
+    write_text(&probe, "")?;
+    std::fs::remove_file(&probe).map_err(|source| PipelineError::Io {
+        path: probe.clone(),
+        source,
+    })
+}
+
+/// Checks, before `learn ablations` fits anything, that [`crate::write_ablations`] can write
+/// under `dir` (`ablations.{json,md}` there, figures in `dir/figures`), as
+/// [`OutputPaths::check`] does for a run.
+pub fn check_ablations_output(dir: &Path) -> Result<()> {
+    check_writable(dir)?;
+    check_writable(&dir.join("figures"))
 }
 
 /// Removes the files with extension `extension` directly in `dir` (outputs of an earlier run that
@@ -253,5 +267,28 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(message.contains("README.md/results"), "{message}");
+    }
+
+    #[test]
+    fn the_ablations_output_is_checked_before_any_work() {
+        let dir =
+            std::env::temp_dir().join(format!("pipeline-ablations-out-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        check_ablations_output(&dir.join("out")).unwrap();
+        assert!(dir.join("out/figures").is_dir());
+        assert!(!dir.join("out/.learn-write-check").exists());
+        // A file where the directory should be.
+        let file = dir.join("a-file");
+        std::fs::write(&file, "").unwrap();
+        let message = check_ablations_output(&file).unwrap_err().to_string();
+        assert!(message.contains("a-file"), "{message}");
+        // A directory where `figures/` cannot be made.
+        std::fs::create_dir_all(dir.join("blocked")).unwrap();
+        std::fs::write(dir.join("blocked/figures"), "").unwrap();
+        let message = check_ablations_output(&dir.join("blocked"))
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("blocked/figures"), "{message}");
+        assert!(!message.contains('\n'), "{message}");
     }
 }

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use data::{Condition, FlightLog, Formulation, Mat, Segment, file_sha256};
+use data::{Condition, Derivative, FlightLog, Formulation, Mat, Segment, SplitSpec, file_sha256};
 use indicatif::{ProgressBar, ProgressStyle};
 use learn::{CellResult, DataFile, EquationRule, Experiment, RangeCoverage, explain, row_major};
 use rayon::prelude::*;
@@ -11,7 +11,7 @@ use report::{MethodTrace, Mse, OutputAxis, PublishedTables, QualitativeFigure, R
 use sindy::SegmentEvaluation;
 
 use crate::config::CheckedRunConfig;
-use crate::error::{PipelineError, Result};
+use crate::error::{PipelineError, Result, in_flight};
 use crate::summary::{
     CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,
     StageTiming, Summary,
@@ -131,6 +131,20 @@ pub fn run(
         cells
     })?;
 
+    // The extra columns' folds and bagging blocks against the segments, before LeARN runs.
+    if let Some(path) = &config.raw.variants {
+        let path = root.join(path);
+        let variants = crate::variants::VariantsConfig::read(&path)?;
+        for cell in &cells {
+            let segment = format!(
+                "the {} support segment of {}",
+                cell.formulation.name(),
+                cell.flight.log.path.display()
+            );
+            variants.check_rows(&path, cell.support.len(), &segment, true)?;
+        }
+    }
+
     let seeds = &config.raw.learn.seeds;
     let learn_results = stopwatch.time("LeARN meta-training and adaptation", || {
         let bar = progress_bar(options.show_progress, jobs.len() * seeds.len(), "LeARN");
@@ -227,10 +241,14 @@ fn sindy_cell<'a>(
     condition: &'a Condition,
     flight: &'a EvaluationFlight,
 ) -> Result<Cell<'a>> {
-    let split = config.raw.split.split(flight.log.len())?;
-    let support = formulation.segment(&flight.log, split.support, config.raw.derivative)?;
-    let query = formulation.segment(&flight.log, split.query, config.raw.derivative)?;
-    let sindy = sindy::fit_and_evaluate(&config.raw.sindy, &support, &query)?;
+    let (support, query) = flight_segments(
+        &flight.log,
+        formulation,
+        config.raw.split,
+        config.raw.derivative,
+    )?;
+    let sindy = sindy::fit_and_evaluate(&config.raw.sindy, &support, &query)
+        .map_err(|error| in_flight(&flight.log.path, error))?;
     Ok(Cell {
         formulation,
         condition,
@@ -239,6 +257,23 @@ fn sindy_cell<'a>(
         query,
         sindy,
     })
+}
+
+/// The support and query segments of `log` (cut by `split`, targets by `derivative` on each
+/// segment); errors name the flight's file.
+pub(crate) fn flight_segments(
+    log: &FlightLog,
+    formulation: Formulation,
+    split: SplitSpec,
+    derivative: Derivative,
+) -> Result<(Segment, Segment)> {
+    let segments = || -> std::result::Result<(Segment, Segment), data::DataError> {
+        let rows = split.split(log.len())?;
+        let support = formulation.segment(log, rows.support, derivative)?;
+        let query = formulation.segment(log, rows.query, derivative)?;
+        Ok((support, query))
+    };
+    segments().map_err(|error| in_flight(&log.path, error))
 }
 
 /// LeARN for every cell with one seed, in the cells' order. Under the `paper` protocol one
@@ -626,6 +661,52 @@ fn provenance(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A still flight of `n` samples at 50 Hz read from `path`.
+    fn still_flight(path: &str, n: usize) -> FlightLog {
+        FlightLog {
+            path: PathBuf::from(path),
+            meta: None,
+            time: (0..n).map(|k| k as f64 * 0.02).collect(),
+            position: vec![[0.0; 3]; n],
+            velocity: vec![[0.0; 3]; n],
+            quaternion: vec![[0.0, 0.0, 0.0, 1.0]; n],
+            rotation: vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]; n],
+            body_rate: vec![[0.0; 3]; n],
+            thrust_setpoint: vec![0.5; n],
+            hover_throttle: vec![0.5; n],
+            motor_command: vec![[1500.0; 4]; n],
+            position_desired: None,
+            velocity_desired: None,
+            attitude_setpoint: None,
+            residual_force: None,
+        }
+    }
+
+    #[test]
+    fn a_flight_too_short_to_split_is_named() {
+        let short = still_flight("/data/experiment/short.csv", 3);
+        let message = flight_segments(
+            &short,
+            Formulation::Full,
+            SplitSpec::Halves,
+            Derivative::Forward,
+        )
+        .unwrap_err()
+        .to_string();
+        assert_eq!(
+            message,
+            "/data/experiment/short.csv: split: 3 rows are too few to split (1 / 2)"
+        );
+        let (support, query) = flight_segments(
+            &still_flight("long.csv", 10),
+            Formulation::Full,
+            SplitSpec::Halves,
+            Derivative::Forward,
+        )
+        .unwrap();
+        assert_eq!((support.rows, query.rows), (0..5, 5..10));
+    }
 
     #[test]
     fn figure_names_are_safe() {

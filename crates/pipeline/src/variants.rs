@@ -35,8 +35,29 @@ use sindy::{
     SegmentPredictions, VariantEvaluation, evaluate_features,
 };
 
-use crate::config::{CheckedRunConfig, RunConfig, merge_patch};
+use crate::config::{CheckedRunConfig, RunConfig, check_seeds, merge_patch};
 use crate::error::{PipelineError, Result, write_text};
+use crate::run::flight_segments;
+
+/// The most variants a variants file may declare (every variant runs on every cell and seed; the
+/// committed file declares 14).
+pub const MAX_VARIANTS: usize = 200;
+
+/// Whether `c` may appear in a variant's name: the name is a table column, a Markdown code span
+/// and a JSON key, so no `|`, backtick, space or line break.
+fn is_name_character(c: char) -> bool {
+    c.is_alphanumeric() || matches!(c, '-' | '_' | '.' | '+')
+}
+
+/// A name as a message shows it: quoted, escaped when it holds control characters (so that the
+/// message stays on one line).
+fn shown(name: &str) -> String {
+    if name.chars().any(char::is_control) {
+        format!("{name:?}")
+    } else {
+        format!("'{name}'")
+    }
+}
 
 /// One variant as declared in the configuration.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -80,6 +101,25 @@ impl VariantKind {
             Self::Library(_) | Self::Select { .. } | Self::LearnedBasis(_)
         )
     }
+
+    /// The regression the variant fits itself (not through another variant).
+    fn own_regression(&self) -> Option<&RegressionSpec> {
+        match self {
+            Self::Library(variant) => Some(&variant.regression),
+            Self::LearnedBasis(variant) => Some(&variant.regression),
+            _ => None,
+        }
+    }
+
+    /// Checks the settings that do not depend on the data (libraries, penalties, folds,
+    /// bagging); errors name the field inside the variant (`regression.penalty.lambdas`).
+    fn validate(&self) -> sindy::Result<()> {
+        match self {
+            Self::Library(variant) => variant.validate(),
+            Self::LearnedBasis(variant) => variant.validate(),
+            Self::Select { .. } | Self::Learn | Self::Average { .. } => Ok(()),
+        }
+    }
 }
 
 /// Closed-form adaptation over the meta-trained LeARN networks' outputs, optionally beside a fixed
@@ -95,6 +135,16 @@ pub struct LearnedBasisSpec {
 }
 
 impl LearnedBasisSpec {
+    /// Checks the fixed library and the regression, as [`LibraryRegression::validate`] does.
+    pub fn validate(&self) -> sindy::Result<()> {
+        if let Some(library) = &self.library {
+            library.validate().map_err(|e| e.within("library"))?;
+        }
+        self.regression
+            .validate()
+            .map_err(|e| e.within("regression"))
+    }
+
     /// Features of both segments from the frozen networks (and the fixed library), regression
     /// fitted and its penalty chosen on the support segment.
     pub fn evaluate(
@@ -183,47 +233,75 @@ impl VariantsConfig {
         };
         let raw: VariantsConfig =
             data::json::from_str(&text).map_err(|e| PipelineError::json(path, e))?;
-        if raw.seeds.is_empty() {
-            return Err(error("seeds", "name at least one seed".to_string()));
-        }
-        for (index, seed) in raw.seeds.iter().enumerate() {
-            if raw.seeds[..index].contains(seed) {
-                return Err(error("seeds", format!("seed {seed} is listed twice")));
-            }
+        check_seeds(&raw.seeds).map_err(|message| error("seeds", message))?;
+        if raw.variants.len() > MAX_VARIANTS {
+            return Err(error(
+                "variants",
+                format!(
+                    "{} variants, more than the limit of {MAX_VARIANTS} (pipeline::MAX_VARIANTS)",
+                    raw.variants.len()
+                ),
+            ));
         }
         let names: Vec<&str> = raw.variants.iter().map(|v| v.name.as_str()).collect();
         for (index, name) in names.iter().enumerate() {
+            let field = format!("variants[{index}].name");
             if name.trim().is_empty() {
+                return Err(error(&field, format!("variant {} has no name", index + 1)));
+            }
+            if let Some(bad) = name.chars().find(|&c| !is_name_character(c)) {
                 return Err(error(
-                    "variants",
-                    format!("variant {} has no name", index + 1),
+                    &field,
+                    format!(
+                        "{} has the character {bad:?}; a name (a table column and a Markdown \
+                         code span) may hold only letters, digits, '-', '_', '.' and '+'",
+                        shown(name)
+                    ),
                 ));
             }
             if names[..index].contains(name) {
-                return Err(error("variants", format!("'{name}' is declared twice")));
+                return Err(error(&field, format!("{} is declared twice", shown(name))));
             }
         }
         for (own, variant) in raw.variants.iter().enumerate() {
-            let (others, what) = match &variant.kind {
-                VariantKind::Select { candidates } => (candidates, "candidate"),
-                VariantKind::Average { members } => (members, "member"),
+            let at = format!("variants[{own}] ({})", variant.name);
+            variant.kind.validate().map_err(|e| match e.within("") {
+                sindy::SindyError::Field { field, message } => {
+                    error(&format!("{at}.{field}"), message)
+                }
+                other => error(&at, other.to_string()),
+            })?;
+            let (others, what, list) = match &variant.kind {
+                VariantKind::Select { candidates } => (candidates, "candidate", "candidates"),
+                VariantKind::Average { members } => (members, "member", "members"),
                 _ => continue,
             };
+            let field = format!("{at}.{list}");
             if others.is_empty() {
-                return Err(error(&variant.name, format!("name at least one {what}")));
+                return Err(error(&field, format!("name at least one {what}")));
             }
-            for other in others {
+            for (position, other) in others.iter().enumerate() {
                 let Some(index) = names[..own].iter().position(|n| n == other) else {
                     return Err(error(
-                        &variant.name,
-                        format!("{what} '{other}' must be a variant declared before it"),
+                        &field,
+                        format!(
+                            "{what} {} must be a variant declared before it",
+                            shown(other)
+                        ),
                     ));
                 };
+                if others[..position].contains(other) {
+                    return Err(error(
+                        &field,
+                        format!("{what} {} is listed twice", shown(other)),
+                    ));
+                }
                 if what == "candidate" && !raw.variants[index].kind.is_regression() {
                     return Err(error(
-                        &variant.name,
+                        &field,
                         format!(
-                            "candidate '{other}' has no support cross-validation score to select by"
+                            "candidate {} has no support cross-validation score to select by",
+                            shown(other)
                         ),
                     ));
                 }
@@ -239,7 +317,18 @@ impl VariantsConfig {
             if let Some(name) = name
                 && !names.contains(&name.as_str())
             {
-                return Err(error(field, format!("'{name}' is not a declared variant")));
+                return Err(error(
+                    field,
+                    format!("{} is not a declared variant", shown(name)),
+                ));
+            }
+        }
+        for (index, name) in raw.reproduce.iter().enumerate() {
+            if raw.reproduce[..index].contains(name) {
+                return Err(error(
+                    "reproduce",
+                    format!("{} is listed twice", shown(name)),
+                ));
             }
         }
         Ok(raw)
@@ -254,12 +343,16 @@ impl VariantsConfig {
             root.join(&raw.run)
         };
         let run = RunConfig::load(&run_path, root)?;
-        Ok(CheckedVariants {
+        let checked = CheckedVariants {
             raw,
             path: path.to_path_buf(),
             run,
             root: root.to_path_buf(),
-        })
+        };
+        // The learned-basis variants' LeARN configuration, checked now rather than after the
+        // flights are loaded.
+        learned_basis_config(&checked)?;
+        Ok(checked)
     }
 
     /// The variant whose equations describe `name`: itself when it fits a regression, for an
@@ -272,6 +365,47 @@ impl VariantsConfig {
             }
             _ => None,
         }
+    }
+
+    /// Checks, before any fit, what depends on a support segment of `rows` samples (described by
+    /// `segment` in the message): the cross-validation folds and bagging blocks of every variant
+    /// that fits a regression (with `reproduce_only`, of those `make reproduce` runs). `path` is
+    /// this file.
+    pub(crate) fn check_rows(
+        &self,
+        path: &Path,
+        rows: usize,
+        segment: &str,
+        reproduce_only: bool,
+    ) -> Result<()> {
+        let wanted: Vec<String> = if reproduce_only {
+            self.reproduce_variants()
+                .into_iter()
+                .map(|v| v.name)
+                .collect()
+        } else {
+            self.variants.iter().map(|v| v.name.clone()).collect()
+        };
+        for (index, variant) in self.variants.iter().enumerate() {
+            let Some(regression) = variant.kind.own_regression() else {
+                continue;
+            };
+            if !wanted.contains(&variant.name) {
+                continue;
+            }
+            regression.check_rows(rows).map_err(|e| {
+                let (field, message) = match e.within("regression") {
+                    sindy::SindyError::Field { field, message } => (field, message),
+                    other => ("regression".to_string(), other.to_string()),
+                };
+                PipelineError::Config {
+                    path: path.to_path_buf(),
+                    field: format!("variants[{index}] ({}).{field}", variant.name),
+                    message: format!("{message} ({segment})"),
+                }
+            })?;
+        }
+        Ok(())
     }
 
     /// The `reproduce` variants (and the variants they select from or average), in declaration
@@ -481,12 +615,22 @@ pub fn run_variants(
     let mut cells = Vec::new();
     for &formulation in &run.raw.formulations {
         for (condition, log) in conditions.iter().zip(&logs) {
-            let split = run.raw.split.split(log.len())?;
+            let (support, query) =
+                flight_segments(log, formulation, run.raw.split, run.raw.derivative)?;
+            // What depends on the segment's length (folds, bagging blocks), before any fit.
+            let segment = format!(
+                "the {} support segment of {}",
+                formulation.name(),
+                log.path.display()
+            );
+            config
+                .raw
+                .check_rows(&config.path, support.len(), &segment, false)?;
             cells.push(CellData {
                 formulation,
                 condition,
-                support: formulation.segment(log, split.support, run.raw.derivative)?,
-                query: formulation.segment(log, split.query, run.raw.derivative)?,
+                support,
+                query,
             });
         }
     }
@@ -586,23 +730,37 @@ pub fn run_variants(
     })
 }
 
-fn learned_basis_experiment(config: &CheckedVariants, data_dir: &Path) -> Result<Experiment> {
+/// The run's LeARN configuration with the variants file's `learn_overrides`, checked; errors name
+/// the variants file and `learn_overrides`.
+fn learned_basis_config(config: &CheckedVariants) -> Result<learn::CheckedConfig> {
     let run = &config.run;
-    let mut value = serde_json::to_value(run.learn.get()).map_err(|e| PipelineError::Config {
+    let error = |message: String| PipelineError::Config {
         path: config.path.clone(),
         field: "learn_overrides".to_string(),
-        message: e.to_string(),
-    })?;
+        message,
+    };
+    let with_overrides = |message: String| {
+        error(format!(
+            "{} with these overrides: {message}",
+            run.learn_config_path.display()
+        ))
+    };
+    let mut value = serde_json::to_value(run.learn.get()).map_err(|e| error(e.to_string()))?;
     merge_patch(&mut value, &config.raw.learn_overrides);
     let learn_config: learn::LearnConfig =
-        data::json::from_value(value).map_err(|e| PipelineError::Config {
-            path: config.path.clone(),
-            field: "learn_overrides".to_string(),
-            message: e.to_string(),
-        })?;
-    let checked = learn_config.check(&config.path)?;
+        data::json::from_value(value).map_err(|e| with_overrides(e.to_string()))?;
+    learn_config.check(&config.path).map_err(|e| match e {
+        learn::LearnError::Config { field, message, .. } => {
+            with_overrides(format!("field '{field}': {message}"))
+        }
+        other => with_overrides(other.to_string()),
+    })
+}
+
+fn learned_basis_experiment(config: &CheckedVariants, data_dir: &Path) -> Result<Experiment> {
+    let run = &config.run;
     Ok(Experiment::load(
-        checked,
+        learned_basis_config(config)?,
         run.conditions.clone(),
         data_dir,
         run.protocol,
@@ -658,64 +816,73 @@ pub fn evaluate_variants(
             }
             Ok(found)
         };
-        let outcome = match &spec.kind {
-            VariantKind::Library(variant) => {
-                let evaluation = variant.evaluate(support, query, seed)?;
-                outcome_of(evaluation, BTreeMap::new(), &support.formulation)
-            }
-            VariantKind::Select { candidates } => {
-                let score = |index: usize| outcomes[index].support_cv.unwrap_or(f64::INFINITY);
-                let best = earlier(candidates, "candidate")?
-                    .into_iter()
-                    .min_by(|&a, &b| score(a).total_cmp(&score(b)))
-                    .expect("at least one candidate");
-                let chosen_outcome = &outcomes[best];
-                let mut chosen = chosen_outcome.chosen.clone();
-                chosen.insert(
-                    "variant".to_string(),
-                    serde_json::Value::String(variants[best].name.clone()),
-                );
-                Outcome {
-                    chosen,
-                    ..chosen_outcome.clone()
+        let outcome = (|| -> Result<Outcome> {
+            Ok(match &spec.kind {
+                VariantKind::Library(variant) => {
+                    let evaluation = variant.evaluate(support, query, seed)?;
+                    outcome_of(evaluation, BTreeMap::new(), &support.formulation)
                 }
-            }
-            VariantKind::LearnedBasis(variant) => {
-                let model = meta_trained_once(&mut meta_trained, &mut meta_train)?;
-                let evaluation = variant.evaluate(model, support, query, seed)?;
-                outcome_of(evaluation, BTreeMap::new(), &support.formulation)
-            }
-            VariantKind::Learn => {
-                let model = meta_trained_once(&mut meta_trained, &mut meta_train)?;
-                let adapted = model.adapt(support, &model.config.adaptation);
-                let predict = |segment: &Segment| {
-                    learn::from_row_major(
-                        &model.predict_segment(&adapted, segment),
-                        model.architecture.state_dim,
+                VariantKind::Select { candidates } => {
+                    let score = |index: usize| outcomes[index].support_cv.unwrap_or(f64::INFINITY);
+                    let best = earlier(candidates, "candidate")?
+                        .into_iter()
+                        .min_by(|&a, &b| score(a).total_cmp(&score(b)))
+                        .expect("at least one candidate");
+                    let chosen_outcome = &outcomes[best];
+                    let mut chosen = chosen_outcome.chosen.clone();
+                    chosen.insert(
+                        "variant".to_string(),
+                        serde_json::Value::String(variants[best].name.clone()),
+                    );
+                    Outcome {
+                        chosen,
+                        ..chosen_outcome.clone()
+                    }
+                }
+                VariantKind::LearnedBasis(variant) => {
+                    let model = meta_trained_once(&mut meta_trained, &mut meta_train)?;
+                    let evaluation = variant.evaluate(model, support, query, seed)?;
+                    outcome_of(evaluation, BTreeMap::new(), &support.formulation)
+                }
+                VariantKind::Learn => {
+                    let model = meta_trained_once(&mut meta_trained, &mut meta_train)?;
+                    let adapted = model.adapt(support, &model.config.adaptation);
+                    let predict = |segment: &Segment| {
+                        learn::from_row_major(
+                            &model.predict_segment(&adapted, segment),
+                            model.architecture.state_dim,
+                        )
+                    };
+                    Outcome::unfitted(predict(support), predict(query), support, query)
+                }
+                VariantKind::Average { members } => {
+                    let members: Vec<&SegmentPredictions> = earlier(members, "member")?
+                        .into_iter()
+                        .map(|index| &outcomes[index].predictions)
+                        .collect();
+                    let mean = |prediction: fn(&SegmentPredictions) -> &Mat<f64>| {
+                        let first = prediction(members[0]);
+                        Mat::from_fn(first.nrows(), first.ncols(), |i, j| {
+                            members.iter().map(|m| prediction(m)[(i, j)]).sum::<f64>()
+                                / members.len() as f64
+                        })
+                    };
+                    Outcome::unfitted(
+                        mean(|e| &e.support_prediction),
+                        mean(|e| &e.query_prediction),
+                        support,
+                        query,
                     )
-                };
-                Outcome::unfitted(predict(support), predict(query), support, query)
-            }
-            VariantKind::Average { members } => {
-                let members: Vec<&SegmentPredictions> = earlier(members, "member")?
-                    .into_iter()
-                    .map(|index| &outcomes[index].predictions)
-                    .collect();
-                let mean = |prediction: fn(&SegmentPredictions) -> &Mat<f64>| {
-                    let first = prediction(members[0]);
-                    Mat::from_fn(first.nrows(), first.ncols(), |i, j| {
-                        members.iter().map(|m| prediction(m)[(i, j)]).sum::<f64>()
-                            / members.len() as f64
-                    })
-                };
-                Outcome::unfitted(
-                    mean(|e| &e.support_prediction),
-                    mean(|e| &e.query_prediction),
-                    support,
-                    query,
-                )
-            }
-        };
+                }
+            })
+        })()
+        .map_err(|error| match error {
+            error @ PipelineError::Mismatch { .. } => error,
+            error => PipelineError::Mismatch {
+                what: format!("variant '{}'", spec.name),
+                message: error.to_string(),
+            },
+        })?;
         outcomes.push(outcome);
     }
     Ok(outcomes)
@@ -1289,5 +1456,264 @@ mod tests {
                 .to_string();
             assert!(message.contains(expected), "{name}: {message}");
         }
+    }
+
+    /// `VariantsConfig::read`'s error for the variants `variants` (headline `a`), one line.
+    fn read_error(name: &str, variants: &str, extra: &str) -> String {
+        let path = write(name, &config(variants, extra));
+        let start = std::time::Instant::now();
+        let message = VariantsConfig::read(&path)
+            .err()
+            .unwrap_or_else(|| panic!("{name} was accepted"))
+            .to_string();
+        assert!(
+            start.elapsed().as_secs() < 5,
+            "{name}: {:?}",
+            start.elapsed()
+        );
+        assert!(!message.contains('\n'), "{name}: {message}");
+        assert!(
+            message.starts_with(&format!("{}: ", path.display())),
+            "{name}: {message}"
+        );
+        message
+    }
+
+    #[test]
+    fn every_variant_spec_is_checked_when_the_file_is_read() {
+        let library = |library: &str, regression: &str| {
+            format!(
+                r#"{{"name": "a", "description": "", "kind": "library", "library": {library}, "regression": {regression}}}"#
+            )
+        };
+        let linear = r#"{"linear": true}"#;
+        let ridge = r#"{"penalty": {"kind": "ridge", "lambdas": [0.0]}}"#;
+        let many = |count: usize, value: &str| vec![value; count].join(", ");
+        let cases = [
+            (
+                "bag-block0",
+                library(
+                    linear,
+                    r#"{"penalty": {"kind": "ridge", "lambdas": [0.0]}, "bagging": {"members": 3, "block": 0}}"#,
+                ),
+                "variants[0] (a).regression.bagging.block: 0 must be from 1",
+            ),
+            (
+                "bag-huge",
+                library(
+                    linear,
+                    r#"{"penalty": {"kind": "ridge", "lambdas": [0.0]}, "bagging": {"members": 1000000000, "block": 125}}"#,
+                ),
+                "variants[0] (a).regression.bagging.members: 1000000000 must be from 2 to 1000",
+            ),
+            (
+                "fractions-bad",
+                library(
+                    linear,
+                    r#"{"penalty": {"kind": "lasso", "fractions": [0.1, 2]}}"#,
+                ),
+                "variants[0] (a).regression.penalty.fractions: 2 must be in (0, 1]",
+            ),
+            (
+                "lambdas-neg",
+                library(
+                    linear,
+                    r#"{"penalty": {"kind": "ridge", "lambdas": [0.1, -1]}}"#,
+                ),
+                "variants[0] (a).regression.penalty.lambdas: -1 must be ≥ 0",
+            ),
+            (
+                "lambdas-many",
+                library(
+                    linear,
+                    &format!(
+                        r#"{{"penalty": {{"kind": "ridge", "lambdas": [{}]}}}}"#,
+                        many(1_000_000, "0.5")
+                    ),
+                ),
+                "variants[0] (a).regression.penalty.lambdas: 1000000 candidates, more than the limit of 100",
+            ),
+            (
+                "thresholds-neg",
+                library(
+                    linear,
+                    r#"{"penalty": {"kind": "stlsq", "thresholds": [-0.1], "alpha": 0.05}}"#,
+                ),
+                "variants[0] (a).regression.penalty.thresholds: -0.1 must be ≥ 0",
+            ),
+            (
+                "lib-empty",
+                library("{}", ridge),
+                "variants[0] (a).library: the library has no feature",
+            ),
+            (
+                "lags-bad",
+                library(r#"{"control_lags": [0.5, 1.5]}"#, ridge),
+                "variants[0] (a).library.control_lags: pole 1.5 must lie in [0, 1)",
+            ),
+            (
+                "lags-many",
+                library(
+                    &format!(r#"{{"control_lags": [{}]}}"#, many(100_000, "0.5")),
+                    ridge,
+                ),
+                "variants[0] (a).library.control_lags: 100000 lags, more than the limit of 100",
+            ),
+            (
+                "fourier-huge",
+                library(r#"{"fourier": 1000000000}"#, ridge),
+                "variants[0] (a).library.fourier: 1000000000 frequencies",
+            ),
+            (
+                "folds",
+                library(
+                    linear,
+                    r#"{"penalty": {"kind": "ridge", "lambdas": [0.0]}, "folds": {"folds": 1}}"#,
+                ),
+                "variants[0] (a).regression.folds.folds: 1 must be from 2",
+            ),
+            (
+                "learned-basis",
+                format!(
+                    r#"{{"name": "a", "description": "", "kind": "learned_basis", "features": "basis", "library": {{"fourier": 1000000}}, "regression": {ridge}}}"#
+                ),
+                "variants[0] (a).library.fourier",
+            ),
+        ];
+        for (name, variants, expected) in cases {
+            let message = read_error(name, &variants, "");
+            assert!(message.contains(expected), "{name}: {message}");
+        }
+        let a = library(linear, ridge);
+        let seeds = config(&a, "").replace(
+            r#""seeds": [1]"#,
+            &format!(
+                r#""seeds": [{}]"#,
+                (0..100_000)
+                    .map(|s| s.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        );
+        let message = VariantsConfig::read(&write("seeds-many", &seeds))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("seeds: 100000 seeds, more than the limit of 100"),
+            "{message}"
+        );
+        let select =
+            r#"{"name": "s", "description": "", "kind": "select", "candidates": ["a", "a"]}"#;
+        let message = read_error("candidates-twice", &format!("{a}, {select}"), "");
+        assert!(
+            message.contains("variants[1] (s).candidates: candidate 'a' is listed twice"),
+            "{message}"
+        );
+        let message = read_error("reproduce-twice", &a, r#""reproduce": ["a", "a"],"#);
+        assert!(
+            message.contains("reproduce: 'a' is listed twice"),
+            "{message}"
+        );
+        let many_variants = (0..=MAX_VARIANTS)
+            .map(|k| a.replace(r#""a""#, &format!(r#""a{k}""#)))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let message = read_error("variants-many", &many_variants, "");
+        assert!(
+            message.contains("201 variants, more than the limit of 200"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn variant_names_that_break_tables_or_files_are_refused() {
+        let variant = |name: &str| {
+            format!(
+                r#"{{"name": {}, "description": "", {RIDGE}}}"#,
+                serde_json::to_string(name).unwrap()
+            )
+        };
+        for (index, name) in ["a|b\nc", "a b", "`a`", "a/b", "a\\b", "<a>"]
+            .iter()
+            .enumerate()
+        {
+            let message = read_error(&format!("name-{index}"), &variant(name), "");
+            assert!(
+                message.contains("variants[0].name: ") && message.contains("may hold only"),
+                "{name}: {message}"
+            );
+        }
+        for name in ["lag-ridge-cv", "a_b.c+d", "ridge2"] {
+            let text = config(&variant(name), "")
+                .replace(r#""headline": "a""#, &format!(r#""headline": "{name}""#));
+            VariantsConfig::read(&write("name-good", &text)).unwrap();
+        }
+    }
+
+    #[test]
+    fn an_error_while_evaluating_names_the_variant() {
+        // Bagging blocks longer than the support segment: found against the segment.
+        let text = config(
+            r#"{"name": "a", "description": "", "kind": "library", "library": {"linear": true},
+               "regression": {"penalty": {"kind": "ridge", "lambdas": [0.0]}, "bagging": {"members": 3, "block": 500}}}"#,
+            "",
+        );
+        let read = VariantsConfig::read(&write("evaluate-error", &text)).unwrap();
+        let (support, query) = (segment(60, 0.0), segment(40, 1.3));
+        let message = evaluate_variants(
+            &read.variants,
+            || Ok(untrained_model()),
+            &support,
+            &query,
+            1,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            message.starts_with("variant 'a': ") && message.contains("bagging.block"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn folds_and_blocks_are_checked_against_the_segment_before_any_fit() {
+        let bagged = r#"{"name": "b", "description": "", "kind": "library", "library": {"linear": true},
+               "regression": {"penalty": {"kind": "ridge", "lambdas": [0.0]}, "bagging": {"members": 3, "block": 500}}}"#;
+        let a = format!(r#"{{"name": "a", "description": "", {RIDGE}}}"#);
+        let path = write(
+            "check-rows",
+            &config(&format!("{a}, {bagged}"), r#""reproduce": ["a"],"#),
+        );
+        let read = VariantsConfig::read(&path).unwrap();
+        read.check_rows(&path, 1255, "the segment", false).unwrap();
+        let message = read
+            .check_rows(&path, 400, "the full support segment of f.csv", false)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            message,
+            format!(
+                "{}: variants[1] (b).regression.bagging.block: blocks of 500 samples are longer \
+                 than the segment's 400 samples (the full support segment of f.csv)",
+                path.display()
+            )
+        );
+        // `make reproduce` runs `a` only.
+        read.check_rows(&path, 400, "the segment", true).unwrap();
+        let message = read
+            .check_rows(&path, 20, "the segment", true)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("variants[0] (a).regression.folds: 20 samples are too few"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn the_committed_variants_are_within_every_limit() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../experiments/variants.json");
+        let read = VariantsConfig::read(&path).unwrap();
+        assert_eq!(read.variants.len(), 14);
     }
 }

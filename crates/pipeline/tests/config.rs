@@ -61,6 +61,25 @@ fn overrides_are_merged_before_the_learn_configuration_is_checked() {
 }
 
 #[test]
+fn a_bad_value_set_by_the_overrides_is_blamed_on_the_overrides() {
+    let mut config = committed("experiments/reproduce.json");
+    config["learn"]["overrides"] = json!({"meta_training": {"iterations": 0}});
+    let message = load("zero-iterations", &config).unwrap_err();
+    assert!(
+        message.starts_with(&format!(
+            "{}: learn.overrides: ",
+            std::env::temp_dir()
+                .join(format!("pipeline-config-{}", std::process::id()))
+                .join("zero-iterations.json")
+                .display()
+        )) && message
+            .contains("learn.json with these overrides: field 'meta_training.iterations': "),
+        "{message}"
+    );
+    assert!(!message.contains('\n'), "{message}");
+}
+
+#[test]
 fn bad_values_name_the_file_and_field() {
     let base = committed("experiments/reproduce.json");
     let cases = [
@@ -116,4 +135,96 @@ fn bad_values_name_the_file_and_field() {
         let message = load(field, &config).unwrap_err();
         assert!(message.contains(missing), "{message}");
     }
+}
+
+#[test]
+fn a_library_too_large_for_the_inputs_is_refused_when_the_configuration_is_loaded() {
+    let base = committed("experiments/reproduce.json");
+    for (name, library, expected) in [
+        (
+            "fourier-huge",
+            json!({"kind": "fourier", "frequencies": 1_000_000_000u64}),
+            "single input",
+        ),
+        (
+            "fourier-1e5",
+            json!({"kind": "fourier", "frequencies": 100_000}),
+            "single input",
+        ),
+        (
+            "poly-50",
+            json!({"kind": "polynomial", "degree": 50, "constant": true}),
+            "formulation",
+        ),
+        (
+            "poly-huge",
+            json!({"kind": "polynomial", "degree": u64::MAX, "constant": true}),
+            "limit of 10000",
+        ),
+    ] {
+        let mut config = base.clone();
+        config["sindy"]["library"] = library;
+        let start = std::time::Instant::now();
+        let message = load(name, &config).unwrap_err();
+        assert!(
+            message.contains(&format!("{name}.json: sindy.library: "))
+                && message.contains(expected)
+                && message.contains("limit of 10000"),
+            "{message}"
+        );
+        assert!(
+            start.elapsed().as_secs() < 5,
+            "{name} took {:?}",
+            start.elapsed()
+        );
+    }
+    // Within the limit on every formulation: accepted.
+    let mut config = base.clone();
+    config["sindy"]["library"] = json!({"kind": "polynomial", "degree": 2, "constant": true});
+    load("poly-2", &config).unwrap();
+}
+
+#[test]
+fn split_and_derivative_refuse_fields_their_kind_does_not_have() {
+    let base = committed("experiments/reproduce.json");
+    for (name, field, value) in [
+        (
+            "split-ratio",
+            "split",
+            json!({"kind": "halves", "ratio": 0.3}),
+        ),
+        (
+            "derivative-window",
+            "derivative",
+            json!({"kind": "forward", "window": 5}),
+        ),
+    ] {
+        let mut config = base.clone();
+        config[field] = value;
+        let message = load(name, &config).unwrap_err();
+        assert!(
+            message.contains(&format!("{name}.json: {field}")) && message.contains("unknown field"),
+            "{message}"
+        );
+    }
+    let mut config = base.clone();
+    config["sindy"]["fit_derivative"] = json!({"kind": "central", "order": 2});
+    let message = load("fit-derivative", &config).unwrap_err();
+    assert!(message.contains("unknown field `order`"), "{message}");
+    config["sindy"]["fit_derivative"] = json!({"kind": "savitzky_golay", "window": 4, "order": 2});
+    let message = load("fit-derivative", &config).unwrap_err();
+    assert!(message.contains("sindy.fit_derivative"), "{message}");
+}
+
+#[test]
+fn seeds_are_capped() {
+    let mut config = committed("experiments/reproduce.json");
+    config["learn"]["seeds"] = json!((0..100_000).collect::<Vec<u64>>());
+    let start = std::time::Instant::now();
+    let message = load("many-seeds", &config).unwrap_err();
+    assert!(
+        message.contains("learn.seeds: 100000 seeds, more than the limit of 100"),
+        "{message}"
+    );
+    assert!(start.elapsed().as_secs() < 5);
 }

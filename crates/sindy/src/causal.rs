@@ -12,13 +12,19 @@
 //! segment to the other, and nothing from the future of a sample is used. The constant is left to
 //! the regression (its intercept).
 
-use data::Segment;
+use data::{Formulation, Segment};
 use faer::Mat;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, invalid};
+use crate::error::{Result, field};
+use crate::library::MAX_FEATURES;
 
-/// Which terms the library holds (unchecked; checked by [`CausalLibrary::features`]).
+/// The most control lags a causal library may hold (each adds one feature per control; the
+/// committed variants use 3).
+pub const MAX_CONTROL_LAGS: usize = 100;
+
+/// Which terms the library holds (unchecked; checked by [`CausalLibrary::validate`], which
+/// [`CausalLibrary::features`] calls).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CausalLibrary {
@@ -35,15 +41,38 @@ pub struct CausalLibrary {
 }
 
 impl CausalLibrary {
-    fn check(&self) -> Result<()> {
+    /// Checks the settings: at most [`MAX_CONTROL_LAGS`] lags, each pole in [0, 1), at least one
+    /// feature, and at most [`crate::MAX_FEATURES`] features on every formulation. Errors are
+    /// [`crate::SindyError::Field`] naming the field (`control_lags`, `fourier`; empty for the
+    /// library as a whole).
+    pub fn validate(&self) -> Result<()> {
+        if self.control_lags.len() > MAX_CONTROL_LAGS {
+            return Err(field(
+                "control_lags",
+                format!(
+                    "{} lags, more than the limit of {MAX_CONTROL_LAGS} (sindy::MAX_CONTROL_LAGS)",
+                    self.control_lags.len()
+                ),
+            ));
+        }
         if let Some(a) = self
             .control_lags
             .iter()
             .find(|a| !(a.is_finite() && **a >= 0.0 && **a < 1.0))
         {
-            return Err(invalid(
-                "control lag",
+            return Err(field(
+                "control_lags",
                 format!("pole {a} must lie in [0, 1)"),
+            ));
+        }
+        if self.fourier > MAX_FEATURES / 2 {
+            return Err(field(
+                "fourier",
+                format!(
+                    "{} frequencies give more than the limit of {MAX_FEATURES} features \
+                     (sindy::MAX_FEATURES) on a single input",
+                    self.fourier
+                ),
             ));
         }
         if !self.linear
@@ -51,14 +80,37 @@ impl CausalLibrary {
             && !self.control_squares
             && self.control_lags.is_empty()
         {
-            return Err(invalid("causal library", "it has no feature"));
+            return Err(field("", "the library has no feature"));
+        }
+        for formulation in Formulation::ALL {
+            let (inputs, controls) = (formulation.input_names().len(), formulation.control_dim());
+            let count = self.feature_count(inputs, controls);
+            if count > MAX_FEATURES {
+                return Err(field(
+                    "",
+                    format!(
+                        "{count} features on the {} formulation ({inputs} inputs, {controls} \
+                         controls), more than the limit of {MAX_FEATURES} (sindy::MAX_FEATURES)",
+                        formulation.name()
+                    ),
+                ));
+            }
         }
         Ok(())
     }
 
+    /// The number of features on `inputs` inputs of which `controls` are controls (saturating).
+    pub fn feature_count(&self, inputs: usize, controls: usize) -> usize {
+        let per_input = usize::from(self.linear).saturating_add(self.fourier.saturating_mul(2));
+        let per_control = usize::from(self.control_squares).saturating_add(self.control_lags.len());
+        per_input
+            .saturating_mul(inputs)
+            .saturating_add(per_control.saturating_mul(controls))
+    }
+
     /// Θ of `segment` (one row per sample) and the feature names.
     pub fn features(&self, segment: &Segment) -> Result<(Mat<f64>, Vec<String>)> {
-        self.check()?;
+        self.validate()?;
         let formulation = segment.formulation;
         let inputs = segment.inputs();
         let input_names = formulation.input_names();
@@ -131,5 +183,61 @@ mod tests {
         later[4] = 10.0;
         assert_eq!(first_order_lag(&later, 0.5)[..4], lagged[..4]);
         assert_eq!(first_order_lag(&step, 0.0), step);
+    }
+
+    #[test]
+    fn settings_are_checked_with_the_field_they_are_in() {
+        let cases = [
+            (
+                CausalLibrary {
+                    control_lags: vec![0.5; MAX_CONTROL_LAGS + 1],
+                    ..Default::default()
+                },
+                "control_lags",
+                "101 lags, more than the limit of 100",
+            ),
+            (
+                CausalLibrary {
+                    control_lags: vec![0.5, 1.0],
+                    ..Default::default()
+                },
+                "control_lags",
+                "pole 1 must lie in [0, 1)",
+            ),
+            (
+                CausalLibrary {
+                    fourier: 1_000_000_000,
+                    ..Default::default()
+                },
+                "fourier",
+                "limit of 10000",
+            ),
+            (CausalLibrary::default(), "", "no feature"),
+            (
+                CausalLibrary {
+                    fourier: 4_000,
+                    ..Default::default()
+                },
+                "",
+                "features on the",
+            ),
+        ];
+        for (library, expected_field, expected) in cases {
+            match library.validate().unwrap_err() {
+                crate::SindyError::Field { field, message } => {
+                    assert_eq!(field, expected_field, "{message}");
+                    assert!(message.contains(expected), "{message}");
+                }
+                other => panic!("{other}"),
+            }
+        }
+        let committed = CausalLibrary {
+            linear: true,
+            fourier: 1,
+            control_squares: false,
+            control_lags: vec![0.5, 0.8, 0.95],
+        };
+        committed.validate().unwrap();
+        assert_eq!(committed.feature_count(7, 4), 7 * 3 + 4 * 3);
     }
 }

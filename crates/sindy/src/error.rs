@@ -8,6 +8,12 @@ pub enum SindyError {
     /// A parameter outside its valid range, e.g. a negative threshold.
     #[error("invalid {name}: {message}")]
     InvalidParameter { name: String, message: String },
+    /// A field of a serialisable specification (a regression, a causal library) out of range:
+    /// `field` is its path inside that specification, e.g. `penalty.lambdas` of a
+    /// [`crate::RegressionSpec`] (empty: the specification as a whole), so that a configuration
+    /// file can name it in full.
+    #[error("invalid {}: {message}", if field.is_empty() { "specification" } else { field.as_str() })]
+    Field { field: String, message: String },
     /// A library or optimizer specification that does not parse.
     #[error("cannot parse {kind} '{text}': {message}")]
     Parse {
@@ -55,12 +61,43 @@ pub enum SindyError {
     Data(#[from] data::DataError),
 }
 
+impl SindyError {
+    /// This error as a [`SindyError::Field`] of a specification nested at `prefix`: a field error's
+    /// path gets `prefix.` in front, any other error becomes an error of the field `prefix`.
+    /// E.g. a regression's `penalty.lambdas` error is `regression.penalty.lambdas` in a variant.
+    pub fn within(self, prefix: &str) -> Self {
+        match self {
+            Self::Field { field, message } => Self::Field {
+                field: if field.is_empty() {
+                    prefix.to_string()
+                } else if prefix.is_empty() {
+                    field
+                } else {
+                    format!("{prefix}.{field}")
+                },
+                message,
+            },
+            other => Self::Field {
+                field: prefix.to_string(),
+                message: other.to_string(),
+            },
+        }
+    }
+}
+
 /// The crate's result type.
 pub type Result<T> = std::result::Result<T, SindyError>;
 
 pub(crate) fn invalid(name: &str, message: impl Into<String>) -> SindyError {
     SindyError::InvalidParameter {
         name: name.to_string(),
+        message: message.into(),
+    }
+}
+
+pub(crate) fn field(field: &str, message: impl Into<String>) -> SindyError {
+    SindyError::Field {
+        field: field.to_string(),
         message: message.into(),
     }
 }

@@ -61,9 +61,9 @@ mod regression;
 mod selection;
 mod variant;
 
-pub use causal::{CausalLibrary, first_order_lag};
+pub use causal::{CausalLibrary, MAX_CONTROL_LAGS, first_order_lag};
 pub use error::{Result, SindyError};
-pub use library::{CustomFunction, FeatureLibrary, LibrarySpec};
+pub use library::{CustomFunction, FeatureLibrary, LibrarySpec, MAX_FEATURES};
 pub use linalg::least_squares;
 pub use model::{Score, SindyModel, SindyParams, Trajectory, mean_squared_error, r2_score};
 pub use optimizer::{
@@ -73,9 +73,10 @@ pub use optimizer::{
 pub use persist::MODEL_FORMAT;
 pub use pipeline::{SegmentEvaluation, SindyConfig, evaluate_flight, fit_and_evaluate};
 pub use regression::{
-    Bagging, EnsemblePrediction, LinearFit, Penalty, RegressionFit, RegressionSpec, select_rows,
+    Bagging, EnsemblePrediction, LinearFit, MAX_BAGGING_BLOCK, MAX_BAGGING_MEMBERS, MAX_PENALTY,
+    MAX_PENALTY_CANDIDATES, Penalty, RegressionFit, RegressionSpec, select_rows,
 };
-pub use selection::{BlockedFolds, Fold, Selection, cross_validate};
+pub use selection::{BlockedFolds, Fold, MAX_FOLDS, Selection, cross_validate};
 pub use variant::{LibraryRegression, SegmentPredictions, VariantEvaluation, evaluate_features};
 
 /// Re-exported so that users name the same matrix types.

@@ -19,6 +19,14 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, SindyError, invalid};
 
+/// The most features a library may have on the inputs it is applied to (polynomial, Fourier,
+/// custom and concatenated libraries, and [`crate::CausalLibrary`]). It is checked on the feature
+/// count computed in closed form, before any feature is enumerated or any Θ(X) allocated. Far above
+/// every committed configuration (the paper's library, Fourier K = 1, has 2·K·n = 20 features on
+/// the 10 inputs of the full formulation; the largest committed variant library 42), and low
+/// enough that a flight's Θ stays within hundreds of MB.
+pub const MAX_FEATURES: usize = 10_000;
+
 /// A serialisable description of a library made of polynomial and Fourier parts.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
@@ -80,8 +88,41 @@ impl LibrarySpec {
         Ok(spec)
     }
 
-    /// Checks that every part yields at least one feature.
+    /// Number of features on `inputs` input variables, in closed form (nothing is enumerated):
+    /// C(n + d, d) monomials of n inputs up to degree d (one fewer without the constant), 2·K·n
+    /// Fourier terms, the sum over the parts of a concatenation. `None` if it overflows `usize`.
+    pub fn feature_count(&self, inputs: usize) -> Option<usize> {
+        match self {
+            Self::Polynomial { degree, constant } => polynomial_count(inputs, *degree, *constant),
+            Self::Fourier { frequencies } => frequencies.checked_mul(inputs)?.checked_mul(2),
+            Self::Concatenation { parts } => parts.iter().try_fold(0usize, |sum, part| {
+                sum.checked_add(part.feature_count(inputs)?)
+            }),
+        }
+    }
+
+    /// Checks that every part yields at least one feature and that the library has at most
+    /// [`MAX_FEATURES`] features on a single input (the count on the actual inputs is checked
+    /// by [`FeatureLibrary::checked_feature_count`]).
     pub fn validate(&self) -> Result<()> {
+        self.validate_parts()?;
+        if self
+            .feature_count(1)
+            .is_none_or(|count| count > MAX_FEATURES)
+        {
+            return Err(invalid(
+                &format!("library '{self}'"),
+                format!(
+                    "{} features on a single input already, more than the limit of \
+                     {MAX_FEATURES} (sindy::MAX_FEATURES)",
+                    count_text(self.feature_count(1))
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn validate_parts(&self) -> Result<()> {
         match self {
             Self::Polynomial { degree, constant } => {
                 if *degree == 0 && !*constant {
@@ -103,7 +144,7 @@ impl LibrarySpec {
                         "a concatenation needs at least one part",
                     ));
                 }
-                parts.iter().try_for_each(Self::validate)?;
+                parts.iter().try_for_each(Self::validate_parts)?;
             }
         }
         Ok(())
@@ -272,15 +313,16 @@ impl FeatureLibrary {
     /// [`Self::feature_names`], failing when a name repeats (e.g. `poly:1+poly:2` has `x` twice, or
     /// an input named `x^2` next to `x`): a model's terms are identified by name, in its equations
     /// and in its file, so two columns of one name would be merged or lost.
+    ///
+    /// Fails without enumerating anything when the library has more than [`MAX_FEATURES`]
+    /// features on these inputs.
     pub fn unique_feature_names(&self, inputs: &[&str]) -> Result<Vec<String>> {
+        self.checked_feature_count(inputs.len())?;
         let names = self.feature_names(inputs);
         let mut seen = std::collections::HashSet::with_capacity(names.len());
         if let Some(repeated) = names.iter().find(|name| !seen.insert(name.as_str())) {
-            let library = self
-                .spec()
-                .map_or_else(|| "library".to_string(), |spec| format!("library '{spec}'"));
             return Err(invalid(
-                &library,
+                &self.describe(),
                 format!(
                     "it has the feature '{repeated}' twice on inputs {} (each feature must be unique)",
                     inputs.join(", ")
@@ -290,18 +332,46 @@ impl FeatureLibrary {
         Ok(names)
     }
 
-    /// Number of features for `inputs` input variables.
+    /// Number of features for `inputs` input variables, in closed form (saturating at
+    /// `usize::MAX`; see [`Self::checked_feature_count`] for the checked count).
     pub fn feature_count(&self, inputs: usize) -> usize {
-        self.parts
-            .iter()
-            .map(|part| match part {
+        self.exact_feature_count(inputs).unwrap_or(usize::MAX)
+    }
+
+    /// The number of features for `inputs` input variables, failing (before anything is
+    /// enumerated or allocated) when it exceeds [`MAX_FEATURES`].
+    pub fn checked_feature_count(&self, inputs: usize) -> Result<usize> {
+        match self.exact_feature_count(inputs) {
+            Some(count) if count <= MAX_FEATURES => Ok(count),
+            count => Err(invalid(
+                &self.describe(),
+                format!(
+                    "{} features on {inputs} inputs, more than the limit of {MAX_FEATURES} \
+                     (sindy::MAX_FEATURES)",
+                    count_text(count)
+                ),
+            )),
+        }
+    }
+
+    /// `None` if the count overflows `usize`.
+    fn exact_feature_count(&self, inputs: usize) -> Option<usize> {
+        self.parts.iter().try_fold(0usize, |sum, part| {
+            let count = match part {
                 Part::Polynomial { degree, constant } => {
-                    monomials(inputs, *degree, *constant).len()
+                    polynomial_count(inputs, *degree, *constant)?
                 }
-                Part::Fourier { frequencies } => 2 * frequencies * inputs,
-                Part::Custom(functions) => functions.len() * inputs,
-            })
-            .sum()
+                Part::Fourier { frequencies } => frequencies.checked_mul(inputs)?.checked_mul(2)?,
+                Part::Custom(functions) => functions.len().checked_mul(inputs)?,
+            };
+            sum.checked_add(count)
+        })
+    }
+
+    /// `library 'poly:2'`, or `library` for one with custom functions.
+    fn describe(&self) -> String {
+        self.spec()
+            .map_or_else(|| "library".to_string(), |spec| format!("library '{spec}'"))
     }
 
     /// Θ(X): one row per sample of `inputs`, one column per feature.
@@ -407,6 +477,25 @@ fn collect_parts(spec: &LibrarySpec, parts: &mut Vec<Part>) {
             specs.iter().for_each(|s| collect_parts(s, parts));
         }
     }
+}
+
+/// C(n + d, d) (the monomials of n inputs up to degree d, the constant included), minus one
+/// without the constant; `None` if it overflows. Computed as C(n + d, k) with k = min(n, d), each
+/// partial product C(n + d − k + i, i) an integer; it at least doubles with every step, so the loop
+/// ends (by overflow) within about 128 steps whatever n and d are.
+fn polynomial_count(inputs: usize, degree: usize, constant: bool) -> Option<usize> {
+    let k = inputs.min(degree);
+    let base = inputs.max(degree) as u128;
+    let mut count: u128 = 1;
+    for i in 1..=k as u128 {
+        count = count.checked_mul(base + i)? / i;
+    }
+    usize::try_from(count - u128::from(!constant)).ok()
+}
+
+/// A feature count for a message: the number, or "more than" the largest `usize`.
+fn count_text(count: Option<usize>) -> String {
+    count.map_or_else(|| format!("more than {}", usize::MAX), |c| c.to_string())
 }
 
 /// The monomials of `dim` inputs up to `degree`, each as the sorted list of its factors' input
@@ -531,5 +620,96 @@ mod tests {
             assert!(error.contains("librar") || error.contains(text), "{error}");
         }
         assert!(CustomFunction::new("exp", f64::exp).is_err());
+    }
+
+    #[test]
+    fn feature_counts_are_in_closed_form_and_agree_with_the_names() {
+        for inputs in 0..5 {
+            for degree in 0..5 {
+                for constant in [true, false] {
+                    let spec = LibrarySpec::Polynomial { degree, constant };
+                    let library = FeatureLibrary {
+                        parts: vec![Part::Polynomial { degree, constant }],
+                    };
+                    let count = monomials(inputs, degree, constant).len();
+                    assert_eq!(spec.feature_count(inputs), Some(count));
+                    assert_eq!(library.feature_count(inputs), count);
+                }
+            }
+        }
+        let spec = LibrarySpec::parse("poly:2:noconstant+fourier:3").unwrap();
+        let library = FeatureLibrary::from_spec(&spec).unwrap();
+        let names = library.feature_names(&["x", "y", "u"]);
+        assert_eq!(spec.feature_count(3), Some(names.len()));
+        assert_eq!(library.checked_feature_count(3).unwrap(), names.len());
+        // C(503, 3) on three inputs, computed without enumerating 21 million monomials.
+        let poly = LibrarySpec::Polynomial {
+            degree: 500,
+            constant: true,
+        };
+        assert_eq!(poly.feature_count(3), Some(21_084_251));
+        assert_eq!(poly.feature_count(1), Some(501));
+        let huge = LibrarySpec::Polynomial {
+            degree: usize::MAX,
+            constant: true,
+        };
+        assert_eq!(huge.feature_count(1), None);
+        assert_eq!(huge.feature_count(0), Some(1));
+        assert_eq!(
+            LibrarySpec::Fourier {
+                frequencies: usize::MAX
+            }
+            .feature_count(1),
+            None
+        );
+    }
+
+    #[test]
+    fn libraries_larger_than_the_limit_are_refused_before_anything_is_enumerated() {
+        // The spec alone: too many features on a single input.
+        for text in [
+            "fourier:1000000000",
+            "fourier:5001",
+            "poly:10000",
+            "poly:1:noconstant+fourier:5000",
+        ] {
+            let message = LibrarySpec::parse(text).unwrap_err().to_string();
+            assert!(
+                message.contains(&format!("library '{text}'"))
+                    && message.contains("limit of 10000")
+                    && !message.contains('\n'),
+                "{message}"
+            );
+        }
+        assert!(
+            FeatureLibrary::from_spec(&LibrarySpec::Polynomial {
+                degree: usize::MAX,
+                constant: false
+            })
+            .is_err()
+        );
+        LibrarySpec::parse("fourier:5000").unwrap();
+        // On the actual inputs: poly:500 is 501 features on one input, 21 million on three (14 GB
+        // of names and more of Θ): refused in closed form, in no time and memory.
+        let library = FeatureLibrary::from_spec(&LibrarySpec::parse("poly:500").unwrap()).unwrap();
+        let start = std::time::Instant::now();
+        for error in [
+            library.checked_feature_count(3).unwrap_err(),
+            library.unique_feature_names(&["x", "y", "u"]).unwrap_err(),
+        ] {
+            let message = error.to_string();
+            assert_eq!(
+                message,
+                "invalid library 'poly:500': 21084251 features on 3 inputs, more than the limit \
+                 of 10000 (sindy::MAX_FEATURES)"
+            );
+        }
+        assert!(start.elapsed().as_secs() < 1, "{:?}", start.elapsed());
+        assert_eq!(library.checked_feature_count(1).unwrap(), 501);
+        let custom =
+            FeatureLibrary::custom(vec![CustomFunction::new("exp({})", f64::exp).unwrap()])
+                .unwrap();
+        assert!(custom.checked_feature_count(10_001).is_err());
+        assert_eq!(custom.checked_feature_count(10_000).unwrap(), 10_000);
     }
 }

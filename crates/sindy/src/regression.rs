@@ -22,10 +22,23 @@
 use faer::{Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, invalid, shape};
+use crate::error::{Result, field, shape};
 use crate::linalg::ridge_from_gram;
 use crate::optimizer::{Lasso, Stlsq};
 use crate::selection::{BlockedFolds, Fold, Selection, cross_validate};
+
+/// The most candidate values of a penalty (each is cross-validated on every fold; the committed
+/// variants use up to 8).
+pub const MAX_PENALTY_CANDIDATES: usize = 100;
+/// The largest ridge λ and STLSQ α (both per sample, on standardised columns: 1 already shrinks
+/// every coefficient hard; the committed variants use up to 1). Larger values overflow the
+/// solvers' arithmetic instead of meaning anything.
+pub const MAX_PENALTY: f64 = 1e6;
+/// The most members of a bagged ensemble (the committed variants use 20).
+pub const MAX_BAGGING_MEMBERS: usize = 1_000;
+/// The longest bootstrap block, samples (the committed variants use 125; a block is also at most
+/// the segment's length, checked when fitting).
+pub const MAX_BAGGING_BLOCK: usize = 1_000_000;
 
 fn default_true() -> bool {
     true
@@ -44,26 +57,49 @@ pub enum Penalty {
 }
 
 impl Penalty {
+    /// Errors name the field inside a [`RegressionSpec`]: `penalty.lambdas`, `penalty.fractions`,
+    /// `penalty.thresholds` or `penalty.alpha`.
     fn check(&self) -> Result<()> {
         let (name, values, fraction) = match self {
-            Self::Ridge { lambdas } => ("ridge lambdas", lambdas, false),
-            Self::Lasso { fractions } => ("LASSO fractions", fractions, true),
+            Self::Ridge { lambdas } => ("penalty.lambdas", lambdas, false),
+            Self::Lasso { fractions } => ("penalty.fractions", fractions, true),
             Self::Stlsq { thresholds, alpha } => {
-                if !(alpha.is_finite() && *alpha >= 0.0) {
-                    return Err(invalid("STLSQ alpha", format!("{alpha} must be ≥ 0")));
+                if !(0.0..=MAX_PENALTY).contains(alpha) {
+                    return Err(field(
+                        "penalty.alpha",
+                        format!("{alpha} must be from 0 to {MAX_PENALTY:e} (sindy::MAX_PENALTY)"),
+                    ));
                 }
-                ("STLSQ thresholds", thresholds, false)
+                ("penalty.thresholds", thresholds, false)
             }
         };
         if values.is_empty() {
-            return Err(invalid(name, "name at least one candidate"));
+            return Err(field(name, "name at least one candidate"));
+        }
+        if values.len() > MAX_PENALTY_CANDIDATES {
+            return Err(field(
+                name,
+                format!(
+                    "{} candidates, more than the limit of {MAX_PENALTY_CANDIDATES} \
+                     (sindy::MAX_PENALTY_CANDIDATES)",
+                    values.len()
+                ),
+            ));
         }
         if let Some(bad) = values
             .iter()
             .find(|v| !(v.is_finite() && **v >= 0.0 && (!fraction || (**v > 0.0 && **v <= 1.0))))
         {
             let range = if fraction { "in (0, 1]" } else { "≥ 0" };
-            return Err(invalid(name, format!("{bad} must be {range}")));
+            return Err(field(name, format!("{bad} must be {range}")));
+        }
+        if let Self::Ridge { lambdas } = self
+            && let Some(bad) = lambdas.iter().find(|v| **v > MAX_PENALTY)
+        {
+            return Err(field(
+                name,
+                format!("{bad:e} must be at most {MAX_PENALTY:e} (sindy::MAX_PENALTY)"),
+            ));
         }
         Ok(())
     }
@@ -213,6 +249,55 @@ impl RegressionFit {
 }
 
 impl RegressionSpec {
+    /// Checks the settings that do not depend on the data: the penalty's candidates (at most
+    /// [`MAX_PENALTY_CANDIDATES`], each in range), the folds (see [`BlockedFolds::validate`]) and
+    /// the bagging (2 to [`MAX_BAGGING_MEMBERS`] members, blocks of 1 to [`MAX_BAGGING_BLOCK`]
+    /// samples). Errors are [`crate::SindyError::Field`] naming the field, e.g.
+    /// `penalty.lambdas` or `bagging.block`.
+    pub fn validate(&self) -> Result<()> {
+        self.penalty.check()?;
+        self.folds.validate()?;
+        if let Some(bagging) = self.bagging {
+            if !(2..=MAX_BAGGING_MEMBERS).contains(&bagging.members) {
+                return Err(field(
+                    "bagging.members",
+                    format!(
+                        "{} must be from 2 to {MAX_BAGGING_MEMBERS} (sindy::MAX_BAGGING_MEMBERS)",
+                        bagging.members
+                    ),
+                ));
+            }
+            if !(1..=MAX_BAGGING_BLOCK).contains(&bagging.block) {
+                return Err(field(
+                    "bagging.block",
+                    format!(
+                        "{} must be from 1 to {MAX_BAGGING_BLOCK} samples (sindy::MAX_BAGGING_BLOCK)",
+                        bagging.block
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the settings against a segment of `n` samples: the folds fit in it
+    /// ([`BlockedFolds::checked`]) and a bagging block is at most `n` samples long.
+    pub fn check_rows(&self, n: usize) -> Result<()> {
+        self.folds.checked(n)?;
+        if let Some(bagging) = self.bagging
+            && bagging.block > n
+        {
+            return Err(field(
+                "bagging.block",
+                format!(
+                    "blocks of {} samples are longer than the segment's {n} samples",
+                    bagging.block
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// Chooses each target's penalty by blocked cross-validation on the rows of `theta` and
     /// `targets` (and nothing else), refits on all of them, then fits the bagged members.
     pub fn fit(
@@ -221,7 +306,7 @@ impl RegressionSpec {
         targets: MatRef<'_, f64>,
         seed: u64,
     ) -> Result<RegressionFit> {
-        self.penalty.check()?;
+        self.validate()?;
         let n = theta.nrows();
         if targets.nrows() != n {
             return Err(shape(
@@ -231,17 +316,7 @@ impl RegressionSpec {
         }
         check_finite(theta, "features")?;
         check_finite(targets, "targets")?;
-        if let Some(bagging) = self.bagging
-            && (bagging.members < 2 || bagging.block == 0 || bagging.block > n)
-        {
-            return Err(invalid(
-                "bagging",
-                format!(
-                    "{} members of blocks of {} samples: need ≥ 2 members and 1 ≤ block ≤ {n}",
-                    bagging.members, bagging.block
-                ),
-            ));
-        }
+        self.check_rows(n)?;
         let folds = self.folds.checked(n)?;
         let all_rows: Vec<usize> = (0..n).collect();
         let selections = (0..targets.ncols())
@@ -500,5 +575,112 @@ mod tests {
             ..spec
         };
         assert!(bad.fit(theta.as_ref(), targets.as_ref(), 7).is_err());
+    }
+
+    /// The field named by a spec's error, and its message.
+    fn field_error(spec: &RegressionSpec) -> (String, String) {
+        match spec.validate().unwrap_err() {
+            crate::SindyError::Field { field, message } => (field, message),
+            other => panic!("{other}"),
+        }
+    }
+
+    #[test]
+    fn settings_are_checked_before_any_data_with_the_field_they_are_in() {
+        let ridge = |lambdas: Vec<f64>| RegressionSpec {
+            penalty: Penalty::Ridge { lambdas },
+            intercept: true,
+            folds: BlockedFolds::default(),
+            bagging: None,
+        };
+        let bagged = |members, block| RegressionSpec {
+            bagging: Some(Bagging { members, block }),
+            ..ridge(vec![0.0])
+        };
+        let cases = [
+            (ridge(vec![-1.0]), "penalty.lambdas", "-1 must be ≥ 0"),
+            (ridge(Vec::new()), "penalty.lambdas", "at least one"),
+            (
+                ridge(vec![0.1; 1_000_000]),
+                "penalty.lambdas",
+                "1000000 candidates, more than the limit of 100",
+            ),
+            (
+                RegressionSpec {
+                    penalty: Penalty::Lasso {
+                        fractions: vec![0.1, 2.0],
+                    },
+                    ..ridge(vec![0.0])
+                },
+                "penalty.fractions",
+                "2 must be in (0, 1]",
+            ),
+            (
+                RegressionSpec {
+                    penalty: Penalty::Stlsq {
+                        thresholds: vec![-0.1],
+                        alpha: 0.05,
+                    },
+                    ..ridge(vec![0.0])
+                },
+                "penalty.thresholds",
+                "-0.1 must be ≥ 0",
+            ),
+            (
+                RegressionSpec {
+                    penalty: Penalty::Stlsq {
+                        thresholds: vec![0.1],
+                        alpha: f64::NAN,
+                    },
+                    ..ridge(vec![0.0])
+                },
+                "penalty.alpha",
+                "NaN must be from 0 to 1e6",
+            ),
+            (
+                ridge(vec![0.0, 1e308]),
+                "penalty.lambdas",
+                "1e308 must be at most 1e6",
+            ),
+            (bagged(3, 0), "bagging.block", "0 must be from 1"),
+            (
+                bagged(1_000_000_000, 125),
+                "bagging.members",
+                "from 2 to 1000",
+            ),
+            (bagged(1, 125), "bagging.members", "from 2"),
+            (bagged(3, usize::MAX), "bagging.block", "1000000"),
+            (
+                RegressionSpec {
+                    folds: BlockedFolds {
+                        folds: usize::MAX,
+                        gap: 10,
+                    },
+                    ..ridge(vec![0.0])
+                },
+                "folds.folds",
+                "from 2 to 100",
+            ),
+        ];
+        for (spec, expected_field, expected) in cases {
+            let (field, message) = field_error(&spec);
+            assert_eq!(field, expected_field, "{message}");
+            assert!(message.contains(expected), "{field}: {message}");
+        }
+        // Against the rows: a block longer than the segment, and a gap that overflowed before.
+        bagged(20, 125).validate().unwrap();
+        bagged(20, 125).check_rows(1255).unwrap();
+        let message = bagged(20, 125).check_rows(100).unwrap_err().to_string();
+        assert!(message.contains("bagging.block"), "{message}");
+        let wide_gap = RegressionSpec {
+            folds: BlockedFolds {
+                folds: 5,
+                gap: usize::MAX,
+            },
+            ..ridge(vec![0.0])
+        };
+        wide_gap.validate().unwrap();
+        let message = wide_gap.check_rows(1255).unwrap_err().to_string();
+        assert!(message.contains("too few"), "{message}");
     }
 }

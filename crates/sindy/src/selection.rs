@@ -11,7 +11,11 @@ use std::ops::Range;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, invalid};
+use crate::error::{Result, field, invalid};
+
+/// The most cross-validation folds (every candidate is fitted once per fold; the committed
+/// variants use the default, 5).
+pub const MAX_FOLDS: usize = 100;
 
 fn default_folds() -> usize {
     5
@@ -50,18 +54,33 @@ pub struct Fold {
 }
 
 impl BlockedFolds {
-    /// Checks the settings against a segment of `n` samples and returns its folds.
-    pub fn checked(&self, n: usize) -> Result<Vec<Fold>> {
-        if self.folds < 2 {
-            return Err(invalid(
-                "cross-validation folds",
-                format!("{} must be at least 2", self.folds),
+    /// Checks the settings that do not depend on the segment: 2 to [`MAX_FOLDS`] folds. Errors
+    /// are [`crate::SindyError::Field`] naming `folds.folds` (the field inside a
+    /// [`crate::RegressionSpec`]).
+    pub fn validate(&self) -> Result<()> {
+        if !(2..=MAX_FOLDS).contains(&self.folds) {
+            return Err(field(
+                "folds.folds",
+                format!(
+                    "{} must be from 2 to {MAX_FOLDS} (sindy::MAX_FOLDS)",
+                    self.folds
+                ),
             ));
         }
+        Ok(())
+    }
+
+    /// Checks the settings against a segment of `n` samples and returns its folds.
+    pub fn checked(&self, n: usize) -> Result<Vec<Fold>> {
+        self.validate()?;
         let block = n / self.folds;
-        if block < 2 || n < self.folds * 2 + 2 * self.gap {
-            return Err(invalid(
-                "cross-validation folds",
+        let needed = self
+            .folds
+            .saturating_mul(2)
+            .saturating_add(self.gap.saturating_mul(2));
+        if block < 2 || n < needed {
+            return Err(field(
+                "folds",
                 format!(
                     "{n} samples are too few for {} folds with a gap of {}",
                     self.folds, self.gap
@@ -73,7 +92,7 @@ impl BlockedFolds {
                 let start = k * n / self.folds;
                 let end = (k + 1) * n / self.folds;
                 let training = (0..start.saturating_sub(self.gap))
-                    .chain((end + self.gap).min(n)..n)
+                    .chain(end.saturating_add(self.gap).min(n)..n)
                     .collect();
                 Fold {
                     training,

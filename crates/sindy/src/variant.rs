@@ -60,6 +60,16 @@ pub struct VariantEvaluation {
 }
 
 impl LibraryRegression {
+    /// Checks the library ([`CausalLibrary::validate`]) and the regression
+    /// ([`RegressionSpec::validate`]); errors are [`crate::SindyError::Field`] naming the field,
+    /// e.g. `regression.penalty.lambdas` or `library.control_lags`.
+    pub fn validate(&self) -> Result<()> {
+        self.library.validate().map_err(|e| e.within("library"))?;
+        self.regression
+            .validate()
+            .map_err(|e| e.within("regression"))
+    }
+
     /// Builds the library on each segment, fits on the support segment (choosing the penalty
     /// there), predicts both.
     pub fn evaluate(

@@ -37,6 +37,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     let config = VariantsConfig::load(&args.config, &args.root)?;
+    pipeline::check_ablations_output(&args.out)?;
     let data_dir = global.data_dir()?;
     let quiet = global.quiet;
     let progress = |cell: &str| {

@@ -3,8 +3,9 @@
 //! What it is for: reading Neural-Fly flight logs into a typed, validated [`FlightLog`]; reading plain
 //! numeric CSVs by column name ([`NumericTable`]); the paper's three [`Formulation`]s as data (which
 //! state, which inputs, with which scalings); derivative estimators ([`Derivative`]); support/query
-//! splits ([`SplitSpec`]); the experiment's wind conditions ([`ExperimentConditions`]); and finding the
-//! data directory ([`resolve_data_dir`]).
+//! splits ([`SplitSpec`]); the experiment's wind conditions ([`ExperimentConditions`]); finding the
+//! data directory ([`resolve_data_dir`]); and reading the workspace's JSON files with errors that
+//! name the failing field ([`json`]).
 //!
 //! What it is not for: fitting anything. Models live in `sindy` and `learn`, tables in `report`.
 //!

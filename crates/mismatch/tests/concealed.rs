@@ -1,49 +1,15 @@
 //! Behaviour on short simulated flights: nothing on noise alone, the right effect and parameter
 //! when one is concealed, outputs that refuse to overwrite, errors that name the problem.
 
-use std::path::{Path, PathBuf};
-
 use mismatch::{AnalysisSettings, MismatchError, analyze, check_outputs, write_outputs};
-use physics::{
-    Effects, Noise, NominalModel, Scenario, ThrustScale, TorqueBias, Trajectory, simulate,
-};
+use physics::{Effects, NominalModel, Scenario, ThrustScale, TorqueBias, simulate};
 
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+mod common;
+
+use common::{scenario, workspace};
 
 fn model() -> NominalModel {
-    NominalModel::load(&workspace().join("experiments/mismatch/demo-quad.json")).unwrap()
-}
-
-/// A 14 s figure-8 with small sensor noise and the given effects.
-fn scenario(effects: Effects, seed: u64) -> Scenario {
-    Scenario {
-        model: "demo-quad.json".into(),
-        duration_s: 14.0,
-        warmup_s: 3.0,
-        seed,
-        physics_rate_hz: 500.0,
-        log_rate_hz: 50.0,
-        hover_throttle: 0.5,
-        trajectory: Trajectory::Figure8 {
-            center: [0.0, 0.0, 1.5],
-            first: [1.8, 0.0, 0.0],
-            second: [0.0, 0.9, 0.4],
-            period_s: 6.0,
-            low_passes: Vec::new(),
-            yaw_amplitude_rad: 0.3,
-            yaw_period_s: 9.0,
-        },
-        effects,
-        noise: Noise {
-            position_m: 0.002,
-            velocity_m_s: 0.005,
-            attitude_rad: 0.002,
-            rate_rad_s: 0.008,
-        },
-        gains: Default::default(),
-    }
+    common::model("demo-quad.json")
 }
 
 fn flight(effects: Effects, seed: u64) -> data::FlightLog {

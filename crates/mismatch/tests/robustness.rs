@@ -2,46 +2,20 @@
 //! never a panic, a hang, or NaN and infinite numbers in the outputs. The flights are generated and
 //! corrupted in memory (the data crate's reader rejects such values in files before they get here).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use mismatch::{Analysis, AnalysisSettings, MismatchError, analyze, write_figure, write_outputs};
-use physics::{Effects, Noise, NominalModel, Scenario, Trajectory, simulate};
+use physics::{Effects, Scenario, simulate};
 
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+mod common;
 
-fn model(name: &str) -> NominalModel {
-    NominalModel::load(&workspace().join("experiments/mismatch").join(name)).unwrap()
-}
+use common::model;
 
 /// A 12 s simulated figure-8 (with a mixer, so with motor commands and a thrust setpoint).
 fn flight() -> data::FlightLog {
     let scenario = Scenario {
-        model: "demo-quad.json".into(),
         duration_s: 12.0,
-        warmup_s: 3.0,
-        seed: 7,
-        physics_rate_hz: 500.0,
-        log_rate_hz: 50.0,
-        hover_throttle: 0.5,
-        trajectory: Trajectory::Figure8 {
-            center: [0.0, 0.0, 1.5],
-            first: [1.8, 0.0, 0.0],
-            second: [0.0, 0.9, 0.4],
-            period_s: 6.0,
-            low_passes: Vec::new(),
-            yaw_amplitude_rad: 0.3,
-            yaw_period_s: 9.0,
-        },
-        effects: Effects::default(),
-        noise: Noise {
-            position_m: 0.002,
-            velocity_m_s: 0.005,
-            attitude_rad: 0.002,
-            rate_rad_s: 0.008,
-        },
-        gains: Default::default(),
+        ..common::scenario(Effects::default(), 7)
     };
     let mut log = simulate(&model("demo-quad.json"), &scenario, "test").unwrap();
     log.path = PathBuf::from("generated/corrupt_flight.csv");

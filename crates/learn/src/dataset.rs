@@ -180,6 +180,14 @@ pub struct RangeCoverage {
     pub samples_outside: usize,
     /// Per input, in the order of X.
     pub inputs: Vec<InputCoverage>,
+    /// The model's MSE over the samples inside the range (every input within it), when the
+    /// predictions were given and such samples exist.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mse_inside: Option<f64>,
+    /// The model's MSE over the samples outside the range, when the predictions were given and
+    /// such samples exist.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mse_outside: Option<f64>,
 }
 
 /// One input's part of a [`RangeCoverage`].
@@ -248,6 +256,8 @@ impl Standardiser {
                     largest_excess_in_std: 0.0,
                 })
                 .collect(),
+            mse_inside: None,
+            mse_outside: None,
         };
         for row in inputs.chunks_exact(dim) {
             let mut outside = false;
@@ -263,6 +273,43 @@ impl Standardiser {
             }
             coverage.samples_outside += usize::from(outside);
         }
+        Some(coverage)
+    }
+
+    /// [`Standardiser::coverage`] with the MSE of `predictions` against `targets` (row-major,
+    /// one row per input row) split between the rows inside the kept range and those outside it.
+    pub fn coverage_with_errors(
+        &self,
+        inputs: &[f64],
+        names: &[&str],
+        predictions: &[f64],
+        targets: &[f64],
+    ) -> Option<RangeCoverage> {
+        let mut coverage = self.coverage(inputs, names)?;
+        let range = self.range.as_ref()?;
+        let rows = coverage.samples.max(1);
+        let outputs = targets.len() / rows;
+        // (sum of squared errors, values) inside and outside.
+        let mut sums = [(0.0, 0usize); 2];
+        let row_errors = predictions
+            .chunks_exact(outputs)
+            .zip(targets.chunks_exact(outputs));
+        for (row, (predicted, target)) in inputs.chunks_exact(self.mean.len()).zip(row_errors) {
+            let outside = row
+                .iter()
+                .enumerate()
+                .any(|(j, &x)| x < range.low[j] || x > range.high[j]);
+            let sum = &mut sums[usize::from(outside)];
+            sum.0 += predicted
+                .iter()
+                .zip(target)
+                .map(|(p, t)| (p - t) * (p - t))
+                .sum::<f64>();
+            sum.1 += outputs;
+        }
+        let mean = |(total, count): (f64, usize)| (count > 0).then(|| total / count as f64);
+        coverage.mse_inside = mean(sums[0]);
+        coverage.mse_outside = mean(sums[1]);
         Some(coverage)
     }
 
@@ -360,6 +407,31 @@ mod tests {
         assert_eq!(
             Standardiser::fit([&training[..]], 2).coverage(&segment, &["x", "y"]),
             None
+        );
+    }
+
+    #[test]
+    fn coverage_splits_the_squared_error_between_rows_inside_and_outside_the_range() {
+        let training = [0.0, 0.0, 2.0, 4.0];
+        let standardiser = Standardiser::fit([&training[..]], 2)
+            .with_range(InputRange::spanned([&training[..]], 2), false);
+        // The same three rows as above (inside, outside, outside), two outputs each.
+        let segment = [1.0, 2.0, 3.5, 1.0, 2.5, -2.0];
+        let predictions = [1.0, 1.0, 0.0, 0.0, 5.0, 5.0];
+        let targets = [0.0, 3.0, 2.0, 0.0, 5.0, 3.0];
+        let coverage = standardiser
+            .coverage_with_errors(&segment, &["x", "y"], &predictions, &targets)
+            .unwrap();
+        assert_eq!(coverage.samples_outside, 2);
+        assert_eq!(coverage.mse_inside, Some((1.0 + 4.0) / 2.0));
+        assert_eq!(coverage.mse_outside, Some((4.0 + 0.0 + 0.0 + 4.0) / 4.0));
+        // No row outside: no MSE outside.
+        let inside_only = standardiser
+            .coverage_with_errors(&segment[..2], &["x", "y"], &predictions[..2], &targets[..2])
+            .unwrap();
+        assert_eq!(
+            (inside_only.mse_inside, inside_only.mse_outside),
+            (Some(2.5), None)
         );
     }
 

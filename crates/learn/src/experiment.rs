@@ -373,12 +373,8 @@ impl Experiment {
         let (support, query) = flight_segments(log, model.formulation)?;
         let (raw_support, raw_query) = (segment_batch(&support), segment_batch(&query));
         let input_names = model.formulation.input_names();
-        let support_coverage = model
-            .standardiser
-            .coverage(&raw_support.inputs, &input_names);
-        let query_coverage = model.standardiser.coverage(&raw_query.inputs, &input_names);
-        let support_batch = standardised(&model.standardiser, raw_support);
-        let query_batch = standardised(&model.standardiser, raw_query);
+        let support_batch = standardised(&model.standardiser, raw_support.clone());
+        let query_batch = standardised(&model.standardiser, raw_query.clone());
         let architecture = &model.architecture;
         let origin = self.config.origin();
         let adaptation = &self.config.get().adaptation;
@@ -392,6 +388,18 @@ impl Experiment {
         check_finite_parameters(&adapted, &cell, &advice)?;
         let support_predictions = model.predict_segment(&adapted, &support);
         let query_predictions = model.predict_segment(&adapted, &query);
+        let support_coverage = model.standardiser.coverage_with_errors(
+            &raw_support.inputs,
+            &input_names,
+            &support_predictions,
+            &support_batch.targets,
+        );
+        let query_coverage = model.standardiser.coverage_with_errors(
+            &raw_query.inputs,
+            &input_names,
+            &query_predictions,
+            &query_batch.targets,
+        );
         let state_dim = architecture.state_dim;
         let summary = CellSummary {
             formulation: model.formulation,

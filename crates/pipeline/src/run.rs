@@ -421,9 +421,15 @@ fn coverage_note<'a>(
                 .iter()
                 .filter(|input| input.samples_outside > 0)
                 .max_by(|a, b| a.largest_excess_in_std.total_cmp(&b.largest_excess_in_std));
+            let errors = match (coverage.mse_inside, coverage.mse_outside) {
+                (Some(inside), Some(outside)) => {
+                    format!("; MSE {inside:.3} inside, {outside:.3} outside")
+                }
+                _ => String::new(),
+            };
             let detail = farthest.map_or(String::new(), |input| {
                 format!(
-                    " (farthest: {} by {:.1} std)",
+                    " (farthest: {} by {:.1} std{errors})",
                     input.input, input.largest_excess_in_std
                 )
             });
@@ -436,7 +442,8 @@ fn coverage_note<'a>(
     (!parts.is_empty()).then(|| {
         format!(
             "LeARN query samples with an input outside the range of the meta-training inputs \
-             (the networks extrapolate there): {}.",
+             (the networks extrapolate there), with the generalisation MSE over the samples inside \
+             and outside that range: {}.",
             parts.join("; ")
         )
     })
@@ -736,11 +743,15 @@ mod tests {
             samples: 10,
             samples_outside: 0,
             inputs: vec![input("w_x", 0, 0.0), input("w_z", 0, 0.0)],
+            mse_inside: Some(0.5),
+            mse_outside: None,
         };
         let outside = RangeCoverage {
             samples: 10,
             samples_outside: 3,
             inputs: vec![input("w_x", 2, 6.5), input("w_z", 3, 9.61)],
+            mse_inside: Some(0.25),
+            mse_outside: Some(2.5),
         };
         let note = coverage_note(
             [
@@ -751,7 +762,7 @@ mod tests {
             .into_iter(),
         )
         .unwrap();
-        assert!(note.ends_with(": 35wind 0 of 10; 100wind 3 of 10 (farthest: w_z by 9.6 std)."));
+        assert!(note.ends_with(": 35wind 0 of 10; 100wind 3 of 10 (farthest: w_z by 9.6 std; MSE 0.250 inside, 2.500 outside)."));
         assert_eq!(coverage_note([("35wind", None)].into_iter()), None);
     }
 }

@@ -5,7 +5,7 @@
 //! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
 //! score and the one fold c's own validation prefers, and writes all numbers as JSON.
 //!
-//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation|window|basis]
+//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation|window|basis|clamp|tasks]
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -32,7 +32,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `regularisation`: the meta-regulariser μ from 0 to 1e-3;
     // `window`: adaptation updates on windows of 2 or 4 consecutive samples (1: the paper);
     // `basis`: P = 1 or 3 learned basis functions per input instead of the paper's 2;
-    // `clamp`: inputs clamped to the range they span in the meta-training flights.
+    // `clamp`: inputs clamped to the range they span in the meta-training flights;
+    // `tasks`: one meta-training task per wind condition (the paper's task) instead of per flight.
     let stage = arguments.get(2).map_or("grid", String::as_str);
     let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
     let base = checked.get().clone();
@@ -60,7 +61,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         | "regularisation"
         | "window"
         | "basis"
-        | "clamp" => &[(800, 4, 0.1, 0)],
+        | "clamp"
+        | "tasks" => &[(800, 4, 0.1, 0)],
         _ => &[
             (200, 4, 0.1, 0),
             (800, 4, 0.1, 0),
@@ -113,6 +115,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.clamp_inputs = true;
         candidates.push(("it800_tasks4_alpha0.1_clamped".to_string(), config));
     }
+    if stage == "tasks" {
+        // One task per wind condition. A nested-validation meta-training set holds three
+        // conditions (a fold's holds four), so a batch draws at most three: three tasks of 64
+        // points, and two tasks of 128 points (the same points per meta-iteration as now).
+        for (task_batch, points) in [(3, 64), (2, 128)] {
+            let mut config = candidates[0].1.clone();
+            config.meta_training.tasks = learn::TaskGrouping::Condition;
+            config.meta_training.task_batch = task_batch;
+            config.meta_training.support_batch = points;
+            config.meta_training.query_batch = points;
+            candidates.push((
+                format!("it800_conditions{task_batch}_batch{points}_alpha0.1"),
+                config,
+            ));
+        }
+    }
     if stage == "regularisation" {
         for mu in [0.0, 1e-4, 1e-3] {
             let mut config = candidates[0].1.clone();
@@ -163,7 +181,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let passes_grid: &[usize] = match stage {
             "grid" => &[4, 8],
             "passes" => &[8, 16, 24],
-            "basis" | "clamp" => &[16],
+            "basis" | "clamp" | "tasks" => &[16],
             _ => &[8],
         };
         // (step, averaged SGD over the last pass)
@@ -171,7 +189,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "averaging" => &[(0.0005, false)],
             "adaptation-averaging" => &[(0.0005, false), (0.0005, true), (0.001, true)],
             "passes" | "outer" | "regularisation" => &[(0.0005, false), (0.00025, false)],
-            "basis" | "clamp" => &[(0.0005, false)],
+            "basis" | "clamp" | "tasks" => &[(0.0005, false)],
             _ => &[(0.0005, false), (0.001, false)],
         };
         let mut adaptations = Vec::new();

@@ -19,6 +19,19 @@ pub enum Optimizer {
     Adam,
 }
 
+/// What one meta-training task is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TaskGrouping {
+    /// One task per meta-training flight: its support and query segments (the default).
+    #[default]
+    Flight,
+    /// One task per wind condition, the paper's task ("a new task i.e. a new wind condition"): the
+    /// support and query segments of all that condition's flights, pooled. Under the `paper`
+    /// protocol, with one flight per condition, the two are the same.
+    Condition,
+}
+
 /// Meta-training (Algorithm 1).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -34,14 +47,17 @@ pub struct MetaTrainingConfig {
     pub meta_regularisation: f64,
     /// Exact second order, or first order.
     pub order: MetaOrder,
-    /// Tasks (flights) per meta-iteration, drawn without replacement: at most the number of
-    /// meta-training flights.
+    /// What a task is: a flight (the default) or a wind condition.
+    #[serde(default)]
+    pub tasks: TaskGrouping,
+    /// Tasks per meta-iteration, drawn without replacement: at most the number of meta-training
+    /// tasks (flights, or conditions).
     pub task_batch: usize,
-    /// Support points per task (drawn from the first half of the flight, with replacement): at most
-    /// the samples of the shortest such segment.
+    /// Support points per task (drawn from the first half of the task's flights, with
+    /// replacement): at most the samples of the shortest such segment.
     pub support_batch: usize,
-    /// Query points per task (drawn from the second half of the flight, with replacement): at most
-    /// the samples of the shortest such segment.
+    /// Query points per task (drawn from the second half of the task's flights, with
+    /// replacement): at most the samples of the shortest such segment.
     pub query_batch: usize,
     /// Number of meta-iterations.
     pub iterations: usize,

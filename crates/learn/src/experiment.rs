@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::adapt::adapt_online;
-use crate::config::{AdaptationConfig, CheckedConfig, LearnConfig};
+use crate::config::{AdaptationConfig, CheckedConfig, LearnConfig, TaskGrouping};
 use crate::dataset::{
     InputRange, Protocol, RangeCoverage, Standardiser, flight_segments, from_row_major,
     segment_batch,
@@ -228,10 +228,11 @@ impl Experiment {
             input_dim,
         );
         let standardiser = standardiser.with_range(range, config.clamp_inputs);
-        let tasks: Vec<TaskData> = raw_tasks
+        let tasks: Vec<TaskData> = self
+            .grouped(raw_tasks, config.meta_training.tasks)
             .into_iter()
-            .map(|(path, support, query)| TaskData {
-                name: path.display().to_string(),
+            .map(|(name, support, query)| TaskData {
+                name,
                 support: standardised(&standardiser, support),
                 query: standardised(&standardiser, query),
             })
@@ -258,6 +259,43 @@ impl Experiment {
             },
         )?;
         Ok((architecture, standardiser, outcome))
+    }
+
+    /// The meta-training tasks of `flights` (path, support, query) under `grouping`: one per flight,
+    /// named by its path, or one per wind condition, named by the condition, pooling its flights'
+    /// segments in file order (conditions in the order of their first flight).
+    fn grouped(
+        &self,
+        flights: Vec<(&PathBuf, Batch, Batch)>,
+        grouping: TaskGrouping,
+    ) -> Vec<(String, Batch, Batch)> {
+        match grouping {
+            TaskGrouping::Flight => flights
+                .into_iter()
+                .map(|(path, support, query)| (path.display().to_string(), support, query))
+                .collect(),
+            TaskGrouping::Condition => {
+                let known = self.conditions.flight_files(&self.data_dir);
+                let condition_of = |path: &PathBuf| {
+                    known
+                        .iter()
+                        .find(|file| &file.path == path)
+                        .map_or_else(|| path.display().to_string(), |file| file.condition.clone())
+                };
+                let mut groups: Vec<(String, Batch, Batch)> = Vec::new();
+                for (path, support, query) in flights {
+                    let condition = condition_of(path);
+                    match groups.iter_mut().find(|(name, _, _)| name == &condition) {
+                        Some((_, pooled_support, pooled_query)) => {
+                            pooled_support.append(support);
+                            pooled_query.append(query);
+                        }
+                        None => groups.push((condition, support, query)),
+                    }
+                }
+                groups
+            }
+        }
     }
 
     /// Nested validation inside the meta-training sets (leave-condition-out only). For two

@@ -73,7 +73,8 @@ pub mod variants;
 pub use adapt::adapt_online;
 pub use batched::ModelWorkspace;
 pub use config::{
-    AdaptationConfig, CheckedConfig, LearnConfig, MetaTrainingConfig, Optimizer, limits,
+    AdaptationConfig, CheckedConfig, LearnConfig, MetaTrainingConfig, Optimizer, TaskGrouping,
+    limits,
 };
 pub use dataset::{
     InputCoverage, InputRange, Protocol, RangeCoverage, Standardiser, flight_segments,

@@ -35,6 +35,14 @@ pub struct Batch {
     pub targets: Vec<f64>,
 }
 
+impl Batch {
+    /// Appends `other`'s rows (same input and output widths) after this batch's.
+    pub(crate) fn append(&mut self, other: Batch) {
+        self.inputs.extend(other.inputs);
+        self.targets.extend(other.targets);
+    }
+}
+
 /// A task's support batch (inner updates) and query batch (meta-loss).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Task {

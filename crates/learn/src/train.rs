@@ -166,7 +166,7 @@ pub(crate) fn check_sampling(
     if let Some(message) = bound(
         config.task_batch,
         tasks.len(),
-        "meta-training tasks (flights) a batch draws from without replacement".to_string(),
+        "meta-training tasks a batch draws from without replacement".to_string(),
     ) {
         return Err(("meta_training.task_batch", message));
     }

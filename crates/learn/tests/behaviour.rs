@@ -5,7 +5,7 @@ mod common;
 use common::{small_architecture, synthetic_batch, synthetic_tasks};
 use learn::{
     AdaptationConfig, CHECKPOINT_FORMAT, InputRange, LearnConfig, MetaOrder, MetaTrainedModel,
-    MetaTrainingConfig, Optimizer, Protocol, Standardiser, adapt_online, meta_train,
+    MetaTrainingConfig, Optimizer, Protocol, Standardiser, TaskGrouping, adapt_online, meta_train,
 };
 
 fn meta_config(iterations: usize) -> MetaTrainingConfig {
@@ -16,6 +16,7 @@ fn meta_config(iterations: usize) -> MetaTrainingConfig {
         optimizer: Optimizer::Adam,
         meta_regularisation: 1e-6,
         order: MetaOrder::Second,
+        tasks: TaskGrouping::Flight,
         task_batch: 4,
         support_batch: 16,
         query_batch: 16,

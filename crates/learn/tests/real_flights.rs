@@ -3,7 +3,9 @@
 mod common;
 
 use data::{ExperimentConditions, Formulation};
-use learn::{EquationRule, Experiment, LearnConfig, MetaTrainedModel, Protocol, explain_flight};
+use learn::{
+    EquationRule, Experiment, LearnConfig, MetaTrainedModel, Protocol, TaskGrouping, explain_flight,
+};
 
 fn log_rows(data_dir: &std::path::Path) -> usize {
     data::FlightLog::read(&data_dir.join("experiment/custom_figure8_baseline_70p20sint.csv"))
@@ -130,4 +132,50 @@ fn nested_validation_checks_its_candidate_settings() {
         message.contains("adaptation.window") && message.contains("support segment"),
         "{message}"
     );
+}
+
+#[test]
+fn condition_tasks_pool_the_flights_of_each_wind_condition() {
+    let Some(data_dir) = common::real_data_dir() else {
+        return;
+    };
+    let root = common::workspace();
+    let origin = root.join("experiments/learn.json");
+    let config = LearnConfig::load(&origin).unwrap();
+    let experiment_with = |tasks: TaskGrouping, task_batch: usize| {
+        let mut small = config.get().clone();
+        small.meta_training.tasks = tasks;
+        small.meta_training.task_batch = task_batch;
+        small.meta_training.iterations = 2;
+        small.meta_training.support_batch = 16;
+        small.meta_training.query_batch = 16;
+        let conditions =
+            ExperimentConditions::load(&root.join("experiments/conditions.json")).unwrap();
+        Experiment::load(
+            small.check(&origin).unwrap(),
+            conditions,
+            &data_dir,
+            Some(Protocol::LeaveConditionOut),
+        )
+        .unwrap()
+    };
+    // The fold of 70psin20 meta-trains on 24 flights of 4 conditions: 4 condition tasks, and a
+    // batch of 5 distinct tasks exists only per flight.
+    let by_condition = experiment_with(TaskGrouping::Condition, 5)
+        .meta_train(Formulation::Translational, "70psin20", 1)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        by_condition.contains("meta_training.task_batch") && by_condition.contains("at most 4"),
+        "{by_condition}"
+    );
+    let model = experiment_with(TaskGrouping::Condition, 4)
+        .meta_train(Formulation::Translational, "70psin20", 1)
+        .unwrap();
+    assert_eq!(model.data_files.len(), 24);
+    assert_eq!(model.config.meta_training.tasks, TaskGrouping::Condition);
+    let by_flight = experiment_with(TaskGrouping::Flight, 5)
+        .meta_train(Formulation::Translational, "70psin20", 1)
+        .unwrap();
+    assert_ne!(by_flight.parameters, model.parameters);
 }

@@ -1552,6 +1552,11 @@ mod tests {
                 "variants[0] (a).library.control_lags: pole 1.5 must lie in [0, 1)",
             ),
             (
+                "lags-twice",
+                library(r#"{"control_lags": [0.5, 0.8, 0.8]}"#, ridge),
+                "variants[0] (a).library.control_lags: pole 0.8 is listed twice",
+            ),
+            (
                 "lags-many",
                 library(
                     &format!(r#"{{"control_lags": [{}]}}"#, many(100_000, "0.5")),

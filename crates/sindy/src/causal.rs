@@ -41,10 +41,10 @@ pub struct CausalLibrary {
 }
 
 impl CausalLibrary {
-    /// Checks the settings: at most [`MAX_CONTROL_LAGS`] lags, each pole in [0, 1), at least one
-    /// feature, and at most [`crate::MAX_FEATURES`] features on every formulation. Errors are
-    /// [`crate::SindyError::Field`] naming the field (`control_lags`, `fourier`; empty for the
-    /// library as a whole).
+    /// Checks the settings: at most [`MAX_CONTROL_LAGS`] lags, each pole in [0, 1) and none listed
+    /// twice, at least one feature, and at most [`crate::MAX_FEATURES`] features on every
+    /// formulation. Errors are [`crate::SindyError::Field`] naming the field (`control_lags`,
+    /// `fourier`; empty for the library as a whole).
     pub fn validate(&self) -> Result<()> {
         if self.control_lags.len() > MAX_CONTROL_LAGS {
             return Err(field(
@@ -64,6 +64,17 @@ impl CausalLibrary {
                 "control_lags",
                 format!("pole {a} must lie in [0, 1)"),
             ));
+        }
+        // Exact equality (`==`, so 0 and -0 are one pole): two equal poles give two identical,
+        // collinear columns. No tolerance: the poles are read from decimal text, and the same text
+        // always parses to the same f64, so no arithmetic noise can separate two copies of a pole;
+        // poles that differ at all are different filters, and how close two may be before their
+        // columns are too nearly collinear is the regression's conditioning (its penalty), not a
+        // threshold to pick here.
+        for (index, a) in self.control_lags.iter().enumerate() {
+            if self.control_lags[..index].contains(a) {
+                return Err(field("control_lags", format!("pole {a} is listed twice")));
+            }
         }
         if self.fourier > MAX_FEATURES / 2 {
             return Err(field(
@@ -203,6 +214,22 @@ mod tests {
                 },
                 "control_lags",
                 "pole 1 must lie in [0, 1)",
+            ),
+            (
+                CausalLibrary {
+                    control_lags: vec![0.5, 0.8, 0.95, 0.8],
+                    ..Default::default()
+                },
+                "control_lags",
+                "pole 0.8 is listed twice",
+            ),
+            (
+                CausalLibrary {
+                    control_lags: vec![0.0, -0.0],
+                    ..Default::default()
+                },
+                "control_lags",
+                "is listed twice",
             ),
             (
                 CausalLibrary {

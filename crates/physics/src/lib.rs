@@ -4,8 +4,10 @@
 //! how thrust and torques follow from a recorded command); the vocabulary of unmodelled effects
 //! ([`Effects`], ids and parameter names are an output contract); a closed-loop simulator
 //! ([`simulate`]: RK4 rigid body, geometric tracking controller that knows only the nominal model,
-//! figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`]) that writes Neural-Fly logs;
-//! and the residual force of a recorded flight ([`residual_force`], the `fa` column).
+//! figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`]; a [`Scenario`] is read
+//! from JSON or, for examples and tests, built by [`Scenario::figure_eight`]) that writes
+//! Neural-Fly logs; and the residual force of a recorded flight ([`residual_force`], the `fa`
+//! column).
 //!
 //! What it is not for: analysing mismatches (the `mismatch` crate), reading CSVs (the `data` crate).
 //!

@@ -93,6 +93,51 @@ pub const MAX_DELAY_S: f64 = 1.0;
 pub const MAX_REFERENCE_ACCELERATION_M_S2: f64 = 20.0;
 
 impl Scenario {
+    /// A short figure-8 flight built in code, for examples and tests: 6 s recorded (301 rows at
+    /// 50 Hz, just over [`MIN_LOG_ROWS`]) after 4 s of warm-up, a 6 s figure-8 around (0, 0, 1.5) m
+    /// (±1.5 m in x, ±0.8 m in y, ±0.3 m in z) with ±0.2 rad of yaw every 10 s, the sensor noise of
+    /// the demo scenarios in `experiments/mismatch/scenarios/`, no effects and the default rates,
+    /// throttle and gains. `model` is the nominal model file, as in a scenario file. Change any
+    /// field with struct update syntax:
+    ///
+    /// ```
+    /// use physics::{Effects, Scenario, ThrustScale};
+    ///
+    /// let weak = Scenario {
+    ///     effects: Effects { thrust_scale: Some(ThrustScale { k: 0.85 }), ..Effects::default() },
+    ///     ..Scenario::figure_eight("demo-quad.json", 7)
+    /// };
+    /// weak.validate(std::path::Path::new("weak.json")).unwrap();
+    /// ```
+    pub fn figure_eight(model: impl Into<PathBuf>, seed: u64) -> Self {
+        Self {
+            model: model.into(),
+            duration_s: 6.0,
+            warmup_s: 4.0,
+            seed,
+            physics_rate_hz: default_physics_rate(),
+            log_rate_hz: default_log_rate(),
+            hover_throttle: default_hover_throttle(),
+            trajectory: Trajectory::Figure8 {
+                center: [0.0, 0.0, 1.5],
+                first: [1.5, 0.0, 0.0],
+                second: [0.0, 0.8, 0.3],
+                period_s: 6.0,
+                low_passes: Vec::new(),
+                yaw_amplitude_rad: 0.2,
+                yaw_period_s: 10.0,
+            },
+            effects: Effects::default(),
+            noise: Noise {
+                position_m: 0.002,
+                velocity_m_s: 0.005,
+                attitude_rad: 0.002,
+                rate_rad_s: 0.008,
+            },
+            gains: Gains::default(),
+        }
+    }
+
     /// Reads a scenario and its model (resolved relative to the scenario file), and checks both
     /// (together: the simulator needs a mixer, and the reference must stay above the ground).
     pub fn load(path: &Path) -> Result<(Self, NominalModel)> {
@@ -616,27 +661,7 @@ mod tests {
     }
 
     fn scenario() -> Scenario {
-        Scenario {
-            model: "quad.json".into(),
-            duration_s: 6.0,
-            warmup_s: 4.0,
-            seed: 1,
-            physics_rate_hz: 500.0,
-            log_rate_hz: 50.0,
-            hover_throttle: 0.5,
-            trajectory: Trajectory::Figure8 {
-                center: [0.0, 0.0, 1.5],
-                first: [1.8, 0.0, 0.0],
-                second: [0.0, 0.9, 0.4],
-                period_s: 6.0,
-                low_passes: Vec::new(),
-                yaw_amplitude_rad: 0.3,
-                yaw_period_s: 9.0,
-            },
-            effects: Effects::default(),
-            noise: Noise::default(),
-            gains: Gains::default(),
-        }
+        Scenario::figure_eight("quad.json", 1)
     }
 
     /// The field named by the validation error of a changed scenario.
@@ -724,7 +749,7 @@ mod tests {
             rejected_field(set_yaw_period(0.0)),
             "trajectory.yaw_period_s"
         );
-        // a yaw rate no vehicle follows (0.3 rad amplitude every 0.1 s)
+        // a yaw rate no vehicle follows (0.2 rad amplitude every 0.1 s)
         assert_eq!(
             rejected_field(set_yaw_period(0.1)),
             "trajectory.yaw_period_s"

@@ -2,7 +2,7 @@
 
 mod common;
 
-use physics::{Effects, Noise, NominalModel, Scenario, ThrustScale, Trajectory, simulate};
+use physics::{Effects, NominalModel, Scenario, ThrustScale, simulate};
 
 fn demo_model() -> NominalModel {
     NominalModel::load(&common::workspace().join("experiments/mismatch/demo-quad.json")).unwrap()
@@ -10,30 +10,8 @@ fn demo_model() -> NominalModel {
 
 fn scenario(effects: Effects, seed: u64) -> Scenario {
     Scenario {
-        model: "demo-quad.json".into(),
-        duration_s: 6.0,
-        warmup_s: 4.0,
-        seed,
-        physics_rate_hz: 500.0,
-        log_rate_hz: 50.0,
-        hover_throttle: 0.5,
-        trajectory: Trajectory::Figure8 {
-            center: [0.0, 0.0, 1.5],
-            first: [1.5, 0.0, 0.0],
-            second: [0.0, 0.8, 0.3],
-            period_s: 6.0,
-            low_passes: Vec::new(),
-            yaw_amplitude_rad: 0.2,
-            yaw_period_s: 10.0,
-        },
         effects,
-        noise: Noise {
-            position_m: 0.002,
-            velocity_m_s: 0.005,
-            attitude_rad: 0.002,
-            rate_rad_s: 0.008,
-        },
-        gains: Default::default(),
+        ..Scenario::figure_eight("demo-quad.json", seed)
     }
 }
 

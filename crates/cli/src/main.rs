@@ -6,11 +6,12 @@ mod commands;
 use std::process::ExitCode;
 
 use clap::Parser;
+use clap::error::ErrorKind;
 
 fn main() -> ExitCode {
     restore_default_sigpipe();
     report_output_failures();
-    let cli = commands::Cli::parse();
+    let cli = commands::Cli::try_parse().unwrap_or_else(|error| exit_on_usage_error(error));
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
@@ -50,6 +51,28 @@ fn report_output_failures() {
     }));
 }
 
+/// Ends the process on what clap could not parse: help and version as clap prints them, a usage
+/// error (a bad value, a missing or unknown argument, arguments that cannot be combined) as one
+/// line, like every other error, with clap's exit code (2).
+fn exit_on_usage_error(error: clap::Error) -> ! {
+    if !error.use_stderr() || error.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+        error.exit();
+    }
+    eprintln!("{}", one_line_usage(&error.render().to_string()));
+    std::process::exit(error.exit_code());
+}
+
+/// A rendered clap error on one line: its message and tips, without the usage and help hint.
+fn one_line_usage(rendered: &str) -> String {
+    rendered
+        .lines()
+        .map(str::trim)
+        .take_while(|line| !line.starts_with("Usage:"))
+        .filter(|line| !line.is_empty() && !line.starts_with("For more information"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// The chain of causes joined by ": " on one line, without repeating a cause whose text the
 /// message already shows (library errors often print their source themselves).
 fn one_line(error: &anyhow::Error) -> String {
@@ -70,6 +93,26 @@ fn one_line(error: &anyhow::Error) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn usage_errors_are_one_line() {
+        for args in [
+            &["learn", "meta-train", "--seed-spread", "--out", "x.json"][..],
+            &["learn", "sindy"],
+            &["learn", "nope"],
+        ] {
+            let error = commands::Cli::try_parse_from(args).unwrap_err();
+            let line = one_line_usage(&error.render().to_string());
+            assert!(line.starts_with("error: "), "{args:?}: {line}");
+            assert!(!line.contains('\n') && !line.contains("Usage:"), "{line}");
+        }
+        let error = commands::Cli::try_parse_from(["learn", "sindy"]).unwrap_err();
+        let line = one_line_usage(&error.render().to_string());
+        assert!(
+            line.contains("--csv"),
+            "the missing arguments are named: {line}"
+        );
+    }
 
     #[test]
     fn causes_are_not_repeated() {

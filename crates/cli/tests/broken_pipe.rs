@@ -4,14 +4,20 @@
 
 #![cfg(unix)]
 
+mod common;
+
 use std::os::unix::process::ExitStatusExt;
 use std::process::{Command, Stdio};
+
+use common::scratch;
 
 #[test]
 fn a_closed_output_ends_the_command_without_a_panic() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    // An empty data directory: every flight is listed as missing.
+    let data = scratch("closed-output");
     let mut child = Command::new(env!("CARGO_BIN_EXE_learn"))
-        .args(["conditions", "--data", "/nonexistent-learn-data"])
+        .args(["conditions", "--data", data.to_str().unwrap()])
         .current_dir(root)
         .env("RUST_BACKTRACE", "0")
         .stdout(Stdio::piped())
@@ -37,8 +43,9 @@ fn an_unwritable_output_is_a_one_line_error() {
         return; // no /dev/full on this system
     };
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let data = scratch("unwritable-output");
     let output = Command::new(env!("CARGO_BIN_EXE_learn"))
-        .args(["conditions", "--data", "/nonexistent-learn-data"])
+        .args(["conditions", "--data", data.to_str().unwrap()])
         .current_dir(root)
         .env("RUST_BACKTRACE", "0")
         .stdout(full)

@@ -1,6 +1,7 @@
 //! `learn sindy`, `learn data inspect` and `learn conditions` on bad input: a one-line error naming
 //! the file, the line and the column or field, exit code 1, never a panic; and valid input that
-//! used to be refused (a pipe) or misreported (absent columns) is handled.
+//! used to be refused (a pipe) or misreported (absent columns) is handled; a `--data` that is not a
+//! directory is named.
 
 mod common;
 
@@ -333,4 +334,44 @@ fn an_unusable_fit_or_precision_is_an_error_not_inf() {
     );
     assert_eq!(run.code, Some(2), "{}", run.stderr);
     assert!(run.stderr.contains("--precision"), "{}", run.stderr);
+}
+
+#[test]
+fn a_data_directory_that_is_a_file_is_named_by_every_command() {
+    let dir = scratch("data-is-a-file");
+    std::fs::write(dir.join("flights.csv"), "t\n0\n").unwrap();
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let conditions = workspace.join("experiments/conditions.json");
+    let conditions = conditions.to_str().unwrap();
+    let learn_json = workspace.join("experiments/learn.json");
+    let commands: [&[&str]; 2] = [
+        &["conditions", "--config", conditions],
+        &[
+            "meta-train",
+            "--config",
+            learn_json.to_str().unwrap(),
+            "--conditions",
+            conditions,
+        ],
+    ];
+    for given in ["flights.csv", "absent"] {
+        for command in commands {
+            let mut args = vec!["--data", given];
+            args.extend_from_slice(command);
+            let run = learn_in(&dir, &args);
+            let message = run.one_line_error(&[given, "--data"]);
+            assert!(
+                message.starts_with(&format!("error: {given}: ")),
+                "{message}"
+            );
+            assert!(run.stdout.is_empty(), "{command:?}: {}", run.stdout);
+        }
+    }
+    // Without --data (nor NEURAL_FLY_DIR) and no data/neural-fly, `conditions` still lists them.
+    let run = learn_in(&dir, &["conditions", "--config", conditions]);
+    assert!(
+        run.success().contains("no data directory"),
+        "{}",
+        run.stdout
+    );
 }

@@ -288,6 +288,93 @@ fn meta_train_refuses_to_replace_a_checkpoint_in_a_given_directory() {
 }
 
 #[test]
+fn meta_train_refuses_outputs_it_cannot_write_before_any_work() {
+    let dir = scratch("meta-train-unwritable");
+    let config = small_config(&dir, |_| {});
+    std::fs::write(dir.join("file"), "mine").unwrap();
+    std::fs::create_dir_all(dir.join("folder")).unwrap();
+    // With the real flights the run could start: it must not, not even load them.
+    let data = real_data().unwrap_or_else(|| dir.clone());
+    let conditions = workspace().join("experiments/conditions.json");
+    let cases: [(&[&str], &[&str]); 5] = [
+        (
+            &["--checkpoints", "file", "--out", "a.json"],
+            &["file", "--checkpoints", "not a directory"],
+        ),
+        (
+            &["--checkpoints", "file/ck", "--out", "a.json"],
+            &["file/ck", "--checkpoints", "not a directory"],
+        ),
+        (
+            &["--checkpoints", "ck", "--out", "folder", "--force"],
+            &["folder", "--out", "is a directory"],
+        ),
+        (
+            &["--checkpoints", "ck", "--out", "file/a.json"],
+            &["file/a.json", "--out", "not a directory"],
+        ),
+        (
+            &["--seed-spread", "--spread-out", "folder", "--force"],
+            &["folder", "--spread-out", "is a directory"],
+        ),
+    ];
+    for (extra, needles) in cases {
+        let mut args = vec!["--config", path_str(&config)];
+        args.extend_from_slice(extra);
+        let run = if extra[0] == "--seed-spread" {
+            // Every condition (no --condition) and the real flights: a spread run could start.
+            let mut all = vec![
+                "--data",
+                path_str(&data),
+                "meta-train",
+                "--conditions",
+                path_str(&conditions),
+            ];
+            all.extend_from_slice(&args);
+            learn_in(&dir, &all)
+        } else {
+            meta_train(&dir, &data, &args)
+        };
+        run.one_line_error(needles);
+        assert!(
+            run.stdout.is_empty(),
+            "{extra:?}: work began before the error: {}",
+            run.stdout
+        );
+        assert_eq!(std::fs::read_to_string(dir.join("file")).unwrap(), "mine");
+        assert!(!dir.join("ck").exists() && !dir.join("a.json").exists());
+        assert_eq!(std::fs::read_dir(dir.join("folder")).unwrap().count(), 0);
+        assert!(!dir.join("results").exists(), "{extra:?}: nothing written");
+    }
+}
+
+#[test]
+fn meta_train_seed_spread_refuses_out_and_checkpoints_it_would_ignore() {
+    let dir = scratch("meta-train-spread-outputs");
+    let config = small_config(&dir, |_| {});
+    for (flag, value) in [("--out", "a.json"), ("--checkpoints", "ck")] {
+        let run = learn_in(
+            &dir,
+            &[
+                "meta-train",
+                "--config",
+                path_str(&config),
+                "--seed-spread",
+                "--spread-out",
+                "spread.json",
+                flag,
+                value,
+            ],
+        );
+        run.one_line_usage_error(&["--seed-spread", flag, "cannot be used with"]);
+        assert!(run.stdout.is_empty(), "{}", run.stdout);
+        for written in ["a.json", "ck", "spread.json", "results"] {
+            assert!(!dir.join(written).exists(), "{flag}: {written} written");
+        }
+    }
+}
+
+#[test]
 fn meta_train_published_file_given_must_exist_and_parse() {
     let dir = scratch("meta-train-published");
     let config = workspace().join("experiments/learn.json");

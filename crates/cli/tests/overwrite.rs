@@ -27,8 +27,7 @@ fn seed_spread_covers_every_condition_so_it_rejects_one() {
         &dir,
         &["meta-train", "--seed-spread", "--condition", "35wind"],
     );
-    assert_eq!(run.code, Some(2), "{}", run.stderr);
-    assert!(run.stderr.contains("cannot be used with"), "{}", run.stderr);
+    run.one_line_usage_error(&["--seed-spread", "--condition", "cannot be used with"]);
 }
 
 #[test]

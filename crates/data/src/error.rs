@@ -144,6 +144,13 @@ pub enum DataError {
         "no flight data directory found (looked at: {tried}); run `make data`, pass --data DIR or set NEURAL_FLY_DIR"
     )]
     NoDataDir { tried: String },
+    /// A data directory given by `--data` or `$NEURAL_FLY_DIR` (`origin`) that is not one.
+    #[error("{}: {problem} (the data directory given by {origin})", path.display())]
+    NotADataDir {
+        path: PathBuf,
+        origin: String,
+        problem: &'static str,
+    },
     #[error("{what}: {message}")]
     Invalid { what: String, message: String },
 }

@@ -14,24 +14,12 @@ pub const DEFAULT_DATA_DIR: &str = "data/neural-fly";
 
 /// Finds the data directory: `flag` if given, else `$NEURAL_FLY_DIR`, else `data/neural-fly` in the
 /// current directory or the nearest ancestor that has one. A given flag or variable that does not
-/// name a directory is an error (it is never silently skipped).
+/// name a directory is an error naming it (it is never silently skipped); finding none is an error.
 pub fn resolve_data_dir(flag: Option<&Path>) -> Result<PathBuf> {
-    if let Some(dir) = flag {
-        return existing_dir(dir, "--data");
+    if let Some(dir) = find_data_dir(flag)? {
+        return Ok(dir);
     }
-    if let Some(dir) = std::env::var_os(DATA_DIR_VARIABLE).filter(|v| !v.is_empty()) {
-        return existing_dir(Path::new(&dir), DATA_DIR_VARIABLE);
-    }
-    let cwd = std::env::current_dir().map_err(|source| DataError::Io {
-        path: PathBuf::from("."),
-        source,
-    })?;
-    for ancestor in cwd.ancestors() {
-        let candidate = ancestor.join(DEFAULT_DATA_DIR);
-        if candidate.is_dir() {
-            return Ok(candidate);
-        }
-    }
+    let cwd = current_dir()?;
     Err(DataError::NoDataDir {
         tried: format!(
             "${DATA_DIR_VARIABLE} (unset), {DEFAULT_DATA_DIR} in {} and its parents",
@@ -40,14 +28,43 @@ pub fn resolve_data_dir(flag: Option<&Path>) -> Result<PathBuf> {
     })
 }
 
+/// As [`resolve_data_dir`], for commands that can do without flight data: `None` when no
+/// directory was given (no `flag`, `$NEURAL_FLY_DIR` unset) and the default one is absent. A
+/// given flag or variable that does not name a directory is still an error naming it.
+pub fn find_data_dir(flag: Option<&Path>) -> Result<Option<PathBuf>> {
+    if let Some(dir) = flag {
+        return existing_dir(dir, "--data").map(Some);
+    }
+    if let Some(dir) = std::env::var_os(DATA_DIR_VARIABLE).filter(|v| !v.is_empty()) {
+        return existing_dir(Path::new(&dir), DATA_DIR_VARIABLE).map(Some);
+    }
+    Ok(current_dir()?
+        .ancestors()
+        .map(|ancestor| ancestor.join(DEFAULT_DATA_DIR))
+        .find(|candidate| candidate.is_dir()))
+}
+
+fn current_dir() -> Result<PathBuf> {
+    std::env::current_dir().map_err(|source| DataError::Io {
+        path: PathBuf::from("."),
+        source,
+    })
+}
+
 fn existing_dir(dir: &Path, origin: &str) -> Result<PathBuf> {
     if dir.is_dir() {
-        Ok(dir.to_path_buf())
-    } else {
-        Err(DataError::NoDataDir {
-            tried: format!("{} (from {origin}) is not a directory", dir.display()),
-        })
+        return Ok(dir.to_path_buf());
     }
+    let problem = if dir.exists() {
+        "is not a directory"
+    } else {
+        "no such directory"
+    };
+    Err(DataError::NotADataDir {
+        path: dir.to_path_buf(),
+        origin: origin.to_string(),
+        problem,
+    })
 }
 
 /// For tests of this workspace's crates: the real flight data, if present (`$NEURAL_FLY_DIR`, else
@@ -95,10 +112,30 @@ mod tests {
         let message = resolve_data_dir(Some(Path::new("/no/such/dir")))
             .unwrap_err()
             .to_string();
-        assert!(
-            message.contains("/no/such/dir") && message.contains("make data"),
-            "{message}"
+        assert_eq!(
+            message,
+            "/no/such/dir: no such directory (the data directory given by --data)"
         );
+    }
+
+    #[test]
+    fn a_flag_naming_a_file_is_an_error_naming_it() {
+        let path = std::env::temp_dir().join(format!("not-a-data-dir-{}", std::process::id()));
+        std::fs::write(&path, b"x").unwrap();
+        for result in [
+            resolve_data_dir(Some(&path)).map(Some),
+            find_data_dir(Some(&path)),
+        ] {
+            let message = result.unwrap_err().to_string();
+            assert_eq!(
+                message,
+                format!(
+                    "{}: is not a directory (the data directory given by --data)",
+                    path.display()
+                )
+            );
+        }
+        std::fs::remove_file(&path).unwrap();
     }
 
     #[test]

@@ -15,7 +15,7 @@ pub struct Args {
 
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let config = ExperimentConditions::load(&args.config)?;
-    let data_dir = global.data_dir().ok();
+    let data_dir = global.optional_data_dir()?;
     println!(
         "{:<12} {:<10} {:<24} {:<14} files present",
         "condition", "label", "wind speed", "role"

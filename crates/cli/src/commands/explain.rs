@@ -49,7 +49,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         if let Some(flight) = &args.flight {
             inputs.push(("--flight", flight.as_path()));
         }
-        super::check_output(path, args.force, &inputs)?;
+        super::check_output(path, "--json", args.force, &inputs)?;
     }
     let model = MetaTrainedModel::load(&args.checkpoint)?;
     let flight = match args.flight {

@@ -46,8 +46,9 @@ pub struct Args {
     #[arg(long)]
     pub published: Option<PathBuf>,
     /// Rerun every cell with each of the configuration's `spread_seeds` and write the spread
-    /// (every condition: the spread is what the tolerances of paper/tolerances.json come from).
-    #[arg(long, conflicts_with = "condition")]
+    /// (every condition: the spread is what the tolerances of paper/tolerances.json come from) to
+    /// `--spread-out` only: no summary (`--out`), no checkpoints (`--checkpoints`).
+    #[arg(long, conflicts_with_all = ["condition", "out", "checkpoints"])]
     pub seed_spread: bool,
     /// Where `--seed-spread` writes its result.
     #[arg(long, default_value = "experiments/learn-seed-spread.json")]
@@ -176,12 +177,14 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(DEFAULT_CHECKPOINTS));
     if args.seed_spread {
-        super::check_output(&args.spread_out, args.force, &inputs)?;
+        super::check_output(&args.spread_out, "--spread-out", args.force, &inputs)?;
     } else {
         super::refuse_input_as_output(&out, &inputs)?;
+        super::refuse_unwritable_file(&out, "--out")?;
         if args.out.is_some() {
             super::refuse_overwrite(&out, args.force)?;
         }
+        super::refuse_unwritable_dir(&checkpoint_dir, "--checkpoints")?;
     }
     let mut config = LearnConfig::load(&args.config)?;
     if let Some(seed) = args.seed {
@@ -261,6 +264,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
                 );
             }
             super::refuse_input_as_output(&path, &inputs)?;
+            super::refuse_unwritable_file(&path, "--checkpoints")?;
             if args.checkpoints.is_some() {
                 super::refuse_overwrite(&path, args.force)?;
             }

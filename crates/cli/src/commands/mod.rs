@@ -97,6 +97,13 @@ impl Global {
         Ok(data::resolve_data_dir(self.data.as_deref())?)
     }
 
+    /// The data directory when there is one: `None` only when none was given (no `--data`, no
+    /// `$NEURAL_FLY_DIR`) and the default is absent; a given one that is not a directory is an
+    /// error naming it, as for [`Global::data_dir`].
+    pub fn optional_data_dir(&self) -> anyhow::Result<Option<PathBuf>> {
+        Ok(data::find_data_dir(self.data.as_deref())?)
+    }
+
     /// Whether progress bars may be drawn (not quiet, standard error is a terminal).
     #[allow(dead_code)]
     pub fn show_progress(&self) -> bool {
@@ -116,11 +123,59 @@ pub fn refuse_overwrite(path: &Path, force: bool) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Checks a file the command is about to write: never one of its `inputs` (option name, path),
-/// and not an existing file unless `force`.
-pub fn check_output(output: &Path, force: bool, inputs: &[(&str, &Path)]) -> anyhow::Result<()> {
+/// Checks a file the command is about to write (given by `option`): never one of its `inputs`
+/// (option name, path), a place a file can be written, and not an existing file unless `force`.
+pub fn check_output(
+    output: &Path,
+    option: &str,
+    force: bool,
+    inputs: &[(&str, &Path)],
+) -> anyhow::Result<()> {
     refuse_input_as_output(output, inputs)?;
+    refuse_unwritable_file(output, option)?;
     refuse_overwrite(output, force)
+}
+
+/// Refuses, before any work, a file to write (given by `option`) where none can be written: an
+/// existing directory, or a path below something that is not a directory. `--force` cannot help.
+pub fn refuse_unwritable_file(output: &Path, option: &str) -> anyhow::Result<()> {
+    if output.is_dir() {
+        anyhow::bail!(
+            "{}: is a directory, not a file to write ({option})",
+            output.display()
+        );
+    }
+    refuse_below_a_non_directory(output, option)
+}
+
+/// Refuses, before any work, a directory to write files into (given by `option`) that cannot be
+/// one: something other than a directory, or a path below something that is not a directory.
+pub fn refuse_unwritable_dir(dir: &Path, option: &str) -> anyhow::Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        anyhow::bail!(
+            "{}: is not a directory ({option} names the directory to write into)",
+            dir.display()
+        );
+    }
+    refuse_below_a_non_directory(dir, option)
+}
+
+/// Refuses `path` when the nearest of its parents that exists is not a directory (nothing can be
+/// created below it).
+fn refuse_below_a_non_directory(path: &Path, option: &str) -> anyhow::Result<()> {
+    let nearest = path
+        .ancestors()
+        .skip(1)
+        .filter(|parent| !parent.as_os_str().is_empty())
+        .find(|parent| parent.exists());
+    if let Some(parent) = nearest.filter(|parent| !parent.is_dir()) {
+        anyhow::bail!(
+            "{}: {} is not a directory, nothing can be written below it ({option})",
+            path.display(),
+            parent.display()
+        );
+    }
+    Ok(())
 }
 
 /// Whether `a` and `b` name the same existing file (also through links or other spellings).

@@ -24,7 +24,12 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     if args.out.is_dir() {
         bail!("{}: is a directory, not a CSV file", args.out.display());
     }
-    super::check_output(&args.out, args.force, &[("--scenario", &args.scenario)])?;
+    super::check_output(
+        &args.out,
+        "--out",
+        args.force,
+        &[("--scenario", &args.scenario)],
+    )?;
     let (scenario, model) = physics::Scenario::load(&args.scenario)?;
     let name = args
         .out

@@ -108,7 +108,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     }
     let feature_count = library.unique_feature_names(&columns)?.len();
     if let Some(out) = &args.out {
-        super::check_output(out, args.force, &[("--csv", &args.csv)])?;
+        super::check_output(out, "--out", args.force, &[("--csv", &args.csv)])?;
     }
 
     let (time, table) = NumericTable::read_with_time(&args.csv, &args.time, &columns)?;

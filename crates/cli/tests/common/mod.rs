@@ -33,7 +33,16 @@ impl Run {
     /// Asserts a failure with exit code 1 and a one-line `error: …` message containing every one
     /// of `needles` (a file, row or field name), and no panic; returns the message.
     pub fn one_line_error(&self, needles: &[&str]) -> &str {
-        assert_eq!(self.code, Some(1), "exit code; stderr: {}", self.stderr);
+        self.one_line_failure(1, needles)
+    }
+
+    /// As [`Run::one_line_error`], for arguments refused while parsing (exit code 2).
+    pub fn one_line_usage_error(&self, needles: &[&str]) -> &str {
+        self.one_line_failure(2, needles)
+    }
+
+    fn one_line_failure(&self, code: i32, needles: &[&str]) -> &str {
+        assert_eq!(self.code, Some(code), "exit code; stderr: {}", self.stderr);
         let message = self.stderr.trim_end();
         assert!(!message.contains("panicked"), "panic: {message}");
         assert_eq!(message.lines().count(), 1, "not one line: {message}");

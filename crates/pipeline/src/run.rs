@@ -389,10 +389,11 @@ fn build_tables(
                 })
                 .collect();
             let coverages = indices.iter().map(|&index| {
-                let summary = &learn_results[0][index].summary;
+                let first = &learn_results[0][index];
                 (
                     cells[index].condition.label(),
-                    summary.query_coverage.as_ref(),
+                    first.summary.query_coverage.as_ref(),
+                    sindy_query_coverage(&cells[index], first),
                 )
             });
             let mut table = ResultsTable {
@@ -407,24 +408,48 @@ fn build_tables(
         .collect()
 }
 
+/// SINDy's query predictions scored on the same split as LeARN's query coverage: the samples
+/// inside and outside the range of the LeARN meta-training inputs (SINDy itself never saw those
+/// flights; the split only asks whether the samples where LeARN extrapolates are hard for SINDy
+/// too). `None` without a range.
+fn sindy_query_coverage(cell: &Cell, learn_result: &CellResult) -> Option<RangeCoverage> {
+    let names = cell.formulation.input_names();
+    learn_result.model.standardiser.coverage_with_errors(
+        &row_major(&cell.query.inputs()),
+        &names,
+        &row_major(&cell.sindy.query_prediction),
+        &row_major(&cell.query.targets),
+    )
+}
+
 /// The note under a table on how much of each query segment lies outside the range of the
-/// meta-training inputs (where the networks extrapolate), naming the input that goes farthest;
+/// meta-training inputs (where the networks extrapolate), naming the input that goes farthest,
+/// with LeARN's and SINDy's generalisation MSE over the samples inside and outside that range;
 /// `None` if no cell has a range.
 fn coverage_note<'a>(
-    coverages: impl Iterator<Item = (&'a str, Option<&'a RangeCoverage>)>,
+    coverages: impl Iterator<Item = (&'a str, Option<&'a RangeCoverage>, Option<RangeCoverage>)>,
 ) -> Option<String> {
+    let split = |coverage: Option<&RangeCoverage>| match coverage {
+        Some(RangeCoverage {
+            mse_inside: Some(inside),
+            mse_outside: Some(outside),
+            ..
+        }) => Some(format!("{inside:.3} / {outside:.3}")),
+        _ => None,
+    };
     let parts: Vec<String> = coverages
-        .filter_map(|(label, coverage)| {
+        .filter_map(|(label, coverage, sindy)| {
             let coverage = coverage?;
             let farthest = coverage
                 .inputs
                 .iter()
                 .filter(|input| input.samples_outside > 0)
                 .max_by(|a, b| a.largest_excess_in_std.total_cmp(&b.largest_excess_in_std));
-            let errors = match (coverage.mse_inside, coverage.mse_outside) {
-                (Some(inside), Some(outside)) => {
-                    format!("; MSE {inside:.3} inside, {outside:.3} outside")
+            let errors = match (split(Some(coverage)), split(sindy.as_ref())) {
+                (Some(learn), Some(sindy)) => {
+                    format!("; MSE inside / outside: LeARN {learn}, SINDy {sindy}")
                 }
+                (Some(learn), None) => format!("; MSE inside / outside: LeARN {learn}"),
                 _ => String::new(),
             };
             let detail = farthest.map_or(String::new(), |input| {
@@ -442,8 +467,8 @@ fn coverage_note<'a>(
     (!parts.is_empty()).then(|| {
         format!(
             "LeARN query samples with an input outside the range of the meta-training inputs \
-             (the networks extrapolate there), with the generalisation MSE over the samples inside \
-             and outside that range: {}.",
+             (the networks extrapolate there), with the generalisation MSE of each method over the \
+             query samples inside and outside that range: {}.",
             parts.join("; ")
         )
     })
@@ -559,6 +584,7 @@ fn record(cell: &Cell, learn_results: &[Vec<CellResult>], index: usize) -> Resul
             adapt: cell.sindy.support_mse,
             r#gen: cell.sindy.query_mse,
             equations: cell.sindy.model.equations(3),
+            query_coverage: sindy_query_coverage(cell, first),
         },
         learn: LearnCell {
             adapt: mse.adaptation,
@@ -753,16 +779,29 @@ mod tests {
             mse_inside: Some(0.25),
             mse_outside: Some(2.5),
         };
+        let sindy = RangeCoverage {
+            mse_inside: Some(0.5),
+            mse_outside: Some(1.25),
+            ..outside.clone()
+        };
         let note = coverage_note(
             [
-                ("35wind", Some(&inside)),
-                ("100wind", Some(&outside)),
-                ("new", None),
+                ("35wind", Some(&inside), None),
+                ("100wind", Some(&outside), Some(sindy)),
+                ("70wind", Some(&outside), None),
+                ("new", None, None),
             ]
             .into_iter(),
         )
         .unwrap();
-        assert!(note.ends_with(": 35wind 0 of 10; 100wind 3 of 10 (farthest: w_z by 9.6 std; MSE 0.250 inside, 2.500 outside)."));
-        assert_eq!(coverage_note([("35wind", None)].into_iter()), None);
+        assert!(
+            note.ends_with(
+                ": 35wind 0 of 10; \
+                 100wind 3 of 10 (farthest: w_z by 9.6 std; MSE inside / outside: LeARN 0.250 / 2.500, SINDy 0.500 / 1.250); \
+                 70wind 3 of 10 (farthest: w_z by 9.6 std; MSE inside / outside: LeARN 0.250 / 2.500)."
+            ),
+            "{note}"
+        );
+        assert_eq!(coverage_note([("35wind", None, None)].into_iter()), None);
     }
 }

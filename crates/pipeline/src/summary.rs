@@ -50,6 +50,9 @@ pub struct SindyCell {
     pub r#gen: f64,
     /// The fitted equations, three decimals.
     pub equations: Vec<String>,
+    /// SINDy's generalisation MSE split between the query samples inside and outside the range of
+    /// the LeARN meta-training inputs (the same split as `learn.query_coverage`).
+    pub query_coverage: Option<RangeCoverage>,
 }
 
 /// LeARN on one flight with one seed.

@@ -119,7 +119,8 @@ impl CausalLibrary {
             .saturating_add(per_control.saturating_mul(controls))
     }
 
-    /// Θ of `segment` (one row per sample) and the feature names.
+    /// Θ of `segment` (one row per sample) and the feature names: a control lag is named by its
+    /// pole with two decimals, or as many more as it takes to tell the poles apart.
     pub fn features(&self, segment: &Segment) -> Result<(Mat<f64>, Vec<String>)> {
         self.validate()?;
         let formulation = segment.formulation;
@@ -157,15 +158,28 @@ impl CausalLibrary {
                 names.push(format!("{name}^2"));
             }
         }
+        let decimals = distinct_decimals(&self.control_lags);
         for &pole in &self.control_lags {
             for (j, name) in control_names.iter().enumerate() {
                 columns.push(first_order_lag(&control(j), pole));
-                names.push(format!("lag{pole:.2}({name})"));
+                names.push(format!("lag{pole:.decimals$}({name})"));
             }
         }
         let theta = Mat::from_fn(n, columns.len(), |i, j| columns[j][i]);
         Ok((theta, names))
     }
+}
+
+/// The fewest decimals, at least two, with which the (distinct) `poles` print differently.
+fn distinct_decimals(poles: &[f64]) -> usize {
+    (2..17)
+        .find(|&decimals| {
+            let mut printed: Vec<String> =
+                poles.iter().map(|p| format!("{p:.decimals$}")).collect();
+            printed.sort();
+            printed.windows(2).all(|pair| pair[0] != pair[1])
+        })
+        .unwrap_or(17)
 }
 
 /// `s[k] = a·s[k−1] + (1 − a)·u[k]`, `s[0] = u[0]`.
@@ -194,6 +208,14 @@ mod tests {
         later[4] = 10.0;
         assert_eq!(first_order_lag(&later, 0.5)[..4], lagged[..4]);
         assert_eq!(first_order_lag(&step, 0.0), step);
+    }
+
+    #[test]
+    fn lag_names_carry_the_decimals_that_tell_the_poles_apart() {
+        assert_eq!(distinct_decimals(&[0.5, 0.8, 0.95]), 2);
+        assert_eq!(distinct_decimals(&[0.951, 0.954]), 3);
+        assert_eq!(distinct_decimals(&[0.5, 0.5 + 1e-12]), 12);
+        assert_eq!(distinct_decimals(&[]), 2);
     }
 
     #[test]

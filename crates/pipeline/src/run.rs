@@ -573,6 +573,7 @@ fn record(cell: &Cell, learn_results: &[Vec<CellResult>], index: usize) -> Resul
         EquationRule::default(),
     );
     let mse = learn_mse(learn_results, index);
+    let sindy_split = sindy_query_coverage(cell, first);
     Ok(CellRecord {
         table: cell.formulation.name().to_string(),
         condition: cell.condition.name.clone(),
@@ -584,7 +585,8 @@ fn record(cell: &Cell, learn_results: &[Vec<CellResult>], index: usize) -> Resul
             adapt: cell.sindy.support_mse,
             r#gen: cell.sindy.query_mse,
             equations: cell.sindy.model.equations(3),
-            query_coverage: sindy_query_coverage(cell, first),
+            gen_inside_range: sindy_split.as_ref().and_then(|c| c.mse_inside),
+            gen_outside_range: sindy_split.as_ref().and_then(|c| c.mse_outside),
         },
         learn: LearnCell {
             adapt: mse.adaptation,

@@ -50,9 +50,13 @@ pub struct SindyCell {
     pub r#gen: f64,
     /// The fitted equations, three decimals.
     pub equations: Vec<String>,
-    /// SINDy's generalisation MSE split between the query samples inside and outside the range of
-    /// the LeARN meta-training inputs (the same split as `learn.query_coverage`).
-    pub query_coverage: Option<RangeCoverage>,
+    /// SINDy's generalisation MSE over the query samples inside the range of the LeARN
+    /// meta-training inputs, and over those outside it (the samples counted in
+    /// `learn.query_coverage`), when there are such samples.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gen_inside_range: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gen_outside_range: Option<f64>,
 }
 
 /// LeARN on one flight with one seed.

@@ -349,10 +349,15 @@ fn meta_train_refuses_outputs_it_cannot_write_before_any_work() {
 }
 
 #[test]
-fn meta_train_seed_spread_refuses_out_and_checkpoints_it_would_ignore() {
+fn meta_train_seed_spread_refuses_the_flags_it_would_ignore() {
     let dir = scratch("meta-train-spread-outputs");
     let config = small_config(&dir, |_| {});
-    for (flag, value) in [("--out", "a.json"), ("--checkpoints", "ck")] {
+    for (flag, value) in [
+        ("--out", "a.json"),
+        ("--checkpoints", "ck"),
+        ("--seed", "7"),
+        ("--published", "p.json"),
+    ] {
         let run = learn_in(
             &dir,
             &[
@@ -372,6 +377,19 @@ fn meta_train_seed_spread_refuses_out_and_checkpoints_it_would_ignore() {
             assert!(!dir.join(written).exists(), "{flag}: {written} written");
         }
     }
+    // And --spread-out means nothing without --seed-spread.
+    let run = learn_in(
+        &dir,
+        &[
+            "meta-train",
+            "--config",
+            path_str(&config),
+            "--spread-out",
+            "spread.json",
+        ],
+    );
+    run.one_line_usage_error(&["required arguments were not provided: --seed-spread"]);
+    assert!(run.stdout.is_empty() && !dir.join("spread.json").exists());
 }
 
 #[test]

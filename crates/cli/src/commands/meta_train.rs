@@ -47,11 +47,17 @@ pub struct Args {
     pub published: Option<PathBuf>,
     /// Rerun every cell with each of the configuration's `spread_seeds` and write the spread
     /// (every condition: the spread is what the tolerances of paper/tolerances.json come from) to
-    /// `--spread-out` only: no summary (`--out`), no checkpoints (`--checkpoints`).
-    #[arg(long, conflicts_with_all = ["condition", "out", "checkpoints"])]
+    /// `--spread-out` only: no summary (`--out`), no checkpoints (`--checkpoints`), no
+    /// comparison with the published numbers (`--published`), and the seeds are the
+    /// configuration's `spread_seeds` (not `--seed`).
+    #[arg(long, conflicts_with_all = ["condition", "out", "checkpoints", "published", "seed"])]
     pub seed_spread: bool,
-    /// Where `--seed-spread` writes its result.
-    #[arg(long, default_value = "experiments/learn-seed-spread.json")]
+    /// Where `--seed-spread` writes its result (only with `--seed-spread`).
+    #[arg(
+        long,
+        default_value = "experiments/learn-seed-spread.json",
+        requires = "seed_spread"
+    )]
     pub spread_out: PathBuf,
     /// Replace an existing `--spread-out` or `--out` file, or checkpoints in `--checkpoints`.
     /// No output may be one of the input files (--config, --conditions, --published), even

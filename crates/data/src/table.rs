@@ -208,7 +208,8 @@ fn check_text<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str> {
 }
 
 /// Checks what the csv crate reads without complaint: a `#` line, a blank line between rows (it
-/// skips them), an unpaired quote (it reads an unclosed quote to the end of the file), a repeated
+/// skips them), an unpaired quote (it reads an unclosed quote to the end of the file), text after
+/// a closing quote (it joins `"1"2` into `12`), a repeated
 /// column name, a row with more or fewer fields than the header. Returns the line on which each
 /// data row starts.
 fn check_layout(path: &Path, bytes: &[u8], records: &[StringRecord]) -> Result<Vec<usize>> {
@@ -248,6 +249,13 @@ fn check_layout(path: &Path, bytes: &[u8], records: &[StringRecord]) -> Result<V
                 } else {
                     "a '#' comment line (comments are not allowed)"
                 },
+            ));
+        }
+        if let Some(after) = text_after_a_closing_quote(raw) {
+            let at = line + raw[..after].iter().filter(|&&b| b == b'\n').count();
+            return Err(bad_row(
+                at,
+                "text after the closing quote of a quoted cell (quote the whole cell)",
             ));
         }
         if raw.iter().filter(|&&b| b == b'"').count() % 2 == 1 {
@@ -301,6 +309,33 @@ fn check_layout(path: &Path, bytes: &[u8], records: &[StringRecord]) -> Result<V
         lines.push(line);
     }
     Ok(lines)
+}
+
+/// The offset in a record's `raw` bytes of a character that follows the closing quote of a
+/// quoted cell without a ',' or the line's end in between, as in `"1"2` (which the csv crate
+/// reads as `12`). A doubled quote inside a quoted cell is an escaped quote, not a closing one.
+fn text_after_a_closing_quote(raw: &[u8]) -> Option<usize> {
+    #[derive(PartialEq)]
+    enum State {
+        CellStart,
+        Unquoted,
+        Quoted,
+        AfterQuote,
+    }
+    let mut state = State::CellStart;
+    for (at, &byte) in raw.iter().enumerate() {
+        state = match (state, byte) {
+            (State::Quoted, b'"') => State::AfterQuote,
+            (State::Quoted, _) | (State::AfterQuote, b'"') => State::Quoted,
+            (State::AfterQuote, b'\n' | b'\r') => return None,
+            (State::AfterQuote, b',') | (_, b',') => State::CellStart,
+            (State::AfterQuote, _) => return Some(at),
+            (State::CellStart, b'"') => State::Quoted,
+            (_, b'\n' | b'\r') => return None,
+            _ => State::Unquoted,
+        };
+    }
+    None
 }
 
 /// Parses `"1.5"`, `"[1.0, 2.0]"` or `"[[1, 2], [3, 4]]"` into its numbers, in reading order.

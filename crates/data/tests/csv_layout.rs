@@ -131,6 +131,28 @@ fn a_quote_left_open_names_the_line_it_opens_on() {
 }
 
 #[test]
+fn text_after_a_closing_quote_is_an_error_not_joined_to_the_cell() {
+    let text = "t,x\n0,1\n0.1,\"1\"2\n0.2,3\n";
+    let message = numeric_error(&write("joined.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("joined.csv:3: text after the closing quote"),
+        "{message}"
+    );
+    // In the last cell of a multi-line quoted cell's row, the line is where the text is.
+    let text = "t,note,x\n0,\"a\nb\"c,1\n";
+    let message = numeric_error(&write("joined-lines.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("joined-lines.csv:3: text after the closing quote"),
+        "{message}"
+    );
+    // Escaped quotes, quoted cells before a ',' or the line's end, and a CRLF file are fine.
+    let text = "t,note,x\r\n0,\"say \"\"hi\"\"\",\"1\"\r\n0.1,\"\",2\r\n";
+    let (_, table) =
+        NumericTable::read_with_time(&write("quoted.csv", text.as_bytes()), "t", &["x"]).unwrap();
+    assert_eq!(table.column("x").unwrap(), &[1.0, 2.0]);
+}
+
+#[test]
 fn a_blank_line_between_rows_is_named_and_blank_lines_at_the_end_are_ignored() {
     let text = plain(5).replacen("0.2,2,4\n", "0.2,2,4\n\n", 1);
     let message = numeric_error(&write("blank.csv", text.as_bytes()), &["x"]);

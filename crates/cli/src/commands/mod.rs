@@ -178,22 +178,46 @@ fn refuse_below_a_non_directory(path: &Path, option: &str) -> anyhow::Result<()>
     Ok(())
 }
 
-/// Whether `a` and `b` name the same existing file (also through links or other spellings).
-fn same_file(a: &Path, b: &Path) -> bool {
+/// Whether `a` and `b` name the same file, existing or not, whatever the spelling: the same
+/// existing file (also through links), or the same place once `.`, `..` and the links of the
+/// longest existing ancestor are resolved.
+pub fn same_file(a: &Path, b: &Path) -> bool {
     #[cfg(unix)]
     {
         use std::os::unix::fs::MetadataExt;
         if let (Ok(a), Ok(b)) = (std::fs::metadata(a), std::fs::metadata(b)) {
             return a.dev() == b.dev() && a.ino() == b.ino();
         }
-        false
     }
-    #[cfg(not(unix))]
-    {
-        match (a.canonicalize(), b.canonicalize()) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
+    match (resolved(a), resolved(b)) {
+        (Some(a), Some(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// `path` made absolute, `.` dropped and `..` applied, then its longest existing ancestor
+/// canonicalised (links resolved). `None` if the current directory is unknown.
+fn resolved(path: &Path) -> Option<std::path::PathBuf> {
+    use std::path::{Component, PathBuf};
+    let mut lexical = PathBuf::new();
+    for component in std::env::current_dir().ok()?.join(path).components() {
+        match component {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                lexical.pop();
+            }
+            other => lexical.push(other),
         }
+    }
+    let mut base = lexical.as_path();
+    let mut rest = Vec::new();
+    loop {
+        if let Ok(mut canonical) = base.canonicalize() {
+            canonical.extend(rest.iter().rev());
+            return Some(canonical);
+        }
+        rest.push(base.file_name()?);
+        base = base.parent()?;
     }
 }
 
@@ -207,4 +231,31 @@ pub fn refuse_input_as_output(output: &Path, inputs: &[(&str, &Path)]) -> anyhow
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn same_file_sees_through_spellings_of_paths_that_do_not_exist_yet() {
+        let dir = std::env::temp_dir().join(format!("learn-same-file-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("ck")).unwrap();
+        let plain = dir.join("ck/a.json");
+        assert!(same_file(&plain, &dir.join("ck/./a.json")));
+        assert!(same_file(&plain, &dir.join("ck/../ck/a.json")));
+        assert!(same_file(
+            &dir.join("new/x.json"),
+            &dir.join("new/sub/../x.json")
+        ));
+        assert!(!same_file(&plain, &dir.join("ck/b.json")));
+        std::fs::write(&plain, "{}").unwrap();
+        assert!(same_file(&plain, &dir.join("./ck/a.json")));
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(dir.join("ck"), dir.join("link")).unwrap();
+            assert!(same_file(&dir.join("link/c.json"), &dir.join("ck/c.json")));
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

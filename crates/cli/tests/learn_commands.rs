@@ -82,7 +82,7 @@ fn checkpoint(dir: &Path, name: &str, edit: impl FnOnce(&mut MetaTrainedModel)) 
 #[test]
 fn meta_train_rejects_settings_that_make_results_meaningless_naming_the_field() {
     let dir = scratch("meta-train-bad-settings");
-    let cases: [(&str, Value, &str); 9] = [
+    let cases: [(&str, Value, &str); 10] = [
         (
             "iterations",
             json!({"meta_training": {"iterations": 0}}),
@@ -109,6 +109,8 @@ fn meta_train_rejects_settings_that_make_results_meaningless_naming_the_field() 
             "spread_seeds",
         ),
         ("no seeds", json!({"spread_seeds": []}), "spread_seeds"),
+        // A sample standard deviation over one seed is undefined (it used to be written as 0).
+        ("one seed", json!({"spread_seeds": [1]}), "spread_seeds"),
         (
             "basis",
             json!({"basis_per_input": 100000}),
@@ -283,8 +285,147 @@ fn meta_train_refuses_to_replace_a_checkpoint_in_a_given_directory() {
             "--force",
         ],
     );
-    run.success();
+    let stdout = run.success();
     assert!(MetaTrainedModel::load(&existing).is_ok());
+    // The SINDy column is the published number (this command runs no SINDy), and says so.
+    assert!(stdout.contains("| SINDy gen (paper) |"), "{stdout}");
+    // No progress bar when standard error is not a terminal.
+    assert!(run.stderr.is_empty(), "{}", run.stderr);
+}
+
+#[test]
+fn meta_train_never_writes_the_summary_over_one_of_its_checkpoints_whatever_the_spelling() {
+    let dir = scratch("meta-train-out-is-checkpoint");
+    let config = small_config(&dir, |_| {});
+    std::fs::create_dir_all(dir.join("ck")).unwrap();
+    // Without the real flights the refusal must come all the same: it comes before any work.
+    let data = real_data().unwrap_or_else(|| dir.clone());
+    let name = "leave-condition-out-translational-35wind-seed1.json";
+    let mut spellings = vec![format!("./ck/{name}"), format!("ck/../ck/{name}")];
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(dir.join("ck"), dir.join("link")).unwrap();
+        spellings.push(format!("link/{name}"));
+    }
+    for out in &spellings {
+        for force in [false, true] {
+            let mut args = vec!["--config", path_str(&config), "--checkpoints", "ck"];
+            args.extend(["--out", out.as_str()]);
+            if force {
+                args.push("--force");
+            }
+            let run = meta_train(&dir, &data, &args);
+            run.one_line_error(&[out, "--out", "checkpoint of this run"]);
+            assert!(run.stdout.is_empty(), "{out}: work began: {}", run.stdout);
+            assert_eq!(std::fs::read_dir(dir.join("ck")).unwrap().count(), 0);
+        }
+    }
+    // An existing checkpoint given as --out with --force is not replaced either.
+    let existing = dir.join("ck").join(name);
+    std::fs::write(&existing, "mine").unwrap();
+    let out = format!("ck/../ck/{name}");
+    let run = meta_train(
+        &dir,
+        &data,
+        &[
+            "--config",
+            path_str(&config),
+            "--checkpoints",
+            "ck",
+            "--out",
+            &out,
+            "--force",
+        ],
+    );
+    run.one_line_error(&[&out, "--out", "checkpoint of this run"]);
+    assert_eq!(std::fs::read_to_string(&existing).unwrap(), "mine");
+}
+
+#[test]
+fn meta_train_refuses_a_condition_that_is_not_an_evaluation_condition() {
+    let dir = scratch("meta-train-meta-training-condition");
+    let config = small_config(&dir, |_| {});
+    let data = real_data().unwrap_or_else(|| dir.clone());
+    let conditions = workspace().join("experiments/conditions.json");
+    let run = learn_in(
+        &dir,
+        &[
+            "--data",
+            path_str(&data),
+            "meta-train",
+            "--config",
+            path_str(&config),
+            "--conditions",
+            path_str(&conditions),
+            "--condition",
+            "nowind",
+            "--checkpoints",
+            "ck",
+            "--out",
+            "a.json",
+        ],
+    );
+    run.one_line_error(&[
+        "--condition nowind",
+        "not an evaluation condition",
+        "meta-training",
+        "35wind, 70p20sint, 70wind, 100wind",
+    ]);
+    assert!(run.stdout.is_empty(), "work began: {}", run.stdout);
+    assert!(!dir.join("ck").exists() && !dir.join("a.json").exists());
+}
+
+/// `learn` with `args` in `dir` under a pseudo-terminal (util-linux `script`), standard output and
+/// error mixed; `None` where `script` is not installed.
+fn learn_on_a_terminal(dir: &Path, args: &[&str]) -> Option<String> {
+    let command = std::iter::once(env!("CARGO_BIN_EXE_learn"))
+        .chain(args.iter().copied())
+        .collect::<Vec<_>>()
+        .join(" ");
+    let output = std::process::Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .current_dir(dir)
+        .env_remove("NEURAL_FLY_DIR")
+        .output()
+        .ok()?;
+    assert!(output.status.success(), "{output:?}");
+    Some(String::from_utf8_lossy(&output.stdout).into_owned())
+}
+
+#[test]
+fn meta_train_shows_progress_over_the_cells_on_a_terminal_unless_quiet() {
+    let Some(data) = real_data() else {
+        return;
+    };
+    let dir = scratch("meta-train-progress");
+    let config = small_config(&dir, |_| {});
+    let conditions = workspace().join("experiments/conditions.json");
+    for (quiet, out) in [(false, "a.json"), (true, "b.json")] {
+        let mut args = vec!["--data", path_str(&data)];
+        if quiet {
+            args.push("--quiet");
+        }
+        args.extend([
+            "meta-train",
+            "--config",
+            path_str(&config),
+            "--conditions",
+            path_str(&conditions),
+            "--formulation",
+            "translational",
+            "--checkpoints",
+            "ck",
+            "--out",
+            out,
+            "--force",
+        ]);
+        let Some(output) = learn_on_a_terminal(&dir, &args) else {
+            return;
+        };
+        let drawn = output.contains("meta-train [") && output.contains("/4 cells");
+        assert_eq!(drawn, !quiet, "quiet {quiet}: {output}");
+        assert!(output.contains("wrote"), "{output}");
+    }
 }
 
 #[test]
@@ -489,6 +630,52 @@ fn explain_names_a_flight_too_short_to_split() {
 }
 
 #[test]
+fn explain_blames_the_checkpoint_not_the_adaptation_when_it_is_not_finite_before_adapting() {
+    let Some(data) = real_data() else {
+        return;
+    };
+    let dir = scratch("explain-bad-checkpoint");
+    let flight = data.join("experiment/custom_figure8_baseline_35wind.csv");
+    type Edit = fn(&mut MetaTrainedModel);
+    let cases: [(&str, Edit); 3] = [
+        ("parameter.json", |model| model.parameters[0] = 1e308),
+        ("std.json", |model| model.standardiser.std[0] = 1e-300),
+        ("mean.json", |model| model.standardiser.mean[0] = 1e308),
+    ];
+    for (name, edit) in cases {
+        checkpoint(&dir, name, edit);
+        for adapt in [true, false] {
+            let mut args = vec!["explain", name, "--flight", path_str(&flight)];
+            if !adapt {
+                args.push("--no-adapt");
+            }
+            let run = learn_in(&dir, &args);
+            let message = run.one_line_error(&[
+                "custom_figure8_baseline_35wind.csv",
+                "parameters or standardiser",
+                "not finite",
+                "before any adaptation",
+            ]);
+            assert!(
+                !message.contains("adaptation.step") && !message.contains("too large"),
+                "{name}: {message}"
+            );
+        }
+    }
+}
+
+#[test]
+fn explain_refuses_an_unknown_field_in_the_checkpoint_architecture() {
+    let dir = scratch("explain-architecture-field");
+    let path = checkpoint(&dir, "model.json", |_| {});
+    let mut value: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    value["architecture"]["hiden"] = json!([4]);
+    std::fs::write(&path, value.to_string()).unwrap();
+    let run = learn_in(&dir, &["explain", "model.json"]);
+    run.one_line_error(&["model.json", "architecture.hiden", "unknown field"]);
+}
+
+#[test]
 fn explain_reports_non_finite_adaptation_instead_of_printing_nan() {
     let Some(data) = real_data() else {
         return;
@@ -502,11 +689,16 @@ fn explain_reports_non_finite_adaptation_instead_of_printing_nan() {
         &dir,
         &["explain", "model.json", "--flight", path_str(&flight)],
     );
-    run.one_line_error(&[
+    let message = run.one_line_error(&[
         "translational",
         "custom_figure8_baseline_35wind.csv",
         "adaptation.step",
     ]);
+    // Blamed only because the meta-trained parameters alone give finite predictions.
+    assert!(
+        message.contains("finite predictions before adaptation"),
+        "{message}"
+    );
 }
 
 #[test]

@@ -108,7 +108,7 @@ pub struct LearnConfig {
     pub adaptation: AdaptationConfig,
     /// The seed of the reported run (initialisation and task sampling).
     pub seed: u64,
-    /// The seeds of the seed-to-seed spread measurement.
+    /// The seeds of the seed-to-seed spread measurement: at least two, all different.
     pub spread_seeds: Vec<u64>,
 }
 
@@ -299,8 +299,15 @@ impl LearnConfig {
         if !(adaptation.lipschitz_bound.is_finite() && adaptation.lipschitz_bound >= 0.0) {
             return Err(error("adaptation.lipschitz_bound", "must be ≥ 0"));
         }
-        if self.spread_seeds.is_empty() {
-            return Err(error("spread_seeds", "must name at least one seed"));
+        // The spread is a sample standard deviation (n − 1): undefined over fewer than two seeds.
+        if self.spread_seeds.len() < 2 {
+            return Err(error(
+                "spread_seeds",
+                &format!(
+                    "names {} seed(s); the seed-to-seed spread (a sample standard deviation) needs at least two different seeds",
+                    self.spread_seeds.len()
+                ),
+            ));
         }
         let mut seeds = self.spread_seeds.clone();
         seeds.sort_unstable();
@@ -389,6 +396,8 @@ mod tests {
                 c.adaptation.lipschitz_bound = f64::NAN
             }),
             ("spread_seeds", |c| c.spread_seeds = vec![]),
+            ("spread_seeds", |c| c.spread_seeds = vec![1]),
+            ("spread_seeds", |c| c.spread_seeds = vec![4, 4]),
             ("spread_seeds", |c| c.spread_seeds = vec![3, 1, 3]),
         ];
         for (field, edit) in cases {

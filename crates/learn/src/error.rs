@@ -30,6 +30,16 @@ pub enum LearnError {
         condition: String,
         detail: String,
     },
+    /// A condition asked for as a table row (evaluated, the held-out fold) that is only used to
+    /// meta-train.
+    #[error(
+        "condition '{condition}' is not an evaluation condition (its role is {role}); the evaluation conditions are: {evaluation}"
+    )]
+    NotEvaluationCondition {
+        condition: String,
+        role: String,
+        evaluation: String,
+    },
     #[error("unknown protocol '{name}' (known: paper, leave-condition-out, auto)")]
     UnknownProtocol { name: String },
     #[error("{what}: {message}")]

@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use data::{ExperimentConditions, FlightLog, Formulation, Mat, file_sha256};
+use data::{Condition, ExperimentConditions, FlightLog, Formulation, Mat, Role, file_sha256};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -157,13 +157,17 @@ impl Experiment {
     }
 
     /// Meta-trains a model for `formulation`, leaving out `evaluation_condition` under
-    /// `leave-condition-out` (under `paper` the condition only names the fold).
+    /// `leave-condition-out` (under `paper` the condition only names the fold). A condition that
+    /// is not an evaluation condition (role `meta-training`) is refused: it names no fold.
     pub fn meta_train(
         &self,
         formulation: Formulation,
         evaluation_condition: &str,
         seed: u64,
     ) -> Result<MetaTrainedModel> {
+        let held_out = evaluation_condition_of(&self.conditions, evaluation_condition)?
+            .name
+            .clone();
         let config = self.config.get();
         let files =
             self.protocol
@@ -175,11 +179,6 @@ impl Experiment {
             .iter()
             .map(|path| self.data_file(path))
             .collect::<Result<_>>()?;
-        let held_out = self
-            .conditions
-            .condition(evaluation_condition)?
-            .name
-            .clone();
         Ok(MetaTrainedModel {
             format: CHECKPOINT_FORMAT.to_string(),
             formulation,
@@ -384,14 +383,15 @@ impl Experiment {
     }
 
     /// Adapts `model` online on the support segment of the evaluation flight of
-    /// `evaluation_condition` and predicts both segments. Refuses a `leave-condition-out` model
-    /// that was not trained for this condition's fold.
+    /// `evaluation_condition` and predicts both segments. Refuses a condition that is not an
+    /// evaluation condition, and a `leave-condition-out` model that was not trained for this
+    /// condition's fold.
     pub fn evaluate(
         &self,
         model: &MetaTrainedModel,
         evaluation_condition: &str,
     ) -> Result<CellResult> {
-        let condition = self.conditions.condition(evaluation_condition)?;
+        let condition = evaluation_condition_of(&self.conditions, evaluation_condition)?;
         if let Some(held_out) = &model.held_out_condition
             && held_out != &condition.name
         {
@@ -417,8 +417,31 @@ impl Experiment {
         let origin = self.config.origin();
         let adaptation = &self.config.get().adaptation;
         check_window(adaptation, &support, &path, origin)?;
-        let adapted = model.adapt(&support, adaptation);
         let cell = format!("{} {}", model.formulation.name(), condition.name);
+        // The meta-trained model before adaptation: when it already gives non-finite numbers the
+        // adaptation settings are not the cause.
+        let unadapted_adapt_mse = architecture.loss(
+            &model.parameters,
+            &support_batch.inputs,
+            &support_batch.targets,
+        );
+        let unadapted_gen_mse =
+            architecture.loss(&model.parameters, &query_batch.inputs, &query_batch.targets);
+        for (name, value) in [
+            ("unadapted adaptation MSE", unadapted_adapt_mse),
+            ("unadapted generalisation MSE", unadapted_gen_mse),
+        ] {
+            if !value.is_finite() {
+                return Err(LearnError::NotFinite {
+                    cell,
+                    message: format!(
+                        "the meta-trained model gives a non-finite {name} ({value}) before any adaptation: the meta-trained parameters or the input standardisation, not the adaptation settings, are the cause (see meta_training in {})",
+                        origin.display()
+                    ),
+                });
+            }
+        }
+        let adapted = model.adapt(&support, adaptation);
         let advice = format!(
             "lower adaptation.step or adaptation.lipschitz_weight in {}",
             origin.display()
@@ -447,16 +470,8 @@ impl Experiment {
             seed: model.seed,
             adapt_mse: mean_squared_error(&support_predictions, &support_batch.targets),
             gen_mse: mean_squared_error(&query_predictions, &query_batch.targets),
-            unadapted_adapt_mse: architecture.loss(
-                &model.parameters,
-                &support_batch.inputs,
-                &support_batch.targets,
-            ),
-            unadapted_gen_mse: architecture.loss(
-                &model.parameters,
-                &query_batch.inputs,
-                &query_batch.targets,
-            ),
+            unadapted_adapt_mse,
+            unadapted_gen_mse,
             evaluation_file: self.data_file(&path)?,
             support_coverage,
             query_coverage,
@@ -464,8 +479,6 @@ impl Experiment {
         for (name, value) in [
             ("adaptation MSE", summary.adapt_mse),
             ("generalisation MSE", summary.gen_mse),
-            ("unadapted adaptation MSE", summary.unadapted_adapt_mse),
-            ("unadapted generalisation MSE", summary.unadapted_gen_mse),
         ] {
             if !value.is_finite() {
                 return Err(LearnError::NotFinite {
@@ -505,6 +518,22 @@ impl Experiment {
     /// Every cell of the given formulations (× every evaluation condition), in parallel, returned
     /// in table order. Under `paper` one model per formulation serves all conditions.
     pub fn run_cells(&self, formulations: &[Formulation], seed: u64) -> Result<Vec<CellResult>> {
+        self.run_cells_observed(formulations, seed, &|_| {})
+    }
+
+    /// [`Self::run_cells`], calling `cell_done` (from any thread) as each cell is finished.
+    pub fn run_cells_observed(
+        &self,
+        formulations: &[Formulation],
+        seed: u64,
+        cell_done: &(dyn Fn(&CellSummary) + Sync),
+    ) -> Result<Vec<CellResult>> {
+        let observed = |result: Result<CellResult>| {
+            if let Ok(cell) = &result {
+                cell_done(&cell.summary);
+            }
+            result
+        };
         let conditions = self.evaluation_conditions();
         if self.protocol == Protocol::Paper {
             let models: Vec<MetaTrainedModel> = formulations
@@ -517,7 +546,7 @@ impl Experiment {
                 .collect();
             return jobs
                 .par_iter()
-                .map(|(model, condition)| self.evaluate(model, condition))
+                .map(|(model, condition)| observed(self.evaluate(model, condition)))
                 .collect();
         }
         let jobs: Vec<(Formulation, &String)> = formulations
@@ -525,7 +554,7 @@ impl Experiment {
             .flat_map(|&f| conditions.iter().map(move |c| (f, c)))
             .collect();
         jobs.par_iter()
-            .map(|(formulation, condition)| self.run_cell(*formulation, condition, seed))
+            .map(|(formulation, condition)| observed(self.run_cell(*formulation, condition, seed)))
             .collect()
     }
 
@@ -535,9 +564,20 @@ impl Experiment {
         formulations: &[Formulation],
         seeds: &[u64],
     ) -> Result<Vec<SpreadCell>> {
+        self.seed_spread_observed(formulations, seeds, &|_| {})
+    }
+
+    /// [`Self::seed_spread`], calling `cell_done` (from any thread) as each cell of each seed is
+    /// finished.
+    pub fn seed_spread_observed(
+        &self,
+        formulations: &[Formulation],
+        seeds: &[u64],
+        cell_done: &(dyn Fn(&CellSummary) + Sync),
+    ) -> Result<Vec<SpreadCell>> {
         let mut runs: Vec<Vec<CellSummary>> = Vec::with_capacity(seeds.len());
         for &seed in seeds {
-            let cells = self.run_cells(formulations, seed)?;
+            let cells = self.run_cells_observed(formulations, seed, cell_done)?;
             runs.push(cells.into_iter().map(|c| c.summary).collect());
         }
         let cell_count = runs.first().map_or(0, Vec::len);
@@ -605,6 +645,28 @@ pub struct SpreadCell {
     pub adapt_mse: Spread,
 }
 
+/// The evaluation condition `name` (name or label) of `conditions`. A condition that exists but is
+/// only used to meta-train is refused, naming it and listing the evaluation conditions.
+pub fn evaluation_condition_of<'a>(
+    conditions: &'a ExperimentConditions,
+    name: &str,
+) -> Result<&'a Condition> {
+    let condition = conditions.condition(name)?;
+    if condition.role != Role::Evaluation {
+        let evaluation: Vec<&str> = conditions.evaluation().map(|c| c.name.as_str()).collect();
+        return Err(LearnError::NotEvaluationCondition {
+            condition: name.to_string(),
+            role: match condition.role {
+                Role::MetaTraining => "meta-training",
+                Role::Evaluation => "evaluation",
+            }
+            .to_string(),
+            evaluation: evaluation.join(", "),
+        });
+    }
+    Ok(condition)
+}
+
 /// The architecture of `formulation` under `config`.
 pub fn architecture(formulation: Formulation, config: &crate::config::LearnConfig) -> Architecture {
     Architecture {
@@ -648,6 +710,16 @@ fn check_finite_parameters(parameters: &[f64], cell: &str, advice: &str) -> Resu
     Ok(())
 }
 
+/// The name of input `j` of `model`'s formulation.
+fn input_name(model: &MetaTrainedModel, j: usize) -> &'static str {
+    model
+        .formulation
+        .input_names()
+        .get(j)
+        .copied()
+        .unwrap_or("?")
+}
+
 fn standardised(standardiser: &Standardiser, batch: Batch) -> Batch {
     Batch {
         inputs: standardiser.apply(&batch.inputs),
@@ -673,6 +745,39 @@ pub fn explain_flight(
         model.formulation.name(),
         log.path.display()
     );
+    let mut inputs = support_batch.inputs;
+    inputs.extend(query_batch.inputs);
+    // The checkpoint itself, before any adaptation: non-finite numbers here come from its
+    // standardiser or its meta-trained parameters, never from the adaptation settings.
+    let dim = model.architecture.input_dim;
+    if let Some(k) = inputs.iter().position(|x| !x.is_finite()) {
+        let j = k % dim;
+        return Err(LearnError::NotFinite {
+            cell,
+            message: format!(
+                "the checkpoint's standardiser (mean {}, std {} of input '{}') gives standardised inputs that are not finite on this flight",
+                model.standardiser.mean[j],
+                model.standardiser.std[j],
+                input_name(model, j)
+            ),
+        });
+    }
+    let all_finite = |values: &[f64]| values.iter().all(|v| v.is_finite());
+    if !all_finite(&model.architecture.predict(&model.parameters, &inputs)) {
+        // The largest standardised input, to tell a standardiser that blows the inputs up from
+        // parameters that overflow on ordinary inputs.
+        let k = (0..inputs.len())
+            .max_by(|&a, &b| inputs[a].abs().total_cmp(&inputs[b].abs()))
+            .unwrap_or(0);
+        let largest = inputs.get(k).map_or(0.0, |x| x.abs());
+        return Err(LearnError::NotFinite {
+            cell,
+            message: format!(
+                "the checkpoint's meta-trained parameters or standardiser give predictions that are not finite on this flight, before any adaptation (largest standardised input: |{}| = {largest:.3e}); the adaptation settings are not the cause",
+                input_name(model, k % dim)
+            ),
+        });
+    }
     let parameters = if adapt {
         let adaptation = &model.config.adaptation;
         if adaptation.window > support.len() {
@@ -686,17 +791,22 @@ pub fn explain_flight(
             });
         }
         let adapted = model.adapt(&support, adaptation);
-        check_finite_parameters(
-            &adapted,
-            &cell,
-            "the model's adaptation.step or adaptation.lipschitz_weight is too large",
-        )?;
+        // The meta-trained parameters gave finite predictions (checked above): here the
+        // adaptation settings are the cause.
+        let advice = "the model's adaptation.step or adaptation.lipschitz_weight is too large (the meta-trained parameters give finite predictions before adaptation)";
+        check_finite_parameters(&adapted, &cell, advice)?;
+        if !all_finite(&model.architecture.predict(&adapted, &inputs)) {
+            return Err(LearnError::NotFinite {
+                cell,
+                message: format!(
+                    "online adaptation gave predictions that are not finite; {advice}"
+                ),
+            });
+        }
         adapted
     } else {
         model.parameters.clone()
     };
-    let mut inputs = support_batch.inputs;
-    inputs.extend(query_batch.inputs);
     let explanation = crate::explain::explain(
         model.formulation,
         &model.architecture,
@@ -717,4 +827,35 @@ pub fn explain_flight(
         });
     }
     Ok(explanation)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn conditions() -> ExperimentConditions {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../experiments/conditions.json");
+        ExperimentConditions::load(&path).unwrap()
+    }
+
+    #[test]
+    fn only_evaluation_conditions_name_a_cell() {
+        let conditions = conditions();
+        let cell = evaluation_condition_of(&conditions, "70psin20").unwrap();
+        assert_eq!(cell.name, "70p20sint");
+        let error = evaluation_condition_of(&conditions, "nowind").unwrap_err();
+        assert!(
+            matches!(error, LearnError::NotEvaluationCondition { .. }),
+            "{error}"
+        );
+        assert_eq!(
+            error.to_string(),
+            "condition 'nowind' is not an evaluation condition (its role is meta-training); \
+             the evaluation conditions are: 35wind, 70p20sint, 70wind, 100wind"
+        );
+        let message = evaluation_condition_of(&conditions, "nope")
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("unknown condition 'nope'"), "{message}");
+    }
 }

@@ -83,7 +83,7 @@ pub use dataset::{
 pub use error::{LearnError, Result};
 pub use experiment::{
     CellResult, CellSummary, Experiment, SegmentPrediction, Spread, SpreadCell, architecture,
-    explain_flight,
+    evaluation_condition_of, explain_flight,
 };
 pub use explain::{
     EquationRule, Explanation, InputImportance, OutputExplanation, Term, explain, output_symbol,

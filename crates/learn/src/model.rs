@@ -16,6 +16,7 @@ pub const CHECKPOINT_FORMAT: &str = "learn-checkpoint/1";
 
 /// A data file a model was trained or evaluated on, with its SHA-256.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct DataFile {
     pub path: PathBuf,
     pub sha256: String,

@@ -24,6 +24,7 @@ use crate::scalar::Scalar;
 /// Θ(X; ψ) maps X ∈ ℝ^{I+U} to K = P·(I+U) basis values, ℰ(X; φ) to I·K values read row-major as
 /// the I×K selection matrix, and y = Θ·ℰᵀ. Basis index k = j·P + p is m_{p+1} attached to input j.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Architecture {
     /// Number of inputs I + U.
     pub input_dim: usize,

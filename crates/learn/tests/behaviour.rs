@@ -300,6 +300,44 @@ fn checkpoints_round_trip_and_bad_ones_name_the_file() {
 }
 
 #[test]
+fn checkpoints_with_unknown_fields_anywhere_are_refused() {
+    let dir = std::env::temp_dir().join(format!("learn-checkpoint-fields-{}", std::process::id()));
+    let path = dir.join("model.json");
+    let mut model = example_model();
+    model.data_files = vec![learn::DataFile {
+        path: "experiment/a.csv".into(),
+        sha256: "0".repeat(64),
+    }];
+    model.save(&path).unwrap();
+    assert_eq!(MetaTrainedModel::load(&path).unwrap(), model);
+    let text = std::fs::read_to_string(&path).unwrap();
+    // The field's path in the message: at the top, and inside every object of the checkpoint.
+    for (pointer, field) in [
+        ("", "extra"),
+        ("/architecture", "architecture.extra"),
+        ("/standardiser", "standardiser.extra"),
+        ("/config", "config.extra"),
+        ("/data_files/0", "data_files[0].extra"),
+    ] {
+        let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+        value
+            .pointer_mut(pointer)
+            .unwrap()
+            .as_object_mut()
+            .unwrap()
+            .insert("extra".to_string(), serde_json::json!(1));
+        std::fs::write(&path, value.to_string()).unwrap();
+        let message = MetaTrainedModel::load(&path).unwrap_err().to_string();
+        assert!(
+            message.contains("model.json")
+                && message.contains(field)
+                && message.contains("unknown field"),
+            "{pointer}: {message}"
+        );
+    }
+}
+
+#[test]
 fn bad_configurations_name_the_file_and_field() {
     let dir = std::env::temp_dir().join(format!("learn-config-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

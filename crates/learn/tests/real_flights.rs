@@ -74,6 +74,21 @@ fn leave_condition_out_cell_runs_end_to_end() {
 
     // A model of another fold is refused; the checkpoint round-trips and explains.
     assert!(experiment.evaluate(model, "35wind").is_err());
+    // A meta-training condition names no cell: refused by every entry point, before any work.
+    for error in [
+        experiment
+            .run_cell(Formulation::Translational, "nowind", 5)
+            .unwrap_err(),
+        experiment
+            .meta_train(Formulation::Translational, "nowind", 5)
+            .unwrap_err(),
+        experiment.evaluate(model, "nowind").unwrap_err(),
+    ] {
+        assert!(
+            matches!(&error, learn::LearnError::NotEvaluationCondition { condition, .. } if condition == "nowind"),
+            "{error}"
+        );
+    }
     let path = std::env::temp_dir().join(format!("learn-real-{}.json", std::process::id()));
     model.save(&path).unwrap();
     let loaded = MetaTrainedModel::load(&path).unwrap();
@@ -178,4 +193,47 @@ fn condition_tasks_pool_the_flights_of_each_wind_condition() {
         .meta_train(Formulation::Translational, "70psin20", 1)
         .unwrap();
     assert_ne!(by_flight.parameters, model.parameters);
+}
+
+#[test]
+fn every_finished_cell_is_reported_once() {
+    let Some(data_dir) = common::real_data_dir() else {
+        return;
+    };
+    let root = common::workspace();
+    let origin = root.join("experiments/learn.json");
+    let mut small = LearnConfig::load(&origin).unwrap().get().clone();
+    small.meta_training.iterations = 2;
+    small.meta_training.support_batch = 16;
+    small.meta_training.query_batch = 16;
+    small.adaptation.passes = 1;
+    small.spread_seeds = vec![1, 2];
+    let conditions = ExperimentConditions::load(&root.join("experiments/conditions.json")).unwrap();
+    let experiment = Experiment::load(
+        small.check(&origin).unwrap(),
+        conditions,
+        &data_dir,
+        Some(Protocol::LeaveConditionOut),
+    )
+    .unwrap();
+    let seen = std::sync::Mutex::new(Vec::new());
+    let cells = experiment
+        .run_cells_observed(&[Formulation::Translational], 1, &|cell| {
+            seen.lock().unwrap().push(cell.condition.clone())
+        })
+        .unwrap();
+    let mut seen = std::mem::take(&mut *seen.lock().unwrap());
+    seen.sort();
+    let mut expected: Vec<String> = cells.iter().map(|c| c.summary.condition.clone()).collect();
+    expected.sort();
+    assert_eq!(cells.len(), 4);
+    assert_eq!(seen, expected);
+    let count = std::sync::atomic::AtomicUsize::new(0);
+    let spread = experiment
+        .seed_spread_observed(&[Formulation::Translational], &[1, 2], &|_| {
+            count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        })
+        .unwrap();
+    assert_eq!(spread.len(), 4);
+    assert_eq!(count.into_inner(), 8);
 }

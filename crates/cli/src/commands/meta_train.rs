@@ -6,7 +6,8 @@ use std::time::Instant;
 
 use anyhow::Context;
 use data::{ExperimentConditions, Formulation};
-use learn::{CellSummary, Experiment, LearnConfig, Protocol};
+use indicatif::{ProgressBar, ProgressStyle};
+use learn::{CellSummary, Experiment, LearnConfig, Protocol, evaluation_condition_of};
 use report::{Method, PublishedTables};
 use serde_json::{Value, json};
 
@@ -26,7 +27,8 @@ pub struct Args {
     /// Formulations to run (translational, attitude, full); default all three.
     #[arg(long = "formulation")]
     pub formulations: Vec<String>,
-    /// Only this evaluation condition (name or label); default all.
+    /// Only this evaluation condition (name or label; role "evaluation" in --conditions); default
+    /// all.
     #[arg(long)]
     pub condition: Option<String>,
     /// Override the configuration's seed.
@@ -122,9 +124,29 @@ fn published(
     Some((mse.adaptation, mse.generalisation))
 }
 
+/// A bar over `cells` cells on standard error, drawn only when `show` (a terminal, not --quiet), in
+/// the style of `learn reproduce`.
+fn progress_bar(show: bool, cells: usize, message: &str) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(cells as u64).with_message(message.to_string());
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>12} [{bar:32}] {pos}/{len} cells, {elapsed}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    // Drawn (and its clock kept running) from the start: the first cells take seconds.
+    bar.enable_steady_tick(std::time::Duration::from_millis(250));
+    bar
+}
+
+/// The column of SINDy's generalisation MSE as published (this command does not run SINDy).
+const PUBLISHED_SINDY_HEADER: &str = "SINDy gen (paper)";
+
 fn print_cells(cells: &[CellSummary], table: &Option<PublishedTables>) {
     println!(
-        "{:<14} {:<10} {:>8} {:>8} {:>10} | {:>15} {:>12} | {:>9} | {:>13}",
+        "{:<14} {:<10} {:>8} {:>8} {:>10} | {:>15} {:>12} | {:>17} | {:>13}",
         "formulation",
         "condition",
         "adapt",
@@ -132,7 +154,7 @@ fn print_cells(cells: &[CellSummary], table: &Option<PublishedTables>) {
         "gen(unadapted)",
         "published adapt",
         "gen",
-        "SINDy gen",
+        PUBLISHED_SINDY_HEADER,
         "query outside"
     );
     for cell in cells {
@@ -149,7 +171,7 @@ fn print_cells(cells: &[CellSummary], table: &Option<PublishedTables>) {
             format!("{}/{}", c.samples_outside, c.samples)
         });
         println!(
-            "{:<14} {:<10} {:>8.3} {:>8.3} {:>14.3} | {:>15} {:>6} {:<5} | {:>9} | {:>13}",
+            "{:<14} {:<10} {:>8.3} {:>8.3} {:>14.3} | {:>15} {:>6} {:<5} | {:>17} | {:>13}",
             cell.formulation.name(),
             cell.label,
             cell.adapt_mse,
@@ -162,6 +184,67 @@ fn print_cells(cells: &[CellSummary], table: &Option<PublishedTables>) {
             outside,
         );
     }
+}
+
+/// The checkpoint of one cell under `dir`.
+fn checkpoint_path(
+    dir: &Path,
+    protocol: Protocol,
+    formulation: Formulation,
+    condition: &str,
+    seed: u64,
+) -> PathBuf {
+    dir.join(format!(
+        "{}-{}-{condition}-seed{seed}.json",
+        protocol.name(),
+        formulation.name(),
+    ))
+}
+
+/// The directory of the checkpoints (`--checkpoints` or its default).
+fn checkpoint_dir(args: &Args) -> PathBuf {
+    args.checkpoints
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_CHECKPOINTS))
+}
+
+/// Every checkpoint this run writes, checked before any work: never `--out` nor an input (whatever
+/// the spelling of either path), a place a file can be written, not an existing file in a
+/// directory given with --checkpoints unless --force.
+fn check_checkpoints(
+    args: &Args,
+    protocol: Protocol,
+    formulations: &[Formulation],
+    evaluated: &[String],
+    seed: u64,
+    out: &Path,
+    inputs: &[(&str, &Path)],
+) -> anyhow::Result<()> {
+    let dir = checkpoint_dir(args);
+    if super::same_file(out, &dir) {
+        anyhow::bail!(
+            "{}: is both --out and the --checkpoints directory",
+            out.display()
+        );
+    }
+    for &formulation in formulations {
+        for condition in evaluated {
+            let path = checkpoint_path(&dir, protocol, formulation, condition, seed);
+            if super::same_file(&path, out) {
+                anyhow::bail!(
+                    "{}: is both --out and a checkpoint of this run ({}), refusing to write the summary over it",
+                    out.display(),
+                    path.display()
+                );
+            }
+            super::refuse_input_as_output(&path, inputs)?;
+            super::refuse_unwritable_file(&path, "--checkpoints")?;
+            if args.checkpoints.is_some() {
+                super::refuse_overwrite(&path, args.force)?;
+            }
+        }
+    }
+    Ok(())
 }
 
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
@@ -178,10 +261,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT));
-    let checkpoint_dir = args
-        .checkpoints
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(DEFAULT_CHECKPOINTS));
+    let checkpoint_dir = checkpoint_dir(&args);
     if args.seed_spread {
         super::check_output(&args.spread_out, "--spread-out", args.force, &inputs)?;
     } else {
@@ -202,17 +282,39 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let protocol = Protocol::parse(&args.protocol)?;
     let formulations = formulations(&args.formulations)?;
     let evaluated: Vec<String> = match &args.condition {
-        Some(condition) => vec![conditions.condition(condition)?.name.clone()],
+        Some(condition) => vec![
+            evaluation_condition_of(&conditions, condition)
+                .with_context(|| format!("--condition {condition}"))?
+                .name
+                .clone(),
+        ],
         None => conditions.evaluation().map(|c| c.name.clone()).collect(),
     };
-    let experiment = Experiment::load(config.clone(), conditions, &data_dir, protocol)?;
-    let protocol = experiment.protocol();
+    let protocol = Protocol::resolve(protocol, &conditions, &data_dir);
+
+    if !args.seed_spread {
+        let seed = config.get().seed;
+        check_checkpoints(
+            &args,
+            protocol,
+            &formulations,
+            &evaluated,
+            seed,
+            &out,
+            &inputs,
+        )?;
+    }
+    let experiment = Experiment::load(config.clone(), conditions, &data_dir, Some(protocol))?;
     println!("protocol: {}", protocol.name());
 
     if args.seed_spread {
         let seeds = config.get().spread_seeds.clone();
         let started = Instant::now();
-        let spread = experiment.seed_spread(&formulations, &seeds)?;
+        let cells = formulations.len() * experiment.evaluation_conditions().len() * seeds.len();
+        let bar = progress_bar(global.show_progress(), cells, "seed spread");
+        let spread = experiment.seed_spread_observed(&formulations, &seeds, &|_| bar.inc(1));
+        bar.finish_and_clear();
+        let spread = spread?;
         println!(
             "seed spread over seeds {seeds:?} ({:.1} s)",
             started.elapsed().as_secs_f64()
@@ -252,38 +354,25 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     }
 
     let seed = config.get().seed;
-    // Every checkpoint this run writes, checked before any work.
-    let checkpoint_path = |formulation: Formulation, condition: &str| {
-        checkpoint_dir.join(format!(
-            "{}-{}-{condition}-seed{seed}.json",
-            protocol.name(),
-            formulation.name(),
-        ))
-    };
-    for &formulation in &formulations {
-        for condition in &evaluated {
-            let path = checkpoint_path(formulation, condition);
-            if path == out {
-                anyhow::bail!(
-                    "{}: is both --out and a checkpoint of this run",
-                    out.display()
-                );
-            }
-            super::refuse_input_as_output(&path, &inputs)?;
-            super::refuse_unwritable_file(&path, "--checkpoints")?;
-            if args.checkpoints.is_some() {
-                super::refuse_overwrite(&path, args.force)?;
-            }
-        }
-    }
     let started = Instant::now();
+    let bar = progress_bar(
+        global.show_progress(),
+        formulations.len() * evaluated.len(),
+        "meta-train",
+    );
     let cells = match &args.condition {
         Some(condition) => formulations
             .iter()
-            .map(|&f| experiment.run_cell(f, condition, seed))
-            .collect::<learn::Result<Vec<_>>>()?,
-        None => experiment.run_cells(&formulations, seed)?,
+            .map(|&f| {
+                let cell = experiment.run_cell(f, condition, seed);
+                bar.inc(1);
+                cell
+            })
+            .collect::<learn::Result<Vec<_>>>(),
+        None => experiment.run_cells_observed(&formulations, seed, &|_| bar.inc(1)),
     };
+    bar.finish_and_clear();
+    let cells = cells?;
     let elapsed = started.elapsed().as_secs_f64();
     println!(
         "meta-training and adaptation of {} cells: {elapsed:.1} s",
@@ -291,7 +380,13 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     );
     let mut checkpoints = Vec::new();
     for cell in &cells {
-        let path = checkpoint_path(cell.summary.formulation, &cell.summary.condition);
+        let path = checkpoint_path(
+            &checkpoint_dir,
+            protocol,
+            cell.summary.formulation,
+            &cell.summary.condition,
+            seed,
+        );
         cell.model.save(&path)?;
         checkpoints.push(path);
     }

@@ -131,7 +131,7 @@ fn trajectory_settings_are_field_errors_not_a_divergence() {
     );
     simulate_changed(
         "sim-amplitude",
-        |s| s["trajectory"]["first"] = json!([1e6, 0, 0]),
+        |s| s["trajectory"]["first"] = json!([500, 0, 0]),
         &["trajectory", "reference accelerates"],
     );
     simulate_changed(
@@ -286,4 +286,404 @@ fn mismatch_model_rejects_unknown_fields() {
         );
         run.one_line_error(&[file, field]);
     }
+}
+
+/// The model a scenario names is read by `simulate` as much as the scenario: it is never the output,
+/// even with `--force`, whatever the spelling of the path.
+#[test]
+fn simulate_never_writes_over_the_scenarios_model() {
+    let dir = setup("sim-model-out");
+    let model = std::fs::read_to_string(dir.join("quad.json")).unwrap();
+    std::fs::create_dir(dir.join("sub")).unwrap();
+    for out in ["quad.json", "./sub/../quad.json"] {
+        let run = learn_in(
+            &dir,
+            &[
+                "simulate",
+                "--scenario",
+                "control.json",
+                "--out",
+                out,
+                "--force",
+            ],
+        );
+        run.one_line_error(&[out, "model", "control.json", "even with --force"]);
+    }
+    assert_eq!(
+        std::fs::read_to_string(dir.join("quad.json")).unwrap(),
+        model
+    );
+}
+
+/// Settings that would give a log the data tools refuse ("outside the plausible range") are
+/// refused when the scenario is read, naming the field; a model that drives a logged column out
+/// of range is refused before anything is written, naming the column and the model's settings.
+#[test]
+fn simulate_writes_only_logs_the_data_tools_read() {
+    simulate_changed(
+        "sim-center-huge",
+        |s| s["trajectory"]["center"] = json!([1e300, 0, 1.5]),
+        &["trajectory.center", "1e300 m"],
+    );
+    simulate_changed(
+        "sim-center-high",
+        |s| s["trajectory"]["center"] = json!([0, 0, 1e6]),
+        &["trajectory.center"],
+    );
+    simulate_changed(
+        "sim-throttle-tiny",
+        |s| s["hover_throttle"] = json!(1e-300),
+        &["hover_throttle", "1e-300"],
+    );
+    simulate_changed(
+        "sim-noise-huge",
+        |s| s["noise"]["rate_rad_s"] = json!(1e5),
+        &["noise.rate_rad_s"],
+    );
+    let dir = setup("sim-pwm-scale");
+    let mut model: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("quad.json")).unwrap()).unwrap();
+    model["mixer"]["pwm_scale"] = json!(1e6);
+    std::fs::write(dir.join("big.json"), model.to_string()).unwrap();
+    write_scenario(&dir, "s.json", |s| s["model"] = json!("big.json"));
+    let run = learn_in(
+        &dir,
+        &["simulate", "--scenario", "s.json", "--out", "f.csv"],
+    );
+    run.one_line_error(&["s.json", "pwm", "mixer.pwm_scale", "nothing written"]);
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.contains("f.csv"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+    // A scenario at the bounds gives a log that `data inspect` and `mismatch` read.
+    write_scenario(&dir, "edge.json", |s| {
+        s["duration_s"] = json!(5.0);
+        s["hover_throttle"] = json!(0.05);
+        s["trajectory"]["center"] = json!([975, -975, 975]);
+    });
+    learn_in(
+        &dir,
+        &["simulate", "--scenario", "edge.json", "--out", "edge.csv"],
+    )
+    .success();
+    learn_in(&dir, &["data", "inspect", "edge.csv"]).success();
+}
+
+/// A huge number in an error reads as a number, not as 309 digits.
+#[test]
+fn huge_values_are_named_readably() {
+    let dir = setup("sim-dur-readable");
+    write_scenario(&dir, "s.json", |s| s["duration_s"] = json!(1e308));
+    let run = learn_in(
+        &dir,
+        &["simulate", "--scenario", "s.json", "--out", "f.csv"],
+    );
+    let message = run.one_line_error(&["s.json", "duration_s", "1e308"]);
+    assert!(message.len() < 200, "{message}");
+}
+
+/// The demo writes files in `--work` (each case's recording and analysis): existing ones are user
+/// files, replaced only with `--force`, and the refusal comes before any case runs.
+#[test]
+fn demo_does_not_replace_files_in_work_without_force() {
+    let dir = setup("demo-work-notes");
+    write_manifest(&dir, &["control"]);
+    for name in ["mismatch.md", "recording.csv"] {
+        let case = dir.join("work/w/control");
+        let _ = std::fs::remove_dir_all(&case);
+        std::fs::create_dir_all(&case).unwrap();
+        std::fs::write(case.join(name), "notes").unwrap();
+        demo(&dir).one_line_error(&[
+            &format!("work/w/control/{name}"),
+            "already exists",
+            "--force",
+        ]);
+        assert_eq!(std::fs::read_to_string(case.join(name)).unwrap(), "notes");
+        assert_eq!(std::fs::read_dir(&case).unwrap().count(), 1);
+        assert!(!dir.join("out").exists());
+    }
+}
+
+/// No file the demo writes (summaries in --out, case files in --work) may be one of the files it
+/// reads (manifest, scenarios, the models they name), even with --force.
+#[test]
+fn demo_never_writes_over_its_inputs_even_with_force() {
+    let dir = setup("demo-inputs");
+    // the manifest inside the output directory, as one of the summaries
+    std::fs::create_dir(dir.join("o")).unwrap();
+    std::fs::copy(dir.join("quad.json"), dir.join("o/quad.json")).unwrap();
+    write_scenario(&dir.join("o"), "control.json", |_| {});
+    write_manifest(&dir.join("o"), &["control"]);
+    std::fs::rename(dir.join("o/demo.json"), dir.join("o/summary.json")).unwrap();
+    let manifest = std::fs::read_to_string(dir.join("o/summary.json")).unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "mismatch",
+            "--demo",
+            "o/summary.json",
+            "--work",
+            "w",
+            "--out",
+            "o",
+            "--force",
+        ],
+    );
+    run.one_line_error(&["o/summary.json", "demo manifest", "even with --force"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("o/summary.json")).unwrap(),
+        manifest
+    );
+    // a scenario where a case writes its recording
+    std::fs::create_dir_all(dir.join("w/control")).unwrap();
+    write_scenario(&dir.join("w/control"), "recording.csv", |s| {
+        s["model"] = json!("../../quad.json");
+    });
+    std::fs::write(
+        dir.join("demo.json"),
+        r#"{"cases": [{"name": "control", "scenario": "w/control/recording.csv", "purpose": "p"}]}"#,
+    )
+    .unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "mismatch",
+            "--demo",
+            "demo.json",
+            "--work",
+            "w",
+            "--out",
+            "out",
+            "--force",
+        ],
+    );
+    run.one_line_error(&[
+        "w/control/recording.csv",
+        "scenario of demo case \"control\"",
+    ]);
+    // the model a scenario names, as a summary
+    write_scenario(&dir, "s.json", |s| s["model"] = json!("out/summary.md"));
+    std::fs::create_dir(dir.join("out")).unwrap();
+    std::fs::copy(dir.join("quad.json"), dir.join("out/summary.md")).unwrap();
+    std::fs::write(
+        dir.join("demo.json"),
+        r#"{"cases": [{"name": "control", "scenario": "s.json", "purpose": "p"}]}"#,
+    )
+    .unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "mismatch",
+            "--demo",
+            "demo.json",
+            "--work",
+            "w2",
+            "--out",
+            "out",
+            "--force",
+        ],
+    );
+    run.one_line_error(&["out/summary.md", "model of demo case \"control\""]);
+    assert!(!dir.join("w2").exists());
+}
+
+/// With --recording, neither the recording nor the model may be an output, even with --force; an
+/// output directory below a file is refused before the analysis.
+#[test]
+fn recording_outputs_are_checked_before_work() {
+    let dir = setup("mm-recording-outputs");
+    std::fs::create_dir(dir.join("out")).unwrap();
+    std::fs::write(dir.join("out/mismatch.json"), "recording").unwrap();
+    std::fs::copy(dir.join("quad.json"), dir.join("out/mismatch.md")).unwrap();
+    for (recording, model, needle) in [
+        ("out/mismatch.json", "quad.json", "--recording"),
+        ("r.csv", "out/mismatch.md", "--model"),
+    ] {
+        let run = learn_in(
+            &dir,
+            &[
+                "mismatch",
+                "--recording",
+                recording,
+                "--model",
+                model,
+                "--out",
+                "out",
+                "--force",
+            ],
+        );
+        run.one_line_error(&["out/mismatch.", needle, "even with --force"]);
+    }
+    assert_eq!(
+        std::fs::read_to_string(dir.join("out/mismatch.json")).unwrap(),
+        "recording"
+    );
+    // an output directory below a file: refused before the recording is even read
+    let run = learn_in(
+        &dir,
+        &[
+            "mismatch",
+            "--recording",
+            "absent.csv",
+            "--model",
+            "quad.json",
+            "--out",
+            "control.json/sub",
+        ],
+    );
+    run.one_line_error(&["control.json/sub", "not a directory", "--out"]);
+}
+
+/// --work belongs to --demo: the other modes refuse it instead of ignoring it.
+#[test]
+fn work_is_refused_outside_the_demo() {
+    let dir = setup("mm-work-flag");
+    for mode in [["--recording", "r.csv"], ["--flights", "c.json"]] {
+        let run = learn_in(
+            &dir,
+            &[
+                "mismatch",
+                mode[0],
+                mode[1],
+                "--model",
+                "quad.json",
+                "--out",
+                "o",
+                "--work",
+                "zz",
+            ],
+        );
+        run.one_line_usage_error(&[mode[0], "--work", "cannot be used with"]);
+    }
+    let run = learn_in(&dir, &["mismatch", "--out", "o"]);
+    assert_eq!(run.code, Some(2), "{}", run.stderr);
+}
+
+/// A data directory for `--flights` in `dir/data` holding the evaluation flights of `conditions`
+/// (empty files: the checks under test come before any flight is read).
+fn flights_dir(dir: &Path, conditions: &[&str]) -> PathBuf {
+    let data = dir.join("data");
+    std::fs::create_dir_all(data.join("experiment")).unwrap();
+    for condition in conditions {
+        std::fs::write(
+            data.join(format!(
+                "experiment/custom_figure8_baseline_{condition}.csv"
+            )),
+            "",
+        )
+        .unwrap();
+    }
+    data
+}
+
+fn flights(dir: &Path, extra: &[&str]) -> common::Run {
+    let conditions = workspace().join("experiments/conditions.json");
+    learn_in(
+        dir,
+        &[
+            &[
+                "--data",
+                "data",
+                "mismatch",
+                "--flights",
+                conditions.to_str().unwrap(),
+                "--model",
+                "quad.json",
+                "--out",
+                "o",
+            ],
+            extra,
+        ]
+        .concat(),
+    )
+}
+
+/// Every output of --flights is checked before the first flight is analysed.
+#[test]
+fn flights_check_every_output_before_work() {
+    let dir = setup("mm-flights-outputs");
+    flights_dir(
+        &dir,
+        &["nowind", "35wind", "70p20sint", "70wind", "100wind"],
+    );
+    std::fs::create_dir_all(dir.join("o/neural-fly/70wind")).unwrap();
+    std::fs::write(dir.join("o/neural-fly/70wind/mismatch.svg"), "mine").unwrap();
+    flights(&dir, &[]).one_line_error(&["o/neural-fly/70wind/mismatch.svg", "already exists"]);
+    assert!(!dir.join("o/neural-fly/nowind").exists());
+    assert!(!dir.join("o/neural-fly.md").exists());
+    // a condition's directory that is a file
+    std::fs::remove_dir_all(dir.join("o/neural-fly/70wind")).unwrap();
+    std::fs::write(dir.join("o/neural-fly/70wind"), "mine").unwrap();
+    flights(&dir, &["--force"]).one_line_error(&["o/neural-fly/70wind", "not a directory"]);
+    assert!(!dir.join("o/neural-fly/nowind").exists());
+    // the model and the conditions file are inputs, even with --force
+    std::fs::remove_file(dir.join("o/neural-fly/70wind")).unwrap();
+    std::fs::copy(dir.join("quad.json"), dir.join("o/neural-fly.md")).unwrap();
+    let conditions = workspace().join("experiments/conditions.json");
+    let run = learn_in(
+        &dir,
+        &[
+            "--data",
+            "data",
+            "mismatch",
+            "--flights",
+            conditions.to_str().unwrap(),
+            "--model",
+            "o/neural-fly.md",
+            "--out",
+            "o",
+            "--force",
+        ],
+    );
+    run.one_line_error(&["o/neural-fly.md", "--model", "even with --force"]);
+    std::fs::copy(&conditions, dir.join("o/neural-fly.md")).unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "--data",
+            "data",
+            "mismatch",
+            "--flights",
+            "o/neural-fly.md",
+            "--model",
+            "quad.json",
+            "--out",
+            "o",
+            "--force",
+        ],
+    );
+    run.one_line_error(&["o/neural-fly.md", "conditions file", "even with --force"]);
+}
+
+/// No flight at all in the data directory is an error naming it; some missing are reported and
+/// skipped.
+#[test]
+fn flights_need_at_least_one_flight() {
+    let dir = setup("mm-flights-none");
+    flights_dir(&dir, &[]);
+    flights(&dir, &[]).one_line_error(&["data", "none of the 5 evaluation flights"]);
+    assert!(!dir.join("o").exists());
+    // one flight present (a short simulated one): the others are reported missing
+    write_scenario(&dir, "short.json", |s| s["duration_s"] = json!(5.0));
+    learn_in(
+        &dir,
+        &[
+            "simulate",
+            "--scenario",
+            "short.json",
+            "--out",
+            "data/experiment/custom_figure8_baseline_35wind.csv",
+        ],
+    )
+    .success();
+    let out = flights(&dir, &[]).success().to_string();
+    assert!(out.contains("35wind: effects"), "{out}");
+    assert!(
+        out.contains("nowind: ") && out.contains("is missing, skipped"),
+        "{out}"
+    );
+    assert!(dir.join("o/neural-fly.md").exists());
+    assert!(dir.join("o/neural-fly/35wind/mismatch.json").exists());
 }

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis::{AnalysisSettings, analyze};
 use crate::error::{MismatchError, Result, io_error};
-use crate::output::{check_directory, write_outputs};
+use crate::output::{check_directory, output_paths, write_outputs};
 
 /// One case of the manifest.
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -118,49 +118,152 @@ impl DemoManifest {
     }
 }
 
-/// Runs every case and writes `out/summary.md` and `out/summary.json`. Every scenario (and its
-/// model) is read and checked before any case runs.
-pub fn run_demo(manifest_path: &Path, work: &Path, out: &Path, force: bool) -> Result<DemoSummary> {
-    let manifest = load_manifest(manifest_path)?;
-    check_directory(work)?;
-    check_directory(out)?;
-    let summary_paths = [out.join("summary.md"), out.join("summary.json")];
-    if !force && let Some(path) = summary_paths.iter().find(|p| p.exists()) {
-        return Err(MismatchError::Exists { path: path.clone() });
-    }
-    let base = manifest_path.parent().unwrap_or(Path::new("."));
-    let loaded: Vec<(Scenario, NominalModel)> = manifest
-        .cases
-        .iter()
-        .map(|case| Scenario::load(&base.join(&case.scenario)))
-        .collect::<std::result::Result<_, _>>()?;
-    let cases: Vec<CaseOutcome> = manifest
-        .cases
-        .par_iter()
-        .zip(&loaded)
-        .enumerate()
-        .map(|(i, (case, (scenario, model)))| {
-            run_case(case, scenario, model, work).map_err(|e| MismatchError::Config {
-                path: manifest_path.to_path_buf(),
-                field: format!("cases[{i}]"),
-                message: format!("demo case {:?} failed: {e}", case.name),
+/// A demo run read and checked, ready to run: the manifest and every case's scenario and model,
+/// what the run reads and what it writes (so that a caller can check every output before any
+/// work).
+#[derive(Clone, Debug)]
+pub struct DemoPlan {
+    manifest_path: PathBuf,
+    manifest: DemoManifest,
+    /// Per case: its scenario file, the scenario and its model.
+    cases: Vec<(PathBuf, Scenario, NominalModel)>,
+    work: PathBuf,
+    out: PathBuf,
+}
+
+impl DemoPlan {
+    /// Reads and checks the manifest and every case's scenario (and its model). Fails if `work` or
+    /// `out` exists but is not a directory.
+    pub fn load(manifest_path: &Path, work: &Path, out: &Path) -> Result<Self> {
+        let manifest = load_manifest(manifest_path)?;
+        check_directory(work)?;
+        check_directory(out)?;
+        let base = manifest_path.parent().unwrap_or(Path::new("."));
+        let cases = manifest
+            .cases
+            .iter()
+            .map(|case| {
+                let path = base.join(&case.scenario);
+                let (scenario, model) = Scenario::load(&path)?;
+                Ok((path, scenario, model))
             })
+            .collect::<Result<_>>()?;
+        Ok(Self {
+            manifest_path: manifest_path.to_path_buf(),
+            manifest,
+            cases,
+            work: work.to_path_buf(),
+            out: out.to_path_buf(),
         })
-        .collect::<Result<_>>()?;
-    let summary = DemoSummary {
-        cases,
-        targets: serde_json::json!({
-            "named_correctly": "every case", "parameters_within": 0.10, "heldout_reduction_at_least": 0.60
-        }),
-    };
-    std::fs::create_dir_all(out).map_err(io_error(out))?;
-    std::fs::write(
-        &summary_paths[1],
-        serde_json::to_string_pretty(&summary).expect("serialises") + "\n",
-    )
-    .map_err(io_error(&summary_paths[1]))?;
-    std::fs::write(&summary_paths[0], summary.markdown()).map_err(io_error(&summary_paths[0]))?;
-    Ok(summary)
+    }
+
+    /// Every file the run reads, each with what it is: the manifest, and each case's scenario and
+    /// the model that scenario names.
+    pub fn inputs(&self) -> Vec<(String, PathBuf)> {
+        let mut inputs = vec![(
+            "the demo manifest (--demo)".to_string(),
+            self.manifest_path.clone(),
+        )];
+        for (case, (path, scenario, _)) in self.manifest.cases.iter().zip(&self.cases) {
+            inputs.push((
+                format!("the scenario of demo case {:?}", case.name),
+                path.clone(),
+            ));
+            inputs.push((
+                format!("the model of demo case {:?}", case.name),
+                scenario.model_path(path),
+            ));
+        }
+        inputs
+    }
+
+    /// The summary files, `out/summary.md` and `out/summary.json`.
+    pub fn summary_paths(&self) -> [PathBuf; 2] {
+        [self.out.join("summary.md"), self.out.join("summary.json")]
+    }
+
+    /// Each case's directory, `work/<case>`.
+    pub fn case_dirs(&self) -> Vec<PathBuf> {
+        self.manifest
+            .cases
+            .iter()
+            .map(|case| self.work.join(&case.name))
+            .collect()
+    }
+
+    /// The files each case writes in its directory: `recording.csv` and the three files of its
+    /// analysis (`mismatch.{json,svg,md}`).
+    pub fn case_outputs(&self) -> Vec<PathBuf> {
+        self.case_dirs()
+            .iter()
+            .flat_map(|dir| std::iter::once(dir.join("recording.csv")).chain(output_paths(dir)))
+            .collect()
+    }
+
+    /// Fails, before any work, if a directory of the run exists as something else or (unless
+    /// `force`) if any file the run writes exists: the summaries and every case's files.
+    pub fn check_outputs(&self, force: bool) -> Result<()> {
+        for dir in self.case_dirs() {
+            check_directory(&dir)?;
+        }
+        if force {
+            return Ok(());
+        }
+        let existing = self
+            .summary_paths()
+            .into_iter()
+            .chain(self.case_outputs())
+            .find(|p| p.exists());
+        match existing {
+            Some(path) => Err(MismatchError::Exists { path }),
+            None => Ok(()),
+        }
+    }
+
+    /// Runs every case and writes `out/summary.md` and `out/summary.json`; each case writes its
+    /// recording and analysis in `work/<case>/` (existing files replaced only with `force`).
+    pub fn run(&self, force: bool) -> Result<DemoSummary> {
+        let cases: Vec<CaseOutcome> = self
+            .manifest
+            .cases
+            .par_iter()
+            .zip(&self.cases)
+            .enumerate()
+            .map(|(i, (case, (_, scenario, model)))| {
+                run_case(case, scenario, model, &self.work, force).map_err(|e| {
+                    MismatchError::Config {
+                        path: self.manifest_path.clone(),
+                        field: format!("cases[{i}]"),
+                        message: format!("demo case {:?} failed: {e}", case.name),
+                    }
+                })
+            })
+            .collect::<Result<_>>()?;
+        let summary = DemoSummary {
+            cases,
+            targets: serde_json::json!({
+                "named_correctly": "every case", "parameters_within": 0.10, "heldout_reduction_at_least": 0.60
+            }),
+        };
+        let [markdown, json] = self.summary_paths();
+        std::fs::create_dir_all(&self.out).map_err(io_error(&self.out))?;
+        std::fs::write(
+            &json,
+            serde_json::to_string_pretty(&summary).expect("serialises") + "\n",
+        )
+        .map_err(io_error(&json))?;
+        std::fs::write(&markdown, summary.markdown()).map_err(io_error(&markdown))?;
+        Ok(summary)
+    }
+}
+
+/// Runs every case and writes `out/summary.md` and `out/summary.json`. Every scenario (and its
+/// model) is read and checked, and every output file (summaries in `out`, each case's recording and
+/// analysis in `work/<case>/`) checked against `force`, before any case runs.
+pub fn run_demo(manifest_path: &Path, work: &Path, out: &Path, force: bool) -> Result<DemoSummary> {
+    let plan = DemoPlan::load(manifest_path, work, out)?;
+    plan.check_outputs(force)?;
+    plan.run(force)
 }
 
 fn run_case(
@@ -168,10 +271,14 @@ fn run_case(
     scenario: &Scenario,
     model: &NominalModel,
     work: &Path,
+    force: bool,
 ) -> Result<CaseOutcome> {
     let dir = work.join(&case.name);
     let csv = dir.join("recording.csv");
     let log = simulate(model, scenario, &case.name)?;
+    if !force && csv.exists() {
+        return Err(MismatchError::Exists { path: csv });
+    }
     log.write_csv(&csv)?;
     // Blind: the analysis sees only the CSV as written and the nominal model.
     let recording = data::FlightLog::read(&csv)?;
@@ -181,7 +288,7 @@ fn run_case(
         &scenario.model.display().to_string(),
         &AnalysisSettings::default(),
     )?;
-    write_outputs(&analysis, &dir, true)?;
+    write_outputs(&analysis, &dir, force)?;
     let report = &analysis.report;
     let true_effects: Vec<String> = scenario
         .effects
@@ -496,6 +603,73 @@ mod tests {
         );
         assert!(!work.exists(), "a case ran before the check");
         assert!(!dir.join("out").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The plan names every file the demo reads and writes, and a user's file in a case directory
+    /// is replaced only with `force`, refused before any case runs.
+    #[test]
+    fn the_plan_lists_inputs_and_outputs_and_protects_files_in_work() {
+        let dir = std::env::temp_dir().join(format!("mismatch-demo-plan-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        std::fs::copy(
+            workspace.join("experiments/mismatch/demo-quad.json"),
+            dir.join("quad.json"),
+        )
+        .unwrap();
+        let mut scenario: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(workspace.join("experiments/mismatch/scenarios/control.json"))
+                .unwrap(),
+        )
+        .unwrap();
+        scenario["model"] = serde_json::json!("quad.json");
+        std::fs::write(dir.join("control.json"), scenario.to_string()).unwrap();
+        std::fs::write(
+            dir.join("demo.json"),
+            r#"{"cases": [{"name": "control", "scenario": "control.json", "purpose": "p"}]}"#,
+        )
+        .unwrap();
+        let (work, out) = (dir.join("work"), dir.join("out"));
+        let plan = DemoPlan::load(&dir.join("demo.json"), &work, &out).unwrap();
+        let inputs: Vec<PathBuf> = plan.inputs().into_iter().map(|(_, p)| p).collect();
+        assert_eq!(
+            inputs,
+            [
+                dir.join("demo.json"),
+                dir.join("control.json"),
+                dir.join("quad.json")
+            ]
+        );
+        assert_eq!(
+            plan.summary_paths(),
+            [out.join("summary.md"), out.join("summary.json")]
+        );
+        let case = work.join("control");
+        assert_eq!(
+            plan.case_outputs(),
+            [
+                case.join("recording.csv"),
+                case.join("mismatch.json"),
+                case.join("mismatch.svg"),
+                case.join("mismatch.md")
+            ]
+        );
+        plan.check_outputs(false).unwrap();
+        std::fs::create_dir_all(&case).unwrap();
+        std::fs::write(case.join("mismatch.md"), "notes").unwrap();
+        let error = run_demo(&dir.join("demo.json"), &work, &out, false).unwrap_err();
+        assert!(
+            matches!(&error, MismatchError::Exists { path } if *path == case.join("mismatch.md")),
+            "{error}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(case.join("mismatch.md")).unwrap(),
+            "notes"
+        );
+        assert!(!case.join("recording.csv").exists() && !out.exists());
+        plan.check_outputs(true).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -25,6 +25,18 @@ pub enum MismatchError {
     NonFinite { path: PathBuf, what: String },
     #[error("{}: cannot draw the figure: {message}", path.display())]
     Plot { path: PathBuf, message: String },
+    #[error(
+        "{}: none of the {count} evaluation flights listed in {} is there{}: is it the Neural-Fly data directory?",
+        data_dir.display(),
+        conditions.display(),
+        example.as_ref().map(|p| format!(" (e.g. {})", p.display())).unwrap_or_default()
+    )]
+    NoFlights {
+        data_dir: PathBuf,
+        conditions: PathBuf,
+        count: usize,
+        example: Option<PathBuf>,
+    },
     #[error("{}: field '{field}': {message}", path.display())]
     Config {
         path: PathBuf,

@@ -59,7 +59,10 @@ impl Gains {
             if !(value.is_finite() && value > 0.0) {
                 return Err((
                     name.to_string(),
-                    format!("must be a finite positive number, found {value}"),
+                    format!(
+                        "must be a finite positive number, found {}",
+                        crate::error::readable(value)
+                    ),
                 ));
             }
         }
@@ -72,7 +75,10 @@ impl Gains {
             if !(value.is_finite() && value >= 0.0) {
                 return Err((
                     name.to_string(),
-                    format!("must be a finite number ≥ 0, found {value}"),
+                    format!(
+                        "must be a finite number ≥ 0, found {}",
+                        crate::error::readable(value)
+                    ),
                 ));
             }
         }

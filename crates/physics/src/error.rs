@@ -27,3 +27,31 @@ pub enum PhysicsError {
 
 /// Shorthand for results of this crate.
 pub type Result<T, E = PhysicsError> = std::result::Result<T, E>;
+
+/// A number as an error message shows it: plain when it reads well (`3600`, `0.25`), otherwise in
+/// scientific notation (`1e308`, `1e-300`), never as hundreds of digits.
+pub(crate) fn readable(value: f64) -> String {
+    let magnitude = value.abs();
+    if !value.is_finite() || value == 0.0 || (1e-4..1e9).contains(&magnitude) {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::readable;
+
+    #[test]
+    fn large_and_tiny_numbers_read_in_scientific_notation() {
+        assert_eq!(readable(1e308), "1e308");
+        assert_eq!(readable(-1e300), "-1e300");
+        assert_eq!(readable(1e-300), "1e-300");
+        assert_eq!(readable(3600.0), "3600");
+        assert_eq!(readable(0.25), "0.25");
+        assert_eq!(readable(0.0), "0");
+        assert_eq!(readable(f64::NAN), "NaN");
+        assert_eq!(readable(f64::INFINITY), "inf");
+    }
+}

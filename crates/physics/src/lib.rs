@@ -35,10 +35,11 @@ pub use error::{PhysicsError, Result};
 pub use model::{Mixer, NominalModel, ThrustSource, Wrench, angular_acceleration_with_inertia};
 pub use residual::{five_point_derivative, residual_force};
 pub use simulator::{
-    MAX_DELAY_S, MAX_DURATION_S, MAX_LOG_ROWS, MAX_PHYSICS_RATE_HZ,
-    MAX_REFERENCE_ACCELERATION_M_S2, MAX_WARMUP_S, MIN_LOG_ROWS, MIN_PHYSICS_RATE_HZ, Noise,
-    Scenario, simulate,
+    MAX_DELAY_S, MAX_DURATION_S, MAX_LOG_ROWS, MAX_NOISE, MAX_PHYSICS_RATE_HZ,
+    MAX_REFERENCE_ACCELERATION_M_S2, MAX_WARMUP_S, MIN_HOVER_THROTTLE, MIN_LOG_ROWS,
+    MIN_PHYSICS_RATE_HZ, Noise, Scenario, simulate,
 };
 pub use trajectory::{
-    LowPass, MAX_WAYPOINTS, MAX_YAW_RATE_RAD_S, Reference, ReferenceGenerator, Trajectory,
+    LowPass, MAX_POSITION_M, MAX_WAYPOINTS, MAX_YAW_RATE_RAD_S, Reference, ReferenceGenerator,
+    Trajectory,
 };

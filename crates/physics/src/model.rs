@@ -323,7 +323,10 @@ impl FieldReader {
     fn positive(&self, object: &Map<String, Value>, field: &str) -> Result<f64> {
         let value = self.finite(object, field)?;
         if value <= 0.0 {
-            return Err(self.error(field, &format!("must be positive, found {value}")));
+            return Err(self.error(
+                field,
+                &format!("must be positive, found {}", crate::error::readable(value)),
+            ));
         }
         Ok(value)
     }

@@ -19,9 +19,9 @@ use data::{FlightLog, quaternion_from_rotation, rotation_from_quaternion};
 
 use crate::controller::{Gains, GeometricController, MeasuredState};
 use crate::effects::Effects;
-use crate::error::{PhysicsError, Result};
+use crate::error::{PhysicsError, Result, readable};
 use crate::model::NominalModel;
-use crate::trajectory::Trajectory;
+use crate::trajectory::{MAX_POSITION_M, Trajectory};
 use crate::vector::{
     Vec3, add, mat_mul, norm, quaternion_multiply, quaternion_normalize,
     rotation_from_rotation_vector, scale, sub,
@@ -91,6 +91,20 @@ pub const MAX_DELAY_S: f64 = 1.0;
 /// The largest reference acceleration (sampled at every control step of the flight, warm-up
 /// included) a scenario may ask for, m/s² (about 2 g).
 pub const MAX_REFERENCE_ACCELERATION_M_S2: f64 = 20.0;
+/// The lowest `hover_throttle` a scenario may set: a normalised throttle well below any real
+/// vehicle's hover (Neural-Fly: 0.44 to 0.52), and above the smallest the data tools accept (they
+/// divide by it).
+pub const MIN_HOVER_THROTTLE: f64 = 0.05;
+/// The largest standard deviation of each measurement noise (position m, velocity m/s, attitude
+/// rad, body rate rad/s): far above any real sensor's, and small enough that every noisy value
+/// stays inside the ranges the data tools accept. (Near these bounds the closed loop, which sees
+/// the noisy values, may well diverge: [`simulate`] then fails with an error.)
+pub const MAX_NOISE: Noise = Noise {
+    position_m: 1.0,
+    velocity_m_s: 1.0,
+    attitude_rad: 0.5,
+    rate_rad_s: 1.0,
+};
 
 impl Scenario {
     /// A short figure-8 flight built in code, for examples and tests: 6 s recorded (301 rows at
@@ -138,6 +152,15 @@ impl Scenario {
         }
     }
 
+    /// The model file a scenario read from `scenario_path` names (its `model`, relative to the
+    /// scenario file): an input of the simulation as much as the scenario itself.
+    pub fn model_path(&self, scenario_path: &Path) -> PathBuf {
+        scenario_path
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join(&self.model)
+    }
+
     /// Reads a scenario and its model (resolved relative to the scenario file), and checks both
     /// (together: the simulator needs a mixer, and the reference must stay above the ground).
     pub fn load(path: &Path) -> Result<(Self, NominalModel)> {
@@ -150,11 +173,7 @@ impl Scenario {
             message: error.to_string(),
         })?;
         scenario.validate(path)?;
-        let model_path = path
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join(&scenario.model);
-        let model = NominalModel::load(&model_path)?;
+        let model = NominalModel::load(&scenario.model_path(path))?;
         scenario.validate_with_model(&model, path)?;
         Ok((scenario, model))
     }
@@ -162,10 +181,12 @@ impl Scenario {
     /// Checks the settings; errors name the field. Bounds: `duration_s` at most
     /// [`MAX_DURATION_S`], giving between [`MIN_LOG_ROWS`] and [`MAX_LOG_ROWS`] rows; `warmup_s` in
     /// [0, [`MAX_WARMUP_S`]]; `physics_rate_hz` in [[`MIN_PHYSICS_RATE_HZ`],
-    /// [`MAX_PHYSICS_RATE_HZ`]] and a whole multiple of `log_rate_hz`; `hover_throttle` in (0, 1];
-    /// gains, effects, noise and trajectory as their own checks say, a delay of at most
-    /// [`MAX_DELAY_S`], and a reference acceleration of at most
-    /// [`MAX_REFERENCE_ACCELERATION_M_S2`].
+    /// [`MAX_PHYSICS_RATE_HZ`]] and a whole multiple of `log_rate_hz`; `hover_throttle` in
+    /// [[`MIN_HOVER_THROTTLE`], 1]; noise standard deviations in [0, [`MAX_NOISE`]]; gains, effects
+    /// and trajectory as their own checks say, a delay of at most [`MAX_DELAY_S`], and a reference
+    /// that stays within [`MAX_POSITION_M`] of the origin (per coordinate) and accelerates at most
+    /// at [`MAX_REFERENCE_ACCELERATION_M_S2`]. Together these keep every value of the simulated log
+    /// inside the ranges the data tools accept (`PLAUSIBLE_RANGES` of the data crate).
     pub fn validate(&self, origin: &Path) -> Result<()> {
         let field = |field: String, message: String| PhysicsError::Field {
             path: origin.to_path_buf(),
@@ -178,7 +199,7 @@ impl Scenario {
             } else {
                 Err(field(
                     name.to_string(),
-                    format!("must be positive, found {value}"),
+                    format!("must be positive, found {}", readable(value)),
                 ))
             }
         };
@@ -186,7 +207,10 @@ impl Scenario {
         if self.duration_s > MAX_DURATION_S {
             return Err(field(
                 "duration_s".into(),
-                format!("at most {MAX_DURATION_S} s, found {}", self.duration_s),
+                format!(
+                    "at most {MAX_DURATION_S} s, found {}",
+                    readable(self.duration_s)
+                ),
             ));
         }
         if !(self.warmup_s.is_finite() && (0.0..=MAX_WARMUP_S).contains(&self.warmup_s)) {
@@ -194,18 +218,18 @@ impl Scenario {
                 "warmup_s".into(),
                 format!(
                     "must be between 0 and {MAX_WARMUP_S} s, found {}",
-                    self.warmup_s
+                    readable(self.warmup_s)
                 ),
             ));
         }
         positive("log_rate_hz", self.log_rate_hz)?;
         positive("hover_throttle", self.hover_throttle)?;
-        if self.hover_throttle > 1.0 {
+        if !(MIN_HOVER_THROTTLE..=1.0).contains(&self.hover_throttle) {
             return Err(field(
                 "hover_throttle".into(),
                 format!(
-                    "a normalised throttle, must be at most 1, found {}",
-                    self.hover_throttle
+                    "a normalised throttle, must be between {MIN_HOVER_THROTTLE} and 1, found {}",
+                    readable(self.hover_throttle)
                 ),
             ));
         }
@@ -214,7 +238,7 @@ impl Scenario {
                 "physics_rate_hz".into(),
                 format!(
                     "must be between {MIN_PHYSICS_RATE_HZ} and {MAX_PHYSICS_RATE_HZ}, found {}",
-                    self.physics_rate_hz
+                    readable(self.physics_rate_hz)
                 ),
             ));
         }
@@ -243,27 +267,47 @@ impl Scenario {
         if self.effects.delay_s() > MAX_DELAY_S {
             return Err(field(
                 "effects.delay.delay_s".into(),
-                format!("at most {MAX_DELAY_S} s, found {}", self.effects.delay_s()),
+                format!(
+                    "at most {MAX_DELAY_S} s, found {}",
+                    readable(self.effects.delay_s())
+                ),
             ));
         }
-        let n = self.noise;
-        for (name, value) in [
-            ("position_m", n.position_m),
-            ("velocity_m_s", n.velocity_m_s),
-            ("attitude_rad", n.attitude_rad),
-            ("rate_rad_s", n.rate_rad_s),
+        let (n, max) = (self.noise, MAX_NOISE);
+        for (name, value, max, unit) in [
+            ("position_m", n.position_m, max.position_m, "m"),
+            ("velocity_m_s", n.velocity_m_s, max.velocity_m_s, "m/s"),
+            ("attitude_rad", n.attitude_rad, max.attitude_rad, "rad"),
+            ("rate_rad_s", n.rate_rad_s, max.rate_rad_s, "rad/s"),
         ] {
-            if !(value.is_finite() && value >= 0.0) {
+            if !(value.is_finite() && (0.0..=max).contains(&value)) {
                 return Err(field(
                     format!("noise.{name}"),
-                    format!("a standard deviation, must be ≥ 0, found {value}"),
+                    format!(
+                        "a standard deviation, must be between 0 and {max} {unit}, found {}",
+                        readable(value)
+                    ),
                 ));
             }
         }
         self.trajectory.validate().map_err(|(f, m)| field(f, m))?;
         let generator = self.trajectory.generator();
         for t in self.control_times() {
-            let a = norm(generator.at(t).acceleration);
+            let reference = generator.at(t);
+            if let Some(p) = reference
+                .position
+                .iter()
+                .find(|p| p.is_nan() || p.abs() > MAX_POSITION_M)
+            {
+                return Err(field(
+                    "trajectory".into(),
+                    format!(
+                        "the reference reaches the coordinate {} m at t = {t:.2} s, farther than the {MAX_POSITION_M} m from the origin allowed",
+                        readable(*p)
+                    ),
+                ));
+            }
+            let a = norm(reference.acceleration);
             if a.is_nan() || a > MAX_REFERENCE_ACCELERATION_M_S2 {
                 return Err(field(
                     "trajectory".into(),
@@ -736,6 +780,124 @@ mod tests {
         s.validate(Path::new("s.json")).unwrap();
     }
 
+    /// The message of the validation error of a changed scenario.
+    fn rejection(change: impl FnOnce(&mut Scenario)) -> String {
+        let mut s = scenario();
+        change(&mut s);
+        s.validate(Path::new("s.json"))
+            .and_then(|()| s.validate_with_model(&model(), Path::new("s.json")))
+            .unwrap_err()
+            .to_string()
+    }
+
+    fn set_center(center: Vec3) -> impl FnOnce(&mut Scenario) {
+        move |s: &mut Scenario| {
+            if let Trajectory::Figure8 { center: c, .. } = &mut s.trajectory {
+                *c = center;
+            }
+        }
+    }
+
+    /// Settings that would give a log the data tools refuse ("outside the plausible range") are
+    /// refused when the scenario is read, naming the field.
+    #[test]
+    fn settings_that_would_leave_the_plausible_ranges_are_field_errors() {
+        assert_eq!(
+            rejected_field(set_center([1e300, 0.0, 1.5])),
+            "trajectory.center"
+        );
+        assert_eq!(
+            rejected_field(set_center([0.0, 0.0, 1e6])),
+            "trajectory.center"
+        );
+        assert!(
+            rejection(set_center([1e300, 0.0, 1.5])).contains("1e300 m"),
+            "{}",
+            rejection(set_center([1e300, 0.0, 1.5]))
+        );
+        assert_eq!(
+            rejected_field(|s| s.hover_throttle = 1e-300),
+            "hover_throttle"
+        );
+        assert_eq!(
+            rejected_field(|s| s.hover_throttle = MIN_HOVER_THROTTLE / 2.0),
+            "hover_throttle"
+        );
+        for (name, change) in [
+            (
+                "noise.position_m",
+                (|s: &mut Scenario| s.noise.position_m = 1e5) as fn(&mut Scenario),
+            ),
+            ("noise.velocity_m_s", |s| s.noise.velocity_m_s = 1e5),
+            ("noise.attitude_rad", |s| s.noise.attitude_rad = 10.0),
+            ("noise.rate_rad_s", |s| s.noise.rate_rad_s = 1e5),
+        ] {
+            assert_eq!(rejected_field(change), name);
+        }
+        assert_eq!(
+            rejected_field(|s| {
+                if let Trajectory::Figure8 { low_passes, .. } = &mut s.trajectory {
+                    low_passes.push(crate::trajectory::LowPass {
+                        start_s: 1.0,
+                        end_s: 5.0,
+                        height_m: 1e9,
+                        ramp_s: 1.0,
+                    });
+                }
+            }),
+            "trajectory.low_passes[0].height_m"
+        );
+        assert_eq!(
+            rejected_field(|s| {
+                s.trajectory = Trajectory::RandomWaypoints {
+                    seed: 1,
+                    count: 4,
+                    box_min: [-1.0, -1.0, 1.0],
+                    box_max: [1.0, 1.0, 1e7],
+                    segment_s: 2.5,
+                    yaw_amplitude_rad: 0.0,
+                    yaw_period_s: 10.0,
+                };
+            }),
+            "trajectory.box_max"
+        );
+        // every field within the bound, their sum (center + first + second) beyond it
+        assert_eq!(
+            rejected_field(|s| {
+                if let Trajectory::Figure8 {
+                    center,
+                    first,
+                    period_s,
+                    ..
+                } = &mut s.trajectory
+                {
+                    *center = [900.0, 0.0, 1.5];
+                    *first = [900.0, 0.0, 0.0];
+                    *period_s = 60.0;
+                }
+            }),
+            "trajectory"
+        );
+        // the bounds themselves are accepted
+        let mut s = scenario();
+        s.hover_throttle = MIN_HOVER_THROTTLE;
+        s.noise = MAX_NOISE;
+        set_center([MAX_POSITION_M - 2.0, -(MAX_POSITION_M - 2.0), 1.5])(&mut s);
+        s.validate(Path::new("s.json")).unwrap();
+        s.validate_with_model(&model(), Path::new("s.json"))
+            .unwrap();
+    }
+
+    /// Huge numbers in messages read as numbers, not as hundreds of digits.
+    #[test]
+    fn huge_values_are_named_readably() {
+        let message = rejection(|s| s.duration_s = 1e308);
+        assert!(message.contains("found 1e308"), "{message}");
+        assert!(message.len() < 200, "{message}");
+        let message = rejection(|s| s.gains.position = -1e300);
+        assert!(message.contains("found -1e300"), "{message}");
+    }
+
     #[test]
     fn trajectory_fields_are_field_errors_not_divergence() {
         let set_yaw_period = |value: f64| {
@@ -754,10 +916,11 @@ mod tests {
             rejected_field(set_yaw_period(0.1)),
             "trajectory.yaw_period_s"
         );
+        // within the position bound, but a reference no vehicle follows
         assert_eq!(
             rejected_field(|s| {
                 if let Trajectory::Figure8 { first, .. } = &mut s.trajectory {
-                    first[0] = 1e6;
+                    first[0] = 500.0;
                 }
             }),
             "trajectory"

@@ -4,6 +4,7 @@
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
 
+use crate::error::readable;
 use crate::vector::{Vec3, add, scale};
 
 /// Where the vehicle should be at one instant.
@@ -75,16 +76,30 @@ pub struct ReferenceGenerator {
 /// The most waypoints a random-waypoint trajectory may have (each is drawn up front).
 pub const MAX_WAYPOINTS: usize = 100_000;
 
+/// The farthest a reference may be from the origin, per coordinate, m (and the largest coordinate
+/// of a trajectory's `center`, `first`, `second`, `box_min`, `box_max` and low-pass heights): a
+/// kilometre, ten times inside the positions the data tools accept (`data::PLAUSIBLE_RANGES`,
+/// ±1e4 m), which leaves room for the tracking error (the simulation stops beyond 20 m) and the
+/// measurement noise.
+pub const MAX_POSITION_M: f64 = 1000.0;
+
 /// The fastest peak yaw rate `|yaw_amplitude_rad| · 2π / yaw_period_s` accepted, rad/s.
 pub const MAX_YAW_RATE_RAD_S: f64 = std::f64::consts::PI;
 
 impl Trajectory {
-    /// Checks the settings (finite numbers, positive periods and durations, ordered low passes,
-    /// at most [`MAX_WAYPOINTS`] waypoints, a peak yaw rate of at most [`MAX_YAW_RATE_RAD_S`]);
-    /// the error names the field.
+    /// Checks the settings (finite numbers, positions within [`MAX_POSITION_M`] per coordinate,
+    /// positive periods and durations, ordered low passes, at most [`MAX_WAYPOINTS`] waypoints, a
+    /// peak yaw rate of at most [`MAX_YAW_RATE_RAD_S`]); the error names the field.
     pub fn validate(&self) -> Result<(), (String, String)> {
         let bad = |field: &str, message: String| Err((format!("trajectory.{field}"), message));
         let finite3 = |v: &Vec3| v.iter().all(|x| x.is_finite());
+        let too_far = |v: &[f64]| v.iter().copied().find(|x| x.abs() > MAX_POSITION_M);
+        let far_message = |x: f64| {
+            format!(
+                "a coordinate of {} m, farther than the {MAX_POSITION_M} m from the origin a flight may go",
+                readable(x)
+            )
+        };
         let (yaw_amplitude_rad, yaw_period_s) = match self {
             Self::Figure8 {
                 center,
@@ -99,15 +114,24 @@ impl Trajectory {
                     if !finite3(v) {
                         return bad(name, "must be three finite numbers".into());
                     }
+                    if let Some(x) = too_far(v) {
+                        return bad(name, far_message(x));
+                    }
                 }
                 if !(period_s.is_finite() && *period_s > 0.0) {
-                    return bad("period_s", format!("must be positive, found {period_s}"));
+                    return bad(
+                        "period_s",
+                        format!("must be positive, found {}", readable(*period_s)),
+                    );
                 }
                 for (i, pass) in low_passes.iter().enumerate() {
                     let field = format!("low_passes[{i}]");
                     let values = [pass.start_s, pass.end_s, pass.height_m, pass.ramp_s];
                     if values.iter().any(|v| !v.is_finite()) {
                         return bad(&field, "every number must be finite".into());
+                    }
+                    if let Some(x) = too_far(&[pass.height_m]) {
+                        return bad(&format!("{field}.height_m"), far_message(x));
                     }
                     if !(pass.ramp_s > 0.0 && pass.end_s - pass.start_s >= 2.0 * pass.ramp_s) {
                         return bad(
@@ -148,11 +172,17 @@ impl Trajectory {
                     );
                 }
                 if !(segment_s.is_finite() && *segment_s > 0.0) {
-                    return bad("segment_s", format!("must be positive, found {segment_s}"));
+                    return bad(
+                        "segment_s",
+                        format!("must be positive, found {}", readable(*segment_s)),
+                    );
                 }
                 for (name, v) in [("box_min", box_min), ("box_max", box_max)] {
                     if !finite3(v) {
                         return bad(name, "must be three finite numbers".into());
+                    }
+                    if let Some(x) = too_far(v) {
+                        return bad(name, far_message(x));
                     }
                 }
                 if (0..3).any(|i| box_max[i] < box_min[i]) {
@@ -167,7 +197,7 @@ impl Trajectory {
         if !(yaw_period_s.is_finite() && yaw_period_s > 0.0) {
             return bad(
                 "yaw_period_s",
-                format!("must be positive, found {yaw_period_s}"),
+                format!("must be positive, found {}", readable(yaw_period_s)),
             );
         }
         let yaw_rate = yaw_amplitude_rad.abs() * 2.0 * std::f64::consts::PI / yaw_period_s;

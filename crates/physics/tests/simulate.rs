@@ -67,3 +67,36 @@ fn the_closed_loop_conceals_a_thrust_loss_and_runs_are_deterministic() {
         mean(&nominal)
     );
 }
+
+/// A scenario at the edges of what a scenario may ask for (reference near the position bound, the
+/// smallest hover throttle, the largest position noise) still gives a log the data tools
+/// read: the scenario's bounds keep the simulated values inside the data crate's plausible ranges.
+/// (Larger noise of the other measurements may make this closed loop diverge, an error of its own.)
+#[test]
+fn a_scenario_at_its_bounds_gives_a_log_the_data_tools_accept() {
+    let model = demo_model();
+    let edge = physics::MAX_POSITION_M - 25.0;
+    let scenario = Scenario {
+        hover_throttle: physics::MIN_HOVER_THROTTLE,
+        noise: physics::Noise {
+            position_m: physics::MAX_NOISE.position_m,
+            ..Scenario::figure_eight("demo-quad.json", 3).noise
+        },
+        trajectory: physics::Trajectory::Figure8 {
+            center: [edge - 2.0, -(edge - 2.0), edge - 2.0],
+            first: [1.5, 0.0, 0.0],
+            second: [0.0, 0.8, 0.3],
+            period_s: 6.0,
+            low_passes: Vec::new(),
+            yaw_amplitude_rad: 0.2,
+            yaw_period_s: 10.0,
+        },
+        ..Scenario::figure_eight("demo-quad.json", 3)
+    };
+    let log = simulate(&model, &scenario, "edge").unwrap();
+    let dir = common::temp_dir("edge");
+    let path = dir.join("edge.csv");
+    log.write_csv(&path).unwrap();
+    let back = data::FlightLog::read(&path).unwrap();
+    assert_eq!(back.len(), log.len());
+}

@@ -1,24 +1,35 @@
 //! `learn mismatch`: locate, name and fit the physics a nominal model leaves out.
 //!
 //! - `--recording REAL.csv --model NOMINAL.json --out DIR`: one recording → DIR/mismatch.{json,svg,md}.
-//! - `--demo MANIFEST --out DIR`: simulate every case of the manifest with a concealed effect, run
-//!   the analysis blind on each, and write DIR/summary.{md,json}.
+//! - `--demo MANIFEST --out DIR [--work WORK]`: simulate every case of the manifest with a concealed
+//!   effect (WORK/<case>/recording.csv), run the analysis blind on each (WORK/<case>/mismatch.*),
+//!   and write DIR/summary.{md,json}.
 //! - `--flights CONDITIONS.json --model NOMINAL.json --out DIR`: every wind condition's evaluation
-//!   flight of the data directory → DIR/<condition>/… and DIR/neural-fly.md.
+//!   flight of the data directory → DIR/neural-fly/<condition>/… and DIR/neural-fly.md.
+//!
+//! Every mode works out every file it will write and checks them all before any work: none may be
+//! one of the files the run reads (even with `--force`), each must be writable, and none may exist
+//! unless `--force` is given.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::bail;
+use anyhow::Context;
 
 use super::Global;
 
 #[derive(clap::Args, Debug)]
+#[command(group(
+    clap::ArgGroup::new("mode")
+        .required(true)
+        .args(["recording", "demo", "flights"])
+))]
 pub struct Args {
     /// A recording in the Neural-Fly CSV layout.
     #[arg(long, conflicts_with_all = ["demo", "flights"])]
     pub recording: Option<PathBuf>,
-    /// The nominal model JSON (not with --demo: each scenario names its own model).
-    #[arg(long, conflicts_with = "demo")]
+    /// The nominal model JSON (with --recording or --flights; not with --demo: each scenario names
+    /// its own model).
+    #[arg(long, conflicts_with = "demo", required_unless_present = "demo")]
     pub model: Option<PathBuf>,
     /// Output directory.
     #[arg(long)]
@@ -26,65 +37,99 @@ pub struct Args {
     /// A demo manifest: simulated cases with concealed effects.
     #[arg(long, conflicts_with = "flights")]
     pub demo: Option<PathBuf>,
-    /// Where the demo writes its simulated recordings and per-case outputs.
-    #[arg(long, default_value = "target/mismatch-demo")]
-    pub work: PathBuf,
+    /// With --demo: where it writes each case's simulated recording and analysis
+    /// (WORK/<case>/recording.csv, mismatch.{json,svg,md}; default: target/mismatch-demo);
+    /// existing ones are replaced only with --force.
+    #[arg(long, conflicts_with_all = ["recording", "flights"])]
+    pub work: Option<PathBuf>,
     /// The experiment's conditions file: analyse the evaluation flights of every wind condition.
     #[arg(long)]
     pub flights: Option<PathBuf>,
-    /// Overwrite existing output files.
+    /// Overwrite existing output files (never one of the run's inputs).
     #[arg(long)]
     pub force: bool,
 }
 
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     if let Some(manifest) = &args.demo {
-        let summary = mismatch::demo::run_demo(manifest, &args.work, &args.out, args.force)?;
-        print!("{}", summary.table_text());
-        println!("wrote {}", args.out.join("summary.md").display());
-        return Ok(());
+        return run_demo(manifest, &args);
     }
-    let Some(model_path) = &args.model else {
-        bail!("--model is required with --recording or --flights");
-    };
-    // No output file may be one of the inputs, even with --force.
-    let inputs = [
-        ("--model", model_path.as_path()),
-        (
-            "--recording",
-            args.recording.as_deref().unwrap_or(Path::new("")),
-        ),
-        (
-            "--flights",
-            args.flights.as_deref().unwrap_or(Path::new("")),
-        ),
-    ];
-    for output in mismatch::output_paths(&args.out)
-        .iter()
-        .chain([&args.out.join("neural-fly.md")])
-    {
-        super::refuse_input_as_output(output, &inputs)?;
-    }
-    let model = physics::NominalModel::load(model_path)?;
+    let model_path = args
+        .model
+        .as_deref()
+        .context("--model is required with --recording or --flights")?;
     if let Some(conditions) = &args.flights {
-        let data_dir = global.data_dir()?;
-        let lines = mismatch::flights::run_flights(
-            conditions,
-            &data_dir,
-            &model,
-            &model_path.display().to_string(),
-            &args.out,
-            args.force,
-        )?;
-        for line in lines {
-            println!("{line}");
-        }
-        return Ok(());
+        return run_flights(global, conditions, model_path, &args);
     }
-    let Some(recording) = &args.recording else {
-        bail!("give --recording (or --demo, or --flights)");
-    };
-    mismatch::check_outputs(&args.out, args.force)?;
+    let recording = args
+        .recording
+        .as_deref()
+        .context("give --recording (or --demo, or --flights)")?;
+    run_recording(recording, model_path, &args)
+}
+
+/// Where the demo writes its cases without `--work`.
+const DEFAULT_WORK: &str = "target/mismatch-demo";
+
+fn run_demo(manifest: &Path, args: &Args) -> anyhow::Result<()> {
+    let work = args.work.as_deref().unwrap_or(Path::new(DEFAULT_WORK));
+    super::refuse_unwritable_dir(&args.out, "--out")?;
+    super::refuse_unwritable_dir(work, "--work")?;
+    let plan = mismatch::demo::DemoPlan::load(manifest, work, &args.out)?;
+    let summaries = plan.summary_paths();
+    // A case directory must not be a summary file (--work and --out may be the same directory).
+    for dir in plan.case_dirs() {
+        if let Some(summary) = summaries.iter().find(|s| super::same_file(&dir, s)) {
+            anyhow::bail!(
+                "{}: is both a demo case's directory (--work) and a summary file (--out)",
+                summary.display()
+            );
+        }
+    }
+    let outputs: Vec<(PathBuf, &str)> = summaries
+        .iter()
+        .map(|p| (p.clone(), "--out"))
+        .chain(plan.case_outputs().into_iter().map(|p| (p, "--work")))
+        .collect();
+    check_outputs(&outputs, &plan.inputs(), args.force)?;
+    let summary = plan.run(args.force)?;
+    print!("{}", summary.table_text());
+    println!("wrote {}", summaries[0].display());
+    Ok(())
+}
+
+fn run_flights(
+    global: &Global,
+    conditions: &Path,
+    model_path: &Path,
+    args: &Args,
+) -> anyhow::Result<()> {
+    super::refuse_unwritable_dir(&args.out, "--out")?;
+    let data_dir = global.data_dir()?;
+    let plan = mismatch::flights::FlightsPlan::load(conditions, &data_dir, &args.out)?;
+    let mut inputs = plan.inputs();
+    inputs.push(("the --model file".to_string(), model_path.to_path_buf()));
+    let outputs: Vec<(PathBuf, &str)> = plan.outputs().into_iter().map(|p| (p, "--out")).collect();
+    check_outputs(&outputs, &inputs, args.force)?;
+    let model = physics::NominalModel::load(model_path)?;
+    for line in plan.run(&model, &model_path.display().to_string(), args.force)? {
+        println!("{line}");
+    }
+    Ok(())
+}
+
+fn run_recording(recording: &Path, model_path: &Path, args: &Args) -> anyhow::Result<()> {
+    super::refuse_unwritable_dir(&args.out, "--out")?;
+    let inputs = [
+        ("the --model file".to_string(), model_path.to_path_buf()),
+        ("the --recording".to_string(), recording.to_path_buf()),
+    ];
+    let outputs: Vec<(PathBuf, &str)> = mismatch::output_paths(&args.out)
+        .into_iter()
+        .map(|p| (p, "--out"))
+        .collect();
+    check_outputs(&outputs, &inputs, args.force)?;
+    let model = physics::NominalModel::load(model_path)?;
     let log = data::FlightLog::read(recording)?;
     let analysis = mismatch::analyze(
         &log,
@@ -106,5 +151,33 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         report.fit.heldout.after.mse,
         args.out.display()
     );
+    Ok(())
+}
+
+/// Checks every file a run will write (with the option that places it), before any work: none is
+/// one of the run's `inputs` (what each is, its path), whatever `--force` says; each can be written;
+/// none exists unless `force`.
+fn check_outputs(
+    outputs: &[(PathBuf, &str)],
+    inputs: &[(String, PathBuf)],
+    force: bool,
+) -> anyhow::Result<()> {
+    for (output, _) in outputs {
+        if let Some((what, _)) = inputs
+            .iter()
+            .find(|(_, input)| super::same_file(output, input))
+        {
+            anyhow::bail!(
+                "{}: is {what}, which this run reads: refusing to write over it (even with --force)",
+                output.display()
+            );
+        }
+    }
+    for (output, option) in outputs {
+        super::refuse_unwritable_file(output, option)?;
+    }
+    for (output, _) in outputs {
+        super::refuse_overwrite(output, force)?;
+    }
     Ok(())
 }

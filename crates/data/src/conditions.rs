@@ -4,7 +4,7 @@
 //! figure and fold is driven by this list.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
@@ -109,6 +109,16 @@ impl ExperimentConditions {
                     "empty controller name".to_string(),
                 ));
             }
+            // The name becomes part of a path through {controller}: it must stay one component.
+            if controller.contains(['/', '\\']) || matches!(controller.as_str(), "." | "..") {
+                return Err(config_error(
+                    &format!("controllers[{index}]"),
+                    format!(
+                        "'{controller}': a controller name is part of file names (no '/', '\\', \
+                         '.' or '..')"
+                    ),
+                ));
+            }
             if self.controllers[..index].contains(controller) {
                 return Err(config_error(
                     "controllers",
@@ -122,7 +132,13 @@ impl ExperimentConditions {
                 format!("'{}' is not in controllers", self.evaluation_controller),
             ));
         }
-        check_pattern(&self.file_pattern, &["controller", "condition"])
+        // With several controllers, a pattern without {controller} names one file for all of them.
+        let required: &[&str] = if self.controllers.len() > 1 {
+            &["controller", "condition"]
+        } else {
+            &["condition"]
+        };
+        check_pattern(&self.file_pattern, &["controller", "condition"], required)
             .map_err(|message| config_error("file_pattern", message))?;
         if self.conditions.is_empty() {
             return Err(config_error(
@@ -149,11 +165,14 @@ impl ExperimentConditions {
             if let Some((controller, file)) = condition
                 .files
                 .iter()
-                .find(|(_, file)| file.trim().is_empty() || Path::new(file).is_absolute())
+                .find(|(_, file)| file.trim().is_empty() || !inside_data_dir(file))
             {
                 return Err(config_error(
                     &format!("conditions[{index}].files.{controller}"),
-                    format!("'{file}' must be a path relative to the data directory"),
+                    format!(
+                        "'{file}' must be a path relative to the data directory, inside it \
+                         (no '..')"
+                    ),
                 ));
             }
         }
@@ -164,7 +183,7 @@ impl ExperimentConditions {
             ));
         }
         let paper = &self.paper_training;
-        check_pattern(&paper.file_pattern, &["condition"])
+        check_pattern(&paper.file_pattern, &["condition"], &["condition"])
             .map_err(|message| config_error("paper_training.file_pattern", message))?;
         if paper.conditions.is_empty() {
             return Err(config_error(
@@ -292,9 +311,22 @@ impl ExperimentConditions {
     }
 }
 
-/// Checks a file pattern: braces balanced, only the `allowed` placeholders, `{condition}` present,
-/// relative to the data directory.
-fn check_pattern(pattern: &str, allowed: &[&str]) -> std::result::Result<(), String> {
+/// Whether `path` names a place inside the data directory: relative, and without a `..` component.
+fn inside_data_dir(path: &str) -> bool {
+    let path = Path::new(path);
+    !path.has_root()
+        && path
+            .components()
+            .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+}
+
+/// Checks a file pattern: braces balanced, only the `allowed` placeholders, each of the
+/// `required` ones present, a path inside the data directory (relative, no `..`).
+fn check_pattern(
+    pattern: &str,
+    allowed: &[&str],
+    required: &[&str],
+) -> std::result::Result<(), String> {
     let known = allowed
         .iter()
         .map(|p| format!("{{{p}}}"))
@@ -318,12 +350,22 @@ fn check_pattern(pattern: &str, allowed: &[&str]) -> std::result::Result<(), Str
         }
         rest = &after[close + 1..];
     }
-    if !pattern.contains("{condition}") {
-        return Err("must contain {condition}".to_string());
+    if let Some(missing) = required
+        .iter()
+        .find(|p| !pattern.contains(&format!("{{{p}}}")))
+    {
+        return Err(if *missing == "controller" {
+            format!(
+                "'{pattern}' must contain {{controller}}: with several controllers, a pattern \
+                 without it names the same file for all of them"
+            )
+        } else {
+            format!("'{pattern}' must contain {{{missing}}}")
+        });
     }
-    if Path::new(pattern).is_absolute() {
+    if !inside_data_dir(pattern) {
         return Err(format!(
-            "'{pattern}' must be a path relative to the data directory"
+            "'{pattern}' must be a path relative to the data directory, inside it (no '..')"
         ));
     }
     Ok(())
@@ -565,6 +607,81 @@ mod tests {
             "absolute-file",
             |s| s.replace("mine/extra.csv", "/mine/extra.csv"),
             &["conditions[2].files.baseline", "relative"],
+        );
+    }
+
+    #[test]
+    fn file_patterns_name_one_file_per_flight_inside_the_data_directory() {
+        // Without {controller}, the six controllers' flights of a condition would be one file.
+        rejected(
+            "no-controller",
+            |s| s.replace("custom_figure8_{controller}_", "custom_figure8_baseline_"),
+            &[
+                "conditions.json: file_pattern: 'experiment/custom_figure8_baseline_{condition}.csv' \
+                 must contain {controller}",
+            ],
+        );
+        rejected(
+            "no-condition",
+            |s| s.replace("_{controller}_{condition}.csv", "_{controller}.csv"),
+            &[
+                "file_pattern: 'experiment/custom_figure8_{controller}.csv' must contain {condition}",
+            ],
+        );
+        rejected(
+            "paper-no-condition",
+            |s| {
+                s.replace(
+                    "custom_random3_baseline_{condition}",
+                    "custom_random3_baseline",
+                )
+            },
+            &["paper_training.file_pattern", "must contain {condition}"],
+        );
+        rejected(
+            "parent",
+            |s| s.replace("experiment/custom_figure8_", "../"),
+            &[
+                "file_pattern: '../{controller}_{condition}.csv'",
+                "inside it (no '..')",
+            ],
+        );
+        rejected(
+            "parent-inside",
+            |s| s.replace("experiment/custom_figure8_", "experiment/../../"),
+            &["file_pattern", "(no '..')"],
+        );
+        rejected(
+            "paper-parent",
+            |s| s.replace("training/custom_random3", "../training/custom_random3"),
+            &["paper_training.file_pattern", "(no '..')"],
+        );
+        rejected(
+            "parent-file",
+            |s| s.replace("mine/extra.csv", "mine/../../extra.csv"),
+            &["conditions[2].files.baseline", "(no '..')"],
+        );
+        rejected(
+            "controller-path",
+            |s| s.replace("[\"baseline\", \"NF\"]", "[\"baseline\", \"..\"]"),
+            &["controllers[1]", "'..'"],
+        );
+        // One controller: its flights are the only ones, {controller} may be left out.
+        let dir = std::env::temp_dir().join(format!("conditions-one-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("conditions.json");
+        let one = sample()
+            .replace("[\"baseline\", \"NF\"]", "[\"baseline\"]")
+            .replace("custom_figure8_{controller}_", "custom_figure8_baseline_");
+        std::fs::write(&path, one).unwrap();
+        let config = ExperimentConditions::load(&path).unwrap();
+        assert_eq!(
+            config.flight_path(
+                Path::new("/d"),
+                config.condition("70psin20").unwrap(),
+                "baseline"
+            ),
+            Path::new("/d/experiment/custom_figure8_baseline_70p20sint.csv")
         );
     }
 

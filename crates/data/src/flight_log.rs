@@ -222,7 +222,7 @@ impl FlightLog {
             return Err(DataError::MissingColumn {
                 path: path.to_path_buf(),
                 column: "q (or R)".to_string(),
-                present: table.column_names().join(", "),
+                present: table.column_list(),
             });
         }
         let quaternion = if has_q {

@@ -9,7 +9,8 @@ use serde::de::DeserializeOwned;
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct JsonError {
     /// The path of the offending field (`rules[3].tolerance`) and, for text, its line and column;
-    /// only the position when the document itself is malformed.
+    /// `the document (line L column C)` at the document's root (a missing top-level field, text
+    /// after the document).
     pub field: String,
     /// What is wrong, without the position (which `field` holds).
     pub message: String,
@@ -33,14 +34,19 @@ pub fn from_str<T: DeserializeOwned>(text: &str) -> Result<T, JsonError> {
         JsonError {
             field: match path {
                 Some(path) => format!("{path} ({position})"),
-                None => position,
+                // A missing top-level field, or a document that is not an object at all.
+                None => format!("the document ({position})"),
             },
             message: without_position(&inner),
         }
     })?;
     // Trailing characters after the document are an error too (as in `serde_json::from_str`).
     deserializer.end().map_err(|error| JsonError {
-        field: format!("line {} column {}", error.line(), error.column()),
+        field: format!(
+            "the document (line {} column {})",
+            error.line(),
+            error.column()
+        ),
         message: without_position(&error),
     })?;
     Ok(value)
@@ -106,7 +112,23 @@ mod tests {
         assert_eq!(error.message, "EOF while parsing a value");
         assert!(!error.message.contains(" at line "), "{error}");
         let error = from_str::<Inner>("{\"count\": 1} x").unwrap_err();
-        assert_eq!(error.field, "line 1 column 14");
+        assert_eq!(error.field, "the document (line 1 column 14)");
+    }
+
+    #[test]
+    fn a_missing_top_level_field_names_the_document() {
+        let error = from_str::<Outer>("{\"inner\": {\"count\": 1}}").unwrap_err();
+        assert_eq!(error.field, "the document (line 1 column 23)");
+        assert_eq!(error.message, "missing field `rules`");
+        assert_eq!(
+            error.to_string(),
+            "the document (line 1 column 23): missing field `rules`"
+        );
+        let error = from_str::<Outer>("7").unwrap_err();
+        assert!(
+            error.field.starts_with("the document (line 1 column"),
+            "{error}"
+        );
     }
 
     #[test]

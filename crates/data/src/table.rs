@@ -26,6 +26,9 @@ pub struct TextTable {
     lines: Vec<usize>,
 }
 
+/// At most this many column names are listed in an error message.
+pub const LISTED_COLUMNS: usize = 40;
+
 /// The line of the file that holds data row `index` (0-based) when no cell spans lines; the header
 /// is line 1. [`TextTable::line`] gives the exact line of any row.
 pub fn file_row(index: usize) -> usize {
@@ -113,6 +116,22 @@ impl TextTable {
             .collect()
     }
 
+    /// The column names for an error message, comma-separated: the first [`LISTED_COLUMNS`], then
+    /// how many more (a file may have a million columns; the message stays readable).
+    pub fn column_list(&self) -> String {
+        let names = self.frame.get_column_names();
+        let mut list = names
+            .iter()
+            .take(LISTED_COLUMNS)
+            .map(|name| name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ");
+        if names.len() > LISTED_COLUMNS {
+            list.push_str(&format!(" and {} more", names.len() - LISTED_COLUMNS));
+        }
+        list
+    }
+
     /// Whether a column of this name exists.
     pub fn has_column(&self, name: &str) -> bool {
         self.frame.column(name).is_ok()
@@ -122,7 +141,7 @@ impl TextTable {
         let missing = || DataError::MissingColumn {
             path: self.path.clone(),
             column: name.to_string(),
-            present: self.column_names().join(", "),
+            present: self.column_list(),
         };
         let column = self.frame.column(name).map_err(|_| missing())?;
         column.str().map_err(|error| DataError::Csv {
@@ -275,8 +294,10 @@ fn check_layout(path: &Path, bytes: &[u8], records: &[StringRecord]) -> Result<V
             });
         }
         if index == 0 {
-            for (second, name) in header.iter().enumerate() {
-                if let Some(first) = header[..second].iter().position(|n| n == name) {
+            // One pass with the first position of each name: linear in the number of columns.
+            let mut seen = std::collections::HashMap::with_capacity(header.len());
+            for (second, &name) in header.iter().enumerate() {
+                if let Some(&first) = seen.get(name) {
                     return Err(DataError::DuplicateColumn {
                         path: path.to_path_buf(),
                         row: line,
@@ -285,6 +306,7 @@ fn check_layout(path: &Path, bytes: &[u8], records: &[StringRecord]) -> Result<V
                         second: second + 1,
                     });
                 }
+                seen.insert(name, second);
             }
             continue;
         }

@@ -45,6 +45,50 @@ fn a_repeated_column_name_is_an_error_not_a_renamed_copy() {
     );
 }
 
+/// `t,x,c0..c{n-1}` with `rows` rows of ones, x = the row index.
+fn wide(columns: usize, rows: usize) -> String {
+    let names: Vec<String> = (0..columns).map(|k| format!("c{k}")).collect();
+    let mut text = format!("t,x,{}\n", names.join(","));
+    let ones = vec!["1"; columns].join(",");
+    for k in 0..rows {
+        text.push_str(&format!("{:.1},{k},{ones}\n", k as f64 * 0.1));
+    }
+    text
+}
+
+#[test]
+fn a_wide_file_is_read_and_a_duplicate_far_apart_is_named_with_both_positions() {
+    // 200 000 columns: the header check is one pass (it was quadratic: a minute at this width).
+    let columns = 200_000;
+    let good = write("wide.csv", wide(columns, 5).as_bytes());
+    let table = NumericTable::read_with_time(&good, "t", &["x", "c199999"]).unwrap();
+    assert_eq!(table.1.rows(), 5);
+    assert_eq!(table.1.columns[0], vec![0.0, 1.0, 2.0, 3.0, 4.0]);
+    assert_eq!(table.1.columns[1], vec![1.0; 5]);
+
+    // The last column renamed to the first: fields 3 and 200 002, far apart.
+    let text = wide(columns, 5).replacen(",c199999\n", ",c0\n", 1);
+    let path = write("wide-dup.csv", text.as_bytes());
+    let message = numeric_error(&path, &["x"]);
+    assert!(
+        message.contains(&format!(
+            "wide-dup.csv:1:c0: column 'c0' appears twice in the header (fields 3 and {})",
+            columns + 2
+        )),
+        "{message}"
+    );
+
+    // A missing column lists the first names and counts the rest: one short line.
+    let message = numeric_error(&good, &["nope"]);
+    assert!(message.contains("missing column 'nope'"), "{message}");
+    assert!(message.contains("t, x, c0, c1, "), "{message}");
+    assert!(
+        message.ends_with(&format!(" and {} more)", columns + 2 - 40)),
+        "{message}"
+    );
+    assert!(message.len() < 1000, "{message}");
+}
+
 #[test]
 fn a_row_with_an_extra_field_names_its_line() {
     let text = plain(5).replacen("0.2,2,4\n", "0.2,2,4,9\n", 1);

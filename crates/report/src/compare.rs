@@ -103,6 +103,62 @@ impl Tolerances {
         })
     }
 
+    /// Refuses a rule naming a table or a condition the published numbers do not have (a typing
+    /// error such as `translatonal` would make the rule apply to nothing, silently). A rule's
+    /// condition must be one of its table's, or of any table when the rule names none.
+    pub fn check_names(&self, published: &PublishedTables) -> Result<()> {
+        let error = |field: String, message: String| ReportError::Json {
+            path: self.path.clone(),
+            field,
+            message,
+        };
+        let list = |names: Vec<&String>| {
+            names
+                .iter()
+                .map(|n| n.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        for (index, rule) in self.rules.iter().enumerate() {
+            let tables: Vec<(&String, _)> = match &rule.table {
+                Some(table) => match published.tables.get_key_value(table) {
+                    Some(entry) => vec![entry],
+                    None => {
+                        return Err(error(
+                            format!("rules[{index}].table"),
+                            format!(
+                                "'{table}' is not a table of {} (tables: {})",
+                                published.path.display(),
+                                list(published.tables.keys().collect())
+                            ),
+                        ));
+                    }
+                },
+                None => published.tables.iter().collect(),
+            };
+            if let Some(condition) = &rule.condition
+                && !tables.iter().any(|(_, c)| c.contains_key(condition))
+            {
+                let mut known: Vec<&String> = tables.iter().flat_map(|(_, c)| c.keys()).collect();
+                known.sort();
+                known.dedup();
+                let within = match &rule.table {
+                    Some(table) => format!("table '{table}'"),
+                    None => "any table".to_string(),
+                };
+                return Err(error(
+                    format!("rules[{index}].condition"),
+                    format!(
+                        "'{condition}' is not a condition of {within} in {} (conditions: {})",
+                        published.path.display(),
+                        list(known)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// The rule that applies to one cell, if any.
     pub fn rule_for(
         &self,
@@ -182,6 +238,7 @@ impl Comparison {
                 message: format!("no published numbers for the results table '{name}'"),
             });
         }
+        tolerances.check_names(published)?;
         for name in published.tables.keys() {
             if !table_names.contains(&name.as_str()) {
                 table_names.push(name);
@@ -247,6 +304,14 @@ impl Comparison {
                     }
                 }
             }
+        }
+        // A check of nothing is no check: say so instead of "0 of 0 within tolerance".
+        if cells.iter().all(|c| c.published.is_none()) {
+            return Err(ReportError::Json {
+                path: published.path.clone(),
+                field: "tables".to_string(),
+                message: "no published cell to check".to_string(),
+            });
         }
         let protocols = results
             .iter()
@@ -522,5 +587,61 @@ mod tests {
         value["rules"].as_array_mut().unwrap().pop();
         std::fs::write(&path, value.to_string()).unwrap();
         assert_eq!(Tolerances::load(&path).unwrap().path, path);
+    }
+
+    #[test]
+    fn a_rule_naming_an_unknown_table_or_condition_is_refused() {
+        let results = results(mse(0.156, 0.194), mse(0.155, 0.208));
+        let with_rule = |rule: serde_json::Value| {
+            let mut t = tolerances();
+            t.path = PathBuf::from("tolerances.json");
+            t.rules.push(serde_json::from_value(rule).unwrap());
+            Comparison::new(&results, &published(), &t)
+                .unwrap_err()
+                .to_string()
+        };
+        let message = with_rule(
+            serde_json::json!({"method": "sindy", "table": "translatonal",
+            "tolerance": 0.1, "direction": "two-sided"}),
+        );
+        assert!(
+            message.contains("tolerances.json: rules[3].table: 'translatonal' is not a table of")
+                && message.contains("published.json (tables: translational)"),
+            "{message}"
+        );
+        let message = with_rule(serde_json::json!({"method": "sindy", "condition": "35Wind",
+            "tolerance": 0.1, "direction": "two-sided"}));
+        assert!(
+            message.contains("tolerances.json: rules[3].condition: '35Wind' is not a condition")
+                && message.contains("(conditions: 35wind)"),
+            "{message}"
+        );
+        let message = with_rule(
+            serde_json::json!({"method": "sindy", "table": "translational",
+            "condition": "70wind", "tolerance": 0.1, "direction": "two-sided"}),
+        );
+        assert!(
+            message.contains("rules[3].condition: '70wind' is not a condition of table"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn checking_no_published_cell_is_an_error() {
+        let mut empty = published();
+        empty
+            .tables
+            .insert("translational".to_string(), Default::default());
+        let message = Comparison::new(
+            &results(mse(0.1, 0.1), mse(0.1, 0.1)),
+            &empty,
+            &tolerances(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            message.contains("published.json: tables: no published cell to check"),
+            "{message}"
+        );
     }
 }

@@ -266,7 +266,7 @@ pub fn load_tables(dir: &Path) -> Result<Vec<ResultsTable>> {
         path: dir.to_path_buf(),
         source,
     })?;
-    let mut tables = Vec::new();
+    let mut paths = Vec::new();
     for entry in entries {
         let path = entry
             .map_err(|source| ReportError::Io {
@@ -275,8 +275,29 @@ pub fn load_tables(dir: &Path) -> Result<Vec<ResultsTable>> {
             })?
             .path();
         if path.extension().is_some_and(|e| e == "json") {
-            tables.push(ResultsTable::load(&path)?);
+            paths.push(path);
         }
+    }
+    // In name order, so that an error names the same file whatever order the directory lists.
+    paths.sort();
+    let mut tables: Vec<ResultsTable> = Vec::with_capacity(paths.len());
+    // tables[k] is read from paths[k].
+    for path in &paths {
+        let table = ResultsTable::load(path)?;
+        // Two files for one table: which one was meant is unknowable, and the choice would
+        // depend on the files' names.
+        if let Some(earlier) = tables.iter().position(|t| t.table == table.table) {
+            return Err(ReportError::Json {
+                path: path.clone(),
+                field: "table".to_string(),
+                message: format!(
+                    "'{}' is also the table of {} (one file per table)",
+                    table.table,
+                    paths[earlier].display()
+                ),
+            });
+        }
+        tables.push(table);
     }
     if tables.is_empty() {
         return Err(ReportError::Invalid {
@@ -325,6 +346,28 @@ mod tests {
         assert!(row.is_best(Method::Learn, Metric::Adaptation));
         assert!(!row.is_best(Method::Sindy, Metric::Generalisation));
         assert!(row.is_best(Method::Learn, Metric::Generalisation));
+    }
+
+    #[test]
+    fn a_table_in_two_files_is_an_error_naming_both() {
+        let dir = std::env::temp_dir().join(format!("report-two-files-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let table = |generalisation: f64| ResultsTable {
+            table: "translational".to_string(),
+            protocol: "p".to_string(),
+            rows: vec![Row::new("35wind", mse(0.1, generalisation), mse(0.3, 0.4))],
+            notes: Vec::new(),
+        };
+        table(0.2).save(&dir.join("translational.json")).unwrap();
+        assert_eq!(load_tables(&dir).unwrap().len(), 1);
+        table(5.0).save(&dir.join("zzz.json")).unwrap();
+        let message = load_tables(&dir).unwrap_err().to_string();
+        assert!(
+            message.contains("zzz.json: table: 'translational' is also the table of")
+                && message.contains("translational.json (one file per table)"),
+            "{message}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

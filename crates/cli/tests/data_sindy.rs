@@ -282,6 +282,26 @@ fn inconsistent_conditions_are_refused_naming_the_file_and_field() {
         needles.push(name);
         learn_in(&dir, &["conditions", "--config", name]).one_line_error(&needles);
     }
+    // Six controllers and a pattern without {controller}: one file would stand for six flights.
+    let six = conditions("experiment/custom_figure8_baseline_{condition}.csv", a).replace(
+        r#""controllers": ["baseline"]"#,
+        r#""controllers": ["baseline", "indi", "L1", "NF", "NF-C", "NF-T"]"#,
+    );
+    std::fs::write(dir.join("six.json"), six).unwrap();
+    learn_in(&dir, &["conditions", "--config", "six.json"]).one_line_error(&[
+        "six.json: file_pattern: 'experiment/custom_figure8_baseline_{condition}.csv' must \
+         contain {controller}",
+    ]);
+    // A pattern reaching out of the data directory, as an absolute one would.
+    std::fs::write(
+        dir.join("up.json"),
+        conditions("../{controller}_{condition}.csv", a),
+    )
+    .unwrap();
+    learn_in(&dir, &["conditions", "--config", "up.json"]).one_line_error(&[
+        "up.json: file_pattern: '../{controller}_{condition}.csv' must be a path relative to \
+         the data directory, inside it (no '..')",
+    ]);
     std::fs::write(
         dir.join("good.json"),
         conditions(pattern, &format!("{a}, {d}")),
@@ -373,5 +393,77 @@ fn a_data_directory_that_is_a_file_is_named_by_every_command() {
         run.success().contains("no data directory"),
         "{}",
         run.stdout
+    );
+}
+
+#[test]
+fn flags_of_the_other_optimizer_are_refused_not_ignored() {
+    let dir = scratch("sindy-optimizer-flags");
+    std::fs::write(dir.join("s.csv"), signal(200)).unwrap();
+    let lasso = ["--optimizer", "lasso", "--lambda", "0.01"];
+    let with = |extra: &[&str]| {
+        let mut args = lasso.to_vec();
+        args.extend_from_slice(extra);
+        sindy(&dir, "s.csv", "poly:1", &args)
+    };
+    with(&["--threshold", "5", "--alpha", "3", "--max-iter", "1"]).one_line_error(&[
+        "--threshold, --alpha, --max-iter apply to --optimizer stlsq only, not lasso",
+    ]);
+    with(&["--max-iter", "1"])
+        .one_line_error(&["--max-iter applies to --optimizer stlsq only, not lasso"]);
+    assert!(with(&[]).success().contains("x' ="));
+    // And the other way round, as before.
+    sindy(&dir, "s.csv", "poly:1", &["--lambda", "0.01"])
+        .one_line_error(&["--lambda applies to --optimizer lasso only"]);
+    // The STLSQ flags still act on STLSQ: a threshold above every coefficient leaves none.
+    let run = sindy(&dir, "s.csv", "poly:1", &["--threshold", "1e6"]);
+    assert!(!run.success().contains(" u"), "{}", run.stdout);
+}
+
+#[test]
+fn a_model_file_in_a_directory_that_does_not_exist_yet_is_written_there() {
+    let dir = scratch("sindy-out-new-dir");
+    std::fs::write(dir.join("s.csv"), signal(200)).unwrap();
+    let run = sindy(&dir, "s.csv", "poly:1", &["--out", "new/sub/m.json"]);
+    assert!(run.success().contains("x' ="), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("model written to new/sub/m.json"),
+        "{}",
+        run.stderr
+    );
+    let model = sindy::SindyModel::load(&dir.join("new/sub/m.json")).unwrap();
+    assert_eq!(model.feature_names().len(), 4);
+    // Below a file nothing can be made: refused before the fit.
+    std::fs::write(dir.join("file"), "").unwrap();
+    let run = sindy(&dir, "s.csv", "poly:1", &["--out", "file/m.json"]);
+    run.one_line_error(&["file/m.json", "is not a directory"]);
+    assert!(run.stdout.is_empty(), "{}", run.stdout);
+}
+
+#[test]
+fn a_constant_derivative_has_no_r2() {
+    let dir = scratch("sindy-constant-target");
+    let rows: String = (0..50)
+        .map(|k| format!("{:.1},{}\n", k as f64 * 0.1, 2.0 * k as f64 * 0.1))
+        .collect();
+    std::fs::write(dir.join("line.csv"), format!("t,x\n{rows}")).unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "sindy",
+            "--csv",
+            "line.csv",
+            "--state",
+            "x",
+            "--library",
+            "poly:1",
+        ],
+    );
+    assert_eq!(run.success().trim(), "x' = 2.000");
+    assert!(
+        run.stderr
+            .contains("MSE 0.000000, R² n/a (constant target)"),
+        "{}",
+        run.stderr
     );
 }

@@ -120,7 +120,8 @@ impl CausalLibrary {
     }
 
     /// Θ of `segment` (one row per sample) and the feature names: a control lag is named by its
-    /// pole with two decimals, or as many more as it takes to tell the poles apart.
+    /// pole with two decimals, or as many more as it takes to tell the poles apart (up to 17; past
+    /// that, in the shortest form that tells them apart).
     pub fn features(&self, segment: &Segment) -> Result<(Mat<f64>, Vec<String>)> {
         self.validate()?;
         let formulation = segment.formulation;
@@ -158,11 +159,11 @@ impl CausalLibrary {
                 names.push(format!("{name}^2"));
             }
         }
-        let decimals = distinct_decimals(&self.control_lags);
-        for &pole in &self.control_lags {
+        let labels = pole_labels(&self.control_lags);
+        for (&pole, label) in self.control_lags.iter().zip(&labels) {
             for (j, name) in control_names.iter().enumerate() {
                 columns.push(first_order_lag(&control(j), pole));
-                names.push(format!("lag{pole:.decimals$}({name})"));
+                names.push(format!("lag{label}({name})"));
             }
         }
         let theta = Mat::from_fn(n, columns.len(), |i, j| columns[j][i]);
@@ -170,16 +171,24 @@ impl CausalLibrary {
     }
 }
 
-/// The fewest decimals, at least two, with which the (distinct) `poles` print differently.
-fn distinct_decimals(poles: &[f64]) -> usize {
-    (2..17)
-        .find(|&decimals| {
-            let mut printed: Vec<String> =
-                poles.iter().map(|p| format!("{p:.decimals$}")).collect();
-            printed.sort();
-            printed.windows(2).all(|pair| pair[0] != pair[1])
-        })
-        .unwrap_or(17)
+/// The fewest decimals, at least two and at most 17, with which the (distinct) `poles` print
+/// differently; `None` when no such count tells them apart (poles closer than 1e-17, e.g. 0 and
+/// 1e-20).
+fn distinct_decimals(poles: &[f64]) -> Option<usize> {
+    (2..=17).find(|&decimals| {
+        let mut printed: Vec<String> = poles.iter().map(|p| format!("{p:.decimals$}")).collect();
+        printed.sort();
+        printed.windows(2).all(|pair| pair[0] != pair[1])
+    })
+}
+
+/// The poles as written in feature names: with [`distinct_decimals`] fixed decimals, else in
+/// Rust's shortest round-trip form (`1e-20`), which prints distinct values differently.
+fn pole_labels(poles: &[f64]) -> Vec<String> {
+    match distinct_decimals(poles) {
+        Some(decimals) => poles.iter().map(|p| format!("{p:.decimals$}")).collect(),
+        None => poles.iter().map(|p| format!("{p}")).collect(),
+    }
 }
 
 /// `s[k] = a·s[k−1] + (1 − a)·u[k]`, `s[0] = u[0]`.
@@ -212,10 +221,50 @@ mod tests {
 
     #[test]
     fn lag_names_carry_the_decimals_that_tell_the_poles_apart() {
-        assert_eq!(distinct_decimals(&[0.5, 0.8, 0.95]), 2);
-        assert_eq!(distinct_decimals(&[0.951, 0.954]), 3);
-        assert_eq!(distinct_decimals(&[0.5, 0.5 + 1e-12]), 12);
-        assert_eq!(distinct_decimals(&[]), 2);
+        assert_eq!(distinct_decimals(&[0.5, 0.8, 0.95]), Some(2));
+        assert_eq!(distinct_decimals(&[0.951, 0.954]), Some(3));
+        assert_eq!(distinct_decimals(&[0.5, 0.5 + 1e-12]), Some(12));
+        assert_eq!(distinct_decimals(&[0.0, 1e-17]), Some(17));
+        assert_eq!(distinct_decimals(&[]), Some(2));
+        assert_eq!(pole_labels(&[0.5, 0.8, 0.95]), ["0.50", "0.80", "0.95"]);
+        // No count of decimals up to 17 tells 0 from 1e-20: the shortest round-trip form does.
+        assert_eq!(distinct_decimals(&[0.0, 1e-20]), None);
+        assert_eq!(pole_labels(&[0.0, 1e-20]), ["0", "0.00000000000000000001"]);
+    }
+
+    #[test]
+    fn poles_closer_than_the_printed_decimals_still_give_distinct_feature_names() {
+        let library = CausalLibrary {
+            control_lags: vec![0.0, 1e-20],
+            ..Default::default()
+        };
+        let formulation = Formulation::Translational;
+        let n = 4;
+        let segment = Segment {
+            formulation,
+            rows: 0..n,
+            time: (0..n).map(|k| k as f64 * 0.02).collect(),
+            states: Mat::zeros(n, formulation.state_dim()),
+            controls: Mat::from_fn(n, formulation.control_dim(), |i, j| (i + j) as f64),
+            targets: Mat::zeros(n, formulation.state_dim()),
+        };
+        let (_, names) = library.features(&segment).unwrap();
+        let first = formulation.control_names()[0];
+        let lags: Vec<&String> = names
+            .iter()
+            .filter(|n| n.ends_with(&format!("({first})")))
+            .collect();
+        assert_eq!(
+            lags,
+            [
+                &format!("lag0({first})"),
+                &format!("lag0.00000000000000000001({first})")
+            ]
+        );
+        let mut unique = names.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), names.len(), "{names:?}");
     }
 
     #[test]

@@ -125,6 +125,9 @@ pub struct Score {
     /// Coefficient of determination averaged uniformly over state dimensions (scikit-learn's
     /// `r2_score`, PySINDy's default score).
     pub r2: f64,
+    /// Whether R² means anything: `false` when the target of some state is constant up to
+    /// rounding ([`constant_columns`]), where 1 − residual/variance divides by rounding noise.
+    pub r2_defined: bool,
 }
 
 /// Settings of a SINDy fit, checked when [`SindyParams::fit`] runs.
@@ -390,6 +393,7 @@ impl SindyModel {
         Ok(Score {
             mse: mean_squared_error(predicted.as_ref(), actual.as_ref()),
             r2: r2_score(predicted.as_ref(), actual.as_ref()),
+            r2_defined: constant_columns(actual.as_ref()).is_empty(),
         })
     }
 
@@ -537,6 +541,26 @@ pub fn mean_squared_error(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -
     sum / (n * m) as f64
 }
 
+/// The columns of `actual` that are constant up to rounding: standard deviation at most
+/// [`CONSTANT_RELATIVE_SPREAD`] times the largest magnitude in the column (all zeros included).
+/// R² is undefined on them.
+pub fn constant_columns(actual: MatRef<'_, f64>) -> Vec<usize> {
+    let n = actual.nrows();
+    (0..actual.ncols())
+        .filter(|&j| {
+            let column = || (0..n).map(|i| actual[(i, j)]);
+            let mean = column().sum::<f64>() / n as f64;
+            let variance = column().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+            let scale = column().fold(0.0_f64, |m, v| m.max(v.abs()));
+            n == 0 || variance.sqrt() <= CONSTANT_RELATIVE_SPREAD * scale
+        })
+        .collect()
+}
+
+/// See [`constant_columns`]: a spread this small relative to the values is rounding noise (a
+/// derivative estimate of x = 2t varies by ~1e-15).
+pub const CONSTANT_RELATIVE_SPREAD: f64 = 1e-9;
+
 /// Coefficient of determination, averaged uniformly over columns (scikit-learn's `r2_score`).
 pub fn r2_score(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -> f64 {
     let (n, m) = actual.shape();
@@ -621,6 +645,33 @@ mod tests {
         let constant = Mat::from_fn(4, 1, |_, _| 3.0);
         assert_eq!(r2_score(constant.as_ref(), constant.as_ref()), 1.0);
         assert_eq!(mean_squared_error(means.as_ref(), actual.as_ref()), 1.25);
+    }
+
+    #[test]
+    fn a_target_constant_up_to_rounding_has_no_r2() {
+        // 2 plus rounding noise, zeros, and a column that does vary.
+        let actual = Mat::from_fn(6, 3, |i, j| match j {
+            0 => 2.0 + if i % 2 == 0 { 4e-16 } else { -4e-16 },
+            1 => 0.0,
+            _ => i as f64 * 1e-3,
+        });
+        assert_eq!(constant_columns(actual.as_ref()), vec![0, 1]);
+        // On x = 2t the fit is exact, and the score says R² is undefined.
+        let time: Vec<f64> = (0..50).map(|k| k as f64 * 0.1).collect();
+        let states = Mat::from_fn(50, 1, |i, _| 2.0 * time[i]);
+        let trajectory = Trajectory::new(time, states).unwrap();
+        let model = SindyParams::new(&["x"], &[])
+            .fit(std::slice::from_ref(&trajectory))
+            .unwrap();
+        let score = model.score(&trajectory).unwrap();
+        assert!(score.mse < 1e-20, "{score:?}");
+        assert!(!score.r2_defined, "{score:?}");
+        let varying = Trajectory::new(
+            (0..50).map(|k| k as f64 * 0.1).collect(),
+            Mat::from_fn(50, 1, |i, _| (i as f64 * 0.1).sin()),
+        )
+        .unwrap();
+        assert!(model.score(&varying).unwrap().r2_defined);
     }
 
     #[test]

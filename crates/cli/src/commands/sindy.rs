@@ -37,15 +37,20 @@ pub struct Args {
     /// Optimizer.
     #[arg(long, value_enum, default_value = "stlsq")]
     pub optimizer: OptimizerKind,
-    /// STLSQ threshold.
-    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
-    pub threshold: f64,
-    /// STLSQ ridge strength.
-    #[arg(long, default_value_t = sindy::DEFAULT_ALPHA, allow_negative_numbers = true)]
-    pub alpha: f64,
-    /// STLSQ iteration limit.
-    #[arg(long, default_value_t = sindy::DEFAULT_MAX_ITER)]
-    pub max_iter: usize,
+    /// STLSQ threshold; `None`: the default.
+    #[arg(long, allow_negative_numbers = true,
+          help = format!("STLSQ threshold (--optimizer stlsq only) [default: {DEFAULT_THRESHOLD}]"))]
+    pub threshold: Option<f64>,
+    /// STLSQ ridge strength; `None`: `sindy::DEFAULT_ALPHA`.
+    #[arg(long, allow_negative_numbers = true,
+          help = format!("STLSQ ridge strength (--optimizer stlsq only) [default: {}]",
+                         sindy::DEFAULT_ALPHA))]
+    pub alpha: Option<f64>,
+    /// STLSQ iteration limit; `None`: `sindy::DEFAULT_MAX_ITER`.
+    #[arg(long,
+          help = format!("STLSQ iteration limit (--optimizer stlsq only) [default: {}]",
+                         sindy::DEFAULT_MAX_ITER))]
+    pub max_iter: Option<usize>,
     /// LASSO weight λ (required with --optimizer lasso).
     #[arg(long, allow_negative_numbers = true)]
     pub lambda: Option<f64>,
@@ -63,6 +68,9 @@ pub struct Args {
     pub force: bool,
 }
 
+/// The STLSQ threshold when --threshold is not given.
+const DEFAULT_THRESHOLD: f64 = 0.1;
+
 fn optimizer(args: &Args) -> anyhow::Result<OptimizerSpec> {
     Ok(match args.optimizer {
         OptimizerKind::Stlsq => {
@@ -70,14 +78,36 @@ fn optimizer(args: &Args) -> anyhow::Result<OptimizerSpec> {
                 bail!("--lambda applies to --optimizer lasso only");
             }
             OptimizerSpec::Stlsq {
-                threshold: args.threshold,
-                alpha: args.alpha,
-                max_iter: args.max_iter,
+                threshold: args.threshold.unwrap_or(DEFAULT_THRESHOLD),
+                alpha: args.alpha.unwrap_or(sindy::DEFAULT_ALPHA),
+                max_iter: args.max_iter.unwrap_or(sindy::DEFAULT_MAX_ITER),
             }
         }
-        OptimizerKind::Lasso => OptimizerSpec::Lasso {
-            lambda: args.lambda.context("--optimizer lasso needs --lambda L")?,
-        },
+        OptimizerKind::Lasso => {
+            // Flags of the other optimizer would be ignored: refused, named.
+            let stlsq_only: Vec<&str> = [
+                ("--threshold", args.threshold.is_some()),
+                ("--alpha", args.alpha.is_some()),
+                ("--max-iter", args.max_iter.is_some()),
+            ]
+            .into_iter()
+            .filter_map(|(flag, given)| given.then_some(flag))
+            .collect();
+            if !stlsq_only.is_empty() {
+                bail!(
+                    "{} {} to --optimizer stlsq only, not lasso",
+                    stlsq_only.join(", "),
+                    if stlsq_only.len() == 1 {
+                        "applies"
+                    } else {
+                        "apply"
+                    }
+                );
+            }
+            OptimizerSpec::Lasso {
+                lambda: args.lambda.context("--optimizer lasso needs --lambda L")?,
+            }
+        }
     })
 }
 
@@ -158,7 +188,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     let score = model.score(&trajectory)?;
     // Finite inputs can still give an unusable fit (e.g. time steps so small that the derivative
     // estimates overflow): an error, not equations and a score of inf or NaN.
-    if !(score.mse.is_finite() && score.r2.is_finite()) {
+    if !(score.mse.is_finite() && (score.r2.is_finite() || !score.r2_defined)) {
         bail!(
             "{}: the fit is not finite (MSE {}, R² {}): are the time steps of column '{}' in \
              seconds?",
@@ -171,14 +201,24 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     for line in model.equations(usize::from(args.precision)) {
         println!("{line}");
     }
+    // R² divides by the variance of the target: on a constant one it is rounding noise.
+    let r2 = if score.r2_defined {
+        format!("R² {:.6}", score.r2)
+    } else {
+        "R² n/a (constant target)".to_string()
+    };
     eprintln!(
-        "{} samples, {} features; MSE {:.6}, R² {:.6}",
+        "{} samples, {} features; MSE {:.6}, {r2}",
         n,
         model.feature_names().len(),
         score.mse,
-        score.r2
     );
     if let Some(out) = &args.out {
+        // As meta-train and reproduce do: missing parent directories are made (check_output
+        // refused, before the fit, a parent that cannot be one).
+        if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
+        }
         model.save(out, args.force)?;
         eprintln!("model written to {}", out.display());
     }

@@ -69,11 +69,31 @@ pub struct CheckedRunConfig {
     pub conditions_path: PathBuf,
     pub published_path: PathBuf,
     pub learn_config_path: PathBuf,
+    /// The variants file whose `reproduce` variants are added, if any.
+    pub variants_path: Option<PathBuf>,
     pub conditions: ExperimentConditions,
     /// The LeARN configuration after the overrides, checked.
     pub learn: CheckedConfig,
     /// `None`: decided from the data present.
     pub protocol: Option<Protocol>,
+}
+
+impl CheckedRunConfig {
+    /// Every file the run reads besides the flights, each with what names it (the option or the
+    /// field of this file): outputs must be none of them.
+    pub fn input_files(&self, option: &str) -> Vec<(String, PathBuf)> {
+        let field = |name: &str| format!("{name} of {}", self.path.display());
+        let mut inputs = vec![
+            (option.to_string(), self.path.clone()),
+            (field("conditions"), self.conditions_path.clone()),
+            (field("published"), self.published_path.clone()),
+            (field("learn.config"), self.learn_config_path.clone()),
+        ];
+        if let Some(variants) = &self.variants_path {
+            inputs.push((field("variants"), variants.clone()));
+        }
+        inputs
+    }
 }
 
 impl RunConfig {
@@ -162,8 +182,9 @@ impl RunConfig {
         }
         let learn = load_learn_config(&learn_config_path, &self.learn.overrides, path)?;
         report::PublishedTables::load(&published_path)?;
-        if let Some(variants) = &self.variants {
-            crate::variants::VariantsConfig::read(&resolve(variants))?;
+        let variants_path = self.variants.as_deref().map(resolve);
+        if let Some(variants) = &variants_path {
+            crate::variants::VariantsConfig::read(variants)?;
         }
         Ok(CheckedRunConfig {
             sha256: file_sha256(path)?,
@@ -171,6 +192,7 @@ impl RunConfig {
             conditions_path,
             published_path,
             learn_config_path,
+            variants_path,
             conditions,
             learn,
             protocol,
@@ -232,8 +254,12 @@ fn load_learn_config(
         field: "learn.overrides".to_string(),
         message: format!("{} with these overrides: {message}", path.display()),
     };
-    let config: LearnConfig =
-        data::json::from_value(value).map_err(|error| with_overrides(error.to_string()))?;
+    // Without overrides a fault is the file's own: named with its line and column.
+    let config: LearnConfig = if overrides.is_null() {
+        data::json::from_str(&text).map_err(|error| PipelineError::json(path, error))?
+    } else {
+        data::json::from_value(value).map_err(|error| with_overrides(error.to_string()))?
+    };
     match config.check(path) {
         Ok(checked) => Ok(checked),
         Err(error) if overrides.is_null() => Err(error.into()),

@@ -51,10 +51,81 @@ impl OutputPaths {
     }
 }
 
+/// What a run will write, known before it runs: files by name, and directories in which every
+/// file of some extensions is written or removed (a run's tables and figures, whose names depend
+/// on the conditions, and the stale ones of an earlier run).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlannedOutputs {
+    /// Files written (or rewritten), and the probe files of the writability checks.
+    pub files: Vec<PathBuf>,
+    /// A directory and the extensions of the files the run writes or removes directly in it.
+    pub owned: Vec<(PathBuf, Vec<&'static str>)>,
+}
+
+impl PlannedOutputs {
+    /// Whether `path` would be written or removed according to `same_file` (a comparison that
+    /// sees through spellings of the path): the output it would be, for an error message.
+    pub fn clobbers(
+        &self,
+        path: &Path,
+        same_file: &dyn Fn(&Path, &Path) -> bool,
+    ) -> Option<String> {
+        if let Some(file) = self.files.iter().find(|file| same_file(path, file)) {
+            return Some(file.display().to_string());
+        }
+        let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+        let parent = parent.unwrap_or(Path::new("."));
+        let extension = path.extension().and_then(|e| e.to_str())?;
+        self.owned
+            .iter()
+            .find(|(dir, extensions)| extensions.contains(&extension) && same_file(parent, dir))
+            .map(|(dir, _)| format!("every *.{extension} in {} (replaced)", dir.display()))
+    }
+}
+
+const PROBE: &str = ".learn-write-check";
+
+impl OutputPaths {
+    /// The files a run producing the tables `tables` writes and removes (see [`write_outputs`]):
+    /// the README is not among them (it is an input too, updated in place).
+    pub fn planned(&self, tables: &[&str]) -> PlannedOutputs {
+        let mut files: Vec<PathBuf> = tables
+            .iter()
+            .map(|table| self.latex_dir.join(format!("{table}.tex")))
+            .collect();
+        files.extend([
+            self.results_dir.join("summary.json"),
+            self.results_dir.join("timings.json"),
+            self.results_dir.join(PROBE),
+            self.latex_dir.join(PROBE),
+        ]);
+        PlannedOutputs {
+            files,
+            owned: vec![
+                (self.tables_dir(), vec!["json", "md"]),
+                (self.figures_dir(), vec!["svg"]),
+            ],
+        }
+    }
+}
+
+/// The files `learn ablations` writes under `dir` (see [`crate::write_ablations`]).
+pub fn planned_ablations(dir: &Path) -> PlannedOutputs {
+    PlannedOutputs {
+        files: vec![
+            dir.join("ablations.json"),
+            dir.join("ablations.md"),
+            dir.join(PROBE),
+            dir.join("figures").join(PROBE),
+        ],
+        owned: vec![(dir.join("figures"), vec!["svg"])],
+    }
+}
+
 /// Creates `dir` and writes a probe file in it (removed again): a run then never fails at its end
 /// for an output directory it could have checked at its start.
 fn check_writable(dir: &Path) -> Result<()> {
-    let probe = dir.join(".learn-write-check");
+    let probe = dir.join(PROBE);
     write_text(&probe, "")?;
     std::fs::remove_file(&probe).map_err(|source| PipelineError::Io {
         path: probe.clone(),
@@ -225,6 +296,47 @@ pub fn check_paper(tables_dir: &Path, published: &Path, tolerances: &Path) -> Re
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn planned_outputs_name_the_files_written_and_the_directories_replaced() {
+        let paths = OutputPaths {
+            results_dir: PathBuf::from("res"),
+            latex_dir: PathBuf::from("tex"),
+            readme: None,
+        };
+        let planned = paths.planned(&["translational"]);
+        let same = |a: &Path, b: &Path| a == b;
+        let clobbers = |path: &str| planned.clobbers(Path::new(path), &same);
+        assert_eq!(clobbers("res/summary.json").unwrap(), "res/summary.json");
+        assert_eq!(
+            clobbers("tex/translational.tex").unwrap(),
+            "tex/translational.tex"
+        );
+        assert_eq!(
+            clobbers("res/tables/mine.json").unwrap(),
+            "every *.json in res/tables (replaced)"
+        );
+        assert!(clobbers("res/figures/a.svg").is_some());
+        for untouched in [
+            "res/tables/mine.csv",
+            "res/other.json",
+            "tex/attitude.tex",
+            "x.json",
+        ] {
+            assert_eq!(clobbers(untouched), None, "{untouched}");
+        }
+        let ablations = planned_ablations(Path::new("out"));
+        assert!(
+            ablations
+                .clobbers(Path::new("out/ablations.json"), &same)
+                .is_some()
+        );
+        assert!(
+            ablations
+                .clobbers(Path::new("out/variants.json"), &same)
+                .is_none()
+        );
+    }
 
     #[test]
     fn readme_block_is_replaced_and_the_rest_kept() {

@@ -219,6 +219,20 @@ pub struct CheckedVariants {
     pub root: PathBuf,
 }
 
+impl CheckedVariants {
+    /// Every file the ablations read besides the flights (this file, given by `option`, the run
+    /// configuration it names and that one's inputs), each with what names it: outputs must be
+    /// none of them.
+    pub fn input_files(&self, option: &str) -> Vec<(String, PathBuf)> {
+        let mut inputs = vec![(option.to_string(), self.path.clone())];
+        inputs.extend(
+            self.run
+                .input_files(&format!("run of {}", self.path.display())),
+        );
+        inputs
+    }
+}
+
 impl VariantsConfig {
     /// Reads and checks `path` alone (names, candidates, headline), without the run it names.
     pub fn read(path: &Path) -> Result<VariantsConfig> {

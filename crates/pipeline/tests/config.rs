@@ -228,3 +228,23 @@ fn seeds_are_capped() {
     );
     assert!(start.elapsed().as_secs() < 5);
 }
+
+#[test]
+fn a_fault_of_the_learn_configuration_itself_is_named_in_that_file() {
+    let dir = std::env::temp_dir().join(format!("pipeline-learn-own-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut learn = committed("experiments/learn.json");
+    learn.as_object_mut().unwrap().remove("seed");
+    let learn_path = dir.join("noseed.json");
+    std::fs::write(&learn_path, learn.to_string()).unwrap();
+    let mut config = committed("experiments/reproduce.json");
+    config["learn"]["config"] = learn_path.to_str().unwrap().into();
+    let message = load("learn-without-seed", &config).unwrap_err();
+    // No overrides: not blamed on them, and the position in the file is given.
+    assert!(!message.contains("overrides"), "{message}");
+    assert!(
+        message.contains("noseed.json: the document (line 1 column ")
+            && message.ends_with("missing field `seed`"),
+        "{message}"
+    );
+}

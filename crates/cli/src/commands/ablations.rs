@@ -9,15 +9,20 @@ use super::Global;
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// The variants configuration (variants, seeds, headline, figure variant).
-    #[arg(long, default_value = "experiments/variants.json")]
+    #[arg(
+        long,
+        default_value = "experiments/variants.json",
+        conflicts_with = "render_only"
+    )]
     pub config: PathBuf,
     /// Where ablations.{json,md} and figures/ are written.
     #[arg(long, default_value = "results/ablations")]
     pub out: PathBuf,
     /// The project root: relative paths in the configuration start here.
-    #[arg(long, default_value = ".")]
+    #[arg(long, default_value = ".", conflicts_with = "render_only")]
     pub root: PathBuf,
-    /// Only rewrite `<out>/ablations.md` from an existing `ablations.json` (no fitting).
+    /// Only rewrite `<out>/ablations.md` from an existing `ablations.json` (no fitting; --config
+    /// and --root do not apply).
     #[arg(long)]
     pub render_only: bool,
 }
@@ -37,11 +42,17 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     let config = VariantsConfig::load(&args.config, &args.root)?;
-    pipeline::check_ablations_output(&args.out)?;
+    // Before any directory is made: no output may be one of the inputs.
+    super::reproduce::refuse_inputs_as_outputs(
+        &pipeline::planned_ablations(&args.out),
+        &config.input_files("--config"),
+    )?;
     let data_dir = global.data_dir()?;
-    let quiet = global.quiet;
+    pipeline::check_ablations_output(&args.out)?;
+    // Per-cell lines only on a terminal and without --quiet (a log gets the final summary).
+    let show_progress = global.show_progress();
     let progress = |cell: &str| {
-        if !quiet {
+        if show_progress {
             eprintln!("{:>7.1} s  {cell}", start.elapsed().as_secs_f64());
         }
     };

@@ -2,7 +2,8 @@
 
 use std::path::PathBuf;
 
-use pipeline::{OutputPaths, RunConfig, RunOptions, StageTiming};
+use anyhow::bail;
+use pipeline::{OutputPaths, PlannedOutputs, RunConfig, RunOptions, StageTiming};
 
 use super::Global;
 
@@ -28,12 +29,31 @@ pub struct Args {
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let start = std::time::Instant::now();
     let config = RunConfig::load(&args.config, &args.root)?;
-    let data_dir = global.data_dir()?;
     let paths = OutputPaths {
         results_dir: args.out,
         latex_dir: args.latex_dir,
         readme: args.readme,
     };
+    // Before any directory is made: no output may be one of the inputs.
+    let tables: Vec<&str> = config.raw.formulations.iter().map(|f| f.name()).collect();
+    let planned = paths.planned(&tables);
+    let inputs = config.input_files("--config");
+    refuse_inputs_as_outputs(&planned, &inputs)?;
+    if let Some(readme) = &paths.readme {
+        // The README is updated in place; it must be no other input and no other output.
+        let named: Vec<(&str, &std::path::Path)> = inputs
+            .iter()
+            .map(|(option, path)| (option.as_str(), path.as_path()))
+            .collect();
+        super::refuse_input_as_output(readme, &named)?;
+        if let Some(output) = planned.clobbers(readme, &super::same_file) {
+            bail!(
+                "{}: the --readme to update is also an output of the run ({output})",
+                readme.display()
+            );
+        }
+    }
+    let data_dir = global.data_dir()?;
     paths.check()?;
     let print_stage = |timing: &StageTiming| {
         eprintln!("{:>7.2} s  {}", timing.seconds, timing.stage);
@@ -65,4 +85,23 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
 
 fn available_threads() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Refuses, before any work, a run that would write over or remove one of its `inputs` (what names
+/// it, path): a configuration, conditions or published file inside an output directory. No
+/// option can allow it: the run would destroy what it was made from.
+pub(super) fn refuse_inputs_as_outputs(
+    planned: &PlannedOutputs,
+    inputs: &[(String, PathBuf)],
+) -> anyhow::Result<()> {
+    for (option, input) in inputs {
+        if let Some(output) = planned.clobbers(input, &super::same_file) {
+            bail!(
+                "{}: is the {option} input, and the run writes {output}: refusing to write over \
+                 it (choose another output directory)",
+                input.display()
+            );
+        }
+    }
+    Ok(())
 }

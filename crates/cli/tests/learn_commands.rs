@@ -732,3 +732,21 @@ fn explain_rejects_a_window_longer_than_the_support_segment_and_non_finite_coeff
     );
     run.one_line_error(&["custom_figure8_baseline_35wind.csv", "not finite"]);
 }
+
+#[test]
+fn explain_refuses_conditions_with_a_flight_it_would_ignore() {
+    let dir = scratch("explain-conditions-flight");
+    let run = learn_in(
+        &dir,
+        &[
+            "explain",
+            "model.json",
+            "--flight",
+            "flight.csv",
+            "--conditions",
+            "conditions.json",
+        ],
+    );
+    run.one_line_usage_error(&["--conditions", "--flight", "cannot be used with"]);
+    assert!(run.stdout.is_empty(), "{}", run.stdout);
+}

@@ -20,8 +20,12 @@ pub struct Args {
     /// The evaluation condition whose flight to explain over (name or label).
     #[arg(long, conflicts_with = "flight")]
     pub condition: Option<String>,
-    /// Wind conditions and flight files.
-    #[arg(long, default_value = "experiments/conditions.json")]
+    /// Wind conditions and flight files (not with --flight, which names the flight itself).
+    #[arg(
+        long,
+        default_value = "experiments/conditions.json",
+        conflicts_with = "flight"
+    )]
     pub conditions: PathBuf,
     /// Explain the meta-trained model itself, without online adaptation on the flight.
     #[arg(long)]

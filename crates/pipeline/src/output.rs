@@ -73,9 +73,12 @@ impl PlannedOutputs {
         if let Some(file) = self.files.iter().find(|file| same_file(path, file)) {
             return Some(file.display().to_string());
         }
-        let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+        // An existing input is where its links lead: a link elsewhere to a file in an owned
+        // directory is that file.
+        let target = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        let parent = target.parent().filter(|p| !p.as_os_str().is_empty());
         let parent = parent.unwrap_or(Path::new("."));
-        let extension = path.extension().and_then(|e| e.to_str())?;
+        let extension = target.extension().and_then(|e| e.to_str())?;
         self.owned
             .iter()
             .find(|(dir, extensions)| extensions.contains(&extension) && same_file(parent, dir))
@@ -296,6 +299,29 @@ pub fn check_paper(tables_dir: &Path, published: &Path, tolerances: &Path) -> Re
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    #[cfg(unix)]
+    fn an_input_linked_into_a_replaced_directory_is_an_output() {
+        let dir = std::env::temp_dir().join(format!("pipeline-linked-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("res/tables")).unwrap();
+        std::fs::write(dir.join("res/tables/r.json"), "{}").unwrap();
+        std::os::unix::fs::symlink(dir.join("res/tables/r.json"), dir.join("c.json")).unwrap();
+        let paths = OutputPaths {
+            results_dir: dir.join("res"),
+            latex_dir: dir.join("tex"),
+            readme: None,
+        };
+        let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        };
+        let clobbers = paths
+            .planned(&["translational"])
+            .clobbers(&dir.join("c.json"), &same);
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!(clobbers.unwrap().starts_with("every *.json in "));
+    }
 
     #[test]
     fn planned_outputs_name_the_files_written_and_the_directories_replaced() {

@@ -637,10 +637,15 @@ fn explain_blames_the_checkpoint_not_the_adaptation_when_it_is_not_finite_before
     let dir = scratch("explain-bad-checkpoint");
     let flight = data.join("experiment/custom_figure8_baseline_35wind.csv");
     type Edit = fn(&mut MetaTrainedModel);
-    let cases: [(&str, Edit); 3] = [
+    let cases: [(&str, Edit); 4] = [
         ("parameter.json", |model| model.parameters[0] = 1e308),
         ("std.json", |model| model.standardiser.std[0] = 1e-300),
         ("mean.json", |model| model.standardiser.mean[0] = 1e308),
+        // (x + 1e308) / 1e-10 overflows: the standardised inputs themselves are not finite.
+        ("inputs.json", |model| {
+            model.standardiser.mean[0] = -1e308;
+            model.standardiser.std[0] = 1e-10;
+        }),
     ];
     for (name, edit) in cases {
         checkpoint(&dir, name, edit);
@@ -652,10 +657,13 @@ fn explain_blames_the_checkpoint_not_the_adaptation_when_it_is_not_finite_before
             let run = learn_in(&dir, &args);
             let message = run.one_line_error(&[
                 "custom_figure8_baseline_35wind.csv",
-                "parameters or standardiser",
+                "standardiser",
                 "not finite",
                 "before any adaptation",
             ]);
+            if name == "inputs.json" {
+                assert!(message.contains("standardised inputs"), "{message}");
+            }
             assert!(
                 !message.contains("adaptation.step") && !message.contains("too large"),
                 "{name}: {message}"

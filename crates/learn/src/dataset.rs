@@ -289,6 +289,9 @@ impl Standardiser {
         let range = self.range.as_ref()?;
         let rows = coverage.samples.max(1);
         let outputs = targets.len() / rows;
+        if outputs == 0 || self.mean.is_empty() {
+            return Some(coverage);
+        }
         // (sum of squared errors, values) inside and outside.
         let mut sums = [(0.0, 0usize); 2];
         let row_errors = predictions

@@ -755,7 +755,7 @@ pub fn explain_flight(
         return Err(LearnError::NotFinite {
             cell,
             message: format!(
-                "the checkpoint's standardiser (mean {}, std {} of input '{}') gives standardised inputs that are not finite on this flight",
+                "the checkpoint's standardiser (mean {}, std {} of input '{}') gives standardised inputs that are not finite on this flight, before any adaptation; the adaptation settings are not the cause",
                 model.standardiser.mean[j],
                 model.standardiser.std[j],
                 input_name(model, j)

@@ -183,7 +183,8 @@ fn distinct_decimals(poles: &[f64]) -> Option<usize> {
 }
 
 /// The poles as written in feature names: with [`distinct_decimals`] fixed decimals, else in
-/// Rust's shortest round-trip form (`1e-20`), which prints distinct values differently.
+/// Rust's shortest round-trip form (`0.00000000000000000001` for 1e-20), which prints distinct
+/// values differently.
 fn pole_labels(poles: &[f64]) -> Vec<String> {
     match distinct_decimals(poles) {
         Some(decimals) => poles.iter().map(|p| format!("{p:.decimals$}")).collect(),

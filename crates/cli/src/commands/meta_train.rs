@@ -276,7 +276,12 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     if let Some(seed) = args.seed {
         config = config.with_seed(seed);
     }
-    let table = published_tables(args.published.as_deref())?;
+    // The spread is not compared with the paper: no published file is read for it.
+    let table = if args.seed_spread {
+        None
+    } else {
+        published_tables(args.published.as_deref())?
+    };
     let conditions = ExperimentConditions::load(&args.conditions)?;
     let data_dir = global.data_dir()?;
     let protocol = Protocol::parse(&args.protocol)?;

@@ -357,7 +357,8 @@ fn simulate_writes_only_logs_the_data_tools_read() {
         .filter(|name| name.contains("f.csv"))
         .collect();
     assert!(left.is_empty(), "{left:?}");
-    // A scenario at the bounds gives a log that `data inspect` and `mismatch` read.
+    // A scenario near the position bound (975 m of 1000 m) at the lowest hover throttle gives a
+    // log that `data inspect` and `mismatch` read.
     write_scenario(&dir, "edge.json", |s| {
         s["duration_s"] = json!(5.0);
         s["hover_throttle"] = json!(0.05);

@@ -4,7 +4,8 @@
 //! numeric CSVs by column name ([`NumericTable`]); the paper's three [`Formulation`]s as data (which
 //! state, which inputs, with which scalings); derivative estimators ([`Derivative`]); support/query
 //! splits ([`SplitSpec`]); the experiment's wind conditions ([`ExperimentConditions`]); finding the
-//! data directory ([`resolve_data_dir`]); and reading the workspace's JSON files with errors that
+//! data directory ([`resolve_data_dir`]); telling whether two spellings name the same file
+//! ([`paths::same_file`]); and reading the workspace's JSON files with errors that
 //! name the failing field ([`json`]).
 //!
 //! What it is not for: fitting anything. Models live in `sindy` and `learn`, tables in `report`.
@@ -20,6 +21,7 @@ mod formulation;
 pub mod json;
 mod noise_floor;
 mod numeric;
+pub mod paths;
 mod source;
 mod split;
 mod table;

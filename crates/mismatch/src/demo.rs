@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis::{AnalysisSettings, analyze};
 use crate::error::{MismatchError, Result, io_error};
-use crate::output::{check_directory, output_paths, write_outputs};
+use crate::output::{check_directory, check_run_outputs, output_paths, write_outputs};
 
 /// One case of the manifest.
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -200,24 +200,26 @@ impl DemoPlan {
             .collect()
     }
 
-    /// Fails, before any work, if a directory of the run exists as something else or (unless
-    /// `force`) if any file the run writes exists: the summaries and every case's files.
+    /// Fails, before any work, if the run would write over a file it reads: a case's directory
+    /// that is a summary file (`work` and `out` may be the same directory), or any output that is
+    /// one of [`DemoPlan::inputs`] (even with `force`); then if an output cannot be written, or
+    /// (unless `force`) exists: the summaries (`--out`) and every case's files (`--work`). See
+    /// [`check_run_outputs`].
     pub fn check_outputs(&self, force: bool) -> Result<()> {
+        let summaries = self.summary_paths();
         for dir in self.case_dirs() {
-            check_directory(&dir)?;
+            if let Some(summary) = summaries.iter().find(|s| data::paths::same_file(&dir, s)) {
+                return Err(MismatchError::CaseDirectoryIsSummary {
+                    path: summary.clone(),
+                });
+            }
         }
-        if force {
-            return Ok(());
-        }
-        let existing = self
-            .summary_paths()
+        let outputs: Vec<(PathBuf, &str)> = summaries
             .into_iter()
-            .chain(self.case_outputs())
-            .find(|p| p.exists());
-        match existing {
-            Some(path) => Err(MismatchError::Exists { path }),
-            None => Ok(()),
-        }
+            .map(|p| (p, "--out"))
+            .chain(self.case_outputs().into_iter().map(|p| (p, "--work")))
+            .collect();
+        check_run_outputs(&outputs, &self.inputs(), force)
     }
 
     /// Runs every case and writes `out/summary.md` and `out/summary.json`; each case writes its
@@ -255,15 +257,6 @@ impl DemoPlan {
         std::fs::write(&markdown, summary.markdown()).map_err(io_error(&markdown))?;
         Ok(summary)
     }
-}
-
-/// Runs every case and writes `out/summary.md` and `out/summary.json`. Every scenario (and its
-/// model) is read and checked, and every output file (summaries in `out`, each case's recording and
-/// analysis in `work/<case>/`) checked against `force`, before any case runs.
-pub fn run_demo(manifest_path: &Path, work: &Path, out: &Path, force: bool) -> Result<DemoSummary> {
-    let plan = DemoPlan::load(manifest_path, work, out)?;
-    plan.check_outputs(force)?;
-    plan.run(force)
 }
 
 fn run_case(
@@ -594,7 +587,7 @@ mod tests {
         )
         .unwrap();
         let work = dir.join("work");
-        let error = run_demo(&dir.join("demo.json"), &work, &dir.join("out"), false)
+        let error = DemoPlan::load(&dir.join("demo.json"), &work, &dir.join("out"))
             .unwrap_err()
             .to_string();
         assert!(
@@ -659,7 +652,7 @@ mod tests {
         plan.check_outputs(false).unwrap();
         std::fs::create_dir_all(&case).unwrap();
         std::fs::write(case.join("mismatch.md"), "notes").unwrap();
-        let error = run_demo(&dir.join("demo.json"), &work, &out, false).unwrap_err();
+        let error = plan.check_outputs(false).unwrap_err();
         assert!(
             matches!(&error, MismatchError::Exists { path } if *path == case.join("mismatch.md")),
             "{error}"

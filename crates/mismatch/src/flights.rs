@@ -9,7 +9,7 @@ use physics::NominalModel;
 
 use crate::analysis::{AnalysisSettings, Report, analyze};
 use crate::error::{MismatchError, Result, io_error};
-use crate::output::{check_directory, output_paths, write_outputs};
+use crate::output::{check_directory, check_run_outputs, output_paths, write_outputs};
 
 /// The analysis of every condition's evaluation flight, read and checked, ready to run: which
 /// flights are present, what the run reads and what it writes (so that a caller can check every
@@ -96,19 +96,15 @@ impl FlightsPlan {
         self.out.join("neural-fly").join(name)
     }
 
-    /// Fails, before any work, if a directory of the run exists as something else or (unless
-    /// `force`) if any output file exists.
-    pub fn check_outputs(&self, force: bool) -> Result<()> {
-        check_directory(&self.out.join("neural-fly"))?;
-        for (condition, (_, present)) in self.conditions.conditions.iter().zip(&self.flights) {
-            if *present {
-                check_directory(&self.condition_dir(&condition.name))?;
-            }
-        }
-        if !force && let Some(path) = self.outputs().into_iter().find(|p| p.exists()) {
-            return Err(MismatchError::Exists { path });
-        }
-        Ok(())
+    /// Fails, before any work, if an output is one of the files the run reads ([`FlightsPlan::inputs`]
+    /// and the nominal model at `model`), even with `force`; then if an output cannot be written,
+    /// or (unless `force`) exists. See [`check_run_outputs`].
+    pub fn check_outputs(&self, model: &Path, force: bool) -> Result<()> {
+        let mut inputs = self.inputs();
+        inputs.push(("the --model file".to_string(), model.to_path_buf()));
+        let outputs: Vec<(PathBuf, &str)> =
+            self.outputs().into_iter().map(|p| (p, "--out")).collect();
+        check_run_outputs(&outputs, &inputs, force)
     }
 
     /// Analyses each present flight, writes `out/neural-fly/<condition>/mismatch.*` and
@@ -160,22 +156,6 @@ impl FlightsPlan {
         lines.push(format!("wrote {}", summary_path.display()));
         Ok(lines)
     }
-}
-
-/// Analyses each condition's flight, writes `out/neural-fly/<condition>/mismatch.*` and
-/// `out/neural-fly.md`; returns one printed line per flight. Every output is checked (see
-/// [`FlightsPlan::check_outputs`]) before the first flight is analysed.
-pub fn run_flights(
-    conditions_path: &Path,
-    data_dir: &Path,
-    model: &NominalModel,
-    model_name: &str,
-    out: &Path,
-    force: bool,
-) -> Result<Vec<String>> {
-    let plan = FlightsPlan::load(conditions_path, data_dir, out)?;
-    plan.check_outputs(force)?;
-    plan.run(model, model_name, force)
 }
 
 /// `c |w_air|²` when quadratic drag (with or without wind) was found.
@@ -327,6 +307,7 @@ mod tests {
         }
         let out = dir.join("out");
         let plan = FlightsPlan::load(&conditions(), &data, &out).unwrap();
+        let model = dir.join("quad.json");
         let inputs: Vec<PathBuf> = plan.inputs().into_iter().map(|(_, p)| p).collect();
         assert_eq!(
             inputs,
@@ -340,15 +321,15 @@ mod tests {
         assert_eq!(outputs.len(), 1 + 2 * 3);
         assert_eq!(outputs[0], out.join("neural-fly.md"));
         assert!(outputs.contains(&out.join("neural-fly/70wind/mismatch.svg")));
-        plan.check_outputs(false).unwrap();
+        plan.check_outputs(&model, false).unwrap();
         std::fs::create_dir_all(out.join("neural-fly/70wind")).unwrap();
         std::fs::write(out.join("neural-fly/70wind/mismatch.svg"), "mine").unwrap();
-        let error = plan.check_outputs(false).unwrap_err();
+        let error = plan.check_outputs(&model, false).unwrap_err();
         assert!(
             matches!(&error, MismatchError::Exists { path } if *path == out.join("neural-fly/70wind/mismatch.svg")),
             "{error}"
         );
-        plan.check_outputs(true).unwrap();
+        plan.check_outputs(&model, true).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

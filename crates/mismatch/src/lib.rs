@@ -40,7 +40,8 @@ pub use analysis::{
 pub use error::{MismatchError, Result};
 pub use library::{Candidate, TIMING, Term, build_library};
 pub use output::{
-    check_directory, check_outputs, markdown_text, output_paths, write_figure, write_outputs,
+    check_directory, check_outputs, check_run_outputs, markdown_text, output_paths, write_figure,
+    write_outputs,
 };
 pub use problem::{CHANNEL_NAMES, Channels, Problem};
 pub use recording::Recording;

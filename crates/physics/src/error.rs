@@ -19,6 +19,16 @@ pub enum PhysicsError {
         field: String,
         message: String,
     },
+    #[error(
+        "{}: the simulated flight is not a usable log ({cause}); nothing written to {}",
+        scenario.display(),
+        out.display()
+    )]
+    UnusableLog {
+        scenario: PathBuf,
+        out: PathBuf,
+        cause: String,
+    },
     #[error("simulation: {0}")]
     Simulation(String),
     #[error(transparent)]

@@ -6,7 +6,8 @@
 //! ([`simulate`]: RK4 rigid body, geometric tracking controller that knows only the nominal model,
 //! figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`]; a [`Scenario`] is read
 //! from JSON or, for examples and tests, built by [`Scenario::figure_eight`]) that writes
-//! Neural-Fly logs; and the residual force of a recorded flight ([`residual_force`], the `fa`
+//! Neural-Fly logs the data tools read back ([`write_readable`]); and the residual force of a
+//! recorded flight ([`residual_force`], the `fa`
 //! column).
 //!
 //! What it is not for: analysing mismatches (the `mismatch` crate), reading CSVs (the `data` crate).
@@ -25,6 +26,7 @@ mod residual;
 mod simulator;
 mod trajectory;
 pub mod vector;
+mod writer;
 
 pub use controller::{ControlOutput, Gains, GeometricController, MeasuredState};
 pub use effects::{
@@ -43,3 +45,4 @@ pub use trajectory::{
     LowPass, MAX_POSITION_M, MAX_WAYPOINTS, MAX_YAW_RATE_RAD_S, Reference, ReferenceGenerator,
     Trajectory,
 };
+pub use writer::write_readable;

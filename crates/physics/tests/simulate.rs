@@ -68,14 +68,15 @@ fn the_closed_loop_conceals_a_thrust_loss_and_runs_are_deterministic() {
     );
 }
 
-/// A scenario at the edges of what a scenario may ask for (reference near the position bound, the
-/// smallest hover throttle, the largest position noise) still gives a log the data tools
-/// read: the scenario's bounds keep the simulated values inside the data crate's plausible ranges.
+/// A scenario at the edges of what a scenario may ask for (a figure-8 whose reference reaches the
+/// position bound, the smallest hover throttle, the largest position noise) still gives
+/// a log the data tools read: the scenario's bounds keep the simulated values inside the data
+/// crate's plausible ranges.
 /// (Larger noise of the other measurements may make this closed loop diverge, an error of its own.)
 #[test]
 fn a_scenario_at_its_bounds_gives_a_log_the_data_tools_accept() {
     let model = demo_model();
-    let edge = physics::MAX_POSITION_M - 25.0;
+    let edge = physics::MAX_POSITION_M;
     let scenario = Scenario {
         hover_throttle: physics::MIN_HOVER_THROTTLE,
         noise: physics::Noise {
@@ -83,7 +84,7 @@ fn a_scenario_at_its_bounds_gives_a_log_the_data_tools_accept() {
             ..Scenario::figure_eight("demo-quad.json", 3).noise
         },
         trajectory: physics::Trajectory::Figure8 {
-            center: [edge - 2.0, -(edge - 2.0), edge - 2.0],
+            center: [edge - 1.5, -(edge - 0.8), edge - 0.3],
             first: [1.5, 0.0, 0.0],
             second: [0.0, 0.8, 0.3],
             period_s: 6.0,
@@ -93,10 +94,24 @@ fn a_scenario_at_its_bounds_gives_a_log_the_data_tools_accept() {
         },
         ..Scenario::figure_eight("demo-quad.json", 3)
     };
+    scenario
+        .validate_with_model(&model, std::path::Path::new("edge.json"))
+        .unwrap();
     let log = simulate(&model, &scenario, "edge").unwrap();
     let dir = common::temp_dir("edge");
     let path = dir.join("edge.csv");
-    log.write_csv(&path).unwrap();
+    physics::write_readable(&log, &path, std::path::Path::new("edge.json")).unwrap();
     let back = data::FlightLog::read(&path).unwrap();
     assert_eq!(back.len(), log.len());
+    // The reference comes within centimetres of the bound (the centre is one amplitude inside it).
+    let farthest = back
+        .position_desired
+        .unwrap()
+        .iter()
+        .flatten()
+        .fold(0.0_f64, |far, x| far.max(x.abs()));
+    assert!(
+        farthest <= physics::MAX_POSITION_M && farthest > physics::MAX_POSITION_M - 0.05,
+        "{farthest}"
+    );
 }

@@ -13,8 +13,6 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
-
 use super::Global;
 
 #[derive(clap::Args, Debug)]
@@ -51,21 +49,18 @@ pub struct Args {
 }
 
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
-    if let Some(manifest) = &args.demo {
-        return run_demo(manifest, &args);
+    // clap's "mode" group gives exactly one of --recording, --demo and --flights, and --model
+    // with the two that need it; the last arm only keeps the match total.
+    match (&args.recording, &args.demo, &args.flights, &args.model) {
+        (None, Some(manifest), None, None) => run_demo(manifest, &args),
+        (None, None, Some(conditions), Some(model)) => {
+            run_flights(global, conditions, model, &args)
+        }
+        (Some(recording), None, None, Some(model)) => run_recording(recording, model, &args),
+        _ => anyhow::bail!(
+            "give one of --recording or --flights (each with --model), or --demo (without --model)"
+        ),
     }
-    let model_path = args
-        .model
-        .as_deref()
-        .context("--model is required with --recording or --flights")?;
-    if let Some(conditions) = &args.flights {
-        return run_flights(global, conditions, model_path, &args);
-    }
-    let recording = args
-        .recording
-        .as_deref()
-        .context("give --recording (or --demo, or --flights)")?;
-    run_recording(recording, model_path, &args)
 }
 
 /// Where the demo writes its cases without `--work`.
@@ -76,25 +71,10 @@ fn run_demo(manifest: &Path, args: &Args) -> anyhow::Result<()> {
     super::refuse_unwritable_dir(&args.out, "--out")?;
     super::refuse_unwritable_dir(work, "--work")?;
     let plan = mismatch::demo::DemoPlan::load(manifest, work, &args.out)?;
-    let summaries = plan.summary_paths();
-    // A case directory must not be a summary file (--work and --out may be the same directory).
-    for dir in plan.case_dirs() {
-        if let Some(summary) = summaries.iter().find(|s| super::same_file(&dir, s)) {
-            anyhow::bail!(
-                "{}: is both a demo case's directory (--work) and a summary file (--out)",
-                summary.display()
-            );
-        }
-    }
-    let outputs: Vec<(PathBuf, &str)> = summaries
-        .iter()
-        .map(|p| (p.clone(), "--out"))
-        .chain(plan.case_outputs().into_iter().map(|p| (p, "--work")))
-        .collect();
-    check_outputs(&outputs, &plan.inputs(), args.force)?;
+    plan.check_outputs(args.force)?;
     let summary = plan.run(args.force)?;
     print!("{}", summary.table_text());
-    println!("wrote {}", summaries[0].display());
+    println!("wrote {}", plan.summary_paths()[0].display());
     Ok(())
 }
 
@@ -107,10 +87,7 @@ fn run_flights(
     super::refuse_unwritable_dir(&args.out, "--out")?;
     let data_dir = global.data_dir()?;
     let plan = mismatch::flights::FlightsPlan::load(conditions, &data_dir, &args.out)?;
-    let mut inputs = plan.inputs();
-    inputs.push(("the --model file".to_string(), model_path.to_path_buf()));
-    let outputs: Vec<(PathBuf, &str)> = plan.outputs().into_iter().map(|p| (p, "--out")).collect();
-    check_outputs(&outputs, &inputs, args.force)?;
+    plan.check_outputs(model_path, args.force)?;
     let model = physics::NominalModel::load(model_path)?;
     for line in plan.run(&model, &model_path.display().to_string(), args.force)? {
         println!("{line}");
@@ -128,7 +105,7 @@ fn run_recording(recording: &Path, model_path: &Path, args: &Args) -> anyhow::Re
         .into_iter()
         .map(|p| (p, "--out"))
         .collect();
-    check_outputs(&outputs, &inputs, args.force)?;
+    mismatch::check_run_outputs(&outputs, &inputs, args.force)?;
     let model = physics::NominalModel::load(model_path)?;
     let log = data::FlightLog::read(recording)?;
     let analysis = mismatch::analyze(
@@ -151,33 +128,5 @@ fn run_recording(recording: &Path, model_path: &Path, args: &Args) -> anyhow::Re
         report.fit.heldout.after.mse,
         args.out.display()
     );
-    Ok(())
-}
-
-/// Checks every file a run will write (with the option that places it), before any work: none is
-/// one of the run's `inputs` (what each is, its path), whatever `--force` says; each can be written;
-/// none exists unless `force`.
-fn check_outputs(
-    outputs: &[(PathBuf, &str)],
-    inputs: &[(String, PathBuf)],
-    force: bool,
-) -> anyhow::Result<()> {
-    for (output, _) in outputs {
-        if let Some((what, _)) = inputs
-            .iter()
-            .find(|(_, input)| super::same_file(output, input))
-        {
-            anyhow::bail!(
-                "{}: is {what}, which this run reads: refusing to write over it (even with --force)",
-                output.display()
-            );
-        }
-    }
-    for (output, option) in outputs {
-        super::refuse_unwritable_file(output, option)?;
-    }
-    for (output, _) in outputs {
-        super::refuse_overwrite(output, force)?;
-    }
     Ok(())
 }

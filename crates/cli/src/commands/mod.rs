@@ -15,6 +15,9 @@ use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
 
+/// Whether two paths name the same file whatever their spelling (see [`data::paths::same_file`]).
+pub use data::paths::same_file;
+
 /// Learned-library system identification: SINDy and LeARN on quadrotor flights.
 #[derive(Parser, Debug)]
 #[command(name = "learn", version, about)]
@@ -105,7 +108,6 @@ impl Global {
     }
 
     /// Whether progress bars may be drawn (not quiet, standard error is a terminal).
-    #[allow(dead_code)]
     pub fn show_progress(&self) -> bool {
         use std::io::IsTerminal;
         !self.quiet && std::io::stderr().is_terminal()
@@ -163,12 +165,7 @@ pub fn refuse_unwritable_dir(dir: &Path, option: &str) -> anyhow::Result<()> {
 /// Refuses `path` when the nearest of its parents that exists is not a directory (nothing can be
 /// created below it).
 fn refuse_below_a_non_directory(path: &Path, option: &str) -> anyhow::Result<()> {
-    let nearest = path
-        .ancestors()
-        .skip(1)
-        .filter(|parent| !parent.as_os_str().is_empty())
-        .find(|parent| parent.exists());
-    if let Some(parent) = nearest.filter(|parent| !parent.is_dir()) {
+    if let Some(parent) = data::paths::non_directory_ancestor(path) {
         anyhow::bail!(
             "{}: {} is not a directory, nothing can be written below it ({option})",
             path.display(),
@@ -176,49 +173,6 @@ fn refuse_below_a_non_directory(path: &Path, option: &str) -> anyhow::Result<()>
         );
     }
     Ok(())
-}
-
-/// Whether `a` and `b` name the same file, existing or not, whatever the spelling: the same
-/// existing file (also through links), or the same place once `.`, `..` and the links of the
-/// longest existing ancestor are resolved.
-pub fn same_file(a: &Path, b: &Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        if let (Ok(a), Ok(b)) = (std::fs::metadata(a), std::fs::metadata(b)) {
-            return a.dev() == b.dev() && a.ino() == b.ino();
-        }
-    }
-    match (resolved(a), resolved(b)) {
-        (Some(a), Some(b)) => a == b,
-        _ => false,
-    }
-}
-
-/// `path` made absolute, `.` dropped and `..` applied, then its longest existing ancestor
-/// canonicalised (links resolved). `None` if the current directory is unknown.
-fn resolved(path: &Path) -> Option<std::path::PathBuf> {
-    use std::path::{Component, PathBuf};
-    let mut lexical = PathBuf::new();
-    for component in std::env::current_dir().ok()?.join(path).components() {
-        match component {
-            Component::CurDir => {}
-            Component::ParentDir => {
-                lexical.pop();
-            }
-            other => lexical.push(other),
-        }
-    }
-    let mut base = lexical.as_path();
-    let mut rest = Vec::new();
-    loop {
-        if let Ok(mut canonical) = base.canonicalize() {
-            canonical.extend(rest.iter().rev());
-            return Some(canonical);
-        }
-        rest.push(base.file_name()?);
-        base = base.parent()?;
-    }
 }
 
 /// Refuses an output that is one of the command's inputs (`inputs`: option name, path), whatever
@@ -231,31 +185,4 @@ pub fn refuse_input_as_output(output: &Path, inputs: &[(&str, &Path)]) -> anyhow
         );
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn same_file_sees_through_spellings_of_paths_that_do_not_exist_yet() {
-        let dir = std::env::temp_dir().join(format!("learn-same-file-{}", std::process::id()));
-        std::fs::create_dir_all(dir.join("ck")).unwrap();
-        let plain = dir.join("ck/a.json");
-        assert!(same_file(&plain, &dir.join("ck/./a.json")));
-        assert!(same_file(&plain, &dir.join("ck/../ck/a.json")));
-        assert!(same_file(
-            &dir.join("new/x.json"),
-            &dir.join("new/sub/../x.json")
-        ));
-        assert!(!same_file(&plain, &dir.join("ck/b.json")));
-        std::fs::write(&plain, "{}").unwrap();
-        assert!(same_file(&plain, &dir.join("./ck/a.json")));
-        #[cfg(unix)]
-        {
-            std::os::unix::fs::symlink(dir.join("ck"), dir.join("link")).unwrap();
-            assert!(same_file(&dir.join("link/c.json"), &dir.join("ck/c.json")));
-        }
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
 }

@@ -27,7 +27,7 @@ pub struct TextTable {
 }
 
 /// At most this many column names are listed in an error message.
-pub const LISTED_COLUMNS: usize = 40;
+const LISTED_COLUMNS: usize = 40;
 
 /// The line of the file that holds data row `index` (0-based) when no cell spans lines; the header
 /// is line 1. [`TextTable::line`] gives the exact line of any row.

@@ -65,10 +65,7 @@ pub use causal::{CausalLibrary, MAX_CONTROL_LAGS, first_order_lag};
 pub use error::{Result, SindyError};
 pub use library::{CustomFunction, FeatureLibrary, LibrarySpec, MAX_FEATURES};
 pub use linalg::least_squares;
-pub use model::{
-    CONSTANT_RELATIVE_SPREAD, Score, SindyModel, SindyParams, Trajectory, constant_columns,
-    mean_squared_error, r2_score,
-};
+pub use model::{Score, SindyModel, SindyParams, Trajectory, mean_squared_error, r2_score};
 pub use optimizer::{
     DEFAULT_ALPHA, DEFAULT_MAX_ITER, Lasso, Optimizer, OptimizerSpec, Stlsq, StlsqFit,
     kkt_violation,

@@ -126,7 +126,8 @@ pub struct Score {
     /// `r2_score`, PySINDy's default score).
     pub r2: f64,
     /// Whether R² means anything: `false` when the target of some state is constant up to
-    /// rounding ([`constant_columns`]), where 1 − residual/variance divides by rounding noise.
+    /// rounding (a spread of at most 1e-9 of its largest magnitude), where 1 − residual/variance
+    /// divides by rounding noise.
     pub r2_defined: bool,
 }
 
@@ -544,7 +545,7 @@ pub fn mean_squared_error(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -
 /// The columns of `actual` that are constant up to rounding: standard deviation at most
 /// [`CONSTANT_RELATIVE_SPREAD`] times the largest magnitude in the column (all zeros included).
 /// R² is undefined on them.
-pub fn constant_columns(actual: MatRef<'_, f64>) -> Vec<usize> {
+pub(crate) fn constant_columns(actual: MatRef<'_, f64>) -> Vec<usize> {
     let n = actual.nrows();
     (0..actual.ncols())
         .filter(|&j| {
@@ -559,7 +560,7 @@ pub fn constant_columns(actual: MatRef<'_, f64>) -> Vec<usize> {
 
 /// See [`constant_columns`]: a spread this small relative to the values is rounding noise (a
 /// derivative estimate of x = 2t varies by ~1e-15).
-pub const CONSTANT_RELATIVE_SPREAD: f64 = 1e-9;
+pub(crate) const CONSTANT_RELATIVE_SPREAD: f64 = 1e-9;
 
 /// Coefficient of determination, averaged uniformly over columns (scikit-learn's `r2_score`).
 pub fn r2_score(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -> f64 {

@@ -43,7 +43,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     }
     let config = VariantsConfig::load(&args.config, &args.root)?;
     // Before any directory is made: no output may be one of the inputs.
-    super::reproduce::refuse_inputs_as_outputs(
+    super::refuse_inputs_as_outputs(
         &pipeline::planned_ablations(&args.out),
         &config.input_files("--config"),
     )?;

@@ -186,3 +186,22 @@ pub fn refuse_input_as_output(output: &Path, inputs: &[(&str, &Path)]) -> anyhow
     }
     Ok(())
 }
+
+/// Refuses, before any work, a run that would write over or remove one of its `inputs` (what names
+/// it, path): a configuration, conditions or published file inside an output directory. No
+/// option can allow it: the run would destroy what it was made from.
+pub fn refuse_inputs_as_outputs(
+    planned: &pipeline::PlannedOutputs,
+    inputs: &[(String, PathBuf)],
+) -> anyhow::Result<()> {
+    for (option, input) in inputs {
+        if let Some(output) = planned.clobbers(input, &same_file) {
+            anyhow::bail!(
+                "{}: is the {option} input, and the run writes {output}: refusing to write over \
+                 it (choose another output directory)",
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::bail;
-use pipeline::{OutputPaths, PlannedOutputs, RunConfig, RunOptions, StageTiming};
+use pipeline::{OutputPaths, RunConfig, RunOptions, StageTiming};
 
 use super::Global;
 
@@ -38,7 +38,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let tables: Vec<&str> = config.raw.formulations.iter().map(|f| f.name()).collect();
     let planned = paths.planned(&tables);
     let inputs = config.input_files("--config");
-    refuse_inputs_as_outputs(&planned, &inputs)?;
+    super::refuse_inputs_as_outputs(&planned, &inputs)?;
     if let Some(readme) = &paths.readme {
         // The README is updated in place; it must be no other input and no other output.
         let named: Vec<(&str, &std::path::Path)> = inputs
@@ -85,23 +85,4 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
 
 fn available_threads() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
-}
-
-/// Refuses, before any work, a run that would write over or remove one of its `inputs` (what names
-/// it, path): a configuration, conditions or published file inside an output directory. No
-/// option can allow it: the run would destroy what it was made from.
-pub(super) fn refuse_inputs_as_outputs(
-    planned: &PlannedOutputs,
-    inputs: &[(String, PathBuf)],
-) -> anyhow::Result<()> {
-    for (option, input) in inputs {
-        if let Some(output) = planned.clobbers(input, &super::same_file) {
-            bail!(
-                "{}: is the {option} input, and the run writes {output}: refusing to write over \
-                 it (choose another output directory)",
-                input.display()
-            );
-        }
-    }
-    Ok(())
 }

@@ -710,16 +710,6 @@ fn check_finite_parameters(parameters: &[f64], cell: &str, advice: &str) -> Resu
     Ok(())
 }
 
-/// The name of input `j` of `model`'s formulation.
-fn input_name(model: &MetaTrainedModel, j: usize) -> &'static str {
-    model
-        .formulation
-        .input_names()
-        .get(j)
-        .copied()
-        .unwrap_or("?")
-}
-
 fn standardised(standardiser: &Standardiser, batch: Batch) -> Batch {
     Batch {
         inputs: standardiser.apply(&batch.inputs),
@@ -758,7 +748,7 @@ pub fn explain_flight(
                 "the checkpoint's standardiser (mean {}, std {} of input '{}') gives standardised inputs that are not finite on this flight, before any adaptation; the adaptation settings are not the cause",
                 model.standardiser.mean[j],
                 model.standardiser.std[j],
-                input_name(model, j)
+                model.input_name(j)
             ),
         });
     }
@@ -774,7 +764,7 @@ pub fn explain_flight(
             cell,
             message: format!(
                 "the checkpoint's meta-trained parameters or standardiser give predictions that are not finite on this flight, before any adaptation (largest standardised input: |{}| = {largest:.3e}); the adaptation settings are not the cause",
-                input_name(model, k % dim)
+                model.input_name(k % dim)
             ),
         });
     }

@@ -47,6 +47,15 @@ pub struct MetaTrainedModel {
 }
 
 impl MetaTrainedModel {
+    /// The name of input `j` of the model's formulation (`?` past its inputs), for messages.
+    pub(crate) fn input_name(&self, j: usize) -> &'static str {
+        self.formulation
+            .input_names()
+            .get(j)
+            .copied()
+            .unwrap_or("?")
+    }
+
     /// Predictions (rows × I, row-major) for raw inputs (rows × (I+U), row-major).
     pub fn predict(&self, raw_inputs: &[f64]) -> Vec<f64> {
         self.architecture
@@ -164,12 +173,7 @@ impl MetaTrainedModel {
                     "mean {} and std {} of input '{}': the std must be a positive number",
                     standardiser.mean[j],
                     standardiser.std[j],
-                    model
-                        .formulation
-                        .input_names()
-                        .get(j)
-                        .copied()
-                        .unwrap_or("?")
+                    model.input_name(j)
                 ),
             });
         }

@@ -77,23 +77,26 @@ fn the_closed_loop_conceals_a_thrust_loss_and_runs_are_deterministic() {
 fn a_scenario_at_its_bounds_gives_a_log_the_data_tools_accept() {
     let model = demo_model();
     let edge = physics::MAX_POSITION_M;
-    let scenario = Scenario {
+    let figure_eight = Scenario::figure_eight("demo-quad.json", 3);
+    let mut scenario = Scenario {
         hover_throttle: physics::MIN_HOVER_THROTTLE,
         noise: physics::Noise {
             position_m: physics::MAX_NOISE.position_m,
-            ..Scenario::figure_eight("demo-quad.json", 3).noise
+            ..figure_eight.noise
         },
-        trajectory: physics::Trajectory::Figure8 {
-            center: [edge - 1.5, -(edge - 0.8), edge - 0.3],
-            first: [1.5, 0.0, 0.0],
-            second: [0.0, 0.8, 0.3],
-            period_s: 6.0,
-            low_passes: Vec::new(),
-            yaw_amplitude_rad: 0.2,
-            yaw_period_s: 10.0,
-        },
-        ..Scenario::figure_eight("demo-quad.json", 3)
+        ..figure_eight
     };
+    // The figure-8 moved so that each axis reaches the bound: its center one amplitude inside.
+    let physics::Trajectory::Figure8 {
+        center,
+        first,
+        second,
+        ..
+    } = &mut scenario.trajectory
+    else {
+        panic!("Scenario::figure_eight flies a figure-8");
+    };
+    *center = [edge - first[0], -(edge - second[1]), edge - second[2]];
     scenario
         .validate_with_model(&model, std::path::Path::new("edge.json"))
         .unwrap();

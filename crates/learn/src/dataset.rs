@@ -198,6 +198,12 @@ pub struct InputCoverage {
     pub samples_outside: usize,
     /// The largest distance outside the range, in meta-training standard deviations (0 if none).
     pub largest_excess_in_std: f64,
+    /// The part of the model's MSE over the whole segment that comes from the samples outside on
+    /// this input: their summed squared error divided by all values of the segment (so the
+    /// segment's MSE without them would be lower by this much), when the predictions were given
+    /// and such samples exist.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contribution_to_mse: Option<f64>,
 }
 
 impl InputRange {
@@ -254,6 +260,7 @@ impl Standardiser {
                     input: name.to_string(),
                     samples_outside: 0,
                     largest_excess_in_std: 0.0,
+                    contribution_to_mse: None,
                 })
                 .collect(),
             mse_inside: None,
@@ -292,27 +299,37 @@ impl Standardiser {
         if outputs == 0 || self.mean.is_empty() {
             return Some(coverage);
         }
-        // (sum of squared errors, values) inside and outside.
+        // (sum of squared errors, values) inside and outside; per input, the squared error of the
+        // rows outside on that input.
         let mut sums = [(0.0, 0usize); 2];
+        let mut per_input = vec![0.0; self.mean.len()];
         let row_errors = predictions
             .chunks_exact(outputs)
             .zip(targets.chunks_exact(outputs));
         for (row, (predicted, target)) in inputs.chunks_exact(self.mean.len()).zip(row_errors) {
-            let outside = row
-                .iter()
-                .enumerate()
-                .any(|(j, &x)| x < range.low[j] || x > range.high[j]);
-            let sum = &mut sums[usize::from(outside)];
-            sum.0 += predicted
+            let squared_error = predicted
                 .iter()
                 .zip(target)
                 .map(|(p, t)| (p - t) * (p - t))
                 .sum::<f64>();
+            let mut outside = false;
+            for (j, &x) in row.iter().enumerate() {
+                if x < range.low[j] || x > range.high[j] {
+                    outside = true;
+                    per_input[j] += squared_error;
+                }
+            }
+            let sum = &mut sums[usize::from(outside)];
+            sum.0 += squared_error;
             sum.1 += outputs;
         }
         let mean = |(total, count): (f64, usize)| (count > 0).then(|| total / count as f64);
         coverage.mse_inside = mean(sums[0]);
         coverage.mse_outside = mean(sums[1]);
+        let values = (sums[0].1 + sums[1].1) as f64;
+        for (input, squared_error) in coverage.inputs.iter_mut().zip(per_input) {
+            input.contribution_to_mse = (input.samples_outside > 0).then(|| squared_error / values);
+        }
         Some(coverage)
     }
 
@@ -428,6 +445,10 @@ mod tests {
         assert_eq!(coverage.samples_outside, 2);
         assert_eq!(coverage.mse_inside, Some((1.0 + 4.0) / 2.0));
         assert_eq!(coverage.mse_outside, Some((4.0 + 0.0 + 0.0 + 4.0) / 4.0));
+        // x is outside on rows 2 and 3 (squared errors 4 and 4), y on row 3 only; 6 values in all.
+        // The per-input parts overlap (row 3 counts for both) and lie within the MSE.
+        assert_eq!(coverage.inputs[0].contribution_to_mse, Some(8.0 / 6.0));
+        assert_eq!(coverage.inputs[1].contribution_to_mse, Some(4.0 / 6.0));
         // No row outside: no MSE outside.
         let inside_only = standardiser
             .coverage_with_errors(&segment[..2], &["x", "y"], &predictions[..2], &targets[..2])
@@ -435,6 +456,12 @@ mod tests {
         assert_eq!(
             (inside_only.mse_inside, inside_only.mse_outside),
             (Some(2.5), None)
+        );
+        assert!(
+            inside_only
+                .inputs
+                .iter()
+                .all(|input| input.contribution_to_mse.is_none())
         );
     }
 

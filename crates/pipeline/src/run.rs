@@ -454,8 +454,11 @@ fn coverage_note<'a>(
             };
             let detail = farthest.map_or(String::new(), |input| {
                 format!(
-                    " (farthest: {} by {:.1} std{errors})",
-                    input.input, input.largest_excess_in_std
+                    " (farthest: {} by {:.1} std on {} samples{}{errors})",
+                    input.input,
+                    input.largest_excess_in_std,
+                    input.samples_outside,
+                    contributions(input, sindy.as_ref())
                 )
             });
             Some(format!(
@@ -472,6 +475,24 @@ fn coverage_note<'a>(
             parts.join("; ")
         )
     })
+}
+
+/// What the samples outside on `input` add to each method's generalisation MSE (SINDy's from its
+/// own coverage of the same samples), e.g. ", which add 0.126 to LeARN's MSE and 0.020 to
+/// SINDy's"; empty without the errors.
+fn contributions(input: &learn::InputCoverage, sindy: Option<&RangeCoverage>) -> String {
+    let Some(learn) = input.contribution_to_mse else {
+        return String::new();
+    };
+    let sindy = sindy
+        .and_then(|coverage| coverage.inputs.iter().find(|i| i.input == input.input))
+        .and_then(|i| i.contribution_to_mse);
+    match sindy {
+        Some(sindy) => {
+            format!(", which add {learn:.3} to LeARN's MSE and {sindy:.3} to SINDy's")
+        }
+        None => format!(", which add {learn:.3} to LeARN's MSE"),
+    }
 }
 
 /// Column `j` of two stacked matrices.
@@ -766,6 +787,7 @@ mod tests {
             input: input.to_string(),
             samples_outside,
             largest_excess_in_std,
+            contribution_to_mse: (samples_outside > 0).then_some(0.125),
         };
         let inside = RangeCoverage {
             samples: 10,
@@ -781,11 +803,12 @@ mod tests {
             mse_inside: Some(0.25),
             mse_outside: Some(2.5),
         };
-        let sindy = RangeCoverage {
+        let mut sindy = RangeCoverage {
             mse_inside: Some(0.5),
             mse_outside: Some(1.25),
             ..outside.clone()
         };
+        sindy.inputs[1].contribution_to_mse = Some(0.0703125);
         let note = coverage_note(
             [
                 ("35wind", Some(&inside), None),
@@ -799,8 +822,8 @@ mod tests {
         assert!(
             note.ends_with(
                 ": 35wind 0 of 10; \
-                 100wind 3 of 10 (farthest: w_z by 9.6 std; MSE inside / outside: LeARN 0.250 / 2.500, SINDy 0.500 / 1.250); \
-                 70wind 3 of 10 (farthest: w_z by 9.6 std; MSE inside / outside: LeARN 0.250 / 2.500)."
+                 100wind 3 of 10 (farthest: w_z by 9.6 std on 3 samples, which add 0.125 to LeARN's MSE and 0.070 to SINDy's; MSE inside / outside: LeARN 0.250 / 2.500, SINDy 0.500 / 1.250); \
+                 70wind 3 of 10 (farthest: w_z by 9.6 std on 3 samples, which add 0.125 to LeARN's MSE; MSE inside / outside: LeARN 0.250 / 2.500)."
             ),
             "{note}"
         );

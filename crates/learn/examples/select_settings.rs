@@ -5,7 +5,7 @@
 //! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
 //! score and the one fold c's own validation prefers, and writes all numbers as JSON.
 //!
-//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation|window|basis|clamp|tasks]
+//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation|window|basis|clamp|tasks|restarts]
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -33,7 +33,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `window`: adaptation updates on windows of 2 or 4 consecutive samples (1: the paper);
     // `basis`: P = 1 or 3 learned basis functions per input instead of the paper's 2;
     // `clamp`: inputs clamped to the range they span in the meta-training flights;
-    // `tasks`: one meta-training task per wind condition (the paper's task) instead of per flight.
+    // `tasks`: one meta-training task per wind condition (the paper's task) instead of per flight;
+    // `restarts`: several initialisations (seeds) per model, keeping the one with the lowest
+    // support-tail MSE, or averaging their predictions (an ensemble), against a single seed.
     let stage = arguments.get(2).map_or("grid", String::as_str);
     let checked = LearnConfig::load(Path::new("experiments/learn.json"))?;
     let base = checked.get().clone();
@@ -46,6 +48,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(Protocol::LeaveConditionOut),
     )?;
     let folds = experiment.evaluation_conditions();
+    if stage == "restarts" {
+        return restarts(&experiment, &folds, &out);
+    }
 
     // Meta-training candidates (all within the reproduce budget: iterations × tasks ≤ 3200).
     let mut candidates: Vec<(String, LearnConfig)> = Vec::new();
@@ -324,4 +329,207 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::write(&out, serde_json::to_string_pretty(&document)? + "\n")?;
     eprintln!("wrote {out}");
     Ok(())
+}
+
+/// Seeds meta-trained per model in stage `restarts`, and how many of them a strategy draws.
+const RESTART_SEEDS: [u64; 6] = [1, 2, 3, 4, 5, 6];
+const RESTART_GROUP: usize = 3;
+/// The share of the support segment held out (its end) to score an initialisation.
+const SUPPORT_TAIL: f64 = 0.2;
+
+/// Stage `restarts`: is a model built from several initialisations better than one? For every
+/// nested pair and seed of [`RESTART_SEEDS`], meta-trains and adapts with the configured settings
+/// ([`Experiment::nested_validation_detail`]). For every group of [`RESTART_GROUP`] seeds, three
+/// strategies: `select-by-support-tail` keeps the seed whose model, adapted on the first 80% of the
+/// support segment, scores best on its last 20% (uses the support segment only); `ensemble`
+/// averages the adapted models' predictions (no longer the paper's single pair of networks);
+/// `best-by-query` keeps the seed with the lowest generalisation MSE (unattainable: it looks at
+/// the query, a reference for how much choosing could give). `single-seed` is the mean over the
+/// seeds. A strategy's score is its mean over all groups.
+fn restarts(
+    experiment: &Experiment,
+    folds: &[String],
+    out: &str,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut jobs = Vec::new();
+    for formulation in [
+        Formulation::Translational,
+        Formulation::Attitude,
+        Formulation::Full,
+    ] {
+        for (i, a) in folds.iter().enumerate() {
+            for b in &folds[i + 1..] {
+                for seed in RESTART_SEEDS {
+                    jobs.push((formulation, a.clone(), b.clone(), seed));
+                }
+            }
+        }
+    }
+    eprintln!("{} meta-trainings", jobs.len());
+    let results: Vec<[learn::ValidationDetail; 2]> = jobs
+        .par_iter()
+        .map(|(formulation, a, b, seed)| {
+            experiment.nested_validation_detail(*formulation, [a, b], *seed, SUPPORT_TAIL)
+        })
+        .collect::<Result<_, _>>()?;
+    // details[(formulation, fold, validated condition)][seed index]: fold a's validation scores
+    // condition b and fold b's scores condition a.
+    let mut details: BTreeMap<(String, String, String), Vec<&learn::ValidationDetail>> =
+        BTreeMap::new();
+    for ((formulation, a, b, _), [on_a, on_b]) in jobs.iter().zip(&results) {
+        let name = formulation.name().to_string();
+        details
+            .entry((name.clone(), a.clone(), b.clone()))
+            .or_default()
+            .push(on_b);
+        details
+            .entry((name, b.clone(), a.clone()))
+            .or_default()
+            .push(on_a);
+    }
+    let groups = groups_of(RESTART_SEEDS.len(), RESTART_GROUP);
+    let strategies: [(&str, Strategy); 4] = [
+        ("single-seed", |seeds, _| {
+            seeds.iter().map(|d| d.query_mse).sum::<f64>() / seeds.len() as f64
+        }),
+        ("select-by-support-tail", |seeds, group| {
+            let chosen = group
+                .iter()
+                .min_by(|&&i, &&j| {
+                    seeds[i]
+                        .support_tail_mse
+                        .total_cmp(&seeds[j].support_tail_mse)
+                })
+                .copied()
+                .unwrap_or(0);
+            seeds[chosen].query_mse
+        }),
+        ("ensemble", |seeds, group| {
+            let targets = &seeds[group[0]].query_targets;
+            let mut sum = 0.0;
+            for (k, target) in targets.iter().enumerate() {
+                let mean = group
+                    .iter()
+                    .map(|&i| seeds[i].query_predictions[k])
+                    .sum::<f64>()
+                    / group.len() as f64;
+                sum += (mean - target) * (mean - target);
+            }
+            sum / targets.len() as f64
+        }),
+        ("best-by-query", |seeds, group| {
+            group
+                .iter()
+                .map(|&i| seeds[i].query_mse)
+                .fold(f64::INFINITY, f64::min)
+        }),
+    ];
+    let mut report = Vec::new();
+    let mut summary = Vec::new();
+    for formulation in ["translational", "attitude", "full"] {
+        let mut correlations = Vec::new();
+        for ((f, _, _), seeds) in &details {
+            if f == formulation {
+                let tail: Vec<f64> = seeds.iter().map(|d| d.support_tail_mse).collect();
+                let query: Vec<f64> = seeds.iter().map(|d| d.query_mse).collect();
+                correlations.push(correlation(&tail, &query));
+            }
+        }
+        let mut means = serde_json::Map::new();
+        for (name, strategy) in &strategies {
+            let mut fold_scores = Vec::new();
+            for fold in folds {
+                let per_condition: Vec<f64> = details
+                    .iter()
+                    .filter(|((f, c, _), _)| f == formulation && c == fold)
+                    .map(|(_, seeds)| {
+                        groups.iter().map(|g| strategy(seeds, g)).sum::<f64>() / groups.len() as f64
+                    })
+                    .collect();
+                let mean = per_condition.iter().sum::<f64>() / per_condition.len() as f64;
+                fold_scores.push(mean);
+                report.push(json!({
+                    "formulation": formulation,
+                    "fold": fold,
+                    "meta_training": name,
+                    "adaptation": "configured",
+                    "validation_gen_mse": mean,
+                    "per_condition": per_condition,
+                }));
+            }
+            let mean = fold_scores.iter().sum::<f64>() / fold_scores.len() as f64;
+            means.insert(name.to_string(), json!(mean));
+            let formatted: Vec<String> = fold_scores.iter().map(|v| format!("{v:.4}")).collect();
+            println!(
+                "{formulation:14} {name:24} mean {mean:.4} folds {}",
+                formatted.join(" ")
+            );
+        }
+        let correlation = correlations.iter().sum::<f64>() / correlations.len() as f64;
+        println!(
+            "{formulation:14} correlation of support-tail and generalisation MSE over seeds: {correlation:.2}"
+        );
+        summary.push(json!({
+            "formulation": formulation,
+            "mean_over_folds": means,
+            "support_tail_query_correlation": correlation,
+        }));
+    }
+    let document = json!({
+        "protocol": "nested leave-one-condition-out inside each fold's meta-training set",
+        "seeds": RESTART_SEEDS,
+        "group_size": RESTART_GROUP,
+        "support_tail_fraction": SUPPORT_TAIL,
+        "folds": folds,
+        "scores": report,
+        "summary": summary,
+    });
+    if let Some(parent) = Path::new(out).parent() {
+        std::fs::create_dir_all(parent)?;
+    }
+    std::fs::write(out, serde_json::to_string_pretty(&document)? + "\n")?;
+    eprintln!("wrote {out}");
+    Ok(())
+}
+
+/// A way to build one model from a group of seeds (indices into the per-seed details), scored by
+/// its generalisation MSE.
+type Strategy = fn(&[&learn::ValidationDetail], &[usize]) -> f64;
+
+/// Every subset of `size` indices out of `0..count`, in lexicographic order.
+fn groups_of(count: usize, size: usize) -> Vec<Vec<usize>> {
+    let mut groups = Vec::new();
+    let mut current = Vec::with_capacity(size);
+    fn extend(
+        start: usize,
+        count: usize,
+        size: usize,
+        current: &mut Vec<usize>,
+        groups: &mut Vec<Vec<usize>>,
+    ) {
+        if current.len() == size {
+            groups.push(current.clone());
+            return;
+        }
+        for i in start..count {
+            current.push(i);
+            extend(i + 1, count, size, current, groups);
+            current.pop();
+        }
+    }
+    extend(0, count, size, &mut current, &mut groups);
+    groups
+}
+
+/// Pearson's correlation of two equally long samples (NaN if either is constant).
+fn correlation(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
+    for (a, b) in x.iter().zip(y) {
+        sxy += (a - mx) * (b - my);
+        sxx += (a - mx) * (a - mx);
+        syy += (b - my) * (b - my);
+    }
+    sxy / (sxx * syy).sqrt()
 }

@@ -71,6 +71,19 @@ pub struct CellSummary {
     pub query_coverage: Option<RangeCoverage>,
 }
 
+/// One evaluation flight of a nested-validation pair ([`Experiment::nested_validation_detail`]).
+#[derive(Clone, Debug)]
+pub struct ValidationDetail {
+    /// Generalisation MSE after adaptation on the whole support segment.
+    pub query_mse: f64,
+    /// MSE on the support segment's tail after adaptation on the rest of it.
+    pub support_tail_mse: f64,
+    /// The adapted model's query predictions, row-major, samples × I.
+    pub query_predictions: Vec<f64>,
+    /// The query targets, row-major, samples × I.
+    pub query_targets: Vec<f64>,
+}
+
 /// Everything one cell produces.
 #[derive(Clone, Debug)]
 pub struct CellResult {
@@ -313,27 +326,7 @@ impl Experiment {
         adaptations: &[AdaptationConfig],
         seed: u64,
     ) -> Result<[Vec<f64>; 2]> {
-        let first = self.conditions.condition(pair[0])?;
-        let second = self.conditions.condition(pair[1])?;
-        if self.protocol != Protocol::LeaveConditionOut || first.name == second.name {
-            return Err(LearnError::Mismatch {
-                what: format!("nested validation {}/{}", pair[0], pair[1]),
-                message: "needs leave-condition-out and two different conditions".to_string(),
-            });
-        }
-        let second_files: Vec<PathBuf> = self
-            .conditions
-            .flight_files(&self.data_dir)
-            .into_iter()
-            .filter(|f| f.condition == second.name)
-            .map(|f| f.path)
-            .collect();
-        let files: Vec<PathBuf> = self
-            .protocol
-            .training_files(&self.conditions, &self.data_dir, &first.name)?
-            .into_iter()
-            .filter(|path| !second_files.contains(path))
-            .collect();
+        let (first, second, files) = self.nested_training_files(pair)?;
         // The candidate settings are checked as a configuration read from the experiment's file.
         let origin = self.config.origin();
         let config = config.clone().check(origin)?;
@@ -380,6 +373,104 @@ impl Experiment {
                 .collect())
         };
         Ok([score(first)?, score(second)?])
+    }
+
+    /// The two conditions of a nested-validation pair and the flights of neither (the shared
+    /// meta-training set of [`Experiment::nested_validation`]).
+    fn nested_training_files(
+        &self,
+        pair: [&str; 2],
+    ) -> Result<(&data::Condition, &data::Condition, Vec<PathBuf>)> {
+        let first = self.conditions.condition(pair[0])?;
+        let second = self.conditions.condition(pair[1])?;
+        if self.protocol != Protocol::LeaveConditionOut || first.name == second.name {
+            return Err(LearnError::Mismatch {
+                what: format!("nested validation {}/{}", pair[0], pair[1]),
+                message: "needs leave-condition-out and two different conditions".to_string(),
+            });
+        }
+        let second_files: Vec<PathBuf> = self
+            .conditions
+            .flight_files(&self.data_dir)
+            .into_iter()
+            .filter(|f| f.condition == second.name)
+            .map(|f| f.path)
+            .collect();
+        let files: Vec<PathBuf> = self
+            .protocol
+            .training_files(&self.conditions, &self.data_dir, &first.name)?
+            .into_iter()
+            .filter(|path| !second_files.contains(path))
+            .collect();
+        Ok((first, second, files))
+    }
+
+    /// [`Experiment::nested_validation`] with the configured settings, keeping what a comparison
+    /// across seeds needs: for each condition of the pair, the generalisation MSE, the query
+    /// predictions and targets (standardised inputs, raw targets), and the **support-tail MSE**:
+    /// the model adapted on the first `1 − tail_fraction` of the support segment, scored on the
+    /// rest (a held-out score that uses the support segment only, as a method could at run time).
+    pub fn nested_validation_detail(
+        &self,
+        formulation: Formulation,
+        pair: [&str; 2],
+        seed: u64,
+        tail_fraction: f64,
+    ) -> Result<[ValidationDetail; 2]> {
+        if !(tail_fraction > 0.0 && tail_fraction < 1.0) {
+            return Err(LearnError::Mismatch {
+                what: format!("support tail fraction {tail_fraction}"),
+                message: "must lie strictly between 0 and 1".to_string(),
+            });
+        }
+        let (first, second, files) = self.nested_training_files(pair)?;
+        let config = self.config.get();
+        let cell = format!(
+            "{} nested validation {}/{}",
+            formulation.name(),
+            first.name,
+            second.name
+        );
+        let (architecture, standardiser, outcome) =
+            self.meta_train_on(formulation, &files, config, seed, &cell)?;
+        let adaptation = &config.adaptation;
+        let (input_dim, output_dim) = (architecture.input_dim, architecture.state_dim);
+        let detail = |condition: &data::Condition| -> Result<ValidationDetail> {
+            let path = self.conditions.flight_path(
+                &self.data_dir,
+                condition,
+                &self.conditions.evaluation_controller,
+            );
+            let (support, query) = flight_segments(&self.flight(&path)?.log, formulation)?;
+            let support = standardised(&standardiser, segment_batch(&support));
+            let query = standardised(&standardiser, segment_batch(&query));
+            let adapt = |rows: usize| {
+                adapt_online(
+                    &architecture,
+                    &outcome.parameters,
+                    &support.inputs[..rows * input_dim],
+                    &support.targets[..rows * output_dim],
+                    adaptation,
+                )
+            };
+            let rows = support.inputs.len() / input_dim;
+            let head_rows = ((rows as f64) * (1.0 - tail_fraction)).round() as usize;
+            let head_rows = head_rows.clamp(1, rows.saturating_sub(1));
+            let head = adapt(head_rows);
+            let support_tail_mse = architecture.loss(
+                &head,
+                &support.inputs[head_rows * input_dim..],
+                &support.targets[head_rows * output_dim..],
+            );
+            let adapted = adapt(rows);
+            Ok(ValidationDetail {
+                query_mse: architecture.loss(&adapted, &query.inputs, &query.targets),
+                support_tail_mse,
+                query_predictions: architecture.predict(&adapted, &query.inputs),
+                query_targets: query.targets,
+            })
+        };
+        Ok([detail(first)?, detail(second)?])
     }
 
     /// Adapts `model` online on the support segment of the evaluation flight of

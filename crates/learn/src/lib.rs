@@ -82,8 +82,8 @@ pub use dataset::{
 };
 pub use error::{LearnError, Result};
 pub use experiment::{
-    CellResult, CellSummary, Experiment, SegmentPrediction, Spread, SpreadCell, architecture,
-    evaluation_condition_of, explain_flight,
+    CellResult, CellSummary, Experiment, SegmentPrediction, Spread, SpreadCell, ValidationDetail,
+    architecture, evaluation_condition_of, explain_flight,
 };
 pub use explain::{
     EquationRule, Explanation, InputImportance, OutputExplanation, Term, explain, output_symbol,

@@ -237,3 +237,56 @@ fn every_finished_cell_is_reported_once() {
     assert_eq!(spread.len(), 4);
     assert_eq!(count.into_inner(), 8);
 }
+
+#[test]
+fn nested_validation_detail_agrees_with_nested_validation() {
+    let Some(data_dir) = common::real_data_dir() else {
+        return;
+    };
+    let root = common::workspace();
+    let path = root.join("experiments/learn.json");
+    let mut small = LearnConfig::load(&path).unwrap().get().clone();
+    small.meta_training.iterations = 3;
+    small.meta_training.support_batch = 16;
+    small.meta_training.query_batch = 16;
+    small.adaptation.passes = 1;
+    let checked = small.clone().check(&path).unwrap();
+    let conditions = ExperimentConditions::load(&root.join("experiments/conditions.json")).unwrap();
+    let experiment = Experiment::load(
+        checked,
+        conditions,
+        &data_dir,
+        Some(Protocol::LeaveConditionOut),
+    )
+    .unwrap();
+    let pair = ["35wind", "100wind"];
+    let detail = experiment
+        .nested_validation_detail(Formulation::Attitude, pair, 2, 0.2)
+        .unwrap();
+    let scores = experiment
+        .nested_validation(
+            Formulation::Attitude,
+            pair,
+            &small,
+            std::slice::from_ref(&small.adaptation),
+            2,
+        )
+        .unwrap();
+    for (detail, score) in detail.iter().zip(&scores) {
+        // The same meta-training and adaptation: the same generalisation MSE, bit for bit.
+        assert_eq!(detail.query_mse, score[0]);
+        assert_eq!(
+            detail.query_mse,
+            learn::mean_squared_error(&detail.query_predictions, &detail.query_targets)
+        );
+        assert_eq!(detail.query_predictions.len(), detail.query_targets.len());
+        assert!(detail.support_tail_mse.is_finite() && detail.support_tail_mse > 0.0);
+    }
+    for fraction in [0.0, 1.0, f64::NAN] {
+        let message = experiment
+            .nested_validation_detail(Formulation::Attitude, pair, 2, fraction)
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("between 0 and 1"), "{message}");
+    }
+}

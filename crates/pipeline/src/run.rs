@@ -13,8 +13,8 @@ use sindy::SegmentEvaluation;
 use crate::config::CheckedRunConfig;
 use crate::error::{PipelineError, Result, in_flight};
 use crate::summary::{
-    CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,
-    StageTiming, Summary,
+    CellRecord, FileRef, InputContribution, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT,
+    SindyCell, StageTiming, Summary,
 };
 
 /// How a run reports progress.
@@ -608,6 +608,16 @@ fn record(cell: &Cell, learn_results: &[Vec<CellResult>], index: usize) -> Resul
             equations: cell.sindy.model.equations(3),
             gen_inside_range: sindy_split.as_ref().and_then(|c| c.mse_inside),
             gen_outside_range: sindy_split.as_ref().and_then(|c| c.mse_outside),
+            gen_added_outside_range: sindy_split
+                .iter()
+                .flat_map(|c| &c.inputs)
+                .filter_map(|input| {
+                    Some(InputContribution {
+                        input: input.input.clone(),
+                        contribution_to_mse: input.contribution_to_mse?,
+                    })
+                })
+                .collect(),
         },
         learn: LearnCell {
             adapt: mse.adaptation,

@@ -57,6 +57,17 @@ pub struct SindyCell {
     pub gen_inside_range: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gen_outside_range: Option<f64>,
+    /// Per input with query samples outside its range, what those samples add to SINDy's
+    /// generalisation MSE (as `contribution_to_mse` in `learn.query_coverage`), in X order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub gen_added_outside_range: Vec<InputContribution>,
+}
+
+/// What the samples outside one input's range add to a method's MSE.
+#[derive(Clone, Debug, Serialize)]
+pub struct InputContribution {
+    pub input: String,
+    pub contribution_to_mse: f64,
 }
 
 /// LeARN on one flight with one seed.

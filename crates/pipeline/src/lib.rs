@@ -39,7 +39,7 @@ pub use summary::{
 };
 pub use variants::{
     AblationProvenance, AblationRow, Ablations, AblationsOutcome, CheckedVariants,
-    LearnedBasisSpec, MAX_VARIANTS, Outcome, SeedCell, VariantCell, VariantKind, VariantSpec,
-    VariantsConfig, ablations_markdown, evaluate_variants, reproduce_columns, run_variants,
-    write_ablations,
+    ENSEMBLE_SEED_STRIDE, LearnedBasisSpec, MAX_ENSEMBLE_MEMBERS, MAX_VARIANTS, Outcome, SeedCell,
+    VariantCell, VariantKind, VariantSpec, VariantsConfig, ablations_markdown,
+    ensemble_member_seeds, evaluate_variants, reproduce_columns, run_variants, write_ablations,
 };

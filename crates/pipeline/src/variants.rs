@@ -84,13 +84,37 @@ pub enum VariantKind {
     Average {
         members: Vec<String>,
     },
+    /// The mean prediction of `members` LeARN models, each meta-trained from its own seed
+    /// ([`ensemble_member_seeds`]) and adapted online as in `learn`: still of the form Θ·ℰᵀ, with
+    /// the members' basis functions side by side and their coefficients divided by `members`.
+    LearnEnsemble {
+        members: usize,
+    },
+}
+
+/// The most members a `learn_ensemble` variant may have (each is a full meta-training).
+pub const MAX_ENSEMBLE_MEMBERS: usize = 8;
+
+/// How far apart the seeds of a `learn_ensemble`'s members are: member k of the run seed s is
+/// meta-trained with seed s + k·stride, so the members of different run seeds never share one.
+pub const ENSEMBLE_SEED_STRIDE: u64 = 1_000_000;
+
+/// The seeds of the members of a `learn_ensemble` for the run seed `seed`: `seed` itself (the
+/// `learn` variant's model), then `seed + k·ENSEMBLE_SEED_STRIDE`; `None` on overflow.
+pub fn ensemble_member_seeds(seed: u64, members: usize) -> Option<Vec<u64>> {
+    (0..members as u64)
+        .map(|k| seed.checked_add(k.checked_mul(ENSEMBLE_SEED_STRIDE)?))
+        .collect()
 }
 
 impl VariantKind {
     /// Whether the variant needs the meta-trained LeARN networks (the paper's LeARN and the
     /// closed-form adaptations over its basis).
     fn needs_meta_training(&self) -> bool {
-        matches!(self, Self::LearnedBasis(_) | Self::Learn)
+        matches!(
+            self,
+            Self::LearnedBasis(_) | Self::Learn | Self::LearnEnsemble { .. }
+        )
     }
 
     /// Whether the variant fits a regression (and so has a support cross-validation score and
@@ -117,6 +141,19 @@ impl VariantKind {
         match self {
             Self::Library(variant) => variant.validate(),
             Self::LearnedBasis(variant) => variant.validate(),
+            Self::LearnEnsemble { members } => {
+                if (2..=MAX_ENSEMBLE_MEMBERS).contains(members) {
+                    Ok(())
+                } else {
+                    Err(sindy::SindyError::Field {
+                        field: "members".to_string(),
+                        message: format!(
+                            "{members} members; an ensemble has 2 to {MAX_ENSEMBLE_MEMBERS} \
+                             (pipeline::MAX_ENSEMBLE_MEMBERS), each a full meta-training"
+                        ),
+                    })
+                }
+            }
             Self::Select { .. } | Self::Learn | Self::Average { .. } => Ok(()),
         }
     }
@@ -345,6 +382,38 @@ impl VariantsConfig {
                 ));
             }
         }
+        for (index, variant) in raw.variants.iter().enumerate() {
+            if let VariantKind::LearnEnsemble { members } = variant.kind
+                && let Some(seed) = raw
+                    .seeds
+                    .iter()
+                    .find(|&&seed| ensemble_member_seeds(seed, members).is_none())
+            {
+                return Err(error(
+                    "seeds",
+                    format!(
+                        "seed {seed} leaves no room for the member seeds of variants[{index}] \
+                         ({}): seed + k·{ENSEMBLE_SEED_STRIDE} overflows",
+                        variant.name
+                    ),
+                ));
+            }
+        }
+        // `make reproduce` evaluates its columns with the run's one meta-trained model per cell.
+        if let Some(ensemble) = raw
+            .reproduce_variants()
+            .iter()
+            .find(|v| matches!(v.kind, VariantKind::LearnEnsemble { .. }))
+        {
+            return Err(error(
+                "reproduce",
+                format!(
+                    "{} (or a member of a listed variant) is a learn_ensemble, which needs more \
+                     meta-trained models than the run's one per cell; show it in make ablations",
+                    shown(&ensemble.name)
+                ),
+            ));
+        }
         Ok(raw)
     }
 
@@ -457,7 +526,8 @@ pub fn reproduce_columns(
     cells
         .par_iter()
         .map(|(support, query, model)| {
-            let run_model = || -> Result<MetaTrainedModel> { Ok((*model).clone()) };
+            // The run's model serves every variant; `read` refused ensembles in these columns.
+            let run_model = |_seed: u64| -> Result<MetaTrainedModel> { Ok((*model).clone()) };
             let outcomes = evaluate_variants(&variants, run_model, support, query, seed)?;
             Ok(variants
                 .iter()
@@ -788,7 +858,7 @@ fn evaluate_all(
     cell: &CellData,
     seed: u64,
 ) -> Result<Vec<Outcome>> {
-    let meta_train = || -> Result<MetaTrainedModel> {
+    let meta_train = |seed: u64| -> Result<MetaTrainedModel> {
         let experiment = experiment.expect("loaded when a variant needs the LeARN networks");
         Ok(experiment.meta_train(cell.formulation, &cell.condition.name, seed)?)
     };
@@ -802,18 +872,21 @@ fn evaluate_all(
 }
 
 /// Every variant of `variants` on one support/query pair with one seed, in declaration order.
-/// `meta_train` is called at most once, when a learned-basis variant needs the LeARN networks; it
-/// must not read the query segment (the pipeline's leaves the evaluation flight out entirely).
+/// `meta_train(s)` meta-trains the LeARN networks with seed `s`: with `seed` when a learned-basis
+/// variant needs them, with each member seed of a `learn_ensemble`, at most once per seed. It must
+/// not read the query segment (the pipeline's leaves the evaluation flight out entirely).
 pub fn evaluate_variants(
     variants: &[VariantSpec],
-    meta_train: impl FnOnce() -> Result<MetaTrainedModel>,
+    meta_train: impl Fn(u64) -> Result<MetaTrainedModel>,
     support: &Segment,
     query: &Segment,
     seed: u64,
 ) -> Result<Vec<Outcome>> {
     let mut outcomes: Vec<Outcome> = Vec::with_capacity(variants.len());
-    let mut meta_train = Some(meta_train);
-    let mut meta_trained = None;
+    let mut meta_trained = MetaTrainedModels {
+        train: &meta_train,
+        models: BTreeMap::new(),
+    };
     for spec in variants {
         // The indices of the variants `names` (each declared before this one).
         let earlier = |names: &[String], what: &str| -> Result<Vec<usize>> {
@@ -854,20 +927,47 @@ pub fn evaluate_variants(
                     }
                 }
                 VariantKind::LearnedBasis(variant) => {
-                    let model = meta_trained_once(&mut meta_trained, &mut meta_train)?;
+                    let model = meta_trained.get(seed)?;
                     let evaluation = variant.evaluate(model, support, query, seed)?;
                     outcome_of(evaluation, BTreeMap::new(), &support.formulation)
                 }
                 VariantKind::Learn => {
-                    let model = meta_trained_once(&mut meta_trained, &mut meta_train)?;
-                    let adapted = model.adapt(support, &model.config.adaptation);
-                    let predict = |segment: &Segment| {
-                        learn::from_row_major(
-                            &model.predict_segment(&adapted, segment),
-                            model.architecture.state_dim,
-                        )
-                    };
-                    Outcome::unfitted(predict(support), predict(query), support, query)
+                    let model = meta_trained.get(seed)?;
+                    let [on_support, on_query] = adapted_predictions(model, support, query);
+                    Outcome::unfitted(on_support, on_query, support, query)
+                }
+                VariantKind::LearnEnsemble { members } => {
+                    let seeds = ensemble_member_seeds(seed, *members).ok_or_else(|| {
+                        PipelineError::Mismatch {
+                            what: format!("seed {seed}"),
+                            message: "its ensemble member seeds overflow".to_string(),
+                        }
+                    })?;
+                    let mut sums: Option<[Mat<f64>; 2]> = None;
+                    for member_seed in seeds {
+                        let predictions =
+                            adapted_predictions(meta_trained.get(member_seed)?, support, query);
+                        match &mut sums {
+                            None => sums = Some(predictions),
+                            Some(sums) => {
+                                for (sum, prediction) in sums.iter_mut().zip(&predictions) {
+                                    *sum += prediction;
+                                }
+                            }
+                        }
+                    }
+                    let scale = 1.0 / *members as f64;
+                    let [on_support, on_query] = sums.expect("at least two members");
+                    Outcome::unfitted(
+                        Mat::from_fn(on_support.nrows(), on_support.ncols(), |i, j| {
+                            on_support[(i, j)] * scale
+                        }),
+                        Mat::from_fn(on_query.nrows(), on_query.ncols(), |i, j| {
+                            on_query[(i, j)] * scale
+                        }),
+                        support,
+                        query,
+                    )
                 }
                 VariantKind::Average { members } => {
                     let members: Vec<&SegmentPredictions> = earlier(members, "member")?
@@ -902,16 +1002,35 @@ pub fn evaluate_variants(
     Ok(outcomes)
 }
 
-/// The meta-trained model, trained by `train` on first use.
-fn meta_trained_once<'m>(
-    model: &'m mut Option<MetaTrainedModel>,
-    train: &mut Option<impl FnOnce() -> Result<MetaTrainedModel>>,
-) -> Result<&'m MetaTrainedModel> {
-    if model.is_none() {
-        let train = train.take().expect("called once");
-        *model = Some(train()?);
+/// The meta-trained models of one cell, each trained by `train` on first use of its seed.
+struct MetaTrainedModels<'t, F> {
+    train: &'t F,
+    models: BTreeMap<u64, MetaTrainedModel>,
+}
+
+impl<F: Fn(u64) -> Result<MetaTrainedModel>> MetaTrainedModels<'_, F> {
+    fn get(&mut self, seed: u64) -> Result<&MetaTrainedModel> {
+        if !self.models.contains_key(&seed) {
+            let model = (self.train)(seed)?;
+            self.models.insert(seed, model);
+        }
+        Ok(&self.models[&seed])
     }
-    Ok(model.as_ref().expect("set above"))
+}
+
+/// `model` adapted online on `support` (its own adaptation settings), predicting both segments.
+fn adapted_predictions(
+    model: &MetaTrainedModel,
+    support: &Segment,
+    query: &Segment,
+) -> [Mat<f64>; 2] {
+    let adapted = model.adapt(support, &model.config.adaptation);
+    [support, query].map(|segment| {
+        learn::from_row_major(
+            &model.predict_segment(&adapted, segment),
+            model.architecture.state_dim,
+        )
+    })
 }
 
 fn outcome_of(
@@ -1339,7 +1458,7 @@ mod tests {
         let (support, query) = (segment(60, 0.0), segment(40, 1.3));
         let model = untrained_model();
         let outcomes =
-            evaluate_variants(&read.variants, || Ok(model.clone()), &support, &query, 1).unwrap();
+            evaluate_variants(&read.variants, |_| Ok(model.clone()), &support, &query, 1).unwrap();
         let adapted = model.adapt(&support, &model.config.adaptation);
         assert_ne!(adapted, model.parameters, "adaptation moved nothing");
         let expected = model.predict_segment(&adapted, &query);
@@ -1364,6 +1483,98 @@ mod tests {
         );
         assert!(outcomes[1].support_cv.is_none() && outcomes[2].chosen.is_empty());
         assert!(outcomes[0].support_cv.is_some() && outcomes[2].regression.is_none());
+    }
+
+    #[test]
+    fn learn_ensemble_is_the_mean_of_its_members_each_meta_trained_once_from_its_own_seed() {
+        let text = config(
+            r#"{"name": "l", "description": "", "kind": "learn"},
+               {"name": "a", "description": "", "kind": "learn_ensemble", "members": 3}"#,
+            "",
+        );
+        let read = VariantsConfig::read(&write("ensemble", &text)).unwrap();
+        let (support, query) = (segment(60, 0.0), segment(40, 1.3));
+        // A different (untrained) model per seed; the seeds asked for are recorded.
+        let asked = std::sync::Mutex::new(Vec::new());
+        let model_for = |seed: u64| {
+            let mut model = untrained_model();
+            model.seed = seed;
+            model.parameters = model.architecture.initial_parameters(seed);
+            model
+        };
+        let train = |seed: u64| {
+            asked.lock().unwrap().push(seed);
+            Ok(model_for(seed))
+        };
+        let outcomes = evaluate_variants(&read.variants, train, &support, &query, 7).unwrap();
+        // The `learn` model (seed 7) is the ensemble's first member, trained once.
+        assert_eq!(*asked.lock().unwrap(), vec![7, 1_000_007, 2_000_007]);
+        assert_eq!(
+            ensemble_member_seeds(7, 3),
+            Some(vec![7, 1_000_007, 2_000_007])
+        );
+        let members: Vec<[Mat<f64>; 2]> = [7, 1_000_007, 2_000_007]
+            .into_iter()
+            .map(|seed| adapted_predictions(&model_for(seed), &support, &query))
+            .collect();
+        let ensemble = &outcomes[1].predictions;
+        for i in 0..query.len() {
+            for j in 0..3 {
+                let mean = members.iter().map(|m| m[1][(i, j)]).sum::<f64>() / 3.0;
+                assert!(
+                    (ensemble.query_prediction[(i, j)] - mean).abs() <= 1e-12 * mean.abs().max(1.0)
+                );
+            }
+        }
+        assert_eq!(outcomes[0].predictions.query_prediction, members[0][1]);
+        assert_ne!(
+            members[0][1], members[1][1],
+            "the members are different models"
+        );
+        assert!(outcomes[1].chosen.is_empty() && outcomes[1].support_cv.is_none());
+    }
+
+    #[test]
+    fn a_learn_ensemble_is_checked_when_the_file_is_read() {
+        let ensemble = |members: &str| {
+            format!(
+                r#"{{"name": "a", "description": "", "kind": "learn_ensemble", "members": {members}}}"#
+            )
+        };
+        let message = read_error("ensemble-one", &ensemble("1"), "");
+        assert!(
+            message.ends_with(
+                "variants[0] (a).members: 1 members; an ensemble has 2 to 8 (pipeline::MAX_ENSEMBLE_MEMBERS), each a full meta-training"
+            ),
+            "{message}"
+        );
+        let message = read_error("ensemble-many", &ensemble("100"), "");
+        assert!(message.contains("100 members"), "{message}");
+        let overflow = config(&ensemble("3"), "")
+            .replace(r#""seeds": [1]"#, r#""seeds": [1, 18446744073709551000]"#);
+        let path = write("ensemble-overflow", &overflow);
+        let message = VariantsConfig::read(&path).unwrap_err().to_string();
+        assert!(
+            message.contains("seeds: seed 18446744073709551000 leaves no room"),
+            "{message}"
+        );
+        // Shown in make reproduce's columns, directly or through an average: refused.
+        let a = format!(r#"{{"name": "r", "description": "", {RIDGE}}}"#);
+        let average =
+            r#"{"name": "m", "description": "", "kind": "average", "members": ["r", "a"]}"#;
+        for (name, extra) in [
+            ("ensemble-reproduce", r#""reproduce": ["a"],"#),
+            ("ensemble-reproduce-member", r#""reproduce": ["m"],"#),
+        ] {
+            let variants = format!("{a}, {}, {average}", ensemble("3"));
+            let message = read_error(name, &variants, extra);
+            assert!(
+                message.contains(
+                    "reproduce: 'a' (or a member of a listed variant) is a learn_ensemble"
+                ),
+                "{name}: {message}"
+            );
+        }
     }
 
     fn write(name: &str, text: &str) -> PathBuf {
@@ -1681,7 +1892,7 @@ mod tests {
         let (support, query) = (segment(60, 0.0), segment(40, 1.3));
         let message = evaluate_variants(
             &read.variants,
-            || Ok(untrained_model()),
+            |_| Ok(untrained_model()),
             &support,
             &query,
             1,
@@ -1733,6 +1944,6 @@ mod tests {
     fn the_committed_variants_are_within_every_limit() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../experiments/variants.json");
         let read = VariantsConfig::read(&path).unwrap();
-        assert_eq!(read.variants.len(), 14);
+        assert_eq!(read.variants.len(), 15);
     }
 }

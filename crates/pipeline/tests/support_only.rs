@@ -74,13 +74,18 @@ fn perturbing_the_query_changes_no_choice() {
             .unwrap();
         let changed = perturbed(&query);
         let learn_config = config.run.learn.get().clone();
-        let model = || Ok(untrained_model(formulation, &learn_config));
+        let model = |_| Ok(untrained_model(formulation, &learn_config));
         let original = evaluate_variants(&config.raw.variants, model, &support, &query, 3).unwrap();
         let again = evaluate_variants(&config.raw.variants, model, &support, &changed, 3).unwrap();
         for ((spec, a), b) in config.raw.variants.iter().zip(&original).zip(&again) {
             let what = format!("{} {}", formulation.name(), spec.name);
-            // `learn` and `average` choose nothing; every other variant records its choices.
-            let chooses = !matches!(spec.kind, VariantKind::Learn | VariantKind::Average { .. });
+            // `learn`, `learn_ensemble` and `average` choose nothing; every other variant records its choices.
+            let chooses = !matches!(
+                spec.kind,
+                VariantKind::Learn
+                    | VariantKind::LearnEnsemble { .. }
+                    | VariantKind::Average { .. }
+            );
             assert_eq!(!a.chosen.is_empty(), chooses, "{what}: choices recorded");
             assert_eq!(a.chosen, b.chosen, "{what}: a choice moved with the query");
             assert_eq!(a.support_cv, b.support_cv, "{what}");

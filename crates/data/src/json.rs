@@ -2,8 +2,15 @@
 //! or a bad value deep in a file is reported as `meta_training.average_last (line 22 column 20):
 //! invalid value: integer -1, expected usize`, not by its position alone. Every crate's loaders use
 //! this and wrap [`JsonError`] in their own error type with the file's path.
+//!
+//! serde reads a struct from a JSON array as well as from an object (the fields in declaration
+//! order), so `"optimizer": ["stlsq", 0.2]` would be taken silently for an object. Both readers
+//! refuse that: the value read is written back and compared in shape with the document, and an
+//! array where the type holds an object is an error naming the field.
 
+use serde::Serialize;
 use serde::de::DeserializeOwned;
+use serde_json::Value;
 
 /// Where a JSON document failed to deserialise, and why.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -24,7 +31,7 @@ impl std::fmt::Display for JsonError {
 
 /// Deserialises `text` (a leading byte-order mark is ignored, as editors may write one), naming
 /// the field that fails.
-pub fn from_str<T: DeserializeOwned>(text: &str) -> Result<T, JsonError> {
+pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, JsonError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut deserializer = serde_json::Deserializer::from_str(text);
     let value = serde_path_to_error::deserialize(&mut deserializer).map_err(|error| {
@@ -49,16 +56,68 @@ pub fn from_str<T: DeserializeOwned>(text: &str) -> Result<T, JsonError> {
         ),
         message: without_position(&error),
     })?;
+    let document: Value = serde_json::from_str(text).map_err(|error| JsonError {
+        field: "the document".to_string(),
+        message: without_position(&error),
+    })?;
+    objects_not_arrays(&document, &value)?;
     Ok(value)
 }
 
 /// Deserialises an already parsed `value` (e.g. a configuration after a merge patch), naming the
 /// field that fails.
-pub fn from_value<T: DeserializeOwned>(value: serde_json::Value) -> Result<T, JsonError> {
-    serde_path_to_error::deserialize(value).map_err(|error| JsonError {
+pub fn from_value<T: DeserializeOwned + Serialize>(value: Value) -> Result<T, JsonError> {
+    let read: T = serde_path_to_error::deserialize(value.clone()).map_err(|error| JsonError {
         field: field_path(error.path()).unwrap_or_else(|| "the document".to_string()),
         message: without_position(error.inner()),
-    })
+    })?;
+    objects_not_arrays(&value, &read)?;
+    Ok(read)
+}
+
+/// Refuses a `document` that gives an array where `read` (the value deserialised from it) holds
+/// an object: `read` is serialised again and walked beside the document.
+fn objects_not_arrays<T: Serialize>(document: &Value, read: &T) -> Result<(), JsonError> {
+    let written = serde_json::to_value(read).map_err(|error| JsonError {
+        field: "the document".to_string(),
+        message: format!("cannot be checked: {error}"),
+    })?;
+    match array_for_object(document, &written, "") {
+        None => Ok(()),
+        Some(path) => Err(JsonError {
+            field: if path.is_empty() {
+                "the document".to_string()
+            } else {
+                path
+            },
+            message: "expected a JSON object, found an array".to_string(),
+        }),
+    }
+}
+
+/// The path (`a.b[2]`) of the first place where `document` has an array and `written` an object.
+fn array_for_object(document: &Value, written: &Value, path: &str) -> Option<String> {
+    match (document, written) {
+        (Value::Array(_), Value::Object(_)) => Some(path.to_string()),
+        (Value::Object(document), Value::Object(written)) => {
+            written.iter().find_map(|(key, written)| {
+                let inner = if path.is_empty() {
+                    key.clone()
+                } else {
+                    format!("{path}.{key}")
+                };
+                array_for_object(document.get(key)?, written, &inner)
+            })
+        }
+        (Value::Array(document), Value::Array(written)) => document
+            .iter()
+            .zip(written)
+            .enumerate()
+            .find_map(|(index, (document, written))| {
+                array_for_object(document, written, &format!("{path}[{index}]"))
+            }),
+        _ => None,
+    }
 }
 
 /// The path as `a.b[2].c`, or `None` at the document's root.
@@ -79,7 +138,7 @@ mod tests {
     use super::*;
     use serde::Deserialize;
 
-    #[derive(Debug, Deserialize)]
+    #[derive(Debug, Deserialize, Serialize)]
     #[serde(deny_unknown_fields)]
     struct Outer {
         #[allow(dead_code)]
@@ -88,7 +147,7 @@ mod tests {
         rules: Vec<Inner>,
     }
 
-    #[derive(Debug, Deserialize)]
+    #[derive(Debug, Deserialize, Serialize)]
     #[serde(deny_unknown_fields)]
     struct Inner {
         count: usize,
@@ -143,5 +202,27 @@ mod tests {
         let error = from_value::<Outer>(value).unwrap_err();
         assert_eq!(error.field, "inner.count");
         assert!(error.message.starts_with("invalid type: string"), "{error}");
+    }
+
+    #[test]
+    fn an_array_in_place_of_an_object_is_refused_by_its_path() {
+        let error = from_str::<Outer>("{\"inner\": [1], \"rules\": []}").unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "inner: expected a JSON object, found an array"
+        );
+        let error =
+            from_str::<Outer>("{\"inner\": {\"count\": 1}, \"rules\": [{\"count\": 2}, [3]]}")
+                .unwrap_err();
+        assert_eq!(error.field, "rules[1]");
+        let error = from_str::<Outer>("[{\"count\": 1}, []]").unwrap_err();
+        assert_eq!(error.field, "the document");
+        let error =
+            from_value::<Outer>(serde_json::json!({"inner": [4], "rules": []})).unwrap_err();
+        assert_eq!(error.field, "inner");
+        // Arrays where the type holds arrays are fine.
+        let read: Outer =
+            from_str("{\"inner\": {\"count\": 1}, \"rules\": [{\"count\": 2}]}").unwrap();
+        assert_eq!(read.rules.len(), 1);
     }
 }

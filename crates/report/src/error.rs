@@ -31,7 +31,9 @@ pub type Result<T> = std::result::Result<T, ReportError>;
 
 /// Reads a JSON file into `T`, naming the file and the failing field (with its line and column)
 /// on error.
-pub(crate) fn read_json<T: serde::de::DeserializeOwned>(path: &std::path::Path) -> Result<T> {
+pub(crate) fn read_json<T: serde::de::DeserializeOwned + serde::Serialize>(
+    path: &std::path::Path,
+) -> Result<T> {
     let text = std::fs::read_to_string(path).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,

@@ -217,20 +217,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let adaptation_settings: Vec<AdaptationConfig> =
         adaptations.iter().map(|(_, a)| a.clone()).collect();
 
-    let mut jobs = Vec::new();
-    for formulation in [
-        Formulation::Translational,
-        Formulation::Attitude,
-        Formulation::Full,
-    ] {
-        for (i, a) in folds.iter().enumerate() {
-            for b in &folds[i + 1..] {
-                for candidate in 0..candidates.len() {
-                    jobs.push((formulation, a.clone(), b.clone(), candidate));
-                }
-            }
-        }
-    }
+    let candidate_indices: Vec<usize> = (0..candidates.len()).collect();
+    let jobs = pair_jobs(&folds, &candidate_indices);
     eprintln!("{} meta-trainings", jobs.len());
     let results: Vec<[Vec<f64>; 2]> = jobs
         .par_iter()
@@ -331,6 +319,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// One job per formulation, unordered pair of folds (a before b) and item (a candidate, a seed).
+fn pair_jobs<T: Copy>(folds: &[String], items: &[T]) -> Vec<(Formulation, String, String, T)> {
+    let mut jobs = Vec::new();
+    for formulation in [
+        Formulation::Translational,
+        Formulation::Attitude,
+        Formulation::Full,
+    ] {
+        for (i, a) in folds.iter().enumerate() {
+            for b in &folds[i + 1..] {
+                for &item in items {
+                    jobs.push((formulation, a.clone(), b.clone(), item));
+                }
+            }
+        }
+    }
+    jobs
+}
+
 /// Seeds meta-trained per model in stage `restarts`, and how many of them a strategy draws.
 const RESTART_SEEDS: [u64; 6] = [1, 2, 3, 4, 5, 6];
 const RESTART_GROUP: usize = 3;
@@ -351,20 +358,7 @@ fn restarts(
     folds: &[String],
     out: &str,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let mut jobs = Vec::new();
-    for formulation in [
-        Formulation::Translational,
-        Formulation::Attitude,
-        Formulation::Full,
-    ] {
-        for (i, a) in folds.iter().enumerate() {
-            for b in &folds[i + 1..] {
-                for seed in RESTART_SEEDS {
-                    jobs.push((formulation, a.clone(), b.clone(), seed));
-                }
-            }
-        }
-    }
+    let jobs = pair_jobs(folds, &RESTART_SEEDS);
     eprintln!("{} meta-trainings", jobs.len());
     let results: Vec<[learn::ValidationDetail; 2]> = jobs
         .par_iter()

@@ -71,6 +71,15 @@ pub struct CellSummary {
     pub query_coverage: Option<RangeCoverage>,
 }
 
+/// A model meta-trained for a nested-validation pair, with the pair's conditions.
+struct NestedModel<'a> {
+    first: &'a data::Condition,
+    second: &'a data::Condition,
+    architecture: Architecture,
+    standardiser: Standardiser,
+    outcome: MetaTrainingOutcome,
+}
+
 /// One evaluation flight of a nested-validation pair ([`Experiment::nested_validation_detail`]).
 #[derive(Clone, Debug)]
 pub struct ValidationDetail {
@@ -326,7 +335,6 @@ impl Experiment {
         adaptations: &[AdaptationConfig],
         seed: u64,
     ) -> Result<[Vec<f64>; 2]> {
-        let (first, second, files) = self.nested_training_files(pair)?;
         // The candidate settings are checked as a configuration read from the experiment's file.
         let origin = self.config.origin();
         let config = config.clone().check(origin)?;
@@ -338,14 +346,13 @@ impl Experiment {
             }
             .check(origin)?;
         }
-        let cell = format!(
-            "{} nested validation {}/{}",
-            formulation.name(),
-            first.name,
-            second.name
-        );
-        let (architecture, standardiser, outcome) =
-            self.meta_train_on(formulation, &files, config, seed, &cell)?;
+        let NestedModel {
+            first,
+            second,
+            architecture,
+            standardiser,
+            outcome,
+        } = self.nested_meta_train(formulation, pair, config, seed)?;
         let score = |condition: &data::Condition| -> Result<Vec<f64>> {
             let path = self.conditions.flight_path(
                 &self.data_dir,
@@ -375,12 +382,15 @@ impl Experiment {
         Ok([score(first)?, score(second)?])
     }
 
-    /// The two conditions of a nested-validation pair and the flights of neither (the shared
-    /// meta-training set of [`Experiment::nested_validation`]).
-    fn nested_training_files(
+    /// Meta-trains with `config` on the flights of neither condition of a nested-validation pair
+    /// (the shared meta-training set of [`Experiment::nested_validation`]).
+    fn nested_meta_train(
         &self,
+        formulation: Formulation,
         pair: [&str; 2],
-    ) -> Result<(&data::Condition, &data::Condition, Vec<PathBuf>)> {
+        config: &LearnConfig,
+        seed: u64,
+    ) -> Result<NestedModel<'_>> {
         let first = self.conditions.condition(pair[0])?;
         let second = self.conditions.condition(pair[1])?;
         if self.protocol != Protocol::LeaveConditionOut || first.name == second.name {
@@ -402,7 +412,21 @@ impl Experiment {
             .into_iter()
             .filter(|path| !second_files.contains(path))
             .collect();
-        Ok((first, second, files))
+        let cell = format!(
+            "{} nested validation {}/{}",
+            formulation.name(),
+            first.name,
+            second.name
+        );
+        let (architecture, standardiser, outcome) =
+            self.meta_train_on(formulation, &files, config, seed, &cell)?;
+        Ok(NestedModel {
+            first,
+            second,
+            architecture,
+            standardiser,
+            outcome,
+        })
     }
 
     /// [`Experiment::nested_validation`] with the configured settings, keeping what a comparison
@@ -423,16 +447,14 @@ impl Experiment {
                 message: "must lie strictly between 0 and 1".to_string(),
             });
         }
-        let (first, second, files) = self.nested_training_files(pair)?;
         let config = self.config.get();
-        let cell = format!(
-            "{} nested validation {}/{}",
-            formulation.name(),
-            first.name,
-            second.name
-        );
-        let (architecture, standardiser, outcome) =
-            self.meta_train_on(formulation, &files, config, seed, &cell)?;
+        let NestedModel {
+            first,
+            second,
+            architecture,
+            standardiser,
+            outcome,
+        } = self.nested_meta_train(formulation, pair, config, seed)?;
         let adaptation = &config.adaptation;
         let (input_dim, output_dim) = (architecture.input_dim, architecture.state_dim);
         let detail = |condition: &data::Condition| -> Result<ValidationDetail> {

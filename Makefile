@@ -29,7 +29,7 @@ reproduce: build
 
 # Variants beyond the paper (experiments/variants.json): every variant on every cell over 5 seeds,
 # model selection inside the support segment only; results/ablations/ablations.{md,json} and figures
-# with the ensemble band. Takes about 9 minutes on 2 cores (LeARN meta-training for the learned-basis
+# with the ensemble band. Takes about 6 minutes on 2 cores (LeARN meta-training for the learned-basis
 # variants: three models per cell and seed for learn-ensemble3).
 ablations: build
 	$(LEARN) $(QUIET) ablations --config experiments/variants.json --out results/ablations

@@ -466,4 +466,31 @@ fn a_constant_derivative_has_no_r2() {
         "{}",
         run.stderr
     );
+    // With a second, varying state, R² is given for that state alone and the constant one named.
+    let rows: String = (0..200)
+        .map(|k| {
+            let t = k as f64 * 0.01;
+            format!("{t:.2},{},{}\n", 2.0 * t, t.sin())
+        })
+        .collect();
+    std::fs::write(dir.join("two.csv"), format!("t,x,y\n{rows}")).unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "sindy",
+            "--csv",
+            "two.csv",
+            "--state",
+            "x,y",
+            "--library",
+            "fourier:1",
+        ],
+    );
+    run.success();
+    assert!(
+        run.stderr
+            .contains(" over the 1 of 2 states whose target varies (x' constant: no R²)"),
+        "{}",
+        run.stderr
+    );
 }

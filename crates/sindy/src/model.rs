@@ -118,17 +118,25 @@ impl Trajectory {
 }
 
 /// Goodness of fit of ẋ on a trajectory.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Score {
     /// Mean over samples and state dimensions of the squared error.
     pub mse: f64,
     /// Coefficient of determination averaged uniformly over state dimensions (scikit-learn's
-    /// `r2_score`, PySINDy's default score).
+    /// `r2_score`, PySINDy's default score). Meaningless when `constant_states` is not empty.
     pub r2: f64,
-    /// Whether R² means anything: `false` when the target of some state is constant up to
-    /// rounding (a spread of at most 1e-9 of its largest magnitude), where 1 − residual/variance
-    /// divides by rounding noise.
-    pub r2_defined: bool,
+    /// The states (indices) whose target is constant up to rounding (a spread of at most 1e-9 of
+    /// its largest magnitude): their R² would divide by rounding noise.
+    pub constant_states: Vec<usize>,
+    /// R² averaged over the other states only; `None` when every target is constant.
+    pub r2_varying: Option<f64>,
+}
+
+impl Score {
+    /// Whether [`Score::r2`] means anything: no state has a constant target.
+    pub fn r2_defined(&self) -> bool {
+        self.constant_states.is_empty()
+    }
 }
 
 /// Settings of a SINDy fit, checked when [`SindyParams::fit`] runs.
@@ -391,10 +399,19 @@ impl SindyModel {
     pub fn score(&self, trajectory: &Trajectory) -> Result<Score> {
         let predicted = self.predict(trajectory.states.as_ref(), trajectory.controls.as_ref())?;
         let actual = trajectory.targets(self.derivative)?;
+        let constant_states = constant_columns(actual.as_ref());
+        let varying: Vec<usize> = (0..actual.ncols())
+            .filter(|j| !constant_states.contains(j))
+            .collect();
+        let columns =
+            |m: &Mat<f64>| Mat::from_fn(m.nrows(), varying.len(), |i, k| m[(i, varying[k])]);
+        let r2_varying = (!varying.is_empty())
+            .then(|| r2_score(columns(&predicted).as_ref(), columns(&actual).as_ref()));
         Ok(Score {
             mse: mean_squared_error(predicted.as_ref(), actual.as_ref()),
             r2: r2_score(predicted.as_ref(), actual.as_ref()),
-            r2_defined: constant_columns(actual.as_ref()).is_empty(),
+            constant_states,
+            r2_varying,
         })
     }
 
@@ -666,13 +683,43 @@ mod tests {
             .unwrap();
         let score = model.score(&trajectory).unwrap();
         assert!(score.mse < 1e-20, "{score:?}");
-        assert!(!score.r2_defined, "{score:?}");
+        assert!(!score.r2_defined(), "{score:?}");
+        assert_eq!((score.constant_states, score.r2_varying), (vec![0], None));
         let varying = Trajectory::new(
             (0..50).map(|k| k as f64 * 0.1).collect(),
             Mat::from_fn(50, 1, |i, _| (i as f64 * 0.1).sin()),
         )
         .unwrap();
-        assert!(model.score(&varying).unwrap().r2_defined);
+        let score = model.score(&varying).unwrap();
+        assert!(score.r2_defined());
+        assert_eq!(score.r2_varying, Some(score.r2));
+    }
+
+    #[test]
+    fn r2_over_the_varying_states_leaves_the_constant_one_out() {
+        // x = 2t (constant derivative), y = sin t: the fit of ẏ is scored alone.
+        let time: Vec<f64> = (0..200).map(|k| k as f64 * 0.01).collect();
+        let states = Mat::from_fn(
+            200,
+            2,
+            |i, j| {
+                if j == 0 { 2.0 * time[i] } else { time[i].sin() }
+            },
+        );
+        let trajectory = Trajectory::new(time.clone(), states).unwrap();
+        let model = SindyParams::new(&["x", "y"], &[])
+            .fit(std::slice::from_ref(&trajectory))
+            .unwrap();
+        let score = model.score(&trajectory).unwrap();
+        assert_eq!(score.constant_states, vec![0]);
+        let predicted = model
+            .predict(trajectory.states.as_ref(), trajectory.controls.as_ref())
+            .unwrap();
+        let actual = trajectory.targets(model.derivative).unwrap();
+        let only_y = |m: &Mat<f64>| Mat::from_fn(m.nrows(), 1, |i, _| m[(i, 1)]);
+        let expected = r2_score(only_y(&predicted).as_ref(), only_y(&actual).as_ref());
+        assert_eq!(score.r2_varying, Some(expected));
+        assert!(expected > 0.9 && expected < 1.0, "{expected}");
     }
 
     #[test]

@@ -188,7 +188,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     let score = model.score(&trajectory)?;
     // Finite inputs can still give an unusable fit (e.g. time steps so small that the derivative
     // estimates overflow): an error, not equations and a score of inf or NaN.
-    if !(score.mse.is_finite() && (score.r2.is_finite() || !score.r2_defined)) {
+    if !(score.mse.is_finite() && (score.r2.is_finite() || !score.r2_defined())) {
         bail!(
             "{}: the fit is not finite (MSE {}, R² {}): are the time steps of column '{}' in \
              seconds?",
@@ -201,11 +201,23 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     for line in model.equations(usize::from(args.precision)) {
         println!("{line}");
     }
-    // R² divides by the variance of the target: on a constant one it is rounding noise.
-    let r2 = if score.r2_defined {
-        format!("R² {:.6}", score.r2)
-    } else {
-        "R² n/a (constant target)".to_string()
+    // R² divides by the variance of the target: on a constant one it is rounding noise, so such
+    // states are left out of it and named.
+    let states = model.state_names();
+    let constant: Vec<String> = score
+        .constant_states
+        .iter()
+        .map(|&j| format!("{}'", states[j]))
+        .collect();
+    let r2 = match score.r2_varying {
+        _ if constant.is_empty() => format!("R² {:.6}", score.r2),
+        Some(r2) => format!(
+            "R² {r2:.6} over the {} of {} states whose target varies ({} constant: no R²)",
+            states.len() - constant.len(),
+            states.len(),
+            constant.join(", ")
+        ),
+        None => "R² n/a (constant target)".to_string(),
     };
     eprintln!(
         "{} samples, {} features; MSE {:.6}, {r2}",

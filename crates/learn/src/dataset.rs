@@ -206,6 +206,40 @@ pub struct InputCoverage {
     pub contribution_to_mse: Option<f64>,
 }
 
+impl RangeCoverage {
+    /// The mean of several models' coverages of the same segment against the same range (one per
+    /// seed: the range comes from the meta-training flights, not from the seed). The counts must
+    /// agree and are kept; each MSE field is the mean over the models, or `None` if any lacks it.
+    /// `None` for an empty list or counts that disagree.
+    pub fn mean(coverages: &[&RangeCoverage]) -> Option<RangeCoverage> {
+        let (first, rest) = coverages.split_first()?;
+        let same_counts = |other: &RangeCoverage| {
+            other.samples == first.samples
+                && other.samples_outside == first.samples_outside
+                && other.inputs.len() == first.inputs.len()
+                && other.inputs.iter().zip(&first.inputs).all(|(a, b)| {
+                    a.input == b.input
+                        && a.samples_outside == b.samples_outside
+                        && a.largest_excess_in_std == b.largest_excess_in_std
+                })
+        };
+        if !rest.iter().all(|other| same_counts(other)) {
+            return None;
+        }
+        let mean = |field: &dyn Fn(&RangeCoverage) -> Option<f64>| {
+            let values: Option<Vec<f64>> = coverages.iter().map(|c| field(c)).collect();
+            values.map(|values| values.iter().sum::<f64>() / values.len() as f64)
+        };
+        let mut averaged = (*first).clone();
+        averaged.mse_inside = mean(&|c| c.mse_inside);
+        averaged.mse_outside = mean(&|c| c.mse_outside);
+        for (j, input) in averaged.inputs.iter_mut().enumerate() {
+            input.contribution_to_mse = mean(&|c| c.inputs[j].contribution_to_mse);
+        }
+        Some(averaged)
+    }
+}
+
 impl InputRange {
     /// The smallest and largest value of each feature over all rows of all batches.
     pub fn spanned<'a>(batches: impl IntoIterator<Item = &'a [f64]>, dim: usize) -> Self {
@@ -462,6 +496,38 @@ mod tests {
                 .inputs
                 .iter()
                 .all(|input| input.contribution_to_mse.is_none())
+        );
+    }
+
+    #[test]
+    fn the_mean_coverage_keeps_the_counts_and_averages_the_errors() {
+        let training = [0.0, 0.0, 2.0, 4.0];
+        let standardiser = Standardiser::fit([&training[..]], 2)
+            .with_range(InputRange::spanned([&training[..]], 2), false);
+        let segment = [1.0, 2.0, 3.5, 1.0, 2.5, -2.0];
+        let targets = [0.0; 6];
+        let one = standardiser
+            .coverage_with_errors(&segment, &["x", "y"], &[1.0; 6], &targets)
+            .unwrap();
+        let two = standardiser
+            .coverage_with_errors(&segment, &["x", "y"], &[3.0; 6], &targets)
+            .unwrap();
+        let mean = RangeCoverage::mean(&[&one, &two]).unwrap();
+        assert_eq!(mean.samples_outside, 2);
+        assert_eq!(mean.mse_inside, Some(5.0));
+        assert_eq!(mean.mse_outside, Some(5.0));
+        // x is outside on two of three rows: (2·2·1 + 2·2·9) / 2 / 6.
+        assert_eq!(mean.inputs[0].contribution_to_mse, Some(20.0 / 6.0));
+        assert_eq!(RangeCoverage::mean(&[&one]), Some(one.clone()));
+        assert_eq!(RangeCoverage::mean(&[]), None);
+        // Another segment: the counts disagree.
+        let other = standardiser.coverage(&segment[..2], &["x", "y"]).unwrap();
+        assert_eq!(RangeCoverage::mean(&[&one, &other]), None);
+        // A coverage without errors leaves the mean without them.
+        let without = standardiser.coverage(&segment, &["x", "y"]).unwrap();
+        assert_eq!(
+            RangeCoverage::mean(&[&one, &without]).unwrap().mse_inside,
+            None
         );
     }
 

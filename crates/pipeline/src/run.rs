@@ -388,12 +388,15 @@ fn build_tables(
                     )
                 })
                 .collect();
-            let coverages = indices.iter().map(|&index| {
-                let first = &learn_results[0][index];
+            let learn_coverages: Vec<Option<RangeCoverage>> = indices
+                .iter()
+                .map(|&index| seed_mean_coverage(learn_results, index, |s| &s.query_coverage))
+                .collect();
+            let coverages = indices.iter().zip(&learn_coverages).map(|(&index, learn)| {
                 (
                     cells[index].condition.label(),
-                    first.summary.query_coverage.as_ref(),
-                    sindy_query_coverage(&cells[index], first),
+                    learn.as_ref(),
+                    sindy_query_coverage(&cells[index], &learn_results[0][index]),
                 )
             });
             let mut table = ResultsTable {
@@ -406,6 +409,21 @@ fn build_tables(
             table
         })
         .collect()
+}
+
+/// A cell's coverage (`field` of each seed's summary) with LeARN's errors averaged over the seeds,
+/// as its MSE is; the first seed's if the seeds' counts disagree.
+fn seed_mean_coverage(
+    learn_results: &[Vec<CellResult>],
+    index: usize,
+    field: fn(&learn::CellSummary) -> &Option<RangeCoverage>,
+) -> Option<RangeCoverage> {
+    let per_seed: Option<Vec<&RangeCoverage>> = learn_results
+        .iter()
+        .map(|results| field(&results[index].summary).as_ref())
+        .collect();
+    let per_seed = per_seed?;
+    RangeCoverage::mean(&per_seed).or_else(|| per_seed.first().map(|c| (*c).clone()))
 }
 
 /// SINDy's query predictions scored on the same split as LeARN's query coverage: the samples
@@ -637,8 +655,8 @@ fn record(cell: &Cell, learn_results: &[Vec<CellResult>], index: usize) -> Resul
                 })
                 .collect(),
             explanation,
-            support_coverage: first.summary.support_coverage.clone(),
-            query_coverage: first.summary.query_coverage.clone(),
+            support_coverage: seed_mean_coverage(learn_results, index, |s| &s.support_coverage),
+            query_coverage: seed_mean_coverage(learn_results, index, |s| &s.query_coverage),
         },
     })
 }

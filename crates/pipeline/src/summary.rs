@@ -92,7 +92,8 @@ pub struct LearnCell {
     /// The first seed's adapted model, explained over the support segment.
     pub explanation: Explanation,
     /// How much of each segment lies outside the range of the meta-training inputs (the same for
-    /// every seed: it depends on the meta-training flights only).
+    /// every seed: it depends on the meta-training flights only), with LeARN's MSE inside and
+    /// outside that range averaged over the seeds.
     pub support_coverage: Option<RangeCoverage>,
     pub query_coverage: Option<RangeCoverage>,
 }

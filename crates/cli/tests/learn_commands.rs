@@ -253,18 +253,19 @@ fn meta_train_refuses_to_replace_a_checkpoint_in_a_given_directory() {
     std::fs::create_dir_all(dir.join("ck")).unwrap();
     let existing = dir.join("ck/leave-condition-out-translational-35wind-seed1.json");
     std::fs::write(&existing, "mine").unwrap();
-    let run = meta_train(
-        &dir,
-        &data,
-        &[
+    let run_with = |extra: &[&str]| {
+        let mut args = vec![
             "--config",
             path_str(&config),
             "--checkpoints",
             "ck",
             "--out",
             "a.json",
-        ],
-    );
+        ];
+        args.extend(extra);
+        meta_train(&dir, &data, &args)
+    };
+    let run = run_with(&[]);
     run.one_line_error(&[
         "leave-condition-out-translational-35wind-seed1.json",
         "--force",
@@ -272,19 +273,7 @@ fn meta_train_refuses_to_replace_a_checkpoint_in_a_given_directory() {
     assert_eq!(std::fs::read_to_string(&existing).unwrap(), "mine");
     assert!(!dir.join("a.json").exists());
     // With --force both are written.
-    let run = meta_train(
-        &dir,
-        &data,
-        &[
-            "--config",
-            path_str(&config),
-            "--checkpoints",
-            "ck",
-            "--out",
-            "a.json",
-            "--force",
-        ],
-    );
+    let run = run_with(&["--force"]);
     let stdout = run.success();
     assert!(MetaTrainedModel::load(&existing).is_ok());
     // The SINDy column is the published number (this command runs no SINDy), and says so.

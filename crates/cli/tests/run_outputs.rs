@@ -88,21 +88,31 @@ fn reproduce_refuses_inputs_among_the_files_it_writes_or_replaces() {
     let root = root.to_str().unwrap();
     std::fs::create_dir_all(dir.join("res/tables")).unwrap();
     let run = json(&workspace().join("experiments/reproduce.json"));
+    // `reproduce` with `config`, writing to res/ and tex/, updating `readme` if given.
+    let reproduce = |config: &str, readme: Option<&str>| {
+        let mut args = vec![
+            "reproduce",
+            "--root",
+            root,
+            "--config",
+            config,
+            "--out",
+            "res",
+            "--latex-dir",
+            "tex",
+        ];
+        args.extend(
+            readme
+                .map(|readme| ["--readme", readme])
+                .into_iter()
+                .flatten(),
+        );
+        learn_in(&dir, &args)
+    };
 
     // The configuration among the tables, which a run replaces (stale ones are removed).
     std::fs::write(dir.join("res/tables/r.json"), run.to_string()).unwrap();
-    let args = [
-        "reproduce",
-        "--root",
-        root,
-        "--config",
-        "res/tables/r.json",
-        "--out",
-        "res",
-        "--latex-dir",
-        "tex",
-    ];
-    learn_in(&dir, &args).one_line_error(&[
+    reproduce("res/tables/r.json", None).one_line_error(&[
         "res/tables/r.json: is the --config input, and the run writes every *.json in res/tables",
     ]);
 
@@ -112,42 +122,16 @@ fn reproduce_refuses_inputs_among_the_files_it_writes_or_replaces() {
     std::fs::copy(workspace().join("paper/published.json"), &published).unwrap();
     moved["published"] = published.to_str().unwrap().into();
     std::fs::write(dir.join("r.json"), moved.to_string()).unwrap();
-    let args = [
-        "reproduce",
-        "--root",
-        root,
-        "--config",
-        "r.json",
-        "--out",
-        "res",
-        "--latex-dir",
-        "tex",
-    ];
-    learn_in(&dir, &args).one_line_error(&[
+    reproduce("r.json", None).one_line_error(&[
         "res/summary.json: is the published of r.json input",
         "refusing to write over it",
     ]);
 
     // The README to update may be no input and no other output.
     std::fs::write(dir.join("r.json"), run.to_string()).unwrap();
-    let readme_args = |readme: &'static str| {
-        [
-            "reproduce",
-            "--root",
-            root,
-            "--config",
-            "r.json",
-            "--out",
-            "res",
-            "--latex-dir",
-            "tex",
-            "--readme",
-            readme,
-        ]
-    };
-    learn_in(&dir, &readme_args("r.json"))
+    reproduce("r.json", Some("r.json"))
         .one_line_error(&["r.json: is the --config input, refusing to write over it"]);
-    learn_in(&dir, &readme_args("res/timings.json"))
+    reproduce("r.json", Some("res/timings.json"))
         .one_line_error(&["res/timings.json: the --readme to update is also an output of the run"]);
     // Nothing was made: no directory, no probe file.
     assert_eq!(

@@ -709,6 +709,32 @@ mod tests {
     }
 
     /// The field named by the validation error of a changed scenario.
+    /// Adds a low pass at `height_m` (1 s to 5 s) to the figure-8 of `s`.
+    fn add_low_pass(s: &mut Scenario, height_m: f64) {
+        if let Trajectory::Figure8 { low_passes, .. } = &mut s.trajectory {
+            low_passes.push(crate::trajectory::LowPass {
+                start_s: 1.0,
+                end_s: 5.0,
+                height_m,
+                ramp_s: 1.0,
+            });
+        }
+    }
+
+    /// Replaces the trajectory of `s` with `count` random waypoints in a box from
+    /// (-1, -1, 1) to `box_max`.
+    fn random_waypoints(s: &mut Scenario, count: usize, box_max: [f64; 3]) {
+        s.trajectory = Trajectory::RandomWaypoints {
+            seed: 1,
+            count,
+            box_min: [-1.0, -1.0, 1.0],
+            box_max,
+            segment_s: 2.5,
+            yaw_amplitude_rad: 0.0,
+            yaw_period_s: 10.0,
+        };
+    }
+
     fn rejected_field(change: impl FnOnce(&mut Scenario)) -> String {
         let mut s = scenario();
         change(&mut s);
@@ -835,30 +861,11 @@ mod tests {
             assert_eq!(rejected_field(change), name);
         }
         assert_eq!(
-            rejected_field(|s| {
-                if let Trajectory::Figure8 { low_passes, .. } = &mut s.trajectory {
-                    low_passes.push(crate::trajectory::LowPass {
-                        start_s: 1.0,
-                        end_s: 5.0,
-                        height_m: 1e9,
-                        ramp_s: 1.0,
-                    });
-                }
-            }),
+            rejected_field(|s| add_low_pass(s, 1e9)),
             "trajectory.low_passes[0].height_m"
         );
         assert_eq!(
-            rejected_field(|s| {
-                s.trajectory = Trajectory::RandomWaypoints {
-                    seed: 1,
-                    count: 4,
-                    box_min: [-1.0, -1.0, 1.0],
-                    box_max: [1.0, 1.0, 1e7],
-                    segment_s: 2.5,
-                    yaw_amplitude_rad: 0.0,
-                    yaw_period_s: 10.0,
-                };
-            }),
+            rejected_field(|s| random_waypoints(s, 4, [1.0, 1.0, 1e7])),
             "trajectory.box_max"
         );
         // every field within the bound, their sum (center + first + second) beyond it
@@ -925,31 +932,9 @@ mod tests {
             }),
             "trajectory"
         );
+        assert_eq!(rejected_field(|s| add_low_pass(s, -1.0)), "trajectory");
         assert_eq!(
-            rejected_field(|s| {
-                if let Trajectory::Figure8 { low_passes, .. } = &mut s.trajectory {
-                    low_passes.push(crate::trajectory::LowPass {
-                        start_s: 1.0,
-                        end_s: 5.0,
-                        height_m: -1.0,
-                        ramp_s: 1.0,
-                    });
-                }
-            }),
-            "trajectory"
-        );
-        assert_eq!(
-            rejected_field(|s| {
-                s.trajectory = Trajectory::RandomWaypoints {
-                    seed: 1,
-                    count: 1_000_000_000,
-                    box_min: [-1.0, -1.0, 1.0],
-                    box_max: [1.0, 1.0, 2.0],
-                    segment_s: 2.5,
-                    yaw_amplitude_rad: 0.0,
-                    yaw_period_s: 10.0,
-                };
-            }),
+            rejected_field(|s| random_waypoints(s, 1_000_000_000, [1.0, 1.0, 2.0])),
             "trajectory.count"
         );
     }

@@ -21,6 +21,8 @@
 mod controller;
 mod effects;
 mod error;
+mod jitter;
+mod logger;
 mod model;
 mod residual;
 mod simulator;
@@ -34,6 +36,10 @@ pub use effects::{
     MotorLag, QuadraticDrag, ThrustScale, TorqueBias, Wind, ground_ratio,
 };
 pub use error::{PhysicsError, Result};
+pub use jitter::{Jitter, JitterSignal, MAX_JITTER};
+pub use logger::{
+    CommandLogging, Logger, MAX_COMMAND_OFFSET_S, MAX_RATE_LOW_PASS_HZ, MIN_RATE_LOW_PASS_HZ,
+};
 pub use model::{Mixer, NominalModel, ThrustSource, Wrench, angular_acceleration_with_inertia};
 pub use residual::{five_point_derivative, residual_force};
 pub use simulator::{

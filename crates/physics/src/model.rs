@@ -12,6 +12,7 @@ use serde::Serialize;
 use serde_json::{Map, Value};
 
 use crate::error::{PhysicsError, Result};
+use crate::logger::Logger;
 use crate::vector::{E3, Vec3, add, cross, hadamard, mat_vec, scale};
 
 /// Where the collective thrust comes from.
@@ -54,6 +55,10 @@ pub struct NominalModel {
     pub mixer: Option<Mixer>,
     /// Height of the ground plane in the world frame (optional field, default 0), m.
     pub ground_height_m: f64,
+    /// How the recordings compared with this model were logged (optional field; default: the
+    /// command sampled at each row's time, no rate filter).
+    #[serde(skip_serializing_if = "Logger::is_default")]
+    pub logger: Logger,
 }
 
 impl Mixer {
@@ -161,6 +166,10 @@ impl NominalModel {
             None => 0.0,
             Some(_) => fields.finite(object, "ground_height_m")?,
         };
+        let logger = match object.get("logger") {
+            None | Some(Value::Null) => Logger::default(),
+            Some(value) => fields.logger(value)?,
+        };
         Ok(Self {
             mass_kg,
             gravity_m_s2,
@@ -168,6 +177,7 @@ impl NominalModel {
             thrust_source,
             mixer,
             ground_height_m,
+            logger,
         })
     }
 
@@ -270,13 +280,14 @@ pub fn angular_acceleration_with_inertia(inertia: Vec3, rate: Vec3, torque: Vec3
 }
 
 /// The fields of a model file; any other is an error (as `deny_unknown_fields` elsewhere).
-const MODEL_KEYS: [&str; 6] = [
+const MODEL_KEYS: [&str; 7] = [
     "mass_kg",
     "gravity_m_s2",
     "inertia_kg_m2",
     "thrust_source",
     "mixer",
     "ground_height_m",
+    "logger",
 ];
 /// The fields of the `mixer` object.
 const MIXER_KEYS: [&str; 3] = ["pwm_offset", "pwm_scale", "b0"];
@@ -357,6 +368,23 @@ impl FieldReader {
 
     fn numbers(&self, object: &Map<String, Value>, field: &str, count: usize) -> Result<Vec<f64>> {
         self.numbers_of(object.get(field), field, count)
+    }
+
+    fn logger(&self, value: &Value) -> Result<Logger> {
+        let Value::Object(object) = value else {
+            return Err(self.error("logger", &format!("expected an object, found {value}")));
+        };
+        self.known_keys(
+            object,
+            "logger.",
+            &["command", "command_time_offset_s", "rate_low_pass_hz"],
+        )?;
+        let logger: Logger = serde_json::from_value(value.clone())
+            .map_err(|error| self.error("logger", &error.to_string()))?;
+        logger
+            .validate()
+            .map_err(|(field, message)| self.error(&format!("logger.{field}"), &message))?;
+        Ok(logger)
     }
 
     fn mixer(&self, mixer: &Map<String, Value>) -> Result<Mixer> {

@@ -1,12 +1,16 @@
 //! Closed-loop simulation of the real plant (nominal model plus switchable effects) under the
 //! geometric controller, written as a Neural-Fly flight log.
 //!
-//! Timing: the controller runs at the logging rate (50 Hz by default) and each logged row holds the
-//! measured state at `t_k` and the command issued at `t_k`, which the actuators receive (after any
-//! delay) and hold until the next command. The rigid body is integrated with RK4 at
-//! `physics_rate_hz` (≥ 500 Hz); with a motor lag the four motor speeds are part of the state.
-//! Measurement noise (Gaussian, from the scenario's seed) is added to position, velocity, attitude
-//! and body rate; the controller sees the noisy values, as on a real vehicle.
+//! Timing: the controller runs at `controller_rate_hz` (by default the log rate) and each command
+//! is held by the actuators (after any delay) until the next one. Every `controller_rate_hz /
+//! log_rate_hz` control steps a row is logged: the measured state at that instant and the command as
+//! the scenario's [`Logger`] records it (the instantaneous command, the mean over the log period,
+//! either shifted by whole control steps; each command held to the next row when the controller runs
+//! at the log rate). The rigid body is integrated with RK4 at `physics_rate_hz`; with a motor lag
+//! the four motor speeds are part of the state. Measurement noise (Gaussian, from the scenario's
+//! seed) is added to position, velocity, attitude and body rate, the rate after the logger's
+//! optional first-order filter; the controller sees the noisy values, as on a real vehicle. An
+//! optional band-limited [`Jitter`] is added to the commands (and logged with them).
 
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -17,9 +21,11 @@ use serde::{Deserialize, Serialize};
 
 use data::{FlightLog, quaternion_from_rotation, rotation_from_quaternion};
 
-use crate::controller::{Gains, GeometricController, MeasuredState};
+use crate::controller::{ControlOutput, Gains, GeometricController, MeasuredState};
 use crate::effects::Effects;
 use crate::error::{PhysicsError, Result, readable};
+use crate::jitter::{Jitter, JitterSignal};
+use crate::logger::{CommandLogging, Logger};
 use crate::model::NominalModel;
 use crate::trajectory::{MAX_POSITION_M, Trajectory};
 use crate::vector::{
@@ -62,6 +68,17 @@ pub struct Scenario {
     pub noise: Noise,
     #[serde(default)]
     pub gains: Gains,
+    /// How often the controller runs, Hz (default: the log rate). A whole multiple of the log rate
+    /// and a whole divisor of the physics rate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller_rate_hz: Option<f64>,
+    /// How the log is made (default: each command held until the next row when the controller
+    /// runs at the log rate, the instantaneous command otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub logger: Option<Logger>,
+    /// Band-limited jitter added to the controller's commands (none by default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jitter: Option<Jitter>,
 }
 
 fn default_physics_rate() -> f64 {
@@ -149,6 +166,9 @@ impl Scenario {
                 rate_rad_s: 0.008,
             },
             gains: Gains::default(),
+            controller_rate_hz: None,
+            logger: None,
+            jitter: None,
         }
     }
 
@@ -249,6 +269,7 @@ impl Scenario {
                 "must be a whole multiple of log_rate_hz".into(),
             ));
         }
+        self.validate_timing(origin)?;
         let rows = self.rows();
         if !(MIN_LOG_ROWS..=MAX_LOG_ROWS).contains(&rows) {
             return Err(field(
@@ -320,6 +341,89 @@ impl Scenario {
         Ok(())
     }
 
+    /// The controller rate, Hz (the log rate unless set).
+    pub fn controller_rate(&self) -> f64 {
+        self.controller_rate_hz.unwrap_or(self.log_rate_hz)
+    }
+
+    /// The logger: as set, or by default the commands held from row to row when the controller
+    /// runs at the log rate and sampled at each row's time otherwise. This is what a model file
+    /// given to the mismatch tool with this scenario's logs should say (`"logger"`).
+    pub fn logger(&self) -> Logger {
+        self.logger.unwrap_or_else(|| Logger {
+            command: if self.controller_steps_per_row() == 1 {
+                CommandLogging::Held
+            } else {
+                CommandLogging::Sample
+            },
+            ..Logger::default()
+        })
+    }
+
+    /// Control steps per logged row.
+    fn controller_steps_per_row(&self) -> usize {
+        (self.controller_rate() / self.log_rate_hz).round().max(1.0) as usize
+    }
+
+    /// Checks the controller rate, the logger and the jitter against the log and physics rates.
+    fn validate_timing(&self, origin: &Path) -> Result<()> {
+        let field = |field: &str, message: String| PhysicsError::Field {
+            path: origin.to_path_buf(),
+            field: field.to_string(),
+            message,
+        };
+        let whole = |ratio: f64| ratio >= 1.0 - 1e-9 && (ratio - ratio.round()).abs() <= 1e-9;
+        let control = self.controller_rate();
+        if !(control.is_finite() && whole(control / self.log_rate_hz))
+            || !whole(self.physics_rate_hz / control)
+        {
+            return Err(field(
+                "controller_rate_hz",
+                format!(
+                    "must be a whole multiple of log_rate_hz ({}) and a whole divisor of physics_rate_hz ({}), found {}",
+                    readable(self.log_rate_hz),
+                    readable(self.physics_rate_hz),
+                    readable(control)
+                ),
+            ));
+        }
+        let logger = self.logger();
+        logger
+            .validate()
+            .map_err(|(f, m)| field(&format!("logger.{f}"), m))?;
+        let at_log_rate = self.controller_steps_per_row() == 1;
+        if at_log_rate != (logger.command == CommandLogging::Held) {
+            return Err(field(
+                "logger.command",
+                if at_log_rate {
+                    format!(
+                        "with the controller at the log rate each command is held until the next row: the logger's command is \"held\", found \"{}\"",
+                        logger.command.name()
+                    )
+                } else {
+                    "\"held\" needs the controller at the log rate (controller_rate_hz = log_rate_hz)".to_string()
+                },
+            ));
+        }
+        let steps = logger.command_time_offset_s * control;
+        if (steps - steps.round()).abs() > 1e-6 {
+            return Err(field(
+                "logger.command_time_offset_s",
+                format!(
+                    "the simulated logger reads the controller's commands: a whole number of control periods (1/{} s), found {}",
+                    readable(control),
+                    readable(logger.command_time_offset_s)
+                ),
+            ));
+        }
+        if let Some(jitter) = &self.jitter {
+            jitter
+                .validate()
+                .map_err(|(f, m)| field(&format!("jitter.{f}"), m))?;
+        }
+        Ok(())
+    }
+
     /// Checks the scenario against its model: the simulator needs a mixer, and the reference must
     /// stay above the model's ground plane.
     pub fn validate_with_model(&self, model: &NominalModel, origin: &Path) -> Result<()> {
@@ -363,12 +467,11 @@ impl Scenario {
         (self.warmup_s * self.log_rate_hz).round() as usize
     }
 
-    /// The time of every control step, warm-up included (as [`simulate`] computes them).
+    /// The time of every logged row, warm-up included (the references checked at load).
     fn control_times(&self) -> impl Iterator<Item = f64> {
-        let control_dt = 1.0 / self.log_rate_hz;
+        let row_dt = 1.0 / self.log_rate_hz;
         let warmup_rows = self.warmup_rows();
-        (0..warmup_rows + self.rows())
-            .map(move |step| (step as f64 - warmup_rows as f64) * control_dt)
+        (0..warmup_rows + self.rows()).map(move |step| (step as f64 - warmup_rows as f64) * row_dt)
     }
 }
 
@@ -529,81 +632,280 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
             "the simulator needs a model with a mixer (thrust_source \"mixer\")".into(),
         )
     })?;
-    let control_dt = 1.0 / scenario.log_rate_hz;
-    let substeps = (scenario.physics_rate_hz / scenario.log_rate_hz).round() as usize;
-    let h = control_dt / substeps as f64;
+    let mut flight = Flight::new(model, mixer, scenario);
+    let per_row = scenario.controller_steps_per_row();
+    let warmup_steps = scenario.warmup_rows() * per_row;
     let rows = scenario.rows();
-    let warmup_rows = scenario.warmup_rows();
-    let delay_steps = (scenario.effects.delay_s() / h).round() as usize;
-    let generator = scenario.trajectory.generator();
-    let mut controller = GeometricController::new(model, scenario.gains);
-    let plant = Plant {
-        model,
-        effects: scenario.effects,
-    };
-    let mut noise = Gaussian {
-        rng: ChaCha8Rng::seed_from_u64(scenario.seed),
-    };
-    let start = generator.at(-(warmup_rows as f64) * control_dt);
-    let hover_speeds = mixer.speeds_for(&[model.mass_kg * model.gravity_m_s2, 0.0, 0.0, 0.0]);
-    let mut state = PlantState {
-        position: start.position,
-        velocity: start.velocity,
-        quaternion: quaternion_from_rotation(&controller.initial_rotation(&start)),
-        body_rate: [0.0; 3],
-        speeds: hover_speeds,
-    };
-    // Commands per physics step, so that a delay of any multiple of the physics step is exact.
-    let mut applied = CommandQueue::new(delay_steps);
+    let last_row_step = warmup_steps + (rows - 1) * per_row;
+    // Run on after the last row until the commands a look-ahead logger records exist.
+    let last_step = last_row_step + flight.look_ahead_steps();
     let mut log = empty_log(name, rows);
-    for step in 0..warmup_rows + rows {
-        let t = (step as f64 - warmup_rows as f64) * control_dt;
-        let reference = generator.at(t);
-        let measured = measure(&state, &scenario.noise, &mut noise);
-        let output = controller.update(&measured, &reference, control_dt);
-        let wrench = [
+    let mut commands = CommandLog::new(scenario, rows);
+    for step in 0..=last_step {
+        let t = (step as f64 - warmup_steps as f64) * flight.control_dt;
+        let reference = flight.generator.at(t);
+        let measured = flight.measure();
+        let output = flight
+            .controller
+            .update(&measured, &reference, flight.control_dt);
+        let speeds = flight.speeds_for(&output, t);
+        commands.issue(step, speeds, mixer.wrench(&speeds)[0]);
+        if step >= warmup_steps && (step - warmup_steps) % per_row == 0 && step <= last_row_step {
+            record_row(&mut log, &measured, &reference, &output, t);
+            commands.add_row(step - warmup_steps);
+        }
+        commands.fill_ready(step);
+        if step == last_step {
+            break;
+        }
+        flight.advance(speeds, t, &reference)?;
+    }
+    commands.write_into(&mut log, model, mixer, scenario.hover_throttle);
+    Ok(log)
+}
+
+/// The plant, controller and sensors of one simulated flight.
+struct Flight<'a> {
+    plant: Plant<'a>,
+    mixer: &'a crate::model::Mixer,
+    state: PlantState,
+    controller: GeometricController,
+    generator: crate::trajectory::ReferenceGenerator,
+    noise: Gaussian,
+    noise_levels: Noise,
+    jitter: Option<JitterSignal>,
+    /// Actuator commands per physics step, delayed as the `delay` effect says.
+    applied: CommandQueue,
+    /// The body rate after the logger's first-order filter (the true rate without one).
+    filtered_rate: Vec3,
+    rate_time_constant: f64,
+    control_dt: f64,
+    substeps: usize,
+    look_ahead: usize,
+}
+
+impl<'a> Flight<'a> {
+    fn new(model: &'a NominalModel, mixer: &'a crate::model::Mixer, scenario: &Scenario) -> Self {
+        let control_dt = 1.0 / scenario.controller_rate();
+        let substeps = (scenario.physics_rate_hz / scenario.controller_rate()).round() as usize;
+        let h = control_dt / substeps as f64;
+        let generator = scenario.trajectory.generator();
+        let controller = GeometricController::new(model, scenario.gains);
+        let warmup_s = scenario.warmup_rows() as f64 / scenario.log_rate_hz;
+        let start = generator.at(-warmup_s);
+        let hover_speeds = mixer.speeds_for(&[model.mass_kg * model.gravity_m_s2, 0.0, 0.0, 0.0]);
+        let state = PlantState {
+            position: start.position,
+            velocity: start.velocity,
+            quaternion: quaternion_from_rotation(&controller.initial_rotation(&start)),
+            body_rate: [0.0; 3],
+            speeds: hover_speeds,
+        };
+        let logger = scenario.logger();
+        let offset_steps = (logger.command_time_offset_s / control_dt).round() as i64;
+        Self {
+            plant: Plant {
+                model,
+                effects: scenario.effects,
+            },
+            mixer,
+            state,
+            controller,
+            generator,
+            noise: Gaussian {
+                rng: ChaCha8Rng::seed_from_u64(scenario.seed),
+            },
+            noise_levels: scenario.noise,
+            jitter: scenario
+                .jitter
+                .as_ref()
+                .map(|j| JitterSignal::new(j, scenario.seed ^ 0x6a69_7474_6572)),
+            applied: CommandQueue::new((scenario.effects.delay_s() / h).round() as usize),
+            filtered_rate: [0.0; 3],
+            rate_time_constant: logger.rate_time_constant_s(),
+            control_dt,
+            substeps,
+            look_ahead: offset_steps.max(0) as usize,
+        }
+    }
+
+    fn look_ahead_steps(&self) -> usize {
+        self.look_ahead
+    }
+
+    /// What the sensors report now: the state with noise, the rate through the logger's filter.
+    fn measure(&mut self) -> MeasuredState {
+        let mut state = self.state;
+        if self.rate_time_constant > 0.0 {
+            state.body_rate = self.filtered_rate;
+        }
+        measure(&state, &self.noise_levels, &mut self.noise)
+    }
+
+    /// The motor speeds the controller commands, jitter included.
+    fn speeds_for(&self, output: &ControlOutput, t: f64) -> [f64; 4] {
+        let mut wrench = [
             output.thrust,
             output.torque[0],
             output.torque[1],
             output.torque[2],
         ];
-        let speeds = mixer.speeds_for(&wrench);
-        if step < warmup_rows {
-            for _ in 0..substeps {
-                let command = applied.push(speeds);
-                state = rk4_step(&plant, &state, command, h);
+        if let Some(jitter) = &self.jitter {
+            let j = jitter.at(t);
+            let model = self.plant.model;
+            wrench[0] += model.mass_kg * j[0];
+            for i in 0..3 {
+                wrench[i + 1] += model.inertia_kg_m2[i] * j[i + 1];
             }
-            check_state(&state, &reference.position, t)?;
-            continue;
         }
-        let k = step - warmup_rows;
-        let issued_thrust = mixer.wrench(&speeds)[0];
-        log.time.push(t);
-        log.position.push(measured.position);
-        log.velocity.push(measured.velocity);
-        let quaternion = quaternion_from_rotation(&measured.rotation);
-        log.quaternion.push(quaternion);
-        log.rotation.push(measured.rotation);
-        log.body_rate.push(measured.body_rate);
-        log.thrust_setpoint
-            .push(issued_thrust / (model.mass_kg * model.gravity_m_s2) * scenario.hover_throttle);
-        log.hover_throttle.push(scenario.hover_throttle);
-        log.motor_command.push(mixer.pwm(&speeds));
-        push(&mut log.position_desired, reference.position);
-        push(&mut log.velocity_desired, reference.velocity);
-        if let Some(setpoints) = log.attitude_setpoint.as_mut() {
-            setpoints.push(quaternion_from_rotation(&output.desired_rotation));
-        }
-        if k + 1 == rows {
-            break;
-        }
-        for _ in 0..substeps {
-            let command = applied.push(speeds);
-            state = rk4_step(&plant, &state, command, h);
-        }
-        check_state(&state, &reference.position, t)?;
+        self.mixer.speeds_for(&wrench)
     }
-    Ok(log)
+
+    /// Integrates one control period with the commanded speeds.
+    fn advance(
+        &mut self,
+        speeds: [f64; 4],
+        t: f64,
+        reference: &crate::trajectory::Reference,
+    ) -> Result<()> {
+        let h = self.control_dt / self.substeps as f64;
+        let gain = if self.rate_time_constant > 0.0 {
+            1.0 - (-h / self.rate_time_constant).exp()
+        } else {
+            1.0
+        };
+        for _ in 0..self.substeps {
+            let command = self.applied.push(speeds);
+            self.state = rk4_step(&self.plant, &self.state, command, h);
+            for i in 0..3 {
+                self.filtered_rate[i] += gain * (self.state.body_rate[i] - self.filtered_rate[i]);
+            }
+        }
+        check_state(&self.state, &reference.position, t)
+    }
+}
+
+/// Appends one row's measured state and reference (its command is filled by [`CommandLog`]).
+fn record_row(
+    log: &mut FlightLog,
+    measured: &MeasuredState,
+    reference: &crate::trajectory::Reference,
+    output: &ControlOutput,
+    t: f64,
+) {
+    log.time.push(t);
+    log.position.push(measured.position);
+    log.velocity.push(measured.velocity);
+    log.quaternion
+        .push(quaternion_from_rotation(&measured.rotation));
+    log.rotation.push(measured.rotation);
+    log.body_rate.push(measured.body_rate);
+    push(&mut log.position_desired, reference.position);
+    push(&mut log.velocity_desired, reference.velocity);
+    if let Some(setpoints) = log.attitude_setpoint.as_mut() {
+        setpoints.push(quaternion_from_rotation(&output.desired_rotation));
+    }
+}
+
+/// The commands the logger writes: for each row, the issued commands it reads (one, or the mean
+/// over a log period), found in a window of the most recent control steps.
+struct CommandLog {
+    logging: CommandLogging,
+    offset_steps: i64,
+    per_row: usize,
+    /// Recent control steps: (step, motor speeds, thrust).
+    recent: VecDeque<(usize, [f64; 4], f64)>,
+    /// Per row: its control step (from the first row) and, once known, its command.
+    rows: Vec<(usize, Option<([f64; 4], f64)>)>,
+    warmup_steps: usize,
+    first: Option<([f64; 4], f64)>,
+    /// Rows before this one are filled (rows are filled in order).
+    next: usize,
+}
+
+impl CommandLog {
+    fn new(scenario: &Scenario, rows: usize) -> Self {
+        let logger = scenario.logger();
+        let per_row = scenario.controller_steps_per_row();
+        Self {
+            logging: logger.command,
+            offset_steps: (logger.command_time_offset_s * scenario.controller_rate()).round()
+                as i64,
+            per_row,
+            recent: VecDeque::new(),
+            rows: Vec::with_capacity(rows),
+            warmup_steps: scenario.warmup_rows() * per_row,
+            first: None,
+            next: 0,
+        }
+    }
+
+    /// The control steps a row recorded at `step` reads: `[low, high]`.
+    fn span(&self, step: usize) -> (i64, i64) {
+        let at = step as i64 + self.offset_steps;
+        match self.logging {
+            CommandLogging::Sample | CommandLogging::Held => (at, at),
+            CommandLogging::PeriodMean => (at - self.per_row as i64, at - 1),
+        }
+    }
+
+    fn issue(&mut self, step: usize, speeds: [f64; 4], thrust: f64) {
+        self.first.get_or_insert((speeds, thrust));
+        self.recent.push_back((step, speeds, thrust));
+        let keep = self.per_row + self.offset_steps.unsigned_abs() as usize + 2;
+        while self.recent.len() > keep {
+            self.recent.pop_front();
+        }
+    }
+
+    fn add_row(&mut self, step_from_first_row: usize) {
+        self.rows.push((step_from_first_row, None));
+    }
+
+    /// Fills every pending row whose commands have all been issued by `step`.
+    fn fill_ready(&mut self, step: usize) {
+        while self.next < self.rows.len() {
+            let index = self.next;
+            let row_step = self.rows[index].0 + self.warmup_steps;
+            let (low, high) = self.span(row_step);
+            if high > step as i64 {
+                return;
+            }
+            self.next += 1;
+            let first = self.first.expect("a command was issued");
+            let mut sum = ([0.0; 4], 0.0);
+            for wanted in low..=high {
+                let (speeds, thrust) = self
+                    .recent
+                    .iter()
+                    .find(|(s, _, _)| *s as i64 == wanted)
+                    .map(|(_, speeds, thrust)| (*speeds, *thrust))
+                    .unwrap_or(first);
+                for i in 0..4 {
+                    sum.0[i] += speeds[i];
+                }
+                sum.1 += thrust;
+            }
+            let count = (high - low + 1) as f64;
+            self.rows[index].1 = Some((sum.0.map(|v| v / count), sum.1 / count));
+        }
+    }
+
+    fn write_into(
+        self,
+        log: &mut FlightLog,
+        model: &NominalModel,
+        mixer: &crate::model::Mixer,
+        hover_throttle: f64,
+    ) {
+        for (_, command) in self.rows {
+            let (speeds, thrust) = command.expect("every row's command is issued by the last step");
+            log.thrust_setpoint
+                .push(thrust / (model.mass_kg * model.gravity_m_s2) * hover_throttle);
+            log.hover_throttle.push(hover_throttle);
+            log.motor_command.push(mixer.pwm(&speeds));
+        }
+    }
 }
 
 /// The commands issued per physics step, of which only the last `delay_steps + 1` (and the very
@@ -730,6 +1032,7 @@ mod tests {
             box_min: [-1.0, -1.0, 1.0],
             box_max,
             segment_s: 2.5,
+            low_passes: Vec::new(),
             yaw_amplitude_rad: 0.0,
             yaw_period_s: 10.0,
         };
@@ -961,6 +1264,105 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("field 'model'"), "{error}");
+    }
+
+    /// The logger reads the commands its description says: with commands numbered by their control
+    /// step, a row at step s holds s (sample), s + 1 (one step late), or the mean of s − 10 … s − 1
+    /// (the mean over the preceding log period of 10 control steps).
+    #[test]
+    fn the_command_log_reads_what_the_logger_describes() {
+        let logged = |logger: Logger| -> Vec<f64> {
+            let mut s = scenario();
+            s.controller_rate_hz = Some(500.0);
+            s.logger = Some(logger);
+            s.warmup_s = 0.2;
+            let mut commands = CommandLog::new(&s, 3);
+            let warmup_steps = s.warmup_rows() * 10;
+            for step in 0..warmup_steps + 40 {
+                commands.issue(step, [step as f64; 4], 2.0 * step as f64);
+                if step >= warmup_steps
+                    && (step - warmup_steps) % 10 == 0
+                    && step < warmup_steps + 30
+                {
+                    commands.add_row(step - warmup_steps);
+                }
+                commands.fill_ready(step);
+            }
+            commands
+                .rows
+                .iter()
+                .map(|(step, command)| {
+                    let (speeds, thrust) = command.unwrap();
+                    assert_eq!(thrust, 2.0 * speeds[0]);
+                    speeds[0] - (step + warmup_steps) as f64
+                })
+                .collect()
+        };
+        assert_eq!(logged(Logger::default()), [0.0; 3]);
+        let late = Logger {
+            command_time_offset_s: 0.002,
+            ..Logger::default()
+        };
+        assert_eq!(logged(late), [1.0; 3]);
+        let mean = Logger {
+            command: CommandLogging::PeriodMean,
+            ..Logger::default()
+        };
+        assert_eq!(logged(mean), [-5.5; 3]);
+    }
+
+    #[test]
+    fn the_logger_must_match_the_controller_rate() {
+        assert_eq!(
+            rejected_field(|s| s.logger = Some(Logger::default())),
+            "logger.command"
+        );
+        assert_eq!(
+            rejected_field(|s| {
+                s.controller_rate_hz = Some(500.0);
+                s.logger = Some(Logger {
+                    command: CommandLogging::Held,
+                    ..Logger::default()
+                });
+            }),
+            "logger.command"
+        );
+        assert_eq!(
+            rejected_field(|s| s.controller_rate_hz = Some(75.0)),
+            "controller_rate_hz"
+        );
+        assert_eq!(
+            rejected_field(|s| {
+                s.controller_rate_hz = Some(500.0);
+                s.logger = Some(Logger {
+                    command_time_offset_s: 0.0013,
+                    ..Logger::default()
+                });
+            }),
+            "logger.command_time_offset_s"
+        );
+        let mut s = scenario();
+        assert_eq!(s.logger().command, CommandLogging::Held);
+        s.controller_rate_hz = Some(500.0);
+        assert_eq!(s.logger().command, CommandLogging::Sample);
+        s.jitter = Some(Jitter {
+            translational_m_s2: 0.3,
+            angular_rad_s2: 2.0,
+            band_hz: [1.0, 5.0],
+        });
+        s.logger = Some(Logger {
+            command: CommandLogging::PeriodMean,
+            command_time_offset_s: -0.004,
+            rate_low_pass_hz: Some(40.0),
+        });
+        s.physics_rate_hz = 1000.0;
+        s.validate(Path::new("s.json")).unwrap();
+        let log = simulate(&model(), &s, "fast").unwrap();
+        assert_eq!(log.len(), s.rows());
+        assert_eq!(
+            simulate(&model(), &s, "fast").unwrap().motor_command,
+            log.motor_command
+        );
     }
 
     /// The queue gives exactly what indexing the whole history gave.

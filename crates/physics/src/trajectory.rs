@@ -55,11 +55,51 @@ pub enum Trajectory {
         box_min: Vec3,
         box_max: Vec3,
         segment_s: f64,
+        /// Low-altitude passes (non-overlapping).
+        #[serde(default)]
+        low_passes: Vec<LowPass>,
         #[serde(default)]
         yaw_amplitude_rad: f64,
         #[serde(default = "default_yaw_period")]
         yaw_period_s: f64,
     },
+}
+
+/// Checks low passes: finite, within [`MAX_POSITION_M`], ramps that fit, in time order.
+fn validate_low_passes(low_passes: &[LowPass]) -> Result<(), (String, String)> {
+    let bad = |field: &str, message: String| Err((format!("trajectory.{field}"), message));
+    let too_far = |v: &[f64]| v.iter().copied().find(|x| x.abs() > MAX_POSITION_M);
+    let far_message = |x: f64| {
+        format!(
+            "a coordinate of {} m, farther than the {MAX_POSITION_M} m from the origin a flight may go",
+            readable(x)
+        )
+    };
+    for (i, pass) in low_passes.iter().enumerate() {
+        let field = format!("low_passes[{i}]");
+        let values = [pass.start_s, pass.end_s, pass.height_m, pass.ramp_s];
+        if values.iter().any(|v| !v.is_finite()) {
+            return bad(&field, "every number must be finite".into());
+        }
+        if let Some(x) = too_far(&[pass.height_m]) {
+            return bad(&format!("{field}.height_m"), far_message(x));
+        }
+        if !(pass.ramp_s > 0.0 && pass.end_s - pass.start_s >= 2.0 * pass.ramp_s) {
+            return bad(
+                &field,
+                "needs ramp_s > 0 and end_s − start_s ≥ 2 ramp_s".into(),
+            );
+        }
+    }
+    for (i, pair) in low_passes.windows(2).enumerate() {
+        if pair[1].start_s < pair[0].end_s {
+            return bad(
+                &format!("low_passes[{}]", i + 1),
+                "low passes must be in time order and not overlap".into(),
+            );
+        }
+    }
+    Ok(())
 }
 
 fn default_yaw_period() -> f64 {
@@ -124,30 +164,7 @@ impl Trajectory {
                         format!("must be positive, found {}", readable(*period_s)),
                     );
                 }
-                for (i, pass) in low_passes.iter().enumerate() {
-                    let field = format!("low_passes[{i}]");
-                    let values = [pass.start_s, pass.end_s, pass.height_m, pass.ramp_s];
-                    if values.iter().any(|v| !v.is_finite()) {
-                        return bad(&field, "every number must be finite".into());
-                    }
-                    if let Some(x) = too_far(&[pass.height_m]) {
-                        return bad(&format!("{field}.height_m"), far_message(x));
-                    }
-                    if !(pass.ramp_s > 0.0 && pass.end_s - pass.start_s >= 2.0 * pass.ramp_s) {
-                        return bad(
-                            &field,
-                            "needs ramp_s > 0 and end_s − start_s ≥ 2 ramp_s".into(),
-                        );
-                    }
-                }
-                for (i, pair) in low_passes.windows(2).enumerate() {
-                    if pair[1].start_s < pair[0].end_s {
-                        return bad(
-                            &format!("low_passes[{}]", i + 1),
-                            "low passes must be in time order and not overlap".into(),
-                        );
-                    }
-                }
+                validate_low_passes(low_passes)?;
                 (*yaw_amplitude_rad, *yaw_period_s)
             }
             Self::RandomWaypoints {
@@ -155,10 +172,12 @@ impl Trajectory {
                 segment_s,
                 box_min,
                 box_max,
+                low_passes,
                 yaw_amplitude_rad,
                 yaw_period_s,
                 ..
             } => {
+                validate_low_passes(low_passes)?;
                 if *count < 2 {
                     return bad(
                         "count",
@@ -283,14 +302,13 @@ impl ReferenceGenerator {
                     scale(*first, -omega * omega * s1),
                     scale(*second, -4.0 * omega * omega * s2),
                 );
-                if let Some(pass) = low_passes.iter().find(|p| t < p.end_s) {
-                    let (b, db, ddb) = low_pass_blend(pass, t);
-                    let (f, df, ddf) = (position[2], velocity[2], acceleration[2]);
-                    let h = pass.height_m;
-                    position[2] = f * (1.0 - b) + b * h;
-                    velocity[2] = df * (1.0 - b) - f * db + db * h;
-                    acceleration[2] = ddf * (1.0 - b) - 2.0 * df * db - f * ddb + ddb * h;
-                }
+                apply_low_passes(
+                    low_passes,
+                    t,
+                    &mut position,
+                    &mut velocity,
+                    &mut acceleration,
+                );
                 Reference {
                     position,
                     velocity,
@@ -300,13 +318,32 @@ impl ReferenceGenerator {
             }
             Trajectory::RandomWaypoints {
                 segment_s,
+                low_passes,
                 yaw_amplitude_rad,
                 yaw_period_s,
                 ..
             } => {
+                let mut reference = self.waypoint_reference(t, *segment_s);
+                reference.yaw = yaw_at(t, *yaw_amplitude_rad, *yaw_period_s);
+                apply_low_passes(
+                    low_passes,
+                    t,
+                    &mut reference.position,
+                    &mut reference.velocity,
+                    &mut reference.acceleration,
+                );
+                reference
+            }
+        }
+    }
+
+    /// The minimum-jerk waypoint reference at `t` (yaw 0).
+    fn waypoint_reference(&self, t: f64, segment_s: f64) -> Reference {
+        {
+            {
                 let last = self.waypoints.len() - 1;
                 let index = ((t / segment_s).floor().max(0.0) as usize).min(last);
-                let yaw = yaw_at(t, *yaw_amplitude_rad, *yaw_period_s);
+                let yaw = 0.0;
                 if index >= last {
                     return Reference {
                         position: self.waypoints[last],
@@ -327,6 +364,24 @@ impl ReferenceGenerator {
                 }
             }
         }
+    }
+}
+
+/// Blends the height of a reference into the low pass under way at `t`, if any.
+fn apply_low_passes(
+    low_passes: &[LowPass],
+    t: f64,
+    position: &mut Vec3,
+    velocity: &mut Vec3,
+    acceleration: &mut Vec3,
+) {
+    if let Some(pass) = low_passes.iter().find(|p| t < p.end_s) {
+        let (b, db, ddb) = low_pass_blend(pass, t);
+        let (f, df, ddf) = (position[2], velocity[2], acceleration[2]);
+        let h = pass.height_m;
+        position[2] = f * (1.0 - b) + b * h;
+        velocity[2] = df * (1.0 - b) - f * db + db * h;
+        acceleration[2] = ddf * (1.0 - b) - 2.0 * df * db - f * ddb + ddb * h;
     }
 }
 
@@ -481,6 +536,7 @@ mod tests {
             box_min: [-1.0, -1.0, 1.0],
             box_max: [1.0, 1.0, 2.0],
             segment_s,
+            low_passes: Vec::new(),
             yaw_amplitude_rad: 0.5,
             yaw_period_s,
         };
@@ -508,6 +564,7 @@ mod tests {
             box_min: [-2.0, -2.0, 1.0],
             box_max: [2.0, 2.0, 2.0],
             segment_s: 2.5,
+            low_passes: Vec::new(),
             yaw_amplitude_rad: 0.0,
             yaw_period_s: 10.0,
         };

@@ -374,8 +374,9 @@ impl Scenario {
         };
         let whole = |ratio: f64| ratio >= 1.0 - 1e-9 && (ratio - ratio.round()).abs() <= 1e-9;
         let control = self.controller_rate();
-        if !(control.is_finite() && whole(control / self.log_rate_hz))
-            || !whole(self.physics_rate_hz / control)
+        if !(control.is_finite()
+            && whole(control / self.log_rate_hz)
+            && whole(self.physics_rate_hz / control))
         {
             return Err(field(
                 "controller_rate_hz",
@@ -807,6 +808,9 @@ fn record_row(
     }
 }
 
+/// Motor speeds and collective thrust (N) as logged.
+type LoggedCommand = ([f64; 4], f64);
+
 /// The commands the logger writes: for each row, the issued commands it reads (one, or the mean
 /// over a log period), found in a window of the most recent control steps.
 struct CommandLog {
@@ -816,9 +820,9 @@ struct CommandLog {
     /// Recent control steps: (step, motor speeds, thrust).
     recent: VecDeque<(usize, [f64; 4], f64)>,
     /// Per row: its control step (from the first row) and, once known, its command.
-    rows: Vec<(usize, Option<([f64; 4], f64)>)>,
+    rows: Vec<(usize, Option<LoggedCommand>)>,
     warmup_steps: usize,
-    first: Option<([f64; 4], f64)>,
+    first: Option<LoggedCommand>,
     /// Rows before this one are filled (rows are filled in order).
     next: usize,
 }

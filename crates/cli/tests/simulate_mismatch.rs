@@ -18,7 +18,7 @@ fn workspace() -> PathBuf {
 fn setup(test: &str) -> PathBuf {
     let dir = scratch(test);
     std::fs::copy(
-        workspace().join("experiments/mismatch/demo-quad.json"),
+        workspace().join("experiments/mismatch/vehicles/quad-a.json"),
         dir.join("quad.json"),
     )
     .unwrap();
@@ -29,7 +29,7 @@ fn setup(test: &str) -> PathBuf {
 /// Writes the control scenario, changed by `change`, as `name` in `dir`.
 fn write_scenario(dir: &Path, name: &str, change: impl FnOnce(&mut Value)) {
     let text =
-        std::fs::read_to_string(workspace().join("experiments/mismatch/scenarios/control.json"))
+        std::fs::read_to_string(workspace().join("experiments/mismatch/configurations/d.json"))
             .unwrap();
     let mut scenario: Value = serde_json::from_str(&text).unwrap();
     scenario["model"] = json!("quad.json");

@@ -1,27 +1,31 @@
-//! The whole analysis of one recording: compare, locate, explain, fit, validate on held-out data.
+//! The whole analysis of one recording: compare, locate, explain, fit, judge the evidence, validate
+//! on held-out data.
 
-use data::{Derivative, FlightLog, RateFrame};
-use physics::{Effects, NominalModel};
+use data::{FlightLog, RateFrame};
+use physics::{Effects, Logger, NominalModel};
 use serde::Serialize;
 
+use crate::describe::describe;
 use crate::error::{MismatchError, Result};
-use crate::library::{Candidate, TIMING, build_library};
+use crate::evidence::{self, Evidence, EvidenceSettings, explained_fractions};
+use crate::fit::{FitAlternatives, fit_parameters, profile_nonlinear};
+use crate::library::{Candidate, build_library};
 use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
-use crate::refine::{
-    Parameter, effect_column, effects_from, levenberg_marquardt, objective, profile_search,
-    profile_wind,
-};
 use crate::selection::{Design, Selection, SelectionSettings, stability_selection};
+use crate::weak_form::TestFunction;
 
 /// Settings of an analysis (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct AnalysisSettings {
-    /// The smoothed derivative the residual and all MSEs are computed against.
-    pub derivative: Derivative,
+    /// The comparison's test function.
+    pub test_function: TestFunction,
     /// Fraction of the analysed rows, at the end, held out from every fit and choice.
     pub heldout_fraction: f64,
+    /// Length of the blocks that the selection and the evidence rule compare, s.
+    pub block_s: f64,
     pub selection: SelectionSettings,
+    pub evidence: EvidenceSettings,
     /// A channel is significant when its residual RMS exceeds this multiple of its noise floor.
     pub significance_factor: f64,
     /// A window is located where the moving RMS of the residual exceeds this multiple of the floor.
@@ -36,9 +40,11 @@ pub struct AnalysisSettings {
 impl Default for AnalysisSettings {
     fn default() -> Self {
         Self {
-            derivative: Derivative::SMOOTH,
+            test_function: TestFunction::default(),
             heldout_fraction: 0.3,
+            block_s: 1.0,
             selection: SelectionSettings::default(),
+            evidence: EvidenceSettings::default(),
             significance_factor: 2.0,
             window_factor: 2.5,
             window_s: 1.0,
@@ -52,9 +58,18 @@ impl Default for AnalysisSettings {
 #[derive(Clone, Debug, Serialize)]
 pub struct ChannelReport {
     pub name: String,
+    /// RMS of the nominal model's residual over all analysed rows.
     pub residual_rms: f64,
     pub noise_floor: f64,
+    /// The part of the noise floor on the model's side (noise in the commands and attitude it
+    /// reads; the rest is the recorded velocity's or rate's own noise).
+    pub noise_floor_model_side: f64,
+    /// Whether the nominal model's residual exceeds the noise floor significantly.
     pub significant: bool,
+    /// RMS of the fitted model's residual.
+    pub residual_rms_after: f64,
+    /// Whether a significant residual remains with the effects found.
+    pub significant_after: bool,
     pub heldout_mse_before: f64,
     pub heldout_mse_after: f64,
 }
@@ -73,9 +88,11 @@ pub struct EffectReport {
     pub id: String,
     pub parameters: serde_json::Value,
     pub description: String,
-    /// Share of the nominal model's noise-normalised residual sum of squares (fit part) that this
-    /// effect removes, measured by leaving it out of the fitted model.
+    /// This effect's share of the nominal model's noise-normalised residual sum of squares (fit
+    /// part) that the fitted effects remove, in [0, 1]; the shares sum to the total removed.
     pub explained_fraction: f64,
+    /// Why it is named ([`crate::evidence`]).
+    pub evidence: Evidence,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -97,8 +114,8 @@ pub struct Fit {
     pub before: Mse,
     pub after: Mse,
     pub heldout: Heldout,
-    /// What the MSEs are computed against.
-    pub derivative: String,
+    /// What the MSEs are computed on.
+    pub comparison: String,
     pub t_start: f64,
     pub t_end: f64,
 }
@@ -117,12 +134,10 @@ pub struct SelectionReport {
     pub method: String,
     pub settings: SelectionSettings,
     pub candidates: Vec<CandidateReport>,
-    /// Whitened fit errors of the two timing explanations, when the timing term was kept.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub timing_alternatives: Option<serde_json::Value>,
-    /// Wind test: whitened gain per row and channel, and its t-statistic across folds.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub wind_test: Option<serde_json::Value>,
+    /// What the joint fit tried besides the model it kept.
+    pub alternatives: FitAlternatives,
+    /// The effects the evidence rule dropped, with their evidence when dropped.
+    pub dropped: Vec<Evidence>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -138,10 +153,15 @@ pub struct Report {
     pub recording: String,
     pub model: String,
     pub channels: Vec<ChannelReport>,
+    /// Where the nominal model disagrees with the recording.
     pub windows: Vec<Window>,
     pub effects: Vec<EffectReport>,
+    /// Where a significant residual remains that the effects found do not explain.
+    pub unexplained: Vec<Window>,
     pub fit: Fit,
     pub rate_frame: RateFrameReport,
+    /// How the recording's commands and rates were logged (from the model file).
+    pub logger: Logger,
     pub selection: SelectionReport,
     pub settings: AnalysisSettings,
 }
@@ -163,55 +183,54 @@ pub fn analyze(
     model_name: &str,
     settings: &AnalysisSettings,
 ) -> Result<Analysis> {
-    let min_rows = 8 * settings.derivative.min_samples().max(5);
-    let recording = Recording::new(log, model, min_rows)?;
+    let recording = Recording::new(log, model, 40)?;
     let problem = Problem::new(
         recording,
         model.clone(),
-        settings.derivative,
+        settings.test_function,
         settings.heldout_fraction,
     )?;
-    let nominal = Effects::default();
-    let before = problem.residual(&nominal);
-    let fit_rows = 0..problem.split;
-
+    let block_rows = ((settings.block_s / problem.recording.dt).round() as usize).max(1);
+    let before = problem.residual(&Effects::default());
     let (candidates, mut columns) = build_library(&problem);
-    let wind_start = profile_nonlinear(
-        &problem,
-        &before,
-        &candidates,
-        &mut columns,
-        fit_rows.clone(),
-        settings.selection.block_rows,
-    );
+    let wind_start = profile_nonlinear(&problem, &before, &candidates, &mut columns, block_rows);
     let groups: Vec<Vec<usize>> = candidates.iter().map(|c| c.columns.clone()).collect();
-    let block_rows = settings.selection.block_rows;
-    let design = Design::new(&problem, &before, &columns, fit_rows.clone(), block_rows);
+    let design = Design::new(&problem, &before, &columns, 0..problem.split, block_rows);
     let selection = stability_selection(&design, &groups, &settings.selection);
-
-    let fitted = fit_parameters(
+    let (set, alternatives) = fit_parameters(
         &problem,
         &candidates,
         &columns,
         &design,
         &selection,
-        settings,
+        settings.iterations,
+        block_rows,
         wind_start,
     );
-    let (effects, timing_alternatives, wind_test) = fitted;
+    let judgement = evidence::apply(
+        &problem,
+        set,
+        &settings.evidence,
+        settings.iterations / 2,
+        block_rows,
+    );
+    let effects = judgement.set.effects();
     let after = problem.residual(&effects);
     let report = build_report(
         &problem,
         log,
         model_name,
         settings,
-        &before,
-        &after,
-        &effects,
-        &candidates,
-        &selection,
-        timing_alternatives,
-        wind_test,
+        Residuals {
+            before: &before,
+            after: &after,
+        },
+        &judgement,
+        Screen {
+            candidates: &candidates,
+            selection: &selection,
+            alternatives,
+        },
     );
     let analysis = Analysis {
         report,
@@ -279,379 +298,6 @@ fn first_null(value: &serde_json::Value, path: String) -> Option<String> {
     }
 }
 
-/// Replaces the screen columns of the nonlinear candidates by the exact effect at the parameters
-/// a profile search finds next to all other columns: the ground-effect radius, the better of a
-/// delay and a motor lag, and the air velocity of the quadratic drag. Returns that air velocity.
-fn profile_nonlinear(
-    problem: &Problem,
-    before: &[Channels],
-    candidates: &[Candidate],
-    columns: &mut [Vec<Channels>],
-    range: std::ops::Range<usize>,
-    block_rows: usize,
-) -> [f64; 3] {
-    let base = problem.predict(&Effects::default());
-    let total = columns.len();
-    let others_of = |candidate: &Candidate| -> Vec<usize> {
-        (0..total)
-            .filter(|c| !candidate.columns.contains(c))
-            .collect()
-    };
-    let find = |id: &str| candidates.iter().find(|c| c.id == id);
-    if let Some(candidate) = find("ground_effect") {
-        let others = others_of(candidate);
-        let grid: Vec<f64> = (1..=60).map(|i| i as f64 * 0.02).collect();
-        let effect = |r: f64| effects_from(&[Parameter::GroundRadius], &[r]);
-        let (radius, _) = profile_search(
-            problem,
-            columns,
-            &others,
-            range.clone(),
-            block_rows,
-            &grid,
-            effect,
-        );
-        columns[candidate.columns[0]] =
-            effect_column(problem, &base, &effect(radius), radius * radius);
-    }
-    if let Some(candidate) = find(TIMING) {
-        let others = others_of(candidate);
-        let grid: Vec<f64> = (1..=60).map(|i| i as f64 * 0.0025).collect();
-        let best = [Parameter::Delay, Parameter::MotorLag]
-            .into_iter()
-            .map(|kind| {
-                let (value, sse) = profile_search(
-                    problem,
-                    columns,
-                    &others,
-                    range.clone(),
-                    block_rows,
-                    &grid,
-                    |v| effects_from(&[kind], &[v]),
-                );
-                (kind, value, sse)
-            })
-            .min_by(|a, b| a.2.total_cmp(&b.2))
-            .expect("two kinds");
-        columns[candidate.columns[0]] =
-            effect_column(problem, &base, &effects_from(&[best.0], &[best.1]), best.1);
-    }
-    let mut wind = [0.0; 3];
-    if let Some(candidate) = find("quadratic_drag") {
-        let others = others_of(candidate);
-        let (w, _) = profile_wind(problem, before, columns, &others, range.clone(), block_rows);
-        wind = w;
-        let effects = effects_from(
-            &[
-                Parameter::QuadraticDrag,
-                Parameter::Wind(0),
-                Parameter::Wind(1),
-                Parameter::Wind(2),
-            ],
-            &[1.0, w[0], w[1], w[2]],
-        );
-        columns[candidate.columns[0]] = effect_column(problem, &base, &effects, 1.0);
-    }
-    wind
-}
-
-type FitOutcome = (
-    Effects,
-    Option<serde_json::Value>,
-    Option<serde_json::Value>,
-);
-
-fn fit_parameters(
-    problem: &Problem,
-    candidates: &[Candidate],
-    columns: &[Vec<Channels>],
-    design: &Design,
-    selection: &Selection,
-    settings: &AnalysisSettings,
-    wind_start: [f64; 3],
-) -> FitOutcome {
-    let fit_rows = 0..problem.split;
-    let block_rows = settings.selection.block_rows;
-    let kept: Vec<&Candidate> = selection.kept.iter().map(|&g| &candidates[g]).collect();
-    if kept.is_empty() {
-        return (Effects::default(), None, None);
-    }
-    let kept_columns: Vec<usize> = kept.iter().flat_map(|c| c.columns.clone()).collect();
-    let ones = vec![1.0; design.blocks()];
-    let theta = design.solve(&ones, &kept_columns);
-    let coefficient = |column: usize| {
-        theta[kept_columns
-            .iter()
-            .position(|c| *c == column)
-            .expect("kept")]
-    };
-    let mut parameters = Vec::new();
-    let mut values = Vec::new();
-    let mut timing = false;
-    for candidate in &kept {
-        let others: Vec<usize> = kept_columns
-            .iter()
-            .copied()
-            .filter(|c| !candidate.columns.contains(c))
-            .collect();
-        let cols = &candidate.columns;
-        match candidate.id.as_str() {
-            "thrust_scale" => {
-                parameters.push(Parameter::ThrustScale);
-                values.push(1.0 + coefficient(cols[0]));
-            }
-            "linear_drag" => {
-                for (i, &c) in cols.iter().enumerate() {
-                    parameters.push(Parameter::LinearDrag(i));
-                    values.push(coefficient(c).max(0.0));
-                }
-            }
-            "quadratic_drag" => {
-                parameters.push(Parameter::QuadraticDrag);
-                values.push(coefficient(cols[0]).max(0.0));
-            }
-            "ground_effect" => {
-                let grid: Vec<f64> = (1..=60).map(|i| i as f64 * 0.02).collect();
-                let (radius, _) = profile_search(
-                    problem,
-                    columns,
-                    &others,
-                    fit_rows.clone(),
-                    block_rows,
-                    &grid,
-                    |r| effects_from(&[Parameter::GroundRadius], &[r]),
-                );
-                parameters.push(Parameter::GroundRadius);
-                values.push(radius);
-            }
-            "torque_bias" => {
-                for (i, &c) in cols.iter().enumerate() {
-                    parameters.push(Parameter::TorqueBias(i));
-                    values.push(coefficient(c));
-                }
-            }
-            "inertia_scale" => {
-                for (i, &c) in cols.iter().enumerate() {
-                    parameters.push(Parameter::InertiaScale(i));
-                    values.push(1.0 / (1.0 + coefficient(c)).max(0.05));
-                }
-            }
-            id if id == TIMING => timing = true,
-            other => unreachable!("unknown candidate {other}"),
-        }
-    }
-    let screen_values = values.clone();
-    let mut timing_alternatives = None;
-    let (mut parameters, mut values, mut sse) = if timing {
-        let others: Vec<usize> = kept
-            .iter()
-            .filter(|c| c.id != TIMING)
-            .flat_map(|c| c.columns.clone())
-            .collect();
-        let grid: Vec<f64> = (0..=60).map(|i| i as f64 * 0.0025).collect();
-        let mut best: Option<(Vec<Parameter>, Vec<f64>, f64)> = None;
-        let mut scores = serde_json::Map::new();
-        for kind in [Parameter::Delay, Parameter::MotorLag] {
-            let (start, _) = profile_search(
-                problem,
-                columns,
-                &others,
-                fit_rows.clone(),
-                block_rows,
-                &grid,
-                |v| effects_from(&[kind], &[v]),
-            );
-            let mut p = parameters.clone();
-            let mut v = values.clone();
-            p.push(kind);
-            v.push(start);
-            let (v, sse) =
-                levenberg_marquardt(problem, &p, &v, fit_rows.clone(), settings.iterations);
-            scores.insert(kind.effect_id().to_string(), serde_json::json!(sse));
-            if best.as_ref().is_none_or(|b| sse < b.2) {
-                best = Some((p, v, sse));
-            }
-        }
-        timing_alternatives = Some(serde_json::Value::Object(scores));
-        best.expect("two alternatives tried")
-    } else {
-        let (v, sse) = levenberg_marquardt(
-            problem,
-            &parameters,
-            &values,
-            fit_rows.clone(),
-            settings.iterations,
-        );
-        (parameters.clone(), v, sse)
-    };
-    let mut wind_test = None;
-    if parameters.contains(&Parameter::QuadraticDrag) {
-        // The screen's drag column was already at the profiled air velocity: fit with wind, then
-        // test whether still air explains the residual as well.
-        let mut with_wind = parameters.clone();
-        with_wind.extend([Parameter::Wind(0), Parameter::Wind(1), Parameter::Wind(2)]);
-        // Two starts: the still-air fit, and the screen's estimates (the still-air fit may have
-        // pushed the drag coefficient to its bound); both with the profiled air velocity.
-        let starts = [values.clone(), {
-            let mut v = values.clone();
-            v[..screen_values.len()].copy_from_slice(&screen_values);
-            v
-        }];
-        let (v, sse_wind) = starts
-            .iter()
-            .map(|start| {
-                let mut start = start.clone();
-                start.extend(wind_start);
-                levenberg_marquardt(
-                    problem,
-                    &with_wind,
-                    &start,
-                    fit_rows.clone(),
-                    settings.iterations,
-                )
-            })
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .expect("two starts");
-        let count = (fit_rows.len() * problem.channels) as f64;
-        let gain = (sse - sse_wind) / count;
-        let t = fold_t_statistic(
-            problem,
-            &parameters,
-            &values,
-            &with_wind,
-            &v,
-            settings.selection.folds,
-        );
-        let accepted = gain >= settings.selection.min_gain && t >= settings.selection.min_t;
-        wind_test = Some(serde_json::json!({"gain": gain, "t": t, "accepted": accepted}));
-        if accepted {
-            parameters = with_wind;
-            values = v;
-            sse = sse_wind;
-        }
-    }
-    let _ = sse;
-    let (parameters, values) = backward_elimination(problem, parameters, values, settings);
-    (
-        effects_from(&parameters, &values),
-        timing_alternatives,
-        wind_test,
-    )
-}
-
-/// Drops, one at a time, the effect whose removal (with the others refitted) costs least, while
-/// that cost fails the selection's own test (mean whitened gain per row and channel below
-/// `min_gain`, or paired t over blocks below `min_t`). Catches terms the linear screen needed only
-/// to patch a linearisation that the exact fit no longer needs.
-fn backward_elimination(
-    problem: &Problem,
-    mut parameters: Vec<Parameter>,
-    mut values: Vec<f64>,
-    settings: &AnalysisSettings,
-) -> (Vec<Parameter>, Vec<f64>) {
-    let fit_rows = 0..problem.split;
-    loop {
-        let mut ids: Vec<&'static str> = parameters.iter().map(|p| p.effect_id()).collect();
-        ids.dedup();
-        if ids.len() < 2 {
-            return (parameters, values);
-        }
-        let full = block_sse(
-            problem,
-            &effects_from(&parameters, &values),
-            settings.selection.block_rows,
-        );
-        let mut weakest: Option<(f64, Vec<Parameter>, Vec<f64>)> = None;
-        for id in ids {
-            // Wind goes with its drag; wind alone has had its own test.
-            let drop = |p: &Parameter| {
-                p.effect_id() == id || (id == "quadratic_drag" && p.effect_id() == "wind")
-            };
-            let kept: Vec<(Parameter, f64)> = parameters
-                .iter()
-                .zip(&values)
-                .filter(|(p, _)| !drop(p))
-                .map(|(p, v)| (*p, *v))
-                .collect();
-            let (reduced_parameters, start): (Vec<Parameter>, Vec<f64>) = kept.into_iter().unzip();
-            let (reduced_values, _) = levenberg_marquardt(
-                problem,
-                &reduced_parameters,
-                &start,
-                fit_rows.clone(),
-                settings.iterations / 2,
-            );
-            let reduced = block_sse(
-                problem,
-                &effects_from(&reduced_parameters, &reduced_values),
-                settings.selection.block_rows,
-            );
-            let gains: Vec<f64> = reduced
-                .iter()
-                .zip(&full)
-                .map(|(r, f)| r.1 - f.1)
-                .zip(&full)
-                .map(|(g, f)| g / f.0)
-                .collect();
-            let mean = gains.iter().sum::<f64>() / gains.len() as f64;
-            let sd = (gains.iter().map(|g| (g - mean).powi(2)).sum::<f64>()
-                / (gains.len() - 1).max(1) as f64)
-                .sqrt();
-            let t = mean / (sd / (gains.len() as f64).sqrt()).max(1e-300);
-            let passes = mean >= settings.selection.min_gain && t >= settings.selection.min_t;
-            if !passes && weakest.as_ref().is_none_or(|w| mean < w.0) {
-                weakest = Some((mean, reduced_parameters, reduced_values));
-            }
-        }
-        match weakest {
-            Some((_, p, v)) => {
-                parameters = p;
-                values = v;
-            }
-            None => return (parameters, values),
-        }
-    }
-}
-
-/// Per block of fit rows: (row × channel count, whitened sum of squares).
-fn block_sse(problem: &Problem, effects: &Effects, block_rows: usize) -> Vec<(f64, f64)> {
-    let residual = problem.residual(effects);
-    (0..problem.split)
-        .step_by(block_rows)
-        .map(|start| {
-            let end = (start + block_rows).min(problem.split);
-            (
-                ((end - start) * problem.channels) as f64,
-                problem.whitened_sse(&residual, start..end),
-            )
-        })
-        .collect()
-}
-
-/// Paired t-statistic of the per-fold whitened error difference between two fitted models.
-fn fold_t_statistic(
-    problem: &Problem,
-    parameters_a: &[Parameter],
-    values_a: &[f64],
-    parameters_b: &[Parameter],
-    values_b: &[f64],
-    folds: usize,
-) -> f64 {
-    let rows = problem.split;
-    let gains: Vec<f64> = (0..folds)
-        .map(|f| {
-            let range = f * rows / folds..(f + 1) * rows / folds;
-            let a = objective(problem, parameters_a, values_a, range.clone());
-            let b = objective(problem, parameters_b, values_b, range.clone());
-            (a - b) / (range.len() * problem.channels).max(1) as f64
-        })
-        .collect();
-    let mean = gains.iter().sum::<f64>() / folds as f64;
-    let sd =
-        (gains.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / (folds - 1).max(1) as f64).sqrt();
-    mean / (sd / (folds as f64).sqrt()).max(1e-300)
-}
-
 /// Windows where the centred moving RMS of a channel's residual exceeds `factor` × floor.
 fn locate_windows(
     problem: &Problem,
@@ -709,82 +355,103 @@ fn rms(values: impl Iterator<Item = f64>) -> f64 {
     (sum / count.max(1) as f64).sqrt()
 }
 
-#[allow(clippy::too_many_arguments)]
+
+/// The nominal and the fitted model's residuals.
+struct Residuals<'a> {
+    before: &'a [Channels],
+    after: &'a [Channels],
+}
+
+/// What the screen and the fit stage chose and tried.
+struct Screen<'a> {
+    candidates: &'a [Candidate],
+    selection: &'a Selection,
+    alternatives: FitAlternatives,
+}
+
+fn channel_reports(
+    problem: &Problem,
+    settings: &AnalysisSettings,
+    residuals: &Residuals,
+) -> Vec<ChannelReport> {
+    let heldout_rows = problem.split..problem.rows();
+    let channel_mse = |residual: &[Channels], c: usize| {
+        residual[heldout_rows.clone()]
+            .iter()
+            .map(|r| r[c] * r[c])
+            .sum::<f64>()
+            / heldout_rows.len().max(1) as f64
+    };
+    (0..problem.channels)
+        .map(|c| {
+            let floor = problem.noise_floor[c];
+            let residual_rms = rms(residuals.before.iter().map(|r| r[c]));
+            let residual_rms_after = rms(residuals.after.iter().map(|r| r[c]));
+            ChannelReport {
+                name: CHANNEL_NAMES[c].to_string(),
+                residual_rms,
+                noise_floor: floor,
+                noise_floor_model_side: problem.model_noise[c],
+                significant: residual_rms > settings.significance_factor * floor,
+                residual_rms_after,
+                significant_after: residual_rms_after > settings.significance_factor * floor,
+                heldout_mse_before: channel_mse(residuals.before, c),
+                heldout_mse_after: channel_mse(residuals.after, c),
+            }
+        })
+        .collect()
+}
+
 fn build_report(
     problem: &Problem,
     log: &FlightLog,
     model_name: &str,
     settings: &AnalysisSettings,
-    before: &[Channels],
-    after: &[Channels],
-    effects: &Effects,
-    candidates: &[Candidate],
-    selection: &Selection,
-    timing_alternatives: Option<serde_json::Value>,
-    wind_test: Option<serde_json::Value>,
+    residuals: Residuals,
+    judgement: &evidence::Judgement,
+    screen: Screen,
 ) -> Report {
     let fit_rows = 0..problem.split;
     let heldout_rows = problem.split..problem.rows();
-    let channel_mse = |residual: &[Channels], c: usize, range: std::ops::Range<usize>| {
-        residual[range.clone()]
-            .iter()
-            .map(|r| r[c] * r[c])
-            .sum::<f64>()
-            / range.len().max(1) as f64
-    };
-    let channels = (0..problem.channels)
-        .map(|c| {
-            let residual_rms = rms(before.iter().map(|r| r[c]));
-            ChannelReport {
-                name: CHANNEL_NAMES[c].to_string(),
-                residual_rms,
-                noise_floor: problem.noise_floor[c],
-                significant: residual_rms > settings.significance_factor * problem.noise_floor[c],
-                heldout_mse_before: channel_mse(before, c, heldout_rows.clone()),
-                heldout_mse_after: channel_mse(after, c, heldout_rows.clone()),
-            }
-        })
-        .collect();
-    let nominal_sse = problem.whitened_sse(before, fit_rows.clone());
-    let full_sse = problem.whitened_sse(after, fit_rows.clone());
+    let effects = judgement.set.effects();
+    let nominal_sse = problem.whitened_sse(residuals.before, fit_rows.clone());
+    let fitted_sse = problem.whitened_sse(residuals.after, fit_rows.clone());
+    let shares = explained_fractions(&judgement.evidence, nominal_sse, fitted_sse);
     let parameters = serde_json::to_value(effects).expect("effects serialise");
-    let effect_reports = effects
-        .ids()
-        .into_iter()
-        .map(|id| {
-            let without = remove_effect(effects, id);
-            let sse_without = problem.whitened_sse(&problem.residual(&without), fit_rows.clone());
-            EffectReport {
-                id: id.to_string(),
-                parameters: parameters[id].clone(),
-                description: describe(id, effects),
-                explained_fraction: ((sse_without - full_sse) / nominal_sse.max(1e-300)).max(0.0),
-            }
+    let effect_reports = judgement
+        .evidence
+        .iter()
+        .zip(shares)
+        .map(|(evidence, share)| EffectReport {
+            id: evidence.id.clone(),
+            parameters: parameters[evidence.id.as_str()].clone(),
+            description: describe(&evidence.id, &effects),
+            explained_fraction: share,
+            evidence: evidence.clone(),
         })
         .collect();
-    let derivative = match settings.derivative {
-        Derivative::SavitzkyGolay { window, order } => format!(
-            "Savitzky-Golay derivative (window {window}, order {order}) of the recorded velocity and body rate; the model's prediction is smoothed by the matched weights"
-        ),
-        other => format!("{other:?} derivative"),
-    };
     let t = |row: usize| problem.time[row.min(problem.rows() - 1)];
+    let form = &problem.weak_form;
     Report {
         recording: log.path.display().to_string(),
         model: model_name.to_string(),
-        channels,
-        windows: locate_windows(problem, before, settings),
+        channels: channel_reports(problem, settings, &residuals),
+        windows: locate_windows(problem, residuals.before, settings),
         effects: effect_reports,
+        unexplained: locate_windows(problem, residuals.after, settings),
         fit: Fit {
-            before: Mse { mse: problem.mse(before, fit_rows.clone()) },
-            after: Mse { mse: problem.mse(after, fit_rows.clone()) },
+            before: Mse { mse: problem.mse(residuals.before, fit_rows.clone()) },
+            after: Mse { mse: problem.mse(residuals.after, fit_rows.clone()) },
             heldout: Heldout {
-                before: Mse { mse: problem.mse(before, heldout_rows.clone()) },
-                after: Mse { mse: problem.mse(after, heldout_rows.clone()) },
+                before: Mse { mse: problem.mse(residuals.before, heldout_rows.clone()) },
+                after: Mse { mse: problem.mse(residuals.after, heldout_rows.clone()) },
                 t_start: t(heldout_rows.start),
                 t_end: t(heldout_rows.end - 1),
             },
-            derivative,
+            comparison: format!(
+                "weak form: the recorded velocity and body rate against the model's acceleration, both weighted by the test function (1 - s^2)^{} over ±{} s ({} rows each side), so a right model leaves only noise",
+                form.function.power, form.function.half_width_s, form.half
+            ),
             t_start: t(0),
             t_end: t(fit_rows.end - 1),
         },
@@ -793,112 +460,25 @@ fn build_report(
             body_rms: problem.recording.rate_frame_errors.0,
             world_rms: problem.recording.rate_frame_errors.1,
         },
+        logger: problem.model.logger,
         selection: SelectionReport {
-            method: "forward stepwise selection of candidate groups scored by time-blocked cross-validation on the noise-normalised residual, kept when chosen in enough block-bootstrap resamples (stability selection)".to_string(),
+            method: "forward stepwise selection of candidate groups scored by time-blocked cross-validation on the noise-normalised residual, kept when chosen in enough block-bootstrap resamples (stability selection); the kept effects fitted jointly with the exact model; each then kept only when the evidence rule holds for it".to_string(),
             settings: settings.selection,
-            candidates: candidates
+            candidates: screen
+                .candidates
                 .iter()
                 .enumerate()
                 .map(|(g, candidate)| CandidateReport {
                     candidate: candidate.clone(),
-                    selection_frequency: selection.frequencies[g],
-                    chosen_on_data: selection.chosen_on_data.contains(&g),
-                    kept: selection.kept.contains(&g),
+                    selection_frequency: screen.selection.frequencies[g],
+                    chosen_on_data: screen.selection.chosen_on_data.contains(&g),
+                    kept: screen.selection.kept.contains(&g),
                 })
                 .collect(),
-            timing_alternatives,
-            wind_test,
+            alternatives: screen.alternatives,
+            dropped: judgement.dropped.clone(),
         },
         settings: *settings,
-    }
-}
-
-/// The effects without one of them (wind goes with its drag).
-pub fn remove_effect(effects: &Effects, id: &str) -> Effects {
-    let mut e = *effects;
-    match id {
-        "linear_drag" => e.linear_drag = None,
-        "quadratic_drag" => {
-            e.quadratic_drag = None;
-            e.wind = None;
-        }
-        "wind" => e.wind = None,
-        "thrust_scale" => e.thrust_scale = None,
-        "motor_lag" => e.motor_lag = None,
-        "ground_effect" => e.ground_effect = None,
-        "torque_bias" => e.torque_bias = None,
-        "inertia_scale" => e.inertia_scale = None,
-        "delay" => e.delay = None,
-        _ => {}
-    }
-    if e.quadratic_drag.is_none() && e.linear_drag.is_none() {
-        e.wind = None;
-    }
-    e
-}
-
-fn vector(v: [f64; 3], digits: usize) -> String {
-    format!("[{:.digits$}, {:.digits$}, {:.digits$}]", v[0], v[1], v[2])
-}
-
-/// One sentence per effect, in plain words.
-pub fn describe(id: &str, e: &Effects) -> String {
-    match id {
-        "linear_drag" => {
-            let d = e.linear_drag.map(|x| x.d).unwrap_or_default();
-            format!(
-                "Rotor drag: a force against the velocity along each body axis, d = {} 1/s (at 2 m/s forward flight about {:.2} m/s² of deceleration).",
-                vector(d, 3),
-                2.0 * d[0].max(d[1])
-            )
-        }
-        "quadratic_drag" => {
-            let c = e.quadratic_drag.map(|x| x.c).unwrap_or_default();
-            format!(
-                "Aerodynamic drag growing with the square of the airspeed, c = {c:.4} 1/m (at 5 m/s airspeed about {:.2} m/s²).",
-                25.0 * c
-            )
-        }
-        "wind" => {
-            let w = e.air_velocity();
-            format!(
-                "The drag acts on the velocity relative to air moving at {} m/s (speed {:.2} m/s): there is wind.",
-                vector(w, 2),
-                physics::vector::norm(w)
-            )
-        }
-        "thrust_scale" => {
-            let k = e.thrust_scale.map(|x| x.k).unwrap_or(1.0);
-            format!(
-                "The rotors produce {k:.3} times the thrust the model assumes ({:+.1}%).",
-                100.0 * (k - 1.0)
-            )
-        }
-        "motor_lag" => format!(
-            "Each motor reaches its commanded speed with a first-order lag of time constant {:.1} ms.",
-            1000.0 * e.lag_s()
-        ),
-        "ground_effect" => {
-            let r = e.ground_effect.map(|x| x.r_m).unwrap_or_default();
-            format!(
-                "Extra thrust near the ground (ground effect), radius r = {r:.3} m: +{:.1}% thrust at 0.3 m height, +{:.2}% at 1.5 m.",
-                100.0 * (1.0 / (1.0 - physics::ground_ratio(r, 0.3)) - 1.0),
-                100.0 * (1.0 / (1.0 - physics::ground_ratio(r, 1.5)) - 1.0)
-            )
-        }
-        "torque_bias" => format!(
-            "A constant extra angular acceleration {} rad/s² (a torque offset, e.g. an off-centre mass or a tilted motor).",
-            vector(e.torque_bias.map(|x| x.b).unwrap_or_default(), 3)
-        ),
-        "inertia_scale" => format!(
-            "The moments of inertia are {} times the model's.",
-            vector(e.inertia_scale.map(|x| x.k).unwrap_or([1.0; 3]), 3)
-        ),
-        "delay" => format!(
-            "The vehicle responds to its commands {:.1} ms late.",
-            1000.0 * e.delay_s()
-        ),
-        other => other.to_string(),
     }
 }
 

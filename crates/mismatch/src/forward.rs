@@ -1,80 +1,130 @@
-//! The model's prediction averaged over each sample interval, with any set of effects.
+//! The model's acceleration on a fine grid between the rows, with any set of effects.
 //!
-//! Over the interval between rows k and k+1 the recorded command of row k is held (zero-order hold);
-//! a delay shifts that command stream and a motor lag filters it, both evaluated exactly on a fine
-//! grid of [`SUBSTEPS`] sub-intervals. Attitude, velocity, height and rate are interpolated linearly
-//! between the rows. The mean of the acceleration over an interval is what the velocity change over
-//! that interval measures, which is what makes the comparison with a smoothed derivative exact for
-//! a correct model (see [`crate::filter`]).
+//! The command the vehicle received is reconstructed from the logged one as the model's logger
+//! says ([`physics::Logger`]): a cubic (Catmull–Rom) curve through instantaneous samples (half a
+//! control period late when the controller's rate is known: each command is held until the next), or a
+//! command constant over each log period (held from its row to the next, or the mean over the period
+//! before its row), shifted by the logger's time offset. A delay shifts it further and a motor lag
+//! filters it (exactly, for a command constant over each sub-interval). Attitude, velocity, height
+//! and rate are interpolated linearly between the rows. With a body-rate filter in the logger, the
+//! angular acceleration goes through the same first-order filter, as the logged rate did.
 
 use physics::vector::{Mat3, Vec3};
-use physics::{Effects, NominalModel};
+use physics::{CommandLogging, Effects, Logger, NominalModel};
 
 use crate::recording::Recording;
 
 /// Sub-intervals per sample interval.
 pub const SUBSTEPS: usize = 10;
 
-/// Interval means of the translational and (if the model predicts torques) angular accelerations.
+/// The accelerations at the midpoints of every sub-interval (`(n − 1) · SUBSTEPS` of each).
 #[derive(Clone, Debug)]
-pub struct IntervalPrediction {
+pub struct SubstepPrediction {
     pub translational: Vec<Vec3>,
+    /// When the model predicts torques.
     pub angular: Option<Vec<Vec3>>,
 }
 
-/// Predicts every interval of a recording.
-pub fn predict_intervals(
+/// Predicts the accelerations of a recording on the fine grid.
+pub fn predict_substeps(
     recording: &Recording,
     model: &NominalModel,
     effects: &Effects,
-) -> IntervalPrediction {
+) -> SubstepPrediction {
     let n = recording.len();
     let actuators = actuator_trace(
         &recording.commands,
         recording.dt,
         model.actuator_count(),
+        &model.logger,
         effects.delay_s(),
         effects.lag_s(),
     );
     let angular_wanted = model.predicts_torque();
-    let mut translational = Vec::with_capacity(n - 1);
-    let mut angular = Vec::with_capacity(if angular_wanted { n - 1 } else { 0 });
+    let spread = spread_after_lag(recording, effects.lag_s());
+    let total = (n - 1) * SUBSTEPS;
+    let mut translational = Vec::with_capacity(total);
+    let mut angular = Vec::with_capacity(if angular_wanted { total } else { 0 });
     for k in 0..n - 1 {
-        let mut sum_translational = [0.0; 3];
-        let mut sum_angular = [0.0; 3];
         for j in 0..SUBSTEPS {
             let s = (j as f64 + 0.5) / SUBSTEPS as f64;
             let rotation = lerp_matrix(&recording.rotation[k], &recording.rotation[k + 1], s);
             let velocity = lerp(recording.velocity[k], recording.velocity[k + 1], s);
             let height = recording.height[k] + s * (recording.height[k + 1] - recording.height[k]);
-            let wrench = model.wrench(&actuators[k * SUBSTEPS + j]);
-            let a = effects.translational_acceleration(
+            let wrench = model.wrench_with_spread(&actuators[k * SUBSTEPS + j], &spread);
+            translational.push(effects.translational_acceleration(
                 model,
                 &rotation,
                 velocity,
                 height,
                 wrench.thrust,
-            );
-            for i in 0..3 {
-                sum_translational[i] += a[i];
-            }
+            ));
             if angular_wanted {
                 let rate = lerp(recording.body_rate[k], recording.body_rate[k + 1], s);
                 let torque = wrench.torque.unwrap_or([0.0; 3]);
-                let alpha = effects.angular_acceleration(model, rate, torque);
-                for i in 0..3 {
-                    sum_angular[i] += alpha[i];
-                }
+                angular.push(effects.angular_acceleration(model, rate, torque));
             }
         }
-        translational.push(sum_translational.map(|v| v / SUBSTEPS as f64));
-        if angular_wanted {
-            angular.push(sum_angular.map(|v| v / SUBSTEPS as f64));
-        }
     }
-    IntervalPrediction {
+    let tau = model.logger.rate_time_constant_s();
+    if angular_wanted && tau > 0.0 {
+        low_pass(&mut angular, recording.dt / SUBSTEPS as f64, tau);
+    }
+    SubstepPrediction {
         translational,
         angular: angular_wanted.then_some(angular),
+    }
+}
+
+/// The within-row spread of the commands that reaches the actuators: a first-order lag of time
+/// constant `lag` passes `(1 − a) / (1 + a)` of white noise's variance at the command rate
+/// (`a = e^(−h/lag)`, `h` the command period).
+fn spread_after_lag(recording: &Recording, lag: f64) -> [f64; 4] {
+    match recording.command_rate_hz {
+        Some(rate) if lag > 0.0 => {
+            let a = (-1.0 / (rate * lag)).exp();
+            recording.command_spread.map(|v| v * (1.0 - a) / (1.0 + a))
+        }
+        _ => recording.command_spread,
+    }
+}
+
+/// The nominal model's accelerations at the rows themselves, from each row's logged command and
+/// measured state (translational, and angular when the model predicts torques).
+pub fn predict_at_rows(
+    recording: &Recording,
+    model: &NominalModel,
+) -> (Vec<Vec3>, Option<Vec<Vec3>>) {
+    let effects = Effects::default();
+    let mut translational = Vec::with_capacity(recording.len());
+    let mut angular = Vec::with_capacity(recording.len());
+    for k in 0..recording.len() {
+        let wrench = model.wrench(&recording.commands[k]);
+        translational.push(effects.translational_acceleration(
+            model,
+            &recording.rotation[k],
+            recording.velocity[k],
+            recording.height[k],
+            wrench.thrust,
+        ));
+        if let Some(torque) = wrench.torque {
+            angular.push(effects.angular_acceleration(model, recording.body_rate[k], torque));
+        }
+    }
+    let angular = model.predicts_torque().then_some(angular);
+    (translational, angular)
+}
+
+/// First-order low-pass of time constant `tau` over a series at spacing `h`, in place, starting
+/// at the first value.
+fn low_pass(series: &mut [Vec3], h: f64, tau: f64) {
+    let gain = 1.0 - (-h / tau).exp();
+    let mut state = series.first().copied().unwrap_or([0.0; 3]);
+    for value in series.iter_mut() {
+        for i in 0..3 {
+            state[i] += gain * (value[i] - state[i]);
+        }
+        *value = state;
     }
 }
 
@@ -94,45 +144,124 @@ fn lerp_matrix(a: &Mat3, b: &Mat3, s: f64) -> Mat3 {
     ]
 }
 
-/// The actuator states at the midpoint of every sub-interval: the held command stream delayed by
-/// `delay` seconds (the mean over each sub-interval, so it is continuous in the delay) and passed
-/// through a first-order lag of time constant `lag` (exact for a held input).
+/// The logged commands as a function of time (s from the first row), as the logger made them.
+struct Reconstruction<'a> {
+    commands: &'a [[f64; 4]],
+    dt: f64,
+    count: usize,
+    logging: CommandLogging,
+}
+
+impl Reconstruction<'_> {
+    fn at_index(&self, index: i64) -> [f64; 4] {
+        self.commands[index.clamp(0, self.commands.len() as i64 - 1) as usize]
+    }
+
+    /// The mean of the command over `[start, end]` (a sub-interval, shorter than a row interval).
+    fn mean(&self, start: f64, end: f64) -> [f64; 4] {
+        match self.logging {
+            CommandLogging::Sample => self.cubic(0.5 * (start + end)),
+            // Held over [t_j, t_{j+1}); the period mean is the same, one interval earlier.
+            CommandLogging::Held => self.steps(start, end, 0.0),
+            CommandLogging::PeriodMean => self.steps(start, end, self.dt),
+        }
+    }
+
+    /// A command constant over `[t_j − shift, t_{j+1} − shift)`, averaged over `[start, end]`.
+    fn steps(&self, start: f64, end: f64, shift: f64) -> [f64; 4] {
+        let (start, end) = (start + shift, end + shift);
+        let first = (start / self.dt).floor();
+        let boundary = (first + 1.0) * self.dt;
+        let a = self.at_index(first as i64);
+        if end <= boundary {
+            return a;
+        }
+        let b = self.at_index(first as i64 + 1);
+        let weight_first = (boundary - start) / (end - start);
+        let mut mixed = [0.0; 4];
+        for i in 0..self.count {
+            mixed[i] = weight_first * a[i] + (1.0 - weight_first) * b[i];
+        }
+        mixed
+    }
+
+    /// The band-limited curve through the samples at time `t`: Lanczos interpolation with
+    /// [`LANCZOS_LOBES`] lobes (a windowed sinc, near exact for content below half the log rate,
+    /// where a cubic is off by percents at a fifth of the log rate).
+    fn cubic(&self, t: f64) -> [f64; 4] {
+        let position = t / self.dt;
+        let j = position.floor();
+        let s = position - j;
+        let j = j as i64;
+        let a = LANCZOS_LOBES as i64;
+        let mut out = [0.0; 4];
+        let mut total = 0.0;
+        for m in (1 - a)..=a {
+            let x = s - m as f64;
+            let weight = lanczos(x, LANCZOS_LOBES as f64);
+            total += weight;
+            let p = self.at_index(j + m);
+            for i in 0..self.count {
+                out[i] += weight * p[i];
+            }
+        }
+        out.map(|v| v / total)
+    }
+}
+
+/// Lobes of the Lanczos kernel.
+const LANCZOS_LOBES: usize = 4;
+
+/// The Lanczos kernel `sinc(x) sinc(x / a)` on `|x| < a`.
+fn lanczos(x: f64, a: f64) -> f64 {
+    if x.abs() < 1e-12 {
+        return 1.0;
+    }
+    if x.abs() >= a {
+        return 0.0;
+    }
+    let pi_x = std::f64::consts::PI * x;
+    a * pi_x.sin() * (pi_x / a).sin() / (pi_x * pi_x)
+}
+
+/// The actuator states at the midpoint of every sub-interval: the command the vehicle received
+/// (the logged commands as `logger` describes them), `delay` seconds late, through a first-order lag
+/// of time constant `lag` (exact for an input constant over each sub-interval).
 pub fn actuator_trace(
     commands: &[[f64; 4]],
     dt: f64,
     count: usize,
+    logger: &Logger,
     delay: f64,
     lag: f64,
 ) -> Vec<[f64; 4]> {
     let n = commands.len();
     let h = dt / SUBSTEPS as f64;
     let total = (n - 1) * SUBSTEPS;
-    let command_at = |index: f64| -> usize { (index.max(0.0) as usize).min(n - 1) };
-    let mut out = Vec::with_capacity(total);
-    let mut state = commands[0];
+    let reconstruction = Reconstruction {
+        commands,
+        dt,
+        count,
+        logging: logger.command,
+    };
+    // Received at t: logged at t − offset; applied at t: received at t − delay. A sampled command
+    // held for a control period acts, on average, half a period after its sample.
+    let hold = match (logger.command, logger.controller_rate_hz) {
+        (CommandLogging::Sample, Some(rate)) => 0.5 / rate,
+        _ => 0.0,
+    };
+    let shift = logger.command_time_offset_s + hold + delay;
+    let mut state = reconstruction.mean(-shift, h - shift);
     let decay_full = if lag > 0.0 { (-h / lag).exp() } else { 0.0 };
     let decay_half = if lag > 0.0 {
         (-h / (2.0 * lag)).exp()
     } else {
         0.0
     };
+    let mut out = Vec::with_capacity(total);
     for step in 0..total {
-        let start = step as f64 * h - delay;
-        let end = start + h;
-        let first = (start / dt).floor();
-        let boundary = (first + 1.0) * dt;
-        let input = if end <= boundary || first < -1.0 {
-            commands[command_at(first)]
-        } else {
-            let weight_first = (boundary - start) / h;
-            let a = commands[command_at(first)];
-            let b = commands[command_at(first + 1.0)];
-            let mut mixed = [0.0; 4];
-            for i in 0..count {
-                mixed[i] = weight_first * a[i] + (1.0 - weight_first) * b[i];
-            }
-            mixed
-        };
+        let start = step as f64 * h - shift;
+        let input = reconstruction.mean(start, start + h);
         if lag > 0.0 {
             let mut midpoint = [0.0; 4];
             for i in 0..count {
@@ -151,26 +280,62 @@ pub fn actuator_trace(
 mod tests {
     use super::*;
 
+    fn held() -> Logger {
+        Logger {
+            command: CommandLogging::Held,
+            ..Logger::default()
+        }
+    }
+
     #[test]
     fn delay_shifts_the_held_commands_and_lag_approaches_them() {
         let commands: Vec<[f64; 4]> = (0..6).map(|k| [k as f64, 0.0, 0.0, 0.0]).collect();
         let dt = 0.02;
-        let plain = actuator_trace(&commands, dt, 1, 0.0, 0.0);
+        let plain = actuator_trace(&commands, dt, 1, &held(), 0.0, 0.0);
         assert_eq!(plain[SUBSTEPS * 2 + 3][0], 2.0);
         // Delay of exactly one interval: interval 3 sees command 2.
-        let delayed = actuator_trace(&commands, dt, 1, dt, 0.0);
+        let delayed = actuator_trace(&commands, dt, 1, &held(), dt, 0.0);
         assert!((delayed[SUBSTEPS * 3 + 5][0] - 2.0).abs() < 1e-12);
         // Half a sub-interval of delay mixes two commands half and half at the switch.
-        let half = actuator_trace(&commands, dt, 1, dt / SUBSTEPS as f64 / 2.0, 0.0);
+        let half = actuator_trace(&commands, dt, 1, &held(), dt / SUBSTEPS as f64 / 2.0, 0.0);
         assert!((half[SUBSTEPS * 2][0] - 1.5).abs() < 1e-9);
+        // The period mean of row j held over the interval before it: one interval earlier.
+        let mean = Logger {
+            command: CommandLogging::PeriodMean,
+            ..Logger::default()
+        };
+        let early = actuator_trace(&commands, dt, 1, &mean, 0.0, 0.0);
+        assert!((early[SUBSTEPS * 2 + 3][0] - 3.0).abs() < 1e-12);
         // A lag follows a step monotonically, without overshoot, and reaches 1 − e^(−t/τ).
         let step: Vec<[f64; 4]> = (0..6)
             .map(|k| [if k >= 2 { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0])
             .collect();
-        let lagged = actuator_trace(&step, dt, 1, 0.0, 0.05);
+        let lagged = actuator_trace(&step, dt, 1, &held(), 0.0, 0.05);
         let response: Vec<f64> = lagged[SUBSTEPS * 2..].iter().map(|a| a[0]).collect();
         assert!(response.windows(2).all(|w| w[1] > w[0] && w[1] < 1.0));
         let midpoint = (SUBSTEPS as f64 + 0.5) * dt / SUBSTEPS as f64;
         assert!((response[SUBSTEPS] - (1.0 - (-midpoint / 0.05f64).exp())).abs() < 1e-12);
+    }
+
+    /// Samples of a smooth command are reconstructed to a few parts in 10⁴ between the samples,
+    /// and a sampled command's delay moves the curve by exactly that time.
+    #[test]
+    fn sampled_commands_are_interpolated_smoothly() {
+        let dt = 0.02;
+        let f = |t: f64| (2.0 * std::f64::consts::PI * 3.0 * t).sin();
+        let commands: Vec<[f64; 4]> = (0..100)
+            .map(|k| [f(k as f64 * dt), 0.0, 0.0, 0.0])
+            .collect();
+        let trace = actuator_trace(&commands, dt, 1, &Logger::default(), 0.0, 0.0);
+        let h = dt / SUBSTEPS as f64;
+        for (i, value) in trace.iter().enumerate().skip(2 * SUBSTEPS).take(900) {
+            let t = (i as f64 + 0.5) * h;
+            assert!((value[0] - f(t)).abs() < 5e-3, "{} vs {}", value[0], f(t));
+        }
+        let delayed = actuator_trace(&commands, dt, 1, &Logger::default(), 0.013, 0.0);
+        for (i, value) in delayed.iter().enumerate().skip(3 * SUBSTEPS).take(900) {
+            let t = (i as f64 + 0.5) * h - 0.013;
+            assert!((value[0] - f(t)).abs() < 5e-3);
+        }
     }
 }

@@ -22,8 +22,10 @@
 
 mod analysis;
 pub mod demo;
+mod describe;
 mod error;
-pub mod filter;
+pub mod evidence;
+mod fit;
 pub mod flights;
 pub mod forward;
 mod library;
@@ -32,12 +34,15 @@ mod problem;
 mod recording;
 mod refine;
 mod selection;
+pub mod weak_form;
 
 pub use analysis::{
     Analysis, AnalysisSettings, ChannelReport, EffectReport, Fit, Report, Window, analyze,
-    describe, remove_effect,
 };
+pub use describe::{describe, remove_effect};
 pub use error::{MismatchError, Result};
+pub use evidence::{Evidence, EvidenceSettings};
+pub use fit::FittedSet;
 pub use library::{Candidate, TIMING, Term, build_library};
 pub use output::{
     check_directory, check_outputs, check_run_outputs, markdown_text, output_paths, write_figure,
@@ -46,4 +51,6 @@ pub use output::{
 pub use problem::{CHANNEL_NAMES, Channels, Problem};
 pub use recording::Recording;
 pub use refine::{Parameter, effects_from, levenberg_marquardt};
-pub use selection::{Design, Selection, SelectionSettings, stability_selection, stepwise};
+pub use selection::{
+    Design, Selection, SelectionSettings, trimmed_gain, stability_selection, stepwise,
+};

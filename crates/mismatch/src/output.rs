@@ -307,20 +307,64 @@ pub fn markdown_text(analysis: &Analysis) -> String {
         }
     }
     let _ = writeln!(md, "\n## What is missing from the model\n");
+    let rule = report.settings.evidence;
+    let _ = writeln!(
+        md,
+        "An effect is named only when, with the others refitted without it, it passes four tests: on the fit part, its likelihood ratio (corrected for the correlation of neighbouring rows) exceeds the {} quantile of χ², it lowers the noise-normalised residual by at least {} per row and channel, also when the two {} s blocks that gain most are left out (not one transient); and it lowers the held-out residual by at least {:.0}%.\n",
+        rule.significance,
+        rule.min_gain,
+        report.settings.block_s,
+        100.0 * rule.min_heldout_reduction
+    );
     if report.effects.is_empty() {
         let _ = writeln!(
             md,
-            "Nothing: no candidate term explains the residual consistently better than noise (none passed cross-validation in at least {:.0}% of the bootstrap resamples).",
-            100.0 * report.selection.settings.stability_threshold
+            "Nothing: no candidate term explains the residual clearly better than noise."
         );
     } else {
         for e in &report.effects {
             let _ = writeln!(
                 md,
-                "- **{}** — {} It accounts for {:.0}% of the nominal model's (noise-normalised) residual.",
+                "- **{}** — {} It accounts for {:.0}% of the nominal model's (noise-normalised) residual; without it the held-out residual is {:.0}% higher (likelihood ratio {:.0} against {:.1}, gain {:.2} per row and channel, {:.2} without its two largest blocks).",
                 e.id,
                 e.description,
-                100.0 * e.explained_fraction
+                100.0 * e.explained_fraction,
+                100.0 * (e.evidence.heldout_without / e.evidence.heldout_with.max(1e-300) - 1.0),
+                e.evidence.likelihood_ratio,
+                e.evidence.likelihood_ratio_threshold,
+                e.evidence.fit_gain,
+                e.evidence.trimmed_gain
+            );
+        }
+    }
+    for d in &report.selection.dropped {
+        let _ = writeln!(
+            md,
+            "- not named: {} (likelihood ratio {:.1} against {:.1}, gain {:.3}, {:.3} without its two largest blocks, held-out reduction {:.1}%): below the evidence rule.",
+            d.id,
+            d.likelihood_ratio,
+            d.likelihood_ratio_threshold,
+            d.fit_gain,
+            d.trimmed_gain,
+            100.0 * d.heldout_reduction
+        );
+    }
+    if report.unexplained.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nWith the effects named, no stretch of the flight disagrees by more than {:.1} times the noise floor.",
+            report.settings.window_factor
+        );
+    } else {
+        let _ = writeln!(
+            md,
+            "\nA significant residual remains that no effect of the vocabulary explains:\n"
+        );
+        for w in &report.unexplained {
+            let _ = writeln!(
+                md,
+                "- unexplained residual on {}, {:.1}–{:.1} s",
+                w.channel, w.t_start, w.t_end
             );
         }
     }
@@ -345,10 +389,11 @@ pub fn markdown_text(analysis: &Analysis) -> String {
             if c.kept { ", kept" } else { "" }
         );
     }
-    if let Some(timing) = &report.selection.timing_alternatives {
+    if let Some(timing) = &report.selection.alternatives.timing {
         let _ = writeln!(
             md,
-            "\nThe command-rate term was resolved by fitting both a pure delay and a first-order motor lag exactly; noise-normalised fit errors: {timing}. The smaller one was kept."
+            "\nThe command-rate term was resolved by fitting a pure delay, a first-order motor lag and both exactly; noise-normalised fit errors: {}. The smallest was kept, then judged by the evidence rule.",
+            serde_json::Value::Object(timing.clone())
         );
     }
     let fit = &report.fit;

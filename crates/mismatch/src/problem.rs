@@ -1,13 +1,13 @@
-//! The comparison at derivative level: the smoothed derivative of the recording (target), the
-//! model's matched prediction, the residual and its noise floor, per channel.
+//! The comparison in the weak form ([`crate::weak_form`]): the target of the recording (a smoothed
+//! acceleration of the recorded velocity and body rate), the model's value of the same functional,
+//! the residual and its noise floor, per channel.
 
-use data::Derivative;
-use physics::{Effects, NominalModel};
+use physics::{CommandLogging, Effects, NominalModel};
 
 use crate::error::{MismatchError, Result};
-use crate::filter::{MatchedSmoother, white_noise_sigma};
-use crate::forward::predict_intervals;
+use crate::forward::{SUBSTEPS, predict_at_rows, predict_substeps};
 use crate::recording::Recording;
+use crate::weak_form::{TestFunction, WeakForm, white_noise_sigma};
 
 /// Channel names in output order: translational then angular accelerations.
 pub const CHANNEL_NAMES: [&str; 6] = ["vdot_x", "vdot_y", "vdot_z", "wdot_x", "wdot_y", "wdot_z"];
@@ -30,15 +30,18 @@ pub type Channels = [f64; 6];
 pub struct Problem {
     pub recording: Recording,
     pub model: NominalModel,
-    pub smoother: MatchedSmoother,
+    pub weak_form: WeakForm,
     /// 3 (translational only) or 6.
     pub channels: usize,
-    /// Time of each analysed row (the rows where the smoothed derivative is centred).
+    /// Time of each analysed row (the centre of its test function).
     pub time: Vec<f64>,
-    /// Smoothed derivative of the recorded velocity and body rate.
+    /// The weak-form target of the recorded velocity and body rate.
     pub target: Vec<Channels>,
     /// Standard deviation of the residual expected from measurement noise alone.
     pub noise_floor: Channels,
+    /// The part of the noise floor that is on the model's side (from the recorded commands and
+    /// attitude the model reads), per channel: it attenuates fitted scale factors.
+    pub model_noise: Channels,
     /// Analysed rows `[0, split)` are fitted, `[split, len)` are held out.
     pub split: usize,
 }
@@ -48,66 +51,63 @@ impl Problem {
     pub fn new(
         recording: Recording,
         model: NominalModel,
-        derivative: Derivative,
+        test_function: TestFunction,
         heldout_fraction: f64,
     ) -> Result<Self> {
-        let smoother = MatchedSmoother::new(derivative)?;
-        let half = smoother.half_window();
+        let bad = |message: String| MismatchError::Recording {
+            path: recording.path.clone(),
+            message,
+        };
+        let weak_form = test_function.at_interval(recording.dt).map_err(bad)?;
+        let half = weak_form.half;
         let n = recording.len();
         // At least one analysed row to fit and one held out.
         if n < 2 * half + 2 {
-            return Err(MismatchError::Recording {
-                path: recording.path.clone(),
-                message: format!(
-                    "{n} rows, the derivative's window of {} rows needs at least {}",
-                    2 * half + 1,
-                    2 * half + 2
-                ),
-            });
+            return Err(bad(format!(
+                "{n} rows, the comparison's window of {} rows needs at least {}",
+                2 * half + 1,
+                2 * half + 2
+            )));
         }
         let channels = if model.predicts_torque() { 6 } else { 3 };
-        let dt = recording.dt;
         let mut target = vec![[0.0; 6]; n - 2 * half];
+        let nominal = if model.logger.command == CommandLogging::Sample {
+            Some(predict_at_rows(&recording, &model))
+        } else {
+            None
+        };
         let mut noise_floor = [0.0; 6];
+        let mut model_noise = [0.0; 6];
         for c in 0..channels {
             let signal: Vec<f64> = if c < 3 {
                 recording.velocity.iter().map(|v| v[c]).collect()
             } else {
                 recording.body_rate.iter().map(|w| w[c - 3]).collect()
             };
-            for (row, value) in target.iter_mut().zip(smoother.derivative_of(&signal, dt)) {
+            for (row, value) in target.iter_mut().zip(weak_form.target(&signal)) {
                 row[c] = value;
             }
-            let measured = white_noise_sigma(&signal) * smoother.sample_noise_gain() / dt;
-            // The recorded commands are exact; what is noisy on the model side is the measured
-            // attitude tilting the thrust (the gyroscopic term's rate noise is negligible).
-            let model_side = if c < 3 {
-                let direction: Vec<f64> = recording.rotation.iter().map(|r| r[c][2]).collect();
-                let mean_thrust = nominal_thrust_acceleration(&recording, &model);
-                white_noise_sigma(&direction) * mean_thrust * smoother.interval_noise_gain()
-            } else {
-                0.0
-            };
-            noise_floor[c] = measured.hypot(model_side).max(1e-12);
+            let measured = white_noise_sigma(&signal) * weak_form.target_noise_gain();
+            model_noise[c] = model_side_noise(&recording, &model, nominal.as_ref(), c)
+                * weak_form.model_noise_gain();
+            noise_floor[c] = measured.hypot(model_noise[c]).max(1e-12);
         }
         let rows = target.len();
         let split = ((1.0 - heldout_fraction) * rows as f64).round() as usize;
-        if !(1..=rows).contains(&split) {
-            return Err(MismatchError::Recording {
-                path: recording.path.clone(),
-                message: format!(
-                    "a held-out fraction of {heldout_fraction} of {rows} analysed rows leaves no rows to fit"
-                ),
-            });
+        if !(1..rows).contains(&split) {
+            return Err(bad(format!(
+                "a held-out fraction of {heldout_fraction} of {rows} analysed rows leaves no rows to fit or none to hold out"
+            )));
         }
         Ok(Self {
             time: recording.time[half..n - half].to_vec(),
             recording,
             model,
-            smoother,
+            weak_form,
             channels,
             target,
             noise_floor,
+            model_noise,
             split,
         })
     }
@@ -117,15 +117,15 @@ impl Problem {
         self.target.len()
     }
 
-    /// The model's smoothed-derivative prediction with a set of effects, per analysed row.
+    /// The model's value of the weak form with a set of effects, per analysed row.
     pub fn predict(&self, effects: &Effects) -> Vec<Channels> {
-        let intervals = predict_intervals(&self.recording, &self.model, effects);
+        let substeps = predict_substeps(&self.recording, &self.model, effects);
         let mut out = vec![[0.0; 6]; self.rows()];
         for c in 0..self.channels {
             let series: Vec<f64> = if c < 3 {
-                intervals.translational.iter().map(|a| a[c]).collect()
+                substeps.translational.iter().map(|a| a[c]).collect()
             } else {
-                intervals
+                substeps
                     .angular
                     .as_ref()
                     .expect("angular channels")
@@ -133,7 +133,10 @@ impl Problem {
                     .map(|a| a[c - 3])
                     .collect()
             };
-            for (row, value) in out.iter_mut().zip(self.smoother.smooth_intervals(&series)) {
+            for (row, value) in out
+                .iter_mut()
+                .zip(self.weak_form.integrate(&series, SUBSTEPS))
+            {
                 row[c] = value;
             }
         }
@@ -177,4 +180,35 @@ impl Problem {
             })
             .sum()
     }
+}
+
+/// The noise per sample of the model's acceleration on channel `c`: the measured attitude tilting
+/// the thrust (translational channels) and, when the commands are instantaneous samples of a faster
+/// controller's, the part of the command that varies from sample to sample and that the samples
+/// cannot resolve (estimated from the fourth differences of the nominal model's accelerations at
+/// the rows, which include the attitude's part).
+fn model_side_noise(
+    recording: &Recording,
+    model: &NominalModel,
+    nominal: Option<&(Vec<[f64; 3]>, Option<Vec<[f64; 3]>>)>,
+    c: usize,
+) -> f64 {
+    let attitude = if c < 3 {
+        let direction: Vec<f64> = recording.rotation.iter().map(|r| r[c][2]).collect();
+        white_noise_sigma(&direction) * nominal_thrust_acceleration(recording, model)
+    } else {
+        0.0
+    };
+    let Some((translational, angular)) = nominal else {
+        return attitude;
+    };
+    let series: Vec<f64> = if c < 3 {
+        translational.iter().map(|a| a[c]).collect()
+    } else {
+        let Some(angular) = angular.as_ref() else {
+            return attitude;
+        };
+        angular.iter().map(|a| a[c - 3]).collect()
+    };
+    white_noise_sigma(&series).max(attitude)
 }

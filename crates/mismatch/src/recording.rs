@@ -4,10 +4,11 @@
 use std::path::PathBuf;
 
 use data::{FlightLog, RateFrame};
-use physics::NominalModel;
 use physics::vector::{Mat3, Vec3, mat_t_vec};
+use physics::{CommandLogging, NominalModel};
 
 use crate::error::{MismatchError, Result};
+use crate::weak_form::white_noise_sigma;
 
 /// The recorded signals, per row.
 #[derive(Clone, Debug)]
@@ -25,9 +26,14 @@ pub struct Recording {
     /// The frame the `w` column was found to be in, with the RMS errors (body, world) of the check.
     pub rate_frame: RateFrame,
     pub rate_frame_errors: (f64, f64),
-    /// Actuator commands (four normalised motor speeds, or `[T, 0, 0, 0]` in N), held from each row
-    /// to the next.
+    /// Actuator commands (four normalised motor speeds, or `[T, 0, 0, 0]` in N), as logged.
     pub commands: Vec<[f64; 4]>,
+    /// Variance of each actuator command within a row, when the rows hold means over the log
+    /// period of a faster controller's commands (zero otherwise): `(m − 1)` times the variance of the
+    /// logged means' sample-to-sample noise, `m` commands per row, for white command noise.
+    pub command_spread: [f64; 4],
+    /// The rate of the commands a row averages, Hz (when known).
+    pub command_rate_hz: Option<f64>,
 }
 
 impl Recording {
@@ -68,7 +74,7 @@ impl Recording {
                 .map(|(r, w)| mat_t_vec(r, *w))
                 .collect(),
         };
-        let commands = (0..log.len())
+        let commands: Vec<[f64; 4]> = (0..log.len())
             .map(|k| {
                 model.actuator_command(
                     log.thrust_setpoint[k],
@@ -77,9 +83,22 @@ impl Recording {
                 )
             })
             .collect();
+        let dt = log.sample_interval();
+        let command_rate_hz = match model.logger.command {
+            CommandLogging::PeriodMean => model.logger.controller_rate_hz,
+            _ => None,
+        };
+        let mut command_spread = [0.0; 4];
+        if let Some(rate) = command_rate_hz {
+            let per_row = (rate * dt).max(1.0);
+            for i in 0..model.actuator_count() {
+                let series: Vec<f64> = commands.iter().map(|c| c[i]).collect();
+                command_spread[i] = (per_row - 1.0) * white_noise_sigma(&series).powi(2);
+            }
+        }
         Ok(Self {
             path: log.path.clone(),
-            dt: log.sample_interval(),
+            dt,
             time: log.time.clone(),
             rotation: log.rotation.clone(),
             velocity: log.velocity.clone(),
@@ -92,6 +111,8 @@ impl Recording {
             rate_frame: frame,
             rate_frame_errors: (body_rms, world_rms),
             commands,
+            command_spread,
+            command_rate_hz,
         })
     }
 

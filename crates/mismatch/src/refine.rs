@@ -112,16 +112,6 @@ fn whitened(problem: &Problem, residual: &[Channels], range: std::ops::Range<usi
         .collect()
 }
 
-/// Whitened sum of squares of the model with these parameters over rows `range`.
-pub fn objective(
-    problem: &Problem,
-    parameters: &[Parameter],
-    values: &[f64],
-    range: std::ops::Range<usize>,
-) -> f64 {
-    problem.whitened_sse(&problem.residual(&effects_from(parameters, values)), range)
-}
-
 /// Levenberg–Marquardt with a forward-difference Jacobian and bounds by projection.
 pub fn levenberg_marquardt(
     problem: &Problem,

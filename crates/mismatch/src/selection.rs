@@ -3,9 +3,11 @@
 //!
 //! Rows are whitened (each channel divided by its noise floor), so on noise alone the mean square
 //! per row and channel is about 1. A group enters only when it lowers the cross-validated error in
-//! every sense that matters: on average by at least `min_gain` (noise-floor units) and consistently
-//! across the time blocks (paired t-statistic of the per-block cross-validated gains above `min_t`;
-//! blocks, not folds, so that an effect present in only part of the flight can pass). A group is kept when it enters in at least
+//! every sense that matters: on average by at least `min_gain` (noise-floor units), and still by
+//! `min_gain` once the two blocks that gain most are left out ([`trimmed_gain`]), so that an effect
+//! present in only part of the flight, or much stronger in some blocks than in others, can enter,
+//! while a term that fits one transient cannot. A
+//! group is kept when it enters in at least
 //! `stability_threshold` of the resamples. All sums go through per-block Gram matrices, so a
 //! resample or a fold costs a few small solves.
 
@@ -21,11 +23,9 @@ use crate::problem::{Channels, Problem};
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct SelectionSettings {
     pub folds: usize,
-    pub block_rows: usize,
     pub resamples: usize,
     pub stability_threshold: f64,
     pub min_gain: f64,
-    pub min_t: f64,
     pub seed: u64,
 }
 
@@ -33,11 +33,9 @@ impl Default for SelectionSettings {
     fn default() -> Self {
         Self {
             folds: 5,
-            block_rows: 50,
             resamples: 40,
             stability_threshold: 0.7,
             min_gain: 0.05,
-            min_t: 2.0,
             seed: 20240611,
         }
     }
@@ -196,6 +194,27 @@ impl Design {
     }
 }
 
+/// Blocks whose gains are left out by [`trimmed_gain`].
+pub const TRIMMED_BLOCKS: f64 = 2.0;
+
+/// The mean of per-block gains (each with a weight: a block drawn `w` times counts `w` times) once
+/// the [`TRIMMED_BLOCKS`] largest are left out: what remains of a gain when the one or two blocks
+/// that carry most of it are ignored. Near zero for a term that only fits a transient; most of the
+/// mean for an effect present, however unevenly, through much of the flight.
+pub fn trimmed_gain(gains: &[(f64, f64)]) -> f64 {
+    let mut sorted: Vec<(f64, f64)> = gains.iter().copied().filter(|(w, _)| *w > 0.0).collect();
+    sorted.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let total: f64 = sorted.iter().map(|(w, _)| w).sum();
+    let mut to_remove = TRIMMED_BLOCKS;
+    let mut sum = 0.0;
+    for (w, g) in sorted {
+        let removed = w.min(to_remove);
+        to_remove -= removed;
+        sum += (w - removed) * g;
+    }
+    sum / (total - TRIMMED_BLOCKS).max(1.0)
+}
+
 /// Forward stepwise selection of groups; returns the chosen group indices in order of entry.
 pub fn stepwise(
     design: &Design,
@@ -218,23 +237,23 @@ pub fn stepwise(
             let trial_columns: Vec<usize> = columns.iter().chain(group).copied().collect();
             let errors = design.block_errors(weights, &fold_of_block, folds, &trial_columns);
             // Paired comparison over blocks, each counted as often as the resample drew it.
-            let (mut total, mut total_squares, mut count) = (0.0, 0.0, 0.0);
+            let (mut total, mut count) = (0.0, 0.0);
+            let mut positive = Vec::with_capacity(blocks);
             for b in 0..blocks {
                 let gain = current[b] - errors[b];
                 if weights[b] > 0.0 && gain.is_finite() {
                     total += weights[b] * gain;
-                    total_squares += weights[b] * gain * gain;
                     count += weights[b];
+                    positive.push((weights[b], gain));
                 }
             }
             if count < 2.0 {
                 continue;
             }
             let mean = total / count;
-            let variance = ((total_squares - count * mean * mean) / (count - 1.0)).max(0.0);
-            let t = mean / (variance.sqrt() / count.sqrt()).max(1e-300);
+            let consistency = trimmed_gain(&positive);
             if mean >= settings.min_gain
-                && t >= settings.min_t
+                && consistency >= settings.min_gain
                 && best.as_ref().is_none_or(|(_, m, _)| mean > *m)
             {
                 best = Some((g, mean, errors));

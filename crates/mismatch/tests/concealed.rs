@@ -9,7 +9,7 @@ mod common;
 use common::{scenario, workspace};
 
 fn model() -> NominalModel {
-    common::model("demo-quad.json")
+    common::model("vehicles/quad-a.json")
 }
 
 fn flight(effects: Effects, seed: u64) -> data::FlightLog {

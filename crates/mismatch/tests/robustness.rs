@@ -17,7 +17,7 @@ fn flight() -> data::FlightLog {
         duration_s: 12.0,
         ..common::scenario(Effects::default(), 7)
     };
-    let mut log = simulate(&model("demo-quad.json"), &scenario, "test").unwrap();
+    let mut log = simulate(&model("vehicles/quad-a.json"), &scenario, "test").unwrap();
     log.path = PathBuf::from("generated/corrupt_flight.csv");
     log
 }
@@ -89,7 +89,7 @@ fn an_overflowing_rate_is_an_error_even_on_channels_not_compared() {
     );
     let mut log = flight();
     log.body_rate[100] = [0.0, 0.0, 1e300];
-    let message = error_of(&log, "demo-quad.json");
+    let message = error_of(&log, "quad-a.json");
     assert!(message.contains("non-finite"), "{message}");
 }
 

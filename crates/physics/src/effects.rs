@@ -3,7 +3,7 @@
 //!
 //! | id | parameters | physics (accelerations per unit mass, SI) |
 //! |---|---|---|
-//! | `linear_drag` | `d: [dx, dy, dz]` | `a = −R diag(d) Rᵀ v` (1/s) |
+//! | `linear_drag` | `d: [dx, dy, dz]` | `a = −R diag(d) Rᵀ (v − w_air)` (1/s) |
 //! | `quadratic_drag` | `c` | `a = −c |v − w_air| (v − w_air)` (1/m) |
 //! | `wind` | `w_air: [x, y, z]` | air velocity (m/s) seen by the drag terms |
 //! | `thrust_scale` | `k` | `T_real = k T` |
@@ -127,7 +127,7 @@ impl Effects {
             if self.linear_drag.is_none() && self.quadratic_drag.is_none() {
                 return bad(
                     "wind",
-                    "needs a drag effect (quadratic_drag) to act through",
+                    "needs a drag effect (linear_drag or quadratic_drag) to act through",
                 );
             }
         }
@@ -210,7 +210,7 @@ impl Effects {
         let mut a = [0.0; 3];
         let relative = sub(velocity, self.air_velocity());
         if let Some(drag) = self.linear_drag {
-            let body = mat_t_vec(rotation, velocity);
+            let body = mat_t_vec(rotation, relative);
             a = sub(a, mat_vec(rotation, hadamard(drag.d, body)));
         }
         if let Some(drag) = self.quadratic_drag {
@@ -302,8 +302,8 @@ mod tests {
         };
         let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
         let a = effects.drag_acceleration(&identity, [3.0, 0.0, 0.0]);
-        // quadratic: −0.1·2·2 = −0.4; linear: −0.5·3 = −1.5
-        assert!((a[0] + 1.9).abs() < 1e-12 && a[1] == 0.0 && a[2] == 0.0);
+        // quadratic: −0.1·2·2 = −0.4; linear: −0.5·(3 − 1) = −1.0
+        assert!((a[0] + 1.4).abs() < 1e-12 && a[1] == 0.0 && a[2] == 0.0);
     }
 
     #[test]

@@ -49,6 +49,14 @@ pub struct Logger {
     /// Hz; none when absent.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rate_low_pass_hz: Option<f64>,
+    /// The rate at which the controller issues its commands, each held until the next, Hz (with
+    /// `sample` or `period_mean`). A sampled command then acts, on average, half a control period
+    /// after its row's time; and a mixer squares the motor speeds, so the mean thrust over a
+    /// `period_mean` row exceeds the thrust of the mean speed by the speeds' spread within the row,
+    /// which knowing how many commands a row averages lets the model add back. Unknown when absent:
+    /// the command is then taken as a continuous signal.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controller_rate_hz: Option<f64>,
 }
 
 impl Logger {
@@ -75,6 +83,23 @@ impl Logger {
                     crate::error::readable(cutoff)
                 ),
             ));
+        }
+        if let Some(rate) = self.controller_rate_hz {
+            if self.command == CommandLogging::Held {
+                return Err((
+                    "controller_rate_hz".into(),
+                    "a held command changes only at the rows: leave it out".into(),
+                ));
+            }
+            if !(rate.is_finite() && rate > 0.0 && rate <= 1e6) {
+                return Err((
+                    "controller_rate_hz".into(),
+                    format!(
+                        "must be a positive rate up to 1e6 Hz, found {}",
+                        crate::error::readable(rate)
+                    ),
+                ));
+            }
         }
         Ok(())
     }

@@ -222,6 +222,24 @@ impl NominalModel {
         }
     }
 
+    /// Thrust and torques produced by actuator states whose values spread within the time they
+    /// stand for with variances `spread` (a mixer's squares see the spread; `T_sp` is linear).
+    pub fn wrench_with_spread(&self, actuators: &[f64; 4], spread: &[f64; 4]) -> Wrench {
+        match (&self.mixer, self.thrust_source) {
+            (Some(mixer), ThrustSource::Mixer) => {
+                let mut w = mixer.wrench(actuators);
+                for (i, row) in mixer.b0.iter().enumerate() {
+                    w[i] += (0..4).map(|j| row[j] * spread[j]).sum::<f64>();
+                }
+                Wrench {
+                    thrust: w[0],
+                    torque: Some([w[1], w[2], w[3]]),
+                }
+            }
+            _ => self.wrench(actuators),
+        }
+    }
+
     /// Thrust and torques produced by actuator states.
     pub fn wrench(&self, actuators: &[f64; 4]) -> Wrench {
         match self.thrust_source {
@@ -377,7 +395,12 @@ impl FieldReader {
         self.known_keys(
             object,
             "logger.",
-            &["command", "command_time_offset_s", "rate_low_pass_hz"],
+            &[
+                "command",
+                "command_time_offset_s",
+                "rate_low_pass_hz",
+                "controller_rate_hz",
+            ],
         )?;
         let logger: Logger = serde_json::from_value(value.clone())
             .map_err(|error| self.error("logger", &error.to_string()))?;

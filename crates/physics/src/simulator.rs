@@ -127,7 +127,7 @@ impl Scenario {
     /// A short figure-8 flight built in code, for examples and tests: 6 s recorded (301 rows at
     /// 50 Hz, just over [`MIN_LOG_ROWS`]) after 4 s of warm-up, a 6 s figure-8 around (0, 0, 1.5) m
     /// (±1.5 m in x, ±0.8 m in y, ±0.3 m in z) with ±0.2 rad of yaw every 10 s, the sensor noise of
-    /// the demo scenarios in `experiments/mismatch/scenarios/`, no effects and the default rates,
+    /// the demo configurations in `experiments/mismatch/configurations/`, no effects and the default rates,
     /// throttle and gains. `model` is the nominal model file, as in a scenario file. Change any
     /// field with struct update syntax:
     ///
@@ -136,7 +136,7 @@ impl Scenario {
     ///
     /// let weak = Scenario {
     ///     effects: Effects { thrust_scale: Some(ThrustScale { k: 0.85 }), ..Effects::default() },
-    ///     ..Scenario::figure_eight("demo-quad.json", 7)
+    ///     ..Scenario::figure_eight("quad-a.json", 7)
     /// };
     /// weak.validate(std::path::Path::new("weak.json")).unwrap();
     /// ```
@@ -349,15 +349,20 @@ impl Scenario {
     /// The logger: as set, or by default the commands held from row to row when the controller
     /// runs at the log rate and sampled at each row's time otherwise. This is what a model file
     /// given to the mismatch tool with this scenario's logs should say (`"logger"`).
+    /// A `sample` or `period_mean` logger gets the controller rate when it has none.
     pub fn logger(&self) -> Logger {
-        self.logger.unwrap_or_else(|| Logger {
+        let mut logger = self.logger.unwrap_or_else(|| Logger {
             command: if self.controller_steps_per_row() == 1 {
                 CommandLogging::Held
             } else {
                 CommandLogging::Sample
             },
             ..Logger::default()
-        })
+        });
+        if logger.command != CommandLogging::Held && logger.controller_rate_hz.is_none() {
+            logger.controller_rate_hz = Some(self.controller_rate());
+        }
+        logger
     }
 
     /// Control steps per logged row.
@@ -404,6 +409,18 @@ impl Scenario {
                 } else {
                     "\"held\" needs the controller at the log rate (controller_rate_hz = log_rate_hz)".to_string()
                 },
+            ));
+        }
+        if let Some(rate) = logger.controller_rate_hz
+            && (rate - control).abs() > 1e-9 * control
+        {
+            return Err(field(
+                "logger.controller_rate_hz",
+                format!(
+                    "the commands a row averages come from the controller: {}, found {}",
+                    readable(control),
+                    readable(rate)
+                ),
             ));
         }
         let steps = logger.command_time_offset_s * control;
@@ -1358,6 +1375,7 @@ mod tests {
             command: CommandLogging::PeriodMean,
             command_time_offset_s: -0.004,
             rate_low_pass_hz: Some(40.0),
+            controller_rate_hz: None,
         });
         s.physics_rate_hz = 1000.0;
         s.validate(Path::new("s.json")).unwrap();

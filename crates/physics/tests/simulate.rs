@@ -5,13 +5,14 @@ mod common;
 use physics::{Effects, NominalModel, Scenario, ThrustScale, simulate};
 
 fn demo_model() -> NominalModel {
-    NominalModel::load(&common::workspace().join("experiments/mismatch/demo-quad.json")).unwrap()
+    NominalModel::load(&common::workspace().join("experiments/mismatch/vehicles/quad-a.json"))
+        .unwrap()
 }
 
 fn scenario(effects: Effects, seed: u64) -> Scenario {
     Scenario {
         effects,
-        ..Scenario::figure_eight("demo-quad.json", seed)
+        ..Scenario::figure_eight("quad-a.json", seed)
     }
 }
 
@@ -77,7 +78,7 @@ fn the_closed_loop_conceals_a_thrust_loss_and_runs_are_deterministic() {
 fn a_scenario_at_its_bounds_gives_a_log_the_data_tools_accept() {
     let model = demo_model();
     let edge = physics::MAX_POSITION_M;
-    let figure_eight = Scenario::figure_eight("demo-quad.json", 3);
+    let figure_eight = Scenario::figure_eight("quad-a.json", 3);
     let mut scenario = Scenario {
         hover_throttle: physics::MIN_HOVER_THROTTLE,
         noise: physics::Noise {

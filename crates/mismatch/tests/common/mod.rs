@@ -11,7 +11,7 @@ pub fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// A nominal model of `experiments/mismatch/`, e.g. `demo-quad.json`.
+/// A nominal model of `experiments/mismatch/`, e.g. `vehicles/quad-a.json`.
 pub fn model(name: &str) -> NominalModel {
     NominalModel::load(&workspace().join("experiments/mismatch").join(name)).unwrap()
 }
@@ -19,7 +19,7 @@ pub fn model(name: &str) -> NominalModel {
 /// A 14 s figure-8 with small sensor noise and the given effects.
 pub fn scenario(effects: Effects, seed: u64) -> Scenario {
     Scenario {
-        model: "demo-quad.json".into(),
+        model: "quad-a.json".into(),
         duration_s: 14.0,
         warmup_s: 3.0,
         seed,

@@ -1,0 +1,370 @@
+//! The evidence rule: an effect is named only when it buys an improvement clearly beyond noise.
+//!
+//! For every effect of the jointly fitted set, the set without it is refitted, and the effect
+//! passes when all of these hold:
+//! - **significance** (fit part): the likelihood ratio `Λ = ΔSSE / (κ s²)` is at least the
+//!   `significance` quantile of χ² with as many degrees of freedom as the effect has parameters.
+//!   `ΔSSE` is the noise-normalised sum of squares the effect removes, `s²` the full model's
+//!   residual variance per row and channel (noise-normalised, ≈ 1 when the model is right), and `κ`
+//!   the integrated autocorrelation of that residual over the test function's support: the weak
+//!   form's rows share samples, so `κ` neighbouring rows carry about one row's worth of
+//!   independent noise, and `ΔSSE` of a noise-only term is about `κ s² χ²_p`;
+//! - **size** (fit part): the mean gain per row and channel is at least `min_gain` noise variances;
+//! - **consistency** (fit part): the mean gain is still at least `min_gain` when the two blocks (of
+//!   about a second) that gain most are left out ([`crate::selection::trimmed_gain`]): not one
+//!   transient;
+//! - **held out**: on the held-out part, which no fit or choice has seen, the noise-normalised
+//!   residual sum of squares falls by at least `min_heldout_reduction` of its value without the
+//!   effect.
+//!
+//! While an effect fails, the weakest failing one (smallest fit gain) is dropped and the rest
+//! refitted; the rule is then applied again to every effect left.
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::fit::FittedSet;
+use crate::problem::{Channels, Problem};
+use crate::selection::trimmed_gain;
+
+/// The thresholds of the rule (recorded in the output).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct EvidenceSettings {
+    pub significance: f64,
+    pub min_gain: f64,
+    pub min_heldout_reduction: f64,
+}
+
+impl Default for EvidenceSettings {
+    fn default() -> Self {
+        Self {
+            significance: 0.999,
+            min_gain: 0.25,
+            min_heldout_reduction: 0.15,
+        }
+    }
+}
+
+/// The evidence for one effect of the final set.
+#[derive(Clone, Debug, Serialize)]
+pub struct Evidence {
+    pub id: String,
+    /// Parameters of the effect (the degrees of freedom of the test).
+    pub parameters: usize,
+    /// `Λ = ΔSSE / (κ s²)` and the χ² quantile it is compared with.
+    pub likelihood_ratio: f64,
+    pub likelihood_ratio_threshold: f64,
+    /// Mean gain per row and channel on the fit part, in noise-floor units.
+    pub fit_gain: f64,
+    /// The mean gain once the two blocks that gain most are left out.
+    pub trimmed_gain: f64,
+    /// Held-out noise-normalised sum of squares without and with the effect.
+    pub heldout_without: f64,
+    pub heldout_with: f64,
+    /// `1 − with / without`.
+    pub heldout_reduction: f64,
+    /// Fit-part noise-normalised sum of squares the effect removes (others refitted).
+    pub fit_sse_removed: f64,
+    pub passes: bool,
+}
+
+/// Noise-normalised sums of squares of a set's residual: per fit block, and over the held-out part.
+struct Scores {
+    blocks: Vec<f64>,
+    counts: Vec<f64>,
+    heldout: f64,
+}
+
+fn scores(problem: &Problem, set: &FittedSet, block_rows: usize) -> Scores {
+    let residual = problem.residual(&set.effects());
+    let mut blocks = Vec::new();
+    let mut counts = Vec::new();
+    let mut start = 0;
+    while start < problem.split {
+        let end = (start + block_rows).min(problem.split);
+        blocks.push(problem.whitened_sse(&residual, start..end));
+        counts.push(((end - start) * problem.channels) as f64);
+        start = end;
+    }
+    Scores {
+        blocks,
+        counts,
+        heldout: problem.whitened_sse(&residual, problem.split..problem.rows()),
+    }
+}
+
+/// The integrated autocorrelation of a residual over lags up to `lags`, averaged over channels
+/// (at least 1).
+fn autocorrelation_factor(problem: &Problem, residual: &[Channels], lags: usize) -> f64 {
+    let mut total = 0.0;
+    for c in 0..problem.channels {
+        let r: Vec<f64> = residual.iter().map(|x| x[c]).collect();
+        let variance: f64 = r.iter().map(|v| v * v).sum();
+        if variance <= 0.0 {
+            continue;
+        }
+        let mut factor = 1.0;
+        for lag in 1..=lags.min(r.len().saturating_sub(1)) {
+            let covariance: f64 = r[lag..].iter().zip(&r).map(|(a, b)| a * b).sum();
+            factor += 2.0 * covariance / variance;
+        }
+        total += factor;
+    }
+    (total / problem.channels as f64).max(1.0)
+}
+
+/// The `q` quantile of χ² with `p` degrees of freedom (Wilson–Hilferty; within 3.5% of the exact
+/// value at `q = 0.999` for `p ≥ 1`).
+pub fn chi_square_quantile(p: usize, q: f64) -> f64 {
+    let z = normal_quantile(q);
+    let k = p.max(1) as f64;
+    let h = 2.0 / (9.0 * k);
+    k * (1.0 - h + z * h.sqrt()).powi(3)
+}
+
+/// The standard normal quantile (Acklam's rational approximation, relative error below 1.2e-9).
+fn normal_quantile(q: f64) -> f64 {
+    let a = [
+        -3.969683028665376e1,
+        2.209460984245205e2,
+        -2.759285104469687e2,
+        1.383577518672690e2,
+        -3.066479806614716e1,
+        2.506628277459239,
+    ];
+    let b = [
+        -5.447609879822406e1,
+        1.615858368580409e2,
+        -1.556989798598866e2,
+        6.680131188771972e1,
+        -1.328068155288572e1,
+    ];
+    let c = [
+        -7.784894002430293e-3,
+        -3.223964580411365e-1,
+        -2.400758277161838,
+        -2.549732539343734,
+        4.374664141464968,
+        2.938163982698783,
+    ];
+    let d = [
+        7.784695709041462e-3,
+        3.224671290700398e-1,
+        2.445134137142996,
+        3.754408661907416,
+    ];
+    let q = q.clamp(1e-300, 1.0 - 1e-16);
+    let tail = |r: f64| {
+        (((((c[0] * r + c[1]) * r + c[2]) * r + c[3]) * r + c[4]) * r + c[5])
+            / ((((d[0] * r + d[1]) * r + d[2]) * r + d[3]) * r + 1.0)
+    };
+    if q < 0.02425 {
+        tail((-2.0 * q.ln()).sqrt())
+    } else if q > 1.0 - 0.02425 {
+        -tail((-2.0 * (1.0 - q).ln()).sqrt())
+    } else {
+        let r = q - 0.5;
+        let t = r * r;
+        (((((a[0] * t + a[1]) * t + a[2]) * t + a[3]) * t + a[4]) * t + a[5]) * r
+            / (((((b[0] * t + b[1]) * t + b[2]) * t + b[3]) * t + b[4]) * t + 1.0)
+    }
+}
+
+/// What the full set's residual says about the noise: `κ` and `s²` on the fit part.
+struct NoiseScale {
+    autocorrelation: f64,
+    variance: f64,
+}
+
+/// The evidence for effect `id` of `set` (whose scores are `full`); returns it with the refitted
+/// set without the effect.
+fn evidence_for(
+    problem: &Problem,
+    set: &FittedSet,
+    full: &Scores,
+    noise: &NoiseScale,
+    id: &str,
+    settings: &EvidenceSettings,
+    iterations: usize,
+    block_rows: usize,
+) -> (Evidence, FittedSet) {
+    let mut reduced = set.without(id);
+    reduced.refit(problem, iterations);
+    let without = scores(problem, &reduced, block_rows);
+    let gains: Vec<f64> = without
+        .blocks
+        .iter()
+        .zip(&full.blocks)
+        .zip(&full.counts)
+        .map(|((w, f), n)| (w - f) / n)
+        .collect();
+    let rows: f64 = full.counts.iter().sum();
+    let removed: f64 = without.blocks.iter().sum::<f64>() - full.blocks.iter().sum::<f64>();
+    let mean = removed / rows;
+    let weighted: Vec<(f64, f64)> = gains.iter().map(|g| (1.0, *g)).collect();
+    let trimmed = trimmed_gain(&weighted);
+    let parameters = set.parameters.len() - reduced.parameters.len();
+    let likelihood_ratio = removed / (noise.autocorrelation * noise.variance).max(1e-300);
+    let threshold = chi_square_quantile(parameters, settings.significance);
+    let reduction = 1.0 - full.heldout / without.heldout.max(1e-300);
+    let passes = likelihood_ratio >= threshold
+        && mean >= settings.min_gain
+        && trimmed >= settings.min_gain
+        && reduction >= settings.min_heldout_reduction;
+    (
+        Evidence {
+            id: id.to_string(),
+            parameters,
+            likelihood_ratio,
+            likelihood_ratio_threshold: threshold,
+            fit_gain: mean,
+            trimmed_gain: trimmed,
+            heldout_without: without.heldout,
+            heldout_with: full.heldout,
+            heldout_reduction: reduction,
+            fit_sse_removed: removed,
+            passes,
+        },
+        reduced,
+    )
+}
+
+/// The outcome of the rule.
+#[derive(Clone, Debug)]
+pub struct Judgement {
+    /// The effects that pass, jointly refitted.
+    pub set: FittedSet,
+    /// The evidence for each of them, at the final set.
+    pub evidence: Vec<Evidence>,
+    /// The evidence of each effect dropped, when it was dropped (in order).
+    pub dropped: Vec<Evidence>,
+}
+
+/// Applies the rule to a jointly fitted set.
+pub fn apply(
+    problem: &Problem,
+    mut set: FittedSet,
+    settings: &EvidenceSettings,
+    iterations: usize,
+    block_rows: usize,
+) -> Judgement {
+    let mut dropped = Vec::new();
+    loop {
+        let ids = set.ids();
+        if ids.is_empty() {
+            return Judgement {
+                set,
+                evidence: Vec::new(),
+                dropped,
+            };
+        }
+        let full = scores(problem, &set, block_rows);
+        let residual = problem.residual(&set.effects());
+        let fit_residual: Vec<Channels> = residual[..problem.split]
+            .iter()
+            .map(|r| {
+                let mut w = [0.0; 6];
+                for c in 0..problem.channels {
+                    w[c] = r[c] / problem.noise_floor[c];
+                }
+                w
+            })
+            .collect();
+        let noise = NoiseScale {
+            autocorrelation: autocorrelation_factor(
+                problem,
+                &fit_residual,
+                2 * problem.weak_form.half,
+            ),
+            variance: full.blocks.iter().sum::<f64>() / full.counts.iter().sum::<f64>(),
+        };
+        let outcomes: Vec<(Evidence, FittedSet)> = ids
+            .par_iter()
+            .map(|id| {
+                evidence_for(
+                    problem, &set, &full, &noise, id, settings, iterations, block_rows,
+                )
+            })
+            .collect();
+        let weakest = outcomes
+            .iter()
+            .filter(|(e, _)| !e.passes)
+            .min_by(|a, b| a.0.fit_gain.total_cmp(&b.0.fit_gain));
+        match weakest {
+            Some((evidence, reduced)) => {
+                dropped.push(evidence.clone());
+                set = reduced.clone();
+            }
+            None => {
+                return Judgement {
+                    set,
+                    evidence: outcomes.into_iter().map(|(e, _)| e).collect(),
+                    dropped,
+                };
+            }
+        }
+    }
+}
+
+/// Each effect's share of the nominal model's fit-part noise-normalised sum of squares: the total
+/// share the fitted set removes, `1 − SSE(set) / SSE(nominal)` (at least 0), divided among the
+/// effects in proportion to what each one's removal brings back. Each share is in [0, 1] and they
+/// sum to the total.
+pub fn explained_fractions(evidence: &[Evidence], nominal_sse: f64, fitted_sse: f64) -> Vec<f64> {
+    let total = (1.0 - fitted_sse / nominal_sse.max(1e-300)).clamp(0.0, 1.0);
+    let weights: Vec<f64> = evidence
+        .iter()
+        .map(|e| e.fit_sse_removed.max(0.0))
+        .collect();
+    let sum: f64 = weights.iter().sum();
+    weights
+        .iter()
+        .map(|w| {
+            if sum > 0.0 {
+                total * w / sum
+            } else {
+                total / weights.len().max(1) as f64
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn evidence(removed: f64) -> Evidence {
+        Evidence {
+            id: "x".into(),
+            parameters: 1,
+            likelihood_ratio: 100.0,
+            likelihood_ratio_threshold: 10.0,
+            fit_gain: 1.0,
+            trimmed_gain: 1.0,
+            heldout_without: 2.0,
+            heldout_with: 1.0,
+            heldout_reduction: 0.5,
+            fit_sse_removed: removed,
+            passes: true,
+        }
+    }
+
+    /// Shares stay in [0, 1] and sum to the total even when the removals overlap or exceed it.
+    #[test]
+    fn explained_fractions_are_shares_of_the_total() {
+        let shares = explained_fractions(&[evidence(900.0), evidence(300.0)], 1000.0, 100.0);
+        assert!((shares[0] - 0.675).abs() < 1e-12 && (shares[1] - 0.225).abs() < 1e-12);
+        let worse = explained_fractions(&[evidence(-5.0)], 1000.0, 1200.0);
+        assert_eq!(worse, [0.0]);
+        assert!(shares.iter().all(|s| (0.0..=1.0).contains(s)));
+    }
+
+    #[test]
+    fn chi_square_quantiles_are_close_to_the_tables() {
+        for (p, exact) in [(1, 10.828), (3, 16.266), (4, 18.467), (6, 22.458)] {
+            let q = chi_square_quantile(p, 0.999);
+            assert!((q / exact - 1.0).abs() < 0.035, "{p}: {q} vs {exact}");
+        }
+        assert!((normal_quantile(0.975) - 1.959964).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,336 @@
+//! From the screen to a joint fit: the nonlinear candidates' columns at profiled parameters, then
+//! the kept candidates' parameters fitted together with the exact model (Levenberg–Marquardt on the
+//! fit rows), with the timing term resolved into a delay, a motor lag or both, and an air velocity
+//! when a drag was kept.
+
+use physics::Effects;
+use serde::Serialize;
+
+use crate::library::{Candidate, TIMING};
+use crate::problem::{Channels, Problem};
+use crate::refine::{
+    Parameter, effect_column, effects_from, levenberg_marquardt, profile_search, profile_wind,
+};
+use crate::selection::{Design, Selection};
+
+/// Parameters and their values: a set of effects being fitted.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FittedSet {
+    pub parameters: Vec<Parameter>,
+    pub values: Vec<f64>,
+}
+
+impl FittedSet {
+    /// The effects these values describe.
+    pub fn effects(&self) -> Effects {
+        effects_from(&self.parameters, &self.values)
+    }
+
+    /// The effect ids present, in order of first appearance.
+    pub fn ids(&self) -> Vec<&'static str> {
+        let mut ids: Vec<&'static str> = Vec::new();
+        for p in &self.parameters {
+            if !ids.contains(&p.effect_id()) {
+                ids.push(p.effect_id());
+            }
+        }
+        ids
+    }
+
+    /// The set without the parameters of effect `id` (and without the wind when no drag is left).
+    pub fn without(&self, id: &str) -> Self {
+        let drag_left = self.parameters.iter().any(|p| {
+            matches!(p, Parameter::LinearDrag(_) | Parameter::QuadraticDrag) && p.effect_id() != id
+        });
+        let (parameters, values) = self
+            .parameters
+            .iter()
+            .zip(&self.values)
+            .filter(|(p, _)| p.effect_id() != id && (drag_left || !matches!(p, Parameter::Wind(_))))
+            .map(|(p, v)| (*p, *v))
+            .unzip();
+        Self { parameters, values }
+    }
+
+    /// Refits all values by Levenberg–Marquardt on the fit rows; returns the whitened error.
+    pub fn refit(&mut self, problem: &Problem, iterations: usize) -> f64 {
+        let (values, sse) = levenberg_marquardt(
+            problem,
+            &self.parameters,
+            &self.values,
+            0..problem.split,
+            iterations,
+        );
+        self.values = values;
+        sse
+    }
+}
+
+/// What the fit stage tried besides the chosen model (for the report).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct FitAlternatives {
+    /// Whitened fit error of each timing explanation (`delay`, `motor_lag`, `both`), when the
+    /// timing term was kept.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub timing: Option<serde_json::Map<String, serde_json::Value>>,
+    /// Whitened fit error without and with an air velocity, when a drag was kept.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wind: Option<serde_json::Value>,
+}
+
+/// Grid of delays and lag time constants profiled, s.
+fn timing_grid() -> Vec<f64> {
+    (0..=80).map(|i| i as f64 * 0.0025).collect()
+}
+
+/// Grid of ground-effect radii profiled, m.
+fn radius_grid() -> Vec<f64> {
+    (1..=60).map(|i| i as f64 * 0.02).collect()
+}
+
+/// Replaces the screen columns of the nonlinear candidates by the exact effect at the parameters
+/// a profile search finds next to all other columns: the ground-effect radius, the better of a
+/// delay and a motor lag, and the air velocity of the quadratic drag. Returns that air velocity.
+pub fn profile_nonlinear(
+    problem: &Problem,
+    before: &[Channels],
+    candidates: &[Candidate],
+    columns: &mut [Vec<Channels>],
+    block_rows: usize,
+) -> [f64; 3] {
+    let range = 0..problem.split;
+    let base = problem.predict(&Effects::default());
+    let total = columns.len();
+    let others_of = |candidate: &Candidate| -> Vec<usize> {
+        (0..total)
+            .filter(|c| !candidate.columns.contains(c))
+            .collect()
+    };
+    let find = |id: &str| candidates.iter().find(|c| c.id == id);
+    if let Some(candidate) = find("ground_effect") {
+        let others = others_of(candidate);
+        let effect = |r: f64| effects_from(&[Parameter::GroundRadius], &[r]);
+        let (radius, _) = profile_search(
+            problem,
+            columns,
+            &others,
+            range.clone(),
+            block_rows,
+            &radius_grid(),
+            effect,
+        );
+        columns[candidate.columns[0]] =
+            effect_column(problem, &base, &effect(radius), radius * radius);
+    }
+    if let Some(candidate) = find(TIMING) {
+        let others = others_of(candidate);
+        let grid: Vec<f64> = timing_grid().into_iter().skip(1).collect();
+        let best = [Parameter::Delay, Parameter::MotorLag]
+            .into_iter()
+            .map(|kind| {
+                let (value, sse) = profile_search(
+                    problem,
+                    columns,
+                    &others,
+                    range.clone(),
+                    block_rows,
+                    &grid,
+                    |v| effects_from(&[kind], &[v]),
+                );
+                (kind, value, sse)
+            })
+            .min_by(|a, b| a.2.total_cmp(&b.2))
+            .expect("two kinds");
+        columns[candidate.columns[0]] =
+            effect_column(problem, &base, &effects_from(&[best.0], &[best.1]), best.1);
+    }
+    let mut wind = [0.0; 3];
+    if let Some(candidate) = find("quadratic_drag") {
+        let others = others_of(candidate);
+        let (w, _) = profile_wind(problem, before, columns, &others, range, block_rows);
+        wind = w;
+        let effects = effects_from(
+            &[
+                Parameter::QuadraticDrag,
+                Parameter::Wind(0),
+                Parameter::Wind(1),
+                Parameter::Wind(2),
+            ],
+            &[1.0, w[0], w[1], w[2]],
+        );
+        columns[candidate.columns[0]] = effect_column(problem, &base, &effects, 1.0);
+    }
+    wind
+}
+
+/// Starting values of the kept linear candidates from the screen's joint least squares; the
+/// ground-effect radius from its profile. The timing candidate is left to [`fit_timing`].
+fn screen_estimates(
+    problem: &Problem,
+    candidates: &[&Candidate],
+    columns: &[Vec<Channels>],
+    design: &Design,
+    block_rows: usize,
+) -> FittedSet {
+    let kept_columns: Vec<usize> = candidates.iter().flat_map(|c| c.columns.clone()).collect();
+    let theta = design.solve(&vec![1.0; design.blocks()], &kept_columns);
+    let coefficient = |column: usize| {
+        theta[kept_columns
+            .iter()
+            .position(|c| *c == column)
+            .expect("kept")]
+    };
+    let mut set = FittedSet::default();
+    let mut push = |p: Parameter, v: f64| {
+        set.parameters.push(p);
+        set.values.push(v);
+    };
+    for candidate in candidates {
+        let cols = &candidate.columns;
+        match candidate.id.as_str() {
+            "thrust_scale" => push(Parameter::ThrustScale, 1.0 + coefficient(cols[0])),
+            "linear_drag" => {
+                for (i, &c) in cols.iter().enumerate() {
+                    push(Parameter::LinearDrag(i), coefficient(c).max(0.0));
+                }
+            }
+            "quadratic_drag" => push(Parameter::QuadraticDrag, coefficient(cols[0]).max(0.0)),
+            "ground_effect" => {
+                let others: Vec<usize> = kept_columns
+                    .iter()
+                    .copied()
+                    .filter(|c| !cols.contains(c))
+                    .collect();
+                let (radius, _) = profile_search(
+                    problem,
+                    columns,
+                    &others,
+                    0..problem.split,
+                    block_rows,
+                    &radius_grid(),
+                    |r| effects_from(&[Parameter::GroundRadius], &[r]),
+                );
+                push(Parameter::GroundRadius, radius);
+            }
+            "torque_bias" => {
+                for (i, &c) in cols.iter().enumerate() {
+                    push(Parameter::TorqueBias(i), coefficient(c));
+                }
+            }
+            "inertia_scale" => {
+                for (i, &c) in cols.iter().enumerate() {
+                    push(
+                        Parameter::InertiaScale(i),
+                        1.0 / (1.0 + coefficient(c)).max(0.05),
+                    );
+                }
+            }
+            _ => {}
+        }
+    }
+    set
+}
+
+/// Fits the kept candidates jointly. Returns the fitted set and what else was tried.
+pub fn fit_parameters(
+    problem: &Problem,
+    candidates: &[Candidate],
+    columns: &[Vec<Channels>],
+    design: &Design,
+    selection: &Selection,
+    iterations: usize,
+    block_rows: usize,
+    wind_start: [f64; 3],
+) -> (FittedSet, FitAlternatives) {
+    let kept: Vec<&Candidate> = selection.kept.iter().map(|&g| &candidates[g]).collect();
+    let mut alternatives = FitAlternatives::default();
+    if kept.is_empty() {
+        return (FittedSet::default(), alternatives);
+    }
+    let linear = screen_estimates(problem, &kept, columns, design, block_rows);
+    let timing = kept.iter().any(|c| c.id == TIMING);
+    let mut set = if timing {
+        let others: Vec<usize> = kept
+            .iter()
+            .filter(|c| c.id != TIMING)
+            .flat_map(|c| c.columns.clone())
+            .collect();
+        let (set, scores) = fit_timing(problem, columns, &others, &linear, iterations, block_rows);
+        alternatives.timing = Some(scores);
+        set
+    } else {
+        let mut set = linear.clone();
+        set.refit(problem, iterations);
+        set
+    };
+    let has_drag = set
+        .parameters
+        .iter()
+        .any(|p| matches!(p, Parameter::LinearDrag(_) | Parameter::QuadraticDrag));
+    if has_drag {
+        let still = set.refit(problem, 0);
+        let mut with_wind = set.clone();
+        with_wind.parameters.extend((0..3).map(Parameter::Wind));
+        with_wind.values.extend(wind_start);
+        let windy = with_wind.refit(problem, iterations);
+        alternatives.wind = Some(serde_json::json!({"still_air": still, "with_wind": windy}));
+        // The evidence rule decides whether the wind stays; here only whether it fits better.
+        if windy < still {
+            set = with_wind;
+        }
+    }
+    (set, alternatives)
+}
+
+/// Resolves the timing term: a delay, a motor lag, or both, each started from its profile (both
+/// from each single solution), fitted with the linear effects; returns the best fit and every
+/// alternative's whitened error.
+fn fit_timing(
+    problem: &Problem,
+    columns: &[Vec<Channels>],
+    others: &[usize],
+    linear: &FittedSet,
+    iterations: usize,
+    block_rows: usize,
+) -> (FittedSet, serde_json::Map<String, serde_json::Value>) {
+    let mut scores = serde_json::Map::new();
+    let mut singles = Vec::new();
+    for kind in [Parameter::Delay, Parameter::MotorLag] {
+        let (start, _) = profile_search(
+            problem,
+            columns,
+            others,
+            0..problem.split,
+            block_rows,
+            &timing_grid(),
+            |v| effects_from(&[kind], &[v]),
+        );
+        let mut set = linear.clone();
+        set.parameters.push(kind);
+        set.values.push(start);
+        let sse = set.refit(problem, iterations);
+        scores.insert(kind.effect_id().to_string(), serde_json::json!(sse));
+        singles.push((set, sse));
+    }
+    let delay = singles[0].0.values.last().copied().unwrap_or(0.0);
+    let lag = singles[1].0.values.last().copied().unwrap_or(0.0);
+    let mut best_both: Option<(FittedSet, f64)> = None;
+    for (d, l) in [(delay, 0.0), (0.0, lag), (0.5 * delay, 0.5 * lag)] {
+        let mut set = linear.clone();
+        set.parameters
+            .extend([Parameter::Delay, Parameter::MotorLag]);
+        set.values.extend([d, l]);
+        let sse = set.refit(problem, iterations);
+        if best_both.as_ref().is_none_or(|b| sse < b.1) {
+            best_both = Some((set, sse));
+        }
+    }
+    let both = best_both.expect("three starts");
+    scores.insert("both".to_string(), serde_json::json!(both.1));
+    singles.push(both);
+    let best = singles
+        .into_iter()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("alternatives");
+    (best.0, scores)
+}

@@ -162,13 +162,28 @@ fn simulate_refuses_a_directory_as_output() {
     run.one_line_error(&["out.csv", "directory"]);
 }
 
-/// Writes a demo manifest with one case per name, each the control scenario.
+/// Writes a demo manifest of one configuration (`d`, the control scenario) and one no-effect case
+/// per name.
 fn write_manifest(dir: &Path, names: &[&str]) {
+    write_manifest_of(dir, &[("d", "control.json")], names);
+}
+
+/// Writes a demo manifest of the configurations (name, scenario file) and one no-effect case per
+/// name.
+fn write_manifest_of(dir: &Path, configurations: &[(&str, &str)], names: &[&str]) {
     let cases: Vec<Value> = names
         .iter()
-        .map(|name| json!({"name": name, "scenario": "control.json", "purpose": "test"}))
+        .map(|name| json!({"name": name, "effects": {}, "purpose": "test"}))
         .collect();
-    std::fs::write(dir.join("demo.json"), json!({ "cases": cases }).to_string()).unwrap();
+    let configurations: Vec<Value> = configurations
+        .iter()
+        .map(|(name, scenario)| json!({"name": name, "scenario": scenario, "description": "test"}))
+        .collect();
+    std::fs::write(
+        dir.join("demo.json"),
+        json!({ "configurations": configurations, "cases": cases }).to_string(),
+    )
+    .unwrap();
 }
 
 fn demo(dir: &Path) -> common::Run {
@@ -211,12 +226,11 @@ fn demo_checks_every_scenario_before_running_a_case() {
     write_scenario(&dir, "bad.json", |s| {
         s["gains"] = json!({"integral_limit": -1});
     });
-    std::fs::write(
-        dir.join("demo.json"),
-        r#"{"cases": [{"name": "control", "scenario": "control.json", "purpose": "p"},
-                      {"name": "bad", "scenario": "bad.json", "purpose": "p"}]}"#,
-    )
-    .unwrap();
+    write_manifest_of(
+        &dir,
+        &[("good", "control.json"), ("bad", "bad.json")],
+        &["control"],
+    );
     demo(&dir).one_line_error(&["bad.json", "gains.integral_limit"]);
     assert!(!dir.join("work").exists());
 }
@@ -392,12 +406,12 @@ fn demo_does_not_replace_files_in_work_without_force() {
     let dir = setup("demo-work-notes");
     write_manifest(&dir, &["control"]);
     for name in ["mismatch.md", "recording.csv"] {
-        let case = dir.join("work/w/control");
+        let case = dir.join("work/w/d/control");
         let _ = std::fs::remove_dir_all(&case);
         std::fs::create_dir_all(&case).unwrap();
         std::fs::write(case.join(name), "notes").unwrap();
         demo(&dir).one_line_error(&[
-            &format!("work/w/control/{name}"),
+            &format!("work/w/d/control/{name}"),
             "already exists",
             "--force",
         ]);
@@ -438,15 +452,11 @@ fn demo_never_writes_over_its_inputs_even_with_force() {
         manifest
     );
     // a scenario where a case writes its recording
-    std::fs::create_dir_all(dir.join("w/control")).unwrap();
-    write_scenario(&dir.join("w/control"), "recording.csv", |s| {
-        s["model"] = json!("../../quad.json");
+    std::fs::create_dir_all(dir.join("w/d/control")).unwrap();
+    write_scenario(&dir.join("w/d/control"), "recording.csv", |s| {
+        s["model"] = json!("../../../quad.json");
     });
-    std::fs::write(
-        dir.join("demo.json"),
-        r#"{"cases": [{"name": "control", "scenario": "w/control/recording.csv", "purpose": "p"}]}"#,
-    )
-    .unwrap();
+    write_manifest_of(&dir, &[("d", "w/d/control/recording.csv")], &["control"]);
     let run = learn_in(
         &dir,
         &[
@@ -461,18 +471,14 @@ fn demo_never_writes_over_its_inputs_even_with_force() {
         ],
     );
     run.one_line_error(&[
-        "w/control/recording.csv",
-        "scenario of demo case \"control\"",
+        "w/d/control/recording.csv",
+        "scenario of demo configuration \"d\"",
     ]);
     // the model a scenario names, as a summary
     write_scenario(&dir, "s.json", |s| s["model"] = json!("out/summary.md"));
     std::fs::create_dir(dir.join("out")).unwrap();
     std::fs::copy(dir.join("quad.json"), dir.join("out/summary.md")).unwrap();
-    std::fs::write(
-        dir.join("demo.json"),
-        r#"{"cases": [{"name": "control", "scenario": "s.json", "purpose": "p"}]}"#,
-    )
-    .unwrap();
+    write_manifest_of(&dir, &[("d", "s.json")], &["control"]);
     let run = learn_in(
         &dir,
         &[
@@ -486,7 +492,7 @@ fn demo_never_writes_over_its_inputs_even_with_force() {
             "--force",
         ],
     );
-    run.one_line_error(&["out/summary.md", "model of demo case \"control\""]);
+    run.one_line_error(&["out/summary.md", "model of demo configuration \"d\""]);
     assert!(!dir.join("w2").exists());
 }
 
@@ -562,8 +568,8 @@ fn work_is_refused_outside_the_demo() {
     assert_eq!(run.code, Some(2), "{}", run.stderr);
 }
 
-/// A data directory for `--flights` in `dir/data` holding the evaluation flights of `conditions`
-/// (empty files: the checks under test come before any flight is read).
+/// A data directory for `--flights` in `dir/data` holding the baseline controller's flights of
+/// `conditions` (empty files: the checks under test come before any flight is read).
 fn flights_dir(dir: &Path, conditions: &[&str]) -> PathBuf {
     let data = dir.join("data");
     std::fs::create_dir_all(data.join("experiment")).unwrap();
@@ -601,7 +607,8 @@ fn flights(dir: &Path, extra: &[&str]) -> common::Run {
     )
 }
 
-/// Every output of --flights is checked before the first flight is analysed.
+/// Every output of --flights (`<out>/<model stem>.{json,md,svg}`) is checked before the first
+/// flight is read.
 #[test]
 fn flights_check_every_output_before_work() {
     let dir = setup("mm-flights-outputs");
@@ -609,19 +616,18 @@ fn flights_check_every_output_before_work() {
         &dir,
         &["nowind", "35wind", "70p20sint", "70wind", "100wind"],
     );
-    std::fs::create_dir_all(dir.join("o/neural-fly/70wind")).unwrap();
-    std::fs::write(dir.join("o/neural-fly/70wind/mismatch.svg"), "mine").unwrap();
-    flights(&dir, &[]).one_line_error(&["o/neural-fly/70wind/mismatch.svg", "already exists"]);
-    assert!(!dir.join("o/neural-fly/nowind").exists());
-    assert!(!dir.join("o/neural-fly.md").exists());
-    // a condition's directory that is a file
-    std::fs::remove_dir_all(dir.join("o/neural-fly/70wind")).unwrap();
-    std::fs::write(dir.join("o/neural-fly/70wind"), "mine").unwrap();
-    flights(&dir, &["--force"]).one_line_error(&["o/neural-fly/70wind", "not a directory"]);
-    assert!(!dir.join("o/neural-fly/nowind").exists());
+    std::fs::create_dir_all(dir.join("o")).unwrap();
+    std::fs::write(dir.join("o/quad.svg"), "mine").unwrap();
+    flights(&dir, &[]).one_line_error(&["o/quad.svg", "already exists"]);
+    assert_eq!(std::fs::read_to_string(dir.join("o/quad.svg")).unwrap(), "mine");
+    assert!(!dir.join("o/quad.md").exists());
+    // an output that is a directory
+    std::fs::remove_file(dir.join("o/quad.svg")).unwrap();
+    std::fs::create_dir(dir.join("o/quad.md")).unwrap();
+    flights(&dir, &["--force"]).one_line_error(&["o/quad.md", "directory"]);
+    std::fs::remove_dir(dir.join("o/quad.md")).unwrap();
     // the model and the conditions file are inputs, even with --force
-    std::fs::remove_file(dir.join("o/neural-fly/70wind")).unwrap();
-    std::fs::copy(dir.join("quad.json"), dir.join("o/neural-fly.md")).unwrap();
+    std::fs::copy(dir.join("quad.json"), dir.join("o/quad.json")).unwrap();
     let conditions = workspace().join("experiments/conditions.json");
     let run = learn_in(
         &dir,
@@ -632,14 +638,14 @@ fn flights_check_every_output_before_work() {
             "--flights",
             conditions.to_str().unwrap(),
             "--model",
-            "o/neural-fly.md",
+            "o/quad.json",
             "--out",
             "o",
             "--force",
         ],
     );
-    run.one_line_error(&["o/neural-fly.md", "--model", "even with --force"]);
-    std::fs::copy(&conditions, dir.join("o/neural-fly.md")).unwrap();
+    run.one_line_error(&["o/quad.json", "--model", "even with --force"]);
+    std::fs::copy(&conditions, dir.join("o/quad.md")).unwrap();
     let run = learn_in(
         &dir,
         &[
@@ -647,7 +653,7 @@ fn flights_check_every_output_before_work() {
             "data",
             "mismatch",
             "--flights",
-            "o/neural-fly.md",
+            "o/quad.md",
             "--model",
             "quad.json",
             "--out",
@@ -655,36 +661,18 @@ fn flights_check_every_output_before_work() {
             "--force",
         ],
     );
-    run.one_line_error(&["o/neural-fly.md", "conditions file", "even with --force"]);
+    run.one_line_error(&["o/quad.md", "conditions file", "even with --force"]);
 }
 
-/// No flight at all in the data directory is an error naming it; some missing are reported and
-/// skipped.
+/// No flight at all in the data directory is an error naming it; flights without a calm one to
+/// calibrate on are an error naming the calm condition.
 #[test]
-fn flights_need_at_least_one_flight() {
+fn flights_need_a_flight_and_a_calm_one() {
     let dir = setup("mm-flights-none");
     flights_dir(&dir, &[]);
-    flights(&dir, &[]).one_line_error(&["data", "none of the 5 evaluation flights"]);
+    flights(&dir, &[]).one_line_error(&["data", "none of the 30 flights"]);
     assert!(!dir.join("o").exists());
-    // one flight present (a short simulated one): the others are reported missing
-    write_scenario(&dir, "short.json", |s| s["duration_s"] = json!(5.0));
-    learn_in(
-        &dir,
-        &[
-            "simulate",
-            "--scenario",
-            "short.json",
-            "--out",
-            "data/experiment/custom_figure8_baseline_35wind.csv",
-        ],
-    )
-    .success();
-    let out = flights(&dir, &[]).success().to_string();
-    assert!(out.contains("35wind: effects"), "{out}");
-    assert!(
-        out.contains("nowind: ") && out.contains("is missing, skipped"),
-        "{out}"
-    );
-    assert!(dir.join("o/neural-fly.md").exists());
-    assert!(dir.join("o/neural-fly/35wind/mismatch.json").exists());
+    flights_dir(&dir, &["35wind"]);
+    flights(&dir, &[]).one_line_error(&["conditions.json", "calm", "nowind"]);
+    assert!(!dir.join("o").exists());
 }

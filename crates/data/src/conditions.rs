@@ -31,6 +31,15 @@ pub struct Condition {
     pub label: Option<String>,
     /// Wind speed as text, e.g. `8.5 + 2.4 sin(t) m/s`.
     pub wind_speed: String,
+    /// The mean wind speed where the vehicle flies, m/s, when it is known (e.g. a fan setting). Only
+    /// ever compared with what the mismatch tool estimates, never an input to a fit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mean_wind_m_s: Option<f64>,
+    /// Flown in still air: the mismatch tool's joint fit takes these flights' air velocity as zero
+    /// and calibrates the vehicle on them (what still air cannot tell apart from a steady wind,
+    /// such as a tilted thrust axis).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub calm: bool,
     pub role: Role,
     /// Explicit files per controller (paths relative to the data directory), overriding the pattern.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
@@ -123,6 +132,19 @@ impl ExperimentConditions {
                 return Err(config_error(
                     "controllers",
                     format!("controller '{controller}' is listed twice"),
+                ));
+            }
+        }
+        for (index, condition) in self.conditions.iter().enumerate() {
+            if let Some(speed) = condition.mean_wind_m_s
+                && !(speed.is_finite() && (0.0..=1e3).contains(&speed))
+            {
+                return Err(config_error(
+                    &format!("conditions[{index}].mean_wind_m_s"),
+                    format!(
+                        "a wind speed in m/s, between 0 and 1000, found {}",
+                        crate::error::Compact(speed)
+                    ),
                 ));
             }
         }

@@ -355,7 +355,6 @@ fn rms(values: impl Iterator<Item = f64>) -> f64 {
     (sum / count.max(1) as f64).sqrt()
 }
 
-
 /// The nominal and the fitted model's residuals.
 struct Residuals<'a> {
     before: &'a [Channels],

@@ -15,10 +15,19 @@ pub fn remove_effect(effects: &Effects, id: &str) -> Effects {
         "torque_bias" => e.torque_bias = None,
         "inertia_scale" => e.inertia_scale = None,
         "delay" => e.delay = None,
+        "thrust_map" => e.thrust_map = None,
+        "thrust_tilt" => e.thrust_tilt = None,
+        "rotor_drag" => e.rotor_drag = None,
+        "translational_lift" => e.translational_lift = None,
+        "drag_lag" => e.drag_lag = None,
+        "wind_gradient" => e.wind_gradient = None,
         _ => {}
     }
-    if e.quadratic_drag.is_none() && e.linear_drag.is_none() {
+    if e.quadratic_drag.is_none() && e.linear_drag.is_none() && e.rotor_drag.is_none() {
         e.wind = None;
+    }
+    if e.wind.is_none() {
+        e.wind_gradient = None;
     }
     e
 }
@@ -84,6 +93,56 @@ pub fn describe(id: &str, e: &Effects) -> String {
             "The vehicle responds to its commands {:.1} ms late.",
             1000.0 * e.delay_s()
         ),
+        "thrust_map" => {
+            let k = e.thrust_map.map(|m| m.k).unwrap_or([1.0, 1.0, 0.0]);
+            format!(
+                "The thrust does not follow the command in proportion: T / (m g) = {:.3} + {:.3} (x − 1) {:+.3} (x − 1)² for a command asking x m g (at hover {:+.1}%, its slope {:+.0}% from the model's).",
+                k[0],
+                k[1],
+                k[2],
+                100.0 * (k[0] - 1.0),
+                100.0 * (k[1] - 1.0)
+            )
+        }
+        "thrust_tilt" => {
+            let [x, y] = e.thrust_tilt.map(|t| t.angles_rad).unwrap_or([0.0; 2]);
+            format!(
+                "The thrust axis is tilted from the body z axis by {:.2}° about x and {:.2}° about y ({:.2}° in all; uncalibrated, that reads as a steady sideways force of {:.2} m/s²).",
+                x.to_degrees(),
+                y.to_degrees(),
+                (x.cos() * y.cos()).acos().to_degrees(),
+                9.81 * (x.cos() * y.cos()).acos().sin()
+            )
+        }
+        "rotor_drag" => {
+            let d = e.rotor_drag.map(|r| r.d).unwrap_or([0.0; 2]);
+            format!(
+                "Rotor drag proportional to the thrust and linear in the airspeed: {:.3} 1/s edgewise and {:.3} 1/s along the rotor axis (at hover thrust and 5 m/s edgewise airspeed about {:.2} m/s²).",
+                d[0],
+                d[1],
+                5.0 * d[0]
+            )
+        }
+        "translational_lift" => {
+            let c = e.translational_lift.map(|l| l.c).unwrap_or(0.0);
+            format!(
+                "Translational lift: the rotors give more thrust in edgewise airflow, by {:+.1}% at 5 m/s and {:+.1}% at 10 m/s (c = {c:.5} s²/m²).",
+                100.0 * 25.0 * c,
+                100.0 * 100.0 * c
+            )
+        }
+        "drag_lag" => format!(
+            "The air forces follow the velocity with a first-order lag of {:.2} s (the wake and inflow take time to build up).",
+            e.drag_lag_s()
+        ),
+        "wind_gradient" => {
+            let g = e.wind_gradient.map(|g| g.per_m).unwrap_or_default();
+            let largest = g.iter().flatten().fold(0.0f64, |a, b| a.max(b.abs()));
+            format!(
+                "The air velocity is not uniform: it changes by up to {largest:.2} m/s per metre moved (gradient {}).",
+                serde_json::to_string(&g).unwrap_or_default()
+            )
+        }
         other => other.to_string(),
     }
 }

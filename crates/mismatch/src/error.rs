@@ -48,7 +48,7 @@ pub enum MismatchError {
     #[error("{}: cannot draw the figure: {message}", path.display())]
     Plot { path: PathBuf, message: String },
     #[error(
-        "{}: none of the {count} evaluation flights listed in {} is there{}: is it the Neural-Fly data directory?",
+        "{}: none of the {count} flights listed in {} is there{}: is it the Neural-Fly data directory?",
         data_dir.display(),
         conditions.display(),
         example.as_ref().map(|p| format!(" (e.g. {})", p.display())).unwrap_or_default()

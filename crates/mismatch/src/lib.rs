@@ -26,7 +26,7 @@ mod describe;
 mod error;
 pub mod evidence;
 mod fit;
-pub mod flights;
+pub mod fleet;
 pub mod forward;
 mod library;
 mod output;
@@ -52,5 +52,5 @@ pub use problem::{CHANNEL_NAMES, Channels, Problem};
 pub use recording::Recording;
 pub use refine::{Parameter, effects_from, levenberg_marquardt};
 pub use selection::{
-    Design, Selection, SelectionSettings, trimmed_gain, stability_selection, stepwise,
+    Design, Selection, SelectionSettings, stability_selection, stepwise, trimmed_gain,
 };

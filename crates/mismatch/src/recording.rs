@@ -1,4 +1,4 @@
-//! A flight log turned into what the analysis needs: attitude, velocity, height, body rate and the
+//! A flight log turned into what the analysis needs: attitude, velocity, position, body rate and the
 //! actuator commands the nominal model reads from the recorded command columns.
 
 use std::path::PathBuf;
@@ -19,8 +19,8 @@ pub struct Recording {
     pub time: Vec<f64>,
     pub rotation: Vec<Mat3>,
     pub velocity: Vec<Vec3>,
-    /// Height above the model's ground plane, m.
-    pub height: Vec<f64>,
+    /// Position, m (world frame).
+    pub position: Vec<Vec3>,
     /// Body rate, rad/s (converted from the world frame when the `w` column is in the world frame).
     pub body_rate: Vec<Vec3>,
     /// The frame the `w` column was found to be in, with the RMS errors (body, world) of the check.
@@ -102,11 +102,7 @@ impl Recording {
             time: log.time.clone(),
             rotation: log.rotation.clone(),
             velocity: log.velocity.clone(),
-            height: log
-                .position
-                .iter()
-                .map(|p| p[2] - model.ground_height_m)
-                .collect(),
+            position: log.position.clone(),
             body_rate,
             rate_frame: frame,
             rate_frame_errors: (body_rms, world_rms),

@@ -173,6 +173,30 @@ impl WeakForm {
     }
 }
 
+impl WeakForm {
+    /// `∫ φ x dt` at rows `half..n − half` of a signal given at the rows themselves.
+    pub fn integrate_rows(&self, values: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        let mut weights: Vec<f64> = (-(self.half as i64)..=self.half as i64)
+            .map(|j| self.weight(j as f64 * self.dt))
+            .collect();
+        let total: f64 = weights.iter().sum();
+        for w in &mut weights {
+            *w /= total;
+        }
+        (self.half..values.len().saturating_sub(self.half))
+            .map(|k| {
+                let mut out = [0.0; 3];
+                for (w, v) in weights.iter().zip(&values[k - self.half..]) {
+                    for c in 0..3 {
+                        out[c] += w * v[c];
+                    }
+                }
+                out
+            })
+            .collect()
+    }
+}
+
 /// Robust standard deviation of the white noise on a smooth signal, from its fourth differences
 /// (`Δ⁴` of white noise has variance 70 σ²; the median of χ²₁ is 0.4549).
 pub fn white_noise_sigma(x: &[f64]) -> f64 {

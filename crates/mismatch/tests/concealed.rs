@@ -9,7 +9,7 @@ mod common;
 use common::{scenario, workspace};
 
 fn model() -> NominalModel {
-    common::model("vehicles/quad-a.json")
+    common::model_for_scenario()
 }
 
 fn flight(effects: Effects, seed: u64) -> data::FlightLog {
@@ -18,9 +18,9 @@ fn flight(effects: Effects, seed: u64) -> data::FlightLog {
 
 fn settings() -> AnalysisSettings {
     AnalysisSettings {
+        block_s: 0.5,
         selection: mismatch::SelectionSettings {
             resamples: 20,
-            block_rows: 25,
             ..Default::default()
         },
         ..Default::default()

@@ -24,9 +24,9 @@ fn flight() -> data::FlightLog {
 
 fn settings() -> AnalysisSettings {
     AnalysisSettings {
+        block_s: 0.5,
         selection: mismatch::SelectionSettings {
             resamples: 10,
-            block_rows: 25,
             ..Default::default()
         },
         ..Default::default()

@@ -12,6 +12,12 @@
 //! | `torque_bias` | `b: [x, y, z]` | `ω̇ += b` (rad/s²) |
 //! | `inertia_scale` | `k: [x, y, z]` | `J_real = diag(k) J` |
 //! | `delay` | `delay_s` | the vehicle responds to its commands `delay_s` late |
+//! | `thrust_map` | `k: [k0, k1, k2]` | `T_real / (m g) = k0 + k1 (x − 1) + k2 (x − 1)²`, `x = T / (m g)` |
+//! | `thrust_tilt` | `angles_rad: [x, y]` | thrust along `R Rx(x) Ry(y) e3` instead of `R e3` |
+//! | `rotor_drag` | `d: [horizontal, vertical]` | `a = −f R diag(dh, dh, dv) Rᵀ (v − w_air)` (1/s), `f = T_real / (m g)` |
+//! | `translational_lift` | `c` | `T_real ×= 1 + c (v_bx² + v_by²)`, `v_b = Rᵀ (v − w_air)` (s²/m²) |
+//! | `drag_lag` | `tau_s` | the velocity the air terms (drags, lift) see lags `v` by a first-order lag |
+//! | `wind_gradient` | `per_m: 3 × 3`, `reference_m` | the air velocity varies in space: `w_air + G (p − p_ref)` |
 
 use serde::{Deserialize, Serialize};
 
@@ -19,7 +25,7 @@ use crate::model::{NominalModel, angular_acceleration_with_inertia};
 use crate::vector::{E3, Mat3, Vec3, add, hadamard, mat_t_vec, mat_vec, norm, scale, sub};
 
 /// Every effect id of the vocabulary, in a fixed order.
-pub const EFFECT_IDS: [&str; 9] = [
+pub const EFFECT_IDS: [&str; 15] = [
     "linear_drag",
     "quadratic_drag",
     "wind",
@@ -29,6 +35,12 @@ pub const EFFECT_IDS: [&str; 9] = [
     "torque_bias",
     "inertia_scale",
     "delay",
+    "thrust_map",
+    "thrust_tilt",
+    "rotor_drag",
+    "translational_lift",
+    "drag_lag",
+    "wind_gradient",
 ];
 
 /// The largest `(r / 4z)²` the ground-effect formula is evaluated at (the formula diverges at 1):
@@ -80,6 +92,43 @@ pub struct InertiaScale {
 pub struct Delay {
     pub delay_s: f64,
 }
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThrustMap {
+    pub k: Vec3,
+}
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThrustTilt {
+    pub angles_rad: [f64; 2],
+}
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotorDrag {
+    pub d: [f64; 2],
+}
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TranslationalLift {
+    pub c: f64,
+}
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DragLag {
+    pub tau_s: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WindGradient {
+    /// `∂w_air,i / ∂p_j`, 1/s (rows: air velocity component; columns: position coordinate).
+    pub per_m: Mat3,
+    /// Where the air velocity is `w_air`, m.
+    pub reference_m: Vec3,
+}
+
+/// The largest thrust-axis tilt angle accepted, rad.
+pub const MAX_TILT_RAD: f64 = 0.5;
 
 /// A set of effects; `None` means absent. Serialises as `{"<id>": {<parameters>}, ...}`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -103,6 +152,18 @@ pub struct Effects {
     pub inertia_scale: Option<InertiaScale>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub delay: Option<Delay>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thrust_map: Option<ThrustMap>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thrust_tilt: Option<ThrustTilt>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotor_drag: Option<RotorDrag>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub translational_lift: Option<TranslationalLift>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag_lag: Option<DragLag>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wind_gradient: Option<WindGradient>,
 }
 
 impl Effects {
@@ -124,10 +185,13 @@ impl Effects {
             if !finite3(&e.w_air) {
                 return bad("wind.w_air", "must be three finite numbers");
             }
-            if self.linear_drag.is_none() && self.quadratic_drag.is_none() {
+            if self.linear_drag.is_none()
+                && self.quadratic_drag.is_none()
+                && self.rotor_drag.is_none()
+            {
                 return bad(
                     "wind",
-                    "needs a drag effect (linear_drag or quadratic_drag) to act through",
+                    "needs a drag effect (linear_drag, quadratic_drag or rotor_drag) to act through",
                 );
             }
         }
@@ -161,6 +225,66 @@ impl Effects {
         {
             return bad("delay.delay_s", "must be a non-negative number");
         }
+        self.validate_vehicle_effects()
+    }
+
+    /// The checks of the effects found on real vehicles (`thrust_map` … `drag_lag`).
+    fn validate_vehicle_effects(&self) -> Result<(), (String, String)> {
+        let bad = |field: &str, message: &str| Err((field.to_string(), message.to_string()));
+        if let Some(e) = self.thrust_map
+            && !(e.k.iter().all(|v| v.is_finite()) && e.k[0] > 0.0 && e.k[1] > 0.0)
+        {
+            return bad(
+                "thrust_map.k",
+                "must be three finite numbers, the first two positive (thrust at hover and its slope)",
+            );
+        }
+        if let Some(e) = self.thrust_tilt
+            && !e
+                .angles_rad
+                .iter()
+                .all(|a| a.is_finite() && a.abs() <= MAX_TILT_RAD)
+        {
+            return bad(
+                "thrust_tilt.angles_rad",
+                "must be two finite angles of at most 0.5 rad",
+            );
+        }
+        if let Some(e) = self.rotor_drag
+            && !e.d.iter().all(|v| v.is_finite() && *v >= 0.0)
+        {
+            return bad("rotor_drag.d", "must be two finite non-negative numbers");
+        }
+        if let Some(e) = self.translational_lift
+            && !(e.c.is_finite() && e.c >= 0.0)
+        {
+            return bad(
+                "translational_lift.c",
+                "must be a finite non-negative number",
+            );
+        }
+        if let Some(e) = self.drag_lag
+            && !(e.tau_s.is_finite() && e.tau_s >= 0.0)
+        {
+            return bad("drag_lag.tau_s", "must be a non-negative number");
+        }
+        if let Some(e) = self.wind_gradient {
+            let finite = e
+                .per_m
+                .iter()
+                .flatten()
+                .chain(&e.reference_m)
+                .all(|v| v.is_finite());
+            if !finite {
+                return bad("wind_gradient", "must hold finite numbers");
+            }
+            if self.wind.is_none() {
+                return bad(
+                    "wind_gradient",
+                    "needs a wind effect (its air velocity at the reference)",
+                );
+            }
+        }
         Ok(())
     }
 
@@ -176,6 +300,12 @@ impl Effects {
             self.torque_bias.is_some(),
             self.inertia_scale.is_some(),
             self.delay.is_some(),
+            self.thrust_map.is_some(),
+            self.thrust_tilt.is_some(),
+            self.rotor_drag.is_some(),
+            self.translational_lift.is_some(),
+            self.drag_lag.is_some(),
+            self.wind_gradient.is_some(),
         ];
         EFFECT_IDS
             .iter()
@@ -185,9 +315,20 @@ impl Effects {
             .collect()
     }
 
-    /// Air velocity seen by the drag terms (zero without a wind effect).
+    /// Air velocity seen by the drag terms at the reference (zero without a wind effect).
     pub fn air_velocity(&self) -> Vec3 {
         self.wind.map(|w| w.w_air).unwrap_or([0.0; 3])
+    }
+
+    /// Air velocity at `position` (the same everywhere without a wind gradient).
+    pub fn air_velocity_at(&self, position: Vec3) -> Vec3 {
+        match self.wind_gradient {
+            Some(g) => add(
+                self.air_velocity(),
+                mat_vec(&g.per_m, sub(position, g.reference_m)),
+            ),
+            None => self.air_velocity(),
+        }
     }
 
     /// Factor multiplying the nominal thrust: `k / (1 − (r / 4z)²)`.
@@ -205,10 +346,11 @@ impl Effects {
         }
     }
 
-    /// Drag acceleration (world frame) at attitude `rotation` and velocity `velocity`.
-    pub fn drag_acceleration(&self, rotation: &Mat3, velocity: Vec3) -> Vec3 {
+    /// Drag acceleration (world frame) at attitude `rotation`, velocity `velocity` and position
+    /// `position`.
+    pub fn drag_acceleration(&self, rotation: &Mat3, velocity: Vec3, position: Vec3) -> Vec3 {
         let mut a = [0.0; 3];
-        let relative = sub(velocity, self.air_velocity());
+        let relative = sub(velocity, self.air_velocity_at(position));
         if let Some(drag) = self.linear_drag {
             let body = mat_t_vec(rotation, relative);
             a = sub(a, mat_vec(rotation, hadamard(drag.d, body)));
@@ -219,22 +361,60 @@ impl Effects {
         a
     }
 
-    /// The real translational acceleration: nominal gravity and thrust with the thrust factor,
-    /// plus drag.
+    /// The real translational acceleration at attitude `rotation` and position `position`, with
+    /// the nominal thrust `thrust` (N) of the command: gravity, the thrust through the thrust
+    /// effects along its axis, and the drags. `velocity` is what the air terms see (the vehicle's
+    /// velocity, or its lagged value with a `drag_lag`).
     pub fn translational_acceleration(
         &self,
         model: &NominalModel,
         rotation: &Mat3,
         velocity: Vec3,
-        height_above_ground: f64,
+        position: Vec3,
         thrust: f64,
     ) -> Vec3 {
-        let thrust_real = thrust * self.thrust_factor(height_above_ground);
-        let nominal = add(
-            [0.0, 0.0, -model.gravity_m_s2],
-            scale(mat_vec(rotation, E3), thrust_real / model.mass_kg),
-        );
-        add(nominal, self.drag_acceleration(rotation, velocity))
+        let g = model.gravity_m_s2;
+        let height_above_ground = position[2] - model.ground_height_m;
+        let air_body = mat_t_vec(rotation, sub(velocity, self.air_velocity_at(position)));
+        let ratio = self.thrust_ratio(thrust / (model.mass_kg * g), height_above_ground, air_body);
+        let axis = mat_vec(rotation, self.thrust_axis());
+        let mut a = add([0.0, 0.0, -g], scale(axis, g * ratio));
+        if let Some(drag) = self.rotor_drag {
+            let d = [drag.d[0], drag.d[0], drag.d[1]];
+            a = sub(a, scale(mat_vec(rotation, hadamard(d, air_body)), ratio));
+        }
+        add(a, self.drag_acceleration(rotation, velocity, position))
+    }
+
+    /// The real thrust over `m g` for a nominal thrust ratio `x = T / (m g)`: the thrust map (or
+    /// `x`), times the thrust scale, the ground factor and the translational lift at body-frame
+    /// airspeed `air_body`.
+    pub fn thrust_ratio(&self, x: f64, height_above_ground: f64, air_body: Vec3) -> f64 {
+        let mapped = match self.thrust_map {
+            Some(m) => m.k[0] + m.k[1] * (x - 1.0) + m.k[2] * (x - 1.0).powi(2),
+            None => x,
+        };
+        let lift = self
+            .translational_lift
+            .map(|l| 1.0 + l.c * (air_body[0].powi(2) + air_body[1].powi(2)))
+            .unwrap_or(1.0);
+        mapped * self.thrust_factor(height_above_ground) * lift
+    }
+
+    /// The thrust axis in the body frame (`e3` without a tilt).
+    pub fn thrust_axis(&self) -> Vec3 {
+        match self.thrust_tilt {
+            Some(t) => {
+                let [x, y] = t.angles_rad;
+                [y.sin(), -x.sin() * y.cos(), x.cos() * y.cos()]
+            }
+            None => E3,
+        }
+    }
+
+    /// Time constant of the lag of the velocity the air terms see, s (0 without one).
+    pub fn drag_lag_s(&self) -> f64 {
+        self.drag_lag.map(|l| l.tau_s).unwrap_or(0.0)
     }
 
     /// The real inertia diagonal `diag(k) J`.
@@ -301,7 +481,7 @@ mod tests {
             ..Effects::default()
         };
         let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        let a = effects.drag_acceleration(&identity, [3.0, 0.0, 0.0]);
+        let a = effects.drag_acceleration(&identity, [3.0, 0.0, 0.0], [0.0; 3]);
         // quadratic: −0.1·2·2 = −0.4; linear: −0.5·(3 − 1) = −1.0
         assert!((a[0] + 1.4).abs() < 1e-12 && a[1] == 0.0 && a[2] == 0.0);
     }

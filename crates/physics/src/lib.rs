@@ -32,8 +32,9 @@ mod writer;
 
 pub use controller::{ControlOutput, Gains, GeometricController, MeasuredState};
 pub use effects::{
-    Delay, EFFECT_IDS, Effects, GROUND_EFFECT_MAX_RATIO, GroundEffect, InertiaScale, LinearDrag,
-    MotorLag, QuadraticDrag, ThrustScale, TorqueBias, Wind, ground_ratio,
+    Delay, DragLag, EFFECT_IDS, Effects, GROUND_EFFECT_MAX_RATIO, GroundEffect, InertiaScale,
+    LinearDrag, MAX_TILT_RAD, MotorLag, QuadraticDrag, RotorDrag, ThrustMap, ThrustScale,
+    ThrustTilt, TorqueBias, TranslationalLift, Wind, WindGradient, ground_ratio,
 };
 pub use error::{PhysicsError, Result};
 pub use jitter::{Jitter, JitterSignal, MAX_JITTER};

@@ -503,6 +503,8 @@ struct PlantState {
     body_rate: Vec3,
     /// Normalised motor speeds (only integrated with a motor lag).
     speeds: [f64; 4],
+    /// The velocity the air terms see (only integrated with a drag lag).
+    drag_velocity: Vec3,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -512,6 +514,7 @@ struct Derivative {
     quaternion: [f64; 4],
     angular_acceleration: Vec3,
     speeds: [f64; 4],
+    drag_velocity: Vec3,
 }
 
 struct Plant<'a> {
@@ -529,14 +532,24 @@ impl Plant<'_> {
         };
         let wrench = self.model.wrench(&speeds);
         let rotation = rotation_from_quaternion(&state.quaternion);
-        let height = state.position[2] - self.model.ground_height_m;
+        let drag_lag = self.effects.drag_lag_s();
+        let air_velocity = if drag_lag > 0.0 {
+            state.drag_velocity
+        } else {
+            state.velocity
+        };
         let acceleration = self.effects.translational_acceleration(
             self.model,
             &rotation,
-            state.velocity,
-            height,
+            air_velocity,
+            state.position,
             wrench.thrust,
         );
+        let drag_velocity = if drag_lag > 0.0 {
+            scale(sub(state.velocity, state.drag_velocity), 1.0 / drag_lag)
+        } else {
+            [0.0; 3]
+        };
         let torque = wrench.torque.unwrap_or([0.0; 3]);
         let angular_acceleration =
             self.effects
@@ -559,6 +572,7 @@ impl Plant<'_> {
             quaternion,
             angular_acceleration,
             speeds: speeds_rate,
+            drag_velocity,
         }
     }
 }
@@ -576,6 +590,7 @@ fn advance(state: &PlantState, derivative: &Derivative, h: f64) -> PlantState {
         quaternion,
         body_rate: add(state.body_rate, scale(derivative.angular_acceleration, h)),
         speeds,
+        drag_velocity: add(state.drag_velocity, scale(derivative.drag_velocity, h)),
     }
 }
 
@@ -604,6 +619,12 @@ fn rk4_step(plant: &Plant, state: &PlantState, command: [f64; 4], h: f64) -> Pla
             k2.angular_acceleration[i],
             k3.angular_acceleration[i],
             k4.angular_acceleration[i],
+        );
+        combined.drag_velocity[i] = combine(
+            k1.drag_velocity[i],
+            k2.drag_velocity[i],
+            k3.drag_velocity[i],
+            k4.drag_velocity[i],
         );
     }
     for i in 0..4 {
@@ -718,6 +739,7 @@ impl<'a> Flight<'a> {
             quaternion: quaternion_from_rotation(&controller.initial_rotation(&start)),
             body_rate: [0.0; 3],
             speeds: hover_speeds,
+            drag_velocity: start.velocity,
         };
         let logger = scenario.logger();
         let offset_steps = (logger.command_time_offset_s / control_dt).round() as i64;

@@ -4,8 +4,9 @@
 //! - `--demo MANIFEST --out DIR [--work WORK]`: simulate every case of the manifest with a concealed
 //!   effect (WORK/<case>/recording.csv), run the analysis blind on each (WORK/<case>/mismatch.*),
 //!   and write DIR/summary.{md,json}.
-//! - `--flights CONDITIONS.json --model NOMINAL.json --out DIR`: every wind condition's evaluation
-//!   flight of the data directory → DIR/neural-fly/<condition>/… and DIR/neural-fly.md.
+//! - `--flights CONDITIONS.json --model NOMINAL.json --out DIR`: every flight of every condition of
+//!   the data directory analysed together (one vehicle, one air velocity per flight) →
+//!   DIR/<model stem>.{json,md,svg}.
 //!
 //! Every mode works out every file it will write and checks them all before any work: none may be
 //! one of the files the run reads (even with `--force`), each must be writable, and none may exist
@@ -40,7 +41,8 @@ pub struct Args {
     /// existing ones are replaced only with --force.
     #[arg(long, conflicts_with_all = ["recording", "flights"])]
     pub work: Option<PathBuf>,
-    /// The experiment's conditions file: analyse the evaluation flights of every wind condition.
+    /// The experiment's conditions file: analyse every controller's flight at every condition
+    /// together (one vehicle, one air velocity per flight; conditions marked calm calibrate).
     #[arg(long)]
     pub flights: Option<PathBuf>,
     /// Overwrite existing output files (never one of the run's inputs).
@@ -86,10 +88,11 @@ fn run_flights(
 ) -> anyhow::Result<()> {
     super::refuse_unwritable_dir(&args.out, "--out")?;
     let data_dir = global.data_dir()?;
-    let plan = mismatch::flights::FlightsPlan::load(conditions, &data_dir, &args.out)?;
+    let plan = mismatch::fleet::FleetPlan::load(conditions, &data_dir, model_path, &args.out)?;
     plan.check_outputs(model_path, args.force)?;
     let model = physics::NominalModel::load(model_path)?;
-    for line in plan.run(&model, &model_path.display().to_string(), args.force)? {
+    let (_, lines) = plan.run(&model, &model_path.display().to_string(), args.force)?;
+    for line in lines {
         println!("{line}");
     }
     Ok(())

@@ -16,6 +16,16 @@ pub fn model(name: &str) -> NominalModel {
     NominalModel::load(&workspace().join("experiments/mismatch").join(name)).unwrap()
 }
 
+/// The demo vehicle as the tool is given it for logs of [`scenario`]'s simulator: with the
+/// scenario's logger (each command held until the next row).
+pub fn model_for_scenario() -> NominalModel {
+    let scenario = scenario(Effects::default(), 0);
+    NominalModel {
+        logger: scenario.logger(),
+        ..model("vehicles/quad-a.json")
+    }
+}
+
 /// A 14 s figure-8 with small sensor noise and the given effects.
 pub fn scenario(effects: Effects, seed: u64) -> Scenario {
     Scenario {
@@ -43,5 +53,8 @@ pub fn scenario(effects: Effects, seed: u64) -> Scenario {
             rate_rad_s: 0.008,
         },
         gains: Default::default(),
+        controller_rate_hz: None,
+        logger: None,
+        jitter: None,
     }
 }

@@ -1,0 +1,525 @@
+//! The joint fit of one vehicle to several flights: vehicle parameters shared by every flight, one
+//! constant air velocity per flight that is not calm, Levenberg–Marquardt on the weak-form
+//! residuals of all of them. The normal equations have an arrow structure (the vehicle block is
+//! dense, each flight's wind block touches only its flight), solved through the Schur complement of
+//! the wind blocks, so a fit of thirty flights costs a few small solves per iteration.
+
+use faer::Mat;
+use faer::linalg::solvers::Solve;
+use physics::{
+    Delay, DragLag, Effects, QuadraticDrag, RotorDrag, ThrustMap, ThrustTilt, TranslationalLift,
+    Wind, WindGradient,
+};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::problem::Problem;
+
+/// One scalar parameter of the vehicle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum VehicleParameter {
+    ThrustMap(usize),
+    Tilt(usize),
+    RotorDrag(usize),
+    Lift,
+    QuadraticDrag,
+    Delay,
+    DragLag,
+}
+
+impl VehicleParameter {
+    /// The effect id it belongs to.
+    pub fn effect_id(self) -> &'static str {
+        match self {
+            Self::ThrustMap(_) => "thrust_map",
+            Self::Tilt(_) => "thrust_tilt",
+            Self::RotorDrag(_) => "rotor_drag",
+            Self::Lift => "translational_lift",
+            Self::QuadraticDrag => "quadratic_drag",
+            Self::Delay => "delay",
+            Self::DragLag => "drag_lag",
+        }
+    }
+
+    fn bounds(self) -> (f64, f64) {
+        match self {
+            Self::ThrustMap(0) | Self::ThrustMap(1) => (0.05, 20.0),
+            Self::ThrustMap(_) => (-20.0, 20.0),
+            Self::Tilt(_) => (-physics::MAX_TILT_RAD, physics::MAX_TILT_RAD),
+            Self::RotorDrag(_) | Self::Lift | Self::QuadraticDrag => (0.0, f64::INFINITY),
+            Self::Delay => (0.0, 0.3),
+            Self::DragLag => (0.0, 2.0),
+        }
+    }
+
+    /// The value that leaves the nominal model unchanged (a start for the fit).
+    pub fn neutral(self) -> f64 {
+        match self {
+            Self::ThrustMap(0) | Self::ThrustMap(1) => 1.0,
+            _ => 0.0,
+        }
+    }
+
+    /// A finite-difference step.
+    fn step(self, value: f64) -> f64 {
+        let typical = match self {
+            Self::ThrustMap(_) => 1.0,
+            Self::Tilt(_) => 0.01,
+            Self::RotorDrag(_) => 0.1,
+            Self::Lift => 0.001,
+            Self::QuadraticDrag => 0.01,
+            Self::Delay | Self::DragLag => 0.01,
+        };
+        1e-4 * value.abs().max(typical)
+    }
+}
+
+/// The parameters of the vehicle effect `id`.
+pub fn parameters_of(id: &str) -> Vec<VehicleParameter> {
+    use VehicleParameter as P;
+    match id {
+        "thrust_map" => vec![P::ThrustMap(0), P::ThrustMap(1), P::ThrustMap(2)],
+        "thrust_tilt" => vec![P::Tilt(0), P::Tilt(1)],
+        "rotor_drag" => vec![P::RotorDrag(0), P::RotorDrag(1)],
+        "translational_lift" => vec![P::Lift],
+        "quadratic_drag" => vec![P::QuadraticDrag],
+        "delay" => vec![P::Delay],
+        "drag_lag" => vec![P::DragLag],
+        _ => Vec::new(),
+    }
+}
+
+/// A vehicle: effects and their values; and whether the air of its flights may vary in space.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Vehicle {
+    pub parameters: Vec<VehicleParameter>,
+    pub values: Vec<f64>,
+    /// Each windy flight's air gets a gradient (`wind_gradient`) along the axes it flies.
+    pub gradient: bool,
+}
+
+impl Vehicle {
+    /// The effect ids present, in order of first appearance (`wind_gradient` last).
+    pub fn ids(&self) -> Vec<&'static str> {
+        let mut ids: Vec<&'static str> = Vec::new();
+        for p in &self.parameters {
+            if !ids.contains(&p.effect_id()) {
+                ids.push(p.effect_id());
+            }
+        }
+        if self.gradient {
+            ids.push("wind_gradient");
+        }
+        ids
+    }
+
+    /// Adds effect `id` at its neutral values, or `start` (nothing if present).
+    pub fn with(&self, id: &str, start: Option<&[f64]>) -> Self {
+        let mut out = self.clone();
+        if self.ids().contains(&id) {
+            return out;
+        }
+        if id == "wind_gradient" {
+            out.gradient = true;
+            return out;
+        }
+        for (i, p) in parameters_of(id).into_iter().enumerate() {
+            out.parameters.push(p);
+            out.values
+                .push(start.and_then(|s| s.get(i).copied()).unwrap_or(p.neutral()));
+        }
+        out
+    }
+
+    /// Whether an air velocity acts on this vehicle (it has a drag).
+    pub fn feels_wind(&self) -> bool {
+        self.parameters.iter().any(|p| {
+            matches!(
+                p,
+                VehicleParameter::RotorDrag(_) | VehicleParameter::QuadraticDrag
+            )
+        })
+    }
+
+    /// The effects of the vehicle in the air of `air` (none for still air).
+    pub fn effects(&self, air: Option<&Air>) -> Effects {
+        use VehicleParameter as P;
+        let mut e = Effects::default();
+        for (p, &v) in self.parameters.iter().zip(&self.values) {
+            match *p {
+                P::ThrustMap(i) => {
+                    e.thrust_map
+                        .get_or_insert(ThrustMap { k: [1.0, 1.0, 0.0] })
+                        .k[i] = v
+                }
+                P::Tilt(i) => {
+                    e.thrust_tilt
+                        .get_or_insert(ThrustTilt {
+                            angles_rad: [0.0; 2],
+                        })
+                        .angles_rad[i] = v
+                }
+                P::RotorDrag(i) => e.rotor_drag.get_or_insert(RotorDrag { d: [0.0; 2] }).d[i] = v,
+                P::Lift => e.translational_lift = Some(TranslationalLift { c: v }),
+                P::QuadraticDrag => e.quadratic_drag = Some(QuadraticDrag { c: v }),
+                P::Delay => e.delay = Some(Delay { delay_s: v }),
+                P::DragLag => e.drag_lag = Some(DragLag { tau_s: v }),
+            }
+        }
+        if let Some(air) = air
+            && self.feels_wind()
+        {
+            e.wind = Some(Wind {
+                w_air: [air.values[0], air.values[1], air.values[2]],
+            });
+            if !air.axes.is_empty() {
+                let mut per_m = [[0.0; 3]; 3];
+                for (k, &axis) in air.axes.iter().enumerate() {
+                    for c in 0..3 {
+                        per_m[c][axis] = air.values[3 + 3 * k + c];
+                    }
+                }
+                e.wind_gradient = Some(WindGradient {
+                    per_m,
+                    reference_m: air.reference_m,
+                });
+            }
+        }
+        e
+    }
+}
+
+/// A flight's air: its velocity at `reference_m` and, along each position axis of `axes`, its
+/// gradient (`values`: the velocity, then three components per axis).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Air {
+    pub values: Vec<f64>,
+    pub axes: Vec<usize>,
+    pub reference_m: [f64; 3],
+}
+
+impl Air {
+    /// Still air (velocity zero) with room for a gradient along `axes` when `gradient`.
+    pub fn still(reference_m: [f64; 3], axes: &[usize], gradient: bool) -> Self {
+        let axes = if gradient { axes.to_vec() } else { Vec::new() };
+        Self {
+            values: vec![0.0; 3 + 3 * axes.len()],
+            axes,
+            reference_m,
+        }
+    }
+
+    /// The velocity at the reference.
+    pub fn velocity(&self) -> [f64; 3] {
+        [self.values[0], self.values[1], self.values[2]]
+    }
+}
+
+/// One flight in a joint fit: its comparison, whether its air is still, the rows fitted.
+pub struct JointFlight<'a> {
+    pub problem: &'a Problem,
+    pub calm: bool,
+    pub rows: std::ops::Range<usize>,
+    /// Where its air velocity is taken, and the axes its air's gradient may be fitted along.
+    pub reference_m: [f64; 3],
+    pub axes: &'a [usize],
+}
+
+impl JointFlight<'_> {
+    /// Still air for this flight, with room for the vehicle's structure.
+    pub fn still_air(&self, vehicle: &Vehicle) -> Air {
+        Air::still(self.reference_m, self.axes, vehicle.gradient)
+    }
+}
+
+/// What the joint fit holds fixed.
+#[derive(Clone, Debug)]
+pub struct JointSettings {
+    /// Parameters not fitted (kept at their values).
+    pub fixed: Vec<VehicleParameter>,
+    /// Whether the vehicle is fitted at all (false: only the winds).
+    pub fit_vehicle: bool,
+    /// Noise scale per channel (the residual is divided by it).
+    pub scale: [f64; 3],
+    pub iterations: usize,
+}
+
+/// The outcome of a joint fit.
+#[derive(Clone, Debug)]
+pub struct JointFit {
+    pub vehicle: Vehicle,
+    /// Per flight: its air (still for calm flights or a vehicle without drag).
+    pub airs: Vec<Air>,
+}
+
+fn scaled_residual(
+    flight: &JointFlight,
+    vehicle: &Vehicle,
+    air: &Air,
+    scale: &[f64; 3],
+) -> Vec<f64> {
+    let air = (!flight.calm).then_some(air);
+    let residual = flight.problem.residual(&vehicle.effects(air));
+    residual[flight.rows.clone()]
+        .iter()
+        .flat_map(|r| (0..3).map(move |c| r[c] / scale[c]))
+        .collect()
+}
+
+/// Per flight: the scaled residual and its Jacobians with respect to the free vehicle parameters
+/// and to the flight's air parameters (empty for calm flights).
+type Linearisation = (Vec<f64>, Vec<Vec<f64>>, Vec<Vec<f64>>);
+
+fn linearise(
+    flight: &JointFlight,
+    vehicle: &Vehicle,
+    air: &Air,
+    free: &[usize],
+    fit_air: bool,
+    scale: &[f64; 3],
+) -> Linearisation {
+    let base = scaled_residual(flight, vehicle, air, scale);
+    let difference = |shifted: &[f64], step: f64| -> Vec<f64> {
+        shifted
+            .iter()
+            .zip(&base)
+            .map(|(a, b)| (a - b) / step)
+            .collect()
+    };
+    let vehicle_columns = free
+        .iter()
+        .map(|&j| {
+            let step = vehicle.parameters[j].step(vehicle.values[j]);
+            let mut moved = vehicle.clone();
+            moved.values[j] += step;
+            difference(&scaled_residual(flight, &moved, air, scale), step)
+        })
+        .collect();
+    let air_columns = if fit_air {
+        (0..air.values.len())
+            .map(|i| {
+                let mut moved = air.clone();
+                moved.values[i] += 1e-3;
+                difference(&scaled_residual(flight, vehicle, &moved, scale), 1e-3)
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    (base, vehicle_columns, air_columns)
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn total_sse(flights: &[JointFlight], vehicle: &Vehicle, airs: &[Air], scale: &[f64; 3]) -> f64 {
+    flights
+        .par_iter()
+        .zip(airs)
+        .map(|(f, a)| {
+            scaled_residual(f, vehicle, a, scale)
+                .iter()
+                .map(|r| r * r)
+                .sum::<f64>()
+        })
+        .sum()
+}
+
+/// Fits the vehicle (its free parameters) and the air of the flights that are not calm.
+pub fn fit(
+    flights: &[JointFlight],
+    start: &Vehicle,
+    airs: &[Air],
+    settings: &JointSettings,
+) -> JointFit {
+    let mut vehicle = start.clone();
+    let mut airs = airs.to_vec();
+    let free: Vec<usize> = if settings.fit_vehicle {
+        (0..vehicle.parameters.len())
+            .filter(|&j| !settings.fixed.contains(&vehicle.parameters[j]))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let fit_air: Vec<bool> = flights
+        .iter()
+        .map(|f| !f.calm && vehicle.feels_wind())
+        .collect();
+    let scale = &settings.scale;
+    let mut sse = total_sse(flights, &vehicle, &airs, scale);
+    let mut damping = 1e-3;
+    for _ in 0..settings.iterations {
+        let parts: Vec<Linearisation> = flights
+            .par_iter()
+            .enumerate()
+            .map(|(f, flight)| linearise(flight, &vehicle, &airs[f], &free, fit_air[f], scale))
+            .collect();
+        let mut improved = false;
+        for _ in 0..10 {
+            let Some((vehicle_step, air_steps)) = solve_step(&parts, free.len(), damping) else {
+                damping *= 10.0;
+                continue;
+            };
+            let mut trial = vehicle.clone();
+            for (k, &j) in free.iter().enumerate() {
+                let (lo, hi) = trial.parameters[j].bounds();
+                trial.values[j] = (trial.values[j] - vehicle_step[k]).clamp(lo, hi);
+            }
+            let trial_airs: Vec<Air> = airs
+                .iter()
+                .zip(&air_steps)
+                .map(|(a, s)| {
+                    let mut moved = a.clone();
+                    for (v, d) in moved.values.iter_mut().zip(s) {
+                        *v -= d;
+                    }
+                    moved
+                })
+                .collect();
+            let trial_sse = total_sse(flights, &trial, &trial_airs, scale);
+            if trial_sse.is_finite() && trial_sse < sse {
+                let relative = (sse - trial_sse) / sse.max(1e-300);
+                vehicle = trial;
+                airs = trial_airs;
+                sse = trial_sse;
+                damping = (damping / 3.0).max(1e-9);
+                improved = relative > 1e-7;
+                break;
+            }
+            damping *= 10.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    JointFit { vehicle, airs }
+}
+
+/// One damped Gauss–Newton step for the vehicle and every flight's air, through the Schur
+/// complement of the air blocks. `None` when a system is singular.
+fn solve_step(
+    parts: &[Linearisation],
+    free: usize,
+    damping: f64,
+) -> Option<(Vec<f64>, Vec<Vec<f64>>)> {
+    let mut reduced = Mat::<f64>::zeros(free, free);
+    let mut rhs = Mat::<f64>::zeros(free, 1);
+    let mut blocks = Vec::with_capacity(parts.len());
+    for (residual, vehicle_columns, air_columns) in parts {
+        for i in 0..free {
+            rhs[(i, 0)] += dot(&vehicle_columns[i], residual);
+            for j in 0..free {
+                reduced[(i, j)] += dot(&vehicle_columns[i], &vehicle_columns[j]);
+            }
+        }
+        let m = air_columns.len();
+        if m == 0 {
+            blocks.push(None);
+            continue;
+        }
+        let mut d = Mat::<f64>::zeros(m, m);
+        let mut g = Mat::<f64>::zeros(m, 1);
+        let mut b = Mat::<f64>::zeros(free, m);
+        for a in 0..m {
+            g[(a, 0)] = dot(&air_columns[a], residual);
+            for c in 0..m {
+                d[(a, c)] = dot(&air_columns[a], &air_columns[c]);
+            }
+            for i in 0..free {
+                b[(i, a)] = dot(&vehicle_columns[i], &air_columns[a]);
+            }
+        }
+        for a in 0..m {
+            d[(a, a)] += damping * d[(a, a)].max(1e-12);
+        }
+        blocks.push(Some((d, g, b)));
+    }
+    for i in 0..free {
+        reduced[(i, i)] += damping * reduced[(i, i)].max(1e-12);
+    }
+    // Eliminate each air block: S −= B D⁻¹ Bᵀ, r −= B D⁻¹ g.
+    for (d, g, b) in blocks.iter().flatten() {
+        let m = d.nrows();
+        let lu = d.full_piv_lu();
+        let d_inv_g = lu.solve(g);
+        let d_inv_bt = lu.solve(b.transpose().to_owned());
+        for i in 0..free {
+            rhs[(i, 0)] -= (0..m).map(|a| b[(i, a)] * d_inv_g[(a, 0)]).sum::<f64>();
+            for j in 0..free {
+                reduced[(i, j)] -= (0..m).map(|a| b[(i, a)] * d_inv_bt[(a, j)]).sum::<f64>();
+            }
+        }
+    }
+    let vehicle_step: Vec<f64> = if free > 0 {
+        let solution = reduced.full_piv_lu().solve(&rhs);
+        (0..free).map(|i| solution[(i, 0)]).collect()
+    } else {
+        Vec::new()
+    };
+    if vehicle_step.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let air_steps: Vec<Vec<f64>> = blocks
+        .iter()
+        .map(|block| match block {
+            None => Vec::new(),
+            Some((d, g, b)) => {
+                let m = d.nrows();
+                let mut rhs = g.clone();
+                for a in 0..m {
+                    rhs[(a, 0)] -= (0..free).map(|i| b[(i, a)] * vehicle_step[i]).sum::<f64>();
+                }
+                let solution = d.full_piv_lu().solve(&rhs);
+                (0..m).map(|a| solution[(a, 0)]).collect()
+            }
+        })
+        .collect();
+    if air_steps.iter().flatten().any(|v| !v.is_finite()) {
+        return None;
+    }
+    Some((vehicle_step, air_steps))
+}
+
+/// Scaled sum of squares of every flight on its rows, with the vehicle and airs given.
+pub fn scaled_sse_on(
+    flights: &[JointFlight],
+    vehicle: &Vehicle,
+    airs: &[Air],
+    scale: &[f64; 3],
+) -> Vec<f64> {
+    flights
+        .par_iter()
+        .zip(airs)
+        .map(|(f, a)| {
+            scaled_residual(f, vehicle, a, scale)
+                .iter()
+                .map(|r| r * r)
+                .sum::<f64>()
+        })
+        .collect()
+}
+
+/// Per-channel RMS of the residual over every flight's rows (raw units).
+pub fn residual_rms(flights: &[JointFlight], vehicle: &Vehicle, airs: &[Air]) -> [f64; 3] {
+    let sums: Vec<([f64; 3], usize)> = flights
+        .par_iter()
+        .zip(airs)
+        .map(|(f, a)| {
+            let r = scaled_residual(f, vehicle, a, &[1.0; 3]);
+            let mut s = [0.0; 3];
+            for (i, v) in r.iter().enumerate() {
+                s[i % 3] += v * v;
+            }
+            (s, r.len() / 3)
+        })
+        .collect();
+    let rows: usize = sums.iter().map(|s| s.1).sum();
+    let mut out = [0.0; 3];
+    for c in 0..3 {
+        out[c] = (sums.iter().map(|s| s.0[c]).sum::<f64>() / rows.max(1) as f64)
+            .sqrt()
+            .max(1e-12);
+    }
+    out
+}

@@ -619,7 +619,10 @@ fn flights_check_every_output_before_work() {
     std::fs::create_dir_all(dir.join("o")).unwrap();
     std::fs::write(dir.join("o/quad.svg"), "mine").unwrap();
     flights(&dir, &[]).one_line_error(&["o/quad.svg", "already exists"]);
-    assert_eq!(std::fs::read_to_string(dir.join("o/quad.svg")).unwrap(), "mine");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("o/quad.svg")).unwrap(),
+        "mine"
+    );
     assert!(!dir.join("o/quad.md").exists());
     // an output that is a directory
     std::fs::remove_file(dir.join("o/quad.svg")).unwrap();

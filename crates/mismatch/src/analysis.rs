@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::describe::describe;
 use crate::error::{MismatchError, Result};
 use crate::evidence::{self, Evidence, EvidenceSettings, explained_fractions};
-use crate::fit::{FitAlternatives, fit_parameters, profile_nonlinear};
+use crate::fit::{FitAlternatives, Screened, fit_parameters, profile_nonlinear};
 use crate::library::{Candidate, build_library};
 use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
@@ -197,12 +197,15 @@ pub fn analyze(
     let groups: Vec<Vec<usize>> = candidates.iter().map(|c| c.columns.clone()).collect();
     let design = Design::new(&problem, &before, &columns, 0..problem.split, block_rows);
     let selection = stability_selection(&design, &groups, &settings.selection);
+    let screened = Screened {
+        candidates: &candidates,
+        columns: &columns,
+        design: &design,
+        selection: &selection,
+    };
     let (set, alternatives) = fit_parameters(
         &problem,
-        &candidates,
-        &columns,
-        &design,
-        &selection,
+        &screened,
         settings.iterations,
         block_rows,
         wind_start,

@@ -128,7 +128,7 @@ fn normal_quantile(q: f64) -> f64 {
         -3.969683028665376e1,
         2.209460984245205e2,
         -2.759285104469687e2,
-        1.383577518672690e2,
+        1.38357751867269e2,
         -3.066479806614716e1,
         2.506628277459239,
     ];
@@ -176,18 +176,30 @@ struct NoiseScale {
     variance: f64,
 }
 
-/// The evidence for effect `id` of `set` (whose scores are `full`); returns it with the refitted
-/// set without the effect.
-fn evidence_for(
-    problem: &Problem,
-    set: &FittedSet,
-    full: &Scores,
-    noise: &NoiseScale,
-    id: &str,
-    settings: &EvidenceSettings,
+/// What every effect of one set is judged against.
+struct Judge<'a> {
+    problem: &'a Problem,
+    set: &'a FittedSet,
+    full: Scores,
+    noise: NoiseScale,
+    settings: &'a EvidenceSettings,
     iterations: usize,
     block_rows: usize,
-) -> (Evidence, FittedSet) {
+}
+
+/// The evidence for effect `id` of the judged set; returns it with the refitted set without the
+/// effect.
+fn evidence_for(judge: &Judge, id: &str) -> (Evidence, FittedSet) {
+    let Judge {
+        problem,
+        set,
+        full,
+        noise,
+        settings,
+        iterations,
+        block_rows,
+    } = judge;
+    let (problem, iterations, block_rows) = (*problem, *iterations, *block_rows);
     let mut reduced = set.without(id);
     reduced.refit(problem, iterations);
     let without = scores(problem, &reduced, block_rows);
@@ -278,14 +290,17 @@ pub fn apply(
             ),
             variance: full.blocks.iter().sum::<f64>() / full.counts.iter().sum::<f64>(),
         };
-        let outcomes: Vec<(Evidence, FittedSet)> = ids
-            .par_iter()
-            .map(|id| {
-                evidence_for(
-                    problem, &set, &full, &noise, id, settings, iterations, block_rows,
-                )
-            })
-            .collect();
+        let judge = Judge {
+            problem,
+            set: &set,
+            full,
+            noise,
+            settings,
+            iterations,
+            block_rows,
+        };
+        let outcomes: Vec<(Evidence, FittedSet)> =
+            ids.par_iter().map(|id| evidence_for(&judge, id)).collect();
         let weakest = outcomes
             .iter()
             .filter(|(e, _)| !e.passes)

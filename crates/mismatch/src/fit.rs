@@ -231,17 +231,29 @@ fn screen_estimates(
     set
 }
 
+/// What the screen produced: the candidates, their columns, the design and the selection.
+pub struct Screened<'a> {
+    pub candidates: &'a [Candidate],
+    pub columns: &'a [Vec<Channels>],
+    pub design: &'a Design,
+    pub selection: &'a Selection,
+}
+
 /// Fits the kept candidates jointly. Returns the fitted set and what else was tried.
 pub fn fit_parameters(
     problem: &Problem,
-    candidates: &[Candidate],
-    columns: &[Vec<Channels>],
-    design: &Design,
-    selection: &Selection,
+    screened: &Screened,
     iterations: usize,
     block_rows: usize,
     wind_start: [f64; 3],
 ) -> (FittedSet, FitAlternatives) {
+    let Screened {
+        candidates,
+        columns,
+        design,
+        selection,
+    } = screened;
+    let (candidates, columns, design) = (*candidates, *columns, *design);
     let kept: Vec<&Candidate> = selection.kept.iter().map(|&g| &candidates[g]).collect();
     let mut alternatives = FitAlternatives::default();
     if kept.is_empty() {

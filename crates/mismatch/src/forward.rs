@@ -117,12 +117,12 @@ fn spread_after_lag(recording: &Recording, lag: f64) -> [f64; 4] {
     }
 }
 
+/// Translational and (with torques) angular accelerations, one per row.
+pub type RowPrediction = (Vec<Vec3>, Option<Vec<Vec3>>);
+
 /// The nominal model's accelerations at the rows themselves, from each row's logged command and
 /// measured state (translational, and angular when the model predicts torques).
-pub fn predict_at_rows(
-    recording: &Recording,
-    model: &NominalModel,
-) -> (Vec<Vec3>, Option<Vec<Vec3>>) {
+pub fn predict_at_rows(recording: &Recording, model: &NominalModel) -> RowPrediction {
     let effects = Effects::default();
     let mut translational = Vec::with_capacity(recording.len());
     let mut angular = Vec::with_capacity(recording.len());

@@ -5,9 +5,12 @@
 use physics::{CommandLogging, Effects, NominalModel};
 
 use crate::error::{MismatchError, Result};
-use crate::forward::{SUBSTEPS, predict_at_rows, predict_substeps};
+use crate::forward::{RowPrediction, SUBSTEPS, predict_at_rows, predict_substeps};
 use crate::recording::Recording;
 use crate::weak_form::{TestFunction, WeakForm, white_noise_sigma};
+
+/// The fewest test-function windows a recording must span.
+pub const MIN_WINDOWS: usize = 8;
 
 /// Channel names in output order: translational then angular accelerations.
 pub const CHANNEL_NAMES: [&str; 6] = ["vdot_x", "vdot_y", "vdot_z", "wdot_x", "wdot_y", "wdot_z"];
@@ -61,12 +64,12 @@ impl Problem {
         let weak_form = test_function.at_interval(recording.dt).map_err(bad)?;
         let half = weak_form.half;
         let n = recording.len();
-        // At least one analysed row to fit and one held out.
-        if n < 2 * half + 2 {
+        // Enough rows for several windows to fit and to hold out.
+        let needed = MIN_WINDOWS * (2 * half + 1);
+        if n < needed {
             return Err(bad(format!(
-                "{n} rows, the comparison's window of {} rows needs at least {}",
-                2 * half + 1,
-                2 * half + 2
+                "{n} rows, the analysis needs at least {needed} ({MIN_WINDOWS} of the comparison's windows of {} rows)",
+                2 * half + 1
             )));
         }
         let channels = if model.predicts_torque() { 6 } else { 3 };
@@ -190,7 +193,7 @@ impl Problem {
 fn model_side_noise(
     recording: &Recording,
     model: &NominalModel,
-    nominal: Option<&(Vec<[f64; 3]>, Option<Vec<[f64; 3]>>)>,
+    nominal: Option<&RowPrediction>,
     c: usize,
 ) -> f64 {
     let attitude = if c < 3 {

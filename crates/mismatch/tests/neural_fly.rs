@@ -1,4 +1,5 @@
-//! On a real windy flight the tool names drag on the relative wind and improves the held-out fit.
+//! On a real windy flight the tool names a drag on the relative wind, and improves the held-out fit,
+//! from that one flight alone.
 
 use std::path::{Path, PathBuf};
 
@@ -27,10 +28,8 @@ fn names_drag_on_the_relative_wind_in_the_strongest_wind() {
     .unwrap();
     assert_eq!(analysis.report.rate_frame.used, data::RateFrame::World);
     let ids = analysis.fitted.ids();
-    assert!(
-        ids.contains(&"quadratic_drag") && ids.contains(&"wind"),
-        "{ids:?}"
-    );
+    let drag = ids.contains(&"quadratic_drag") || ids.contains(&"linear_drag");
+    assert!(drag && ids.contains(&"wind"), "{ids:?}");
     // The wind tunnel blows along −x at about 12 m/s.
     let wind = analysis.fitted.air_velocity();
     assert!(wind[0] < -8.0, "{wind:?}");

@@ -63,14 +63,23 @@ fn regressors(flight: &FleetFlight, lag: usize) -> (Vec<[f64; 3]>, Vec<[f64; 4]>
     (target, commands)
 }
 
+/// One flight's weak-form angular acceleration and motor commands, with the rows to use.
+type Sample = (Vec<[f64; 3]>, Vec<[f64; 4]>, std::ops::Range<usize>);
+
 /// Least squares of `y = c + B u` per axis on the given rows; returns the coefficients per axis
 /// (constant first).
-fn fit_map(samples: &[(Vec<[f64; 3]>, Vec<[f64; 4]>, std::ops::Range<usize>)]) -> [[f64; 5]; 3] {
+fn fit_map(samples: &[Sample]) -> [[f64; 5]; 3] {
     let mut gram = Mat::<f64>::zeros(5, 5);
     let mut cross = Mat::<f64>::zeros(5, 3);
     for (target, commands, rows) in samples {
         for r in rows.clone() {
-            let x = [1.0, commands[r][0], commands[r][1], commands[r][2], commands[r][3]];
+            let x = [
+                1.0,
+                commands[r][0],
+                commands[r][1],
+                commands[r][2],
+                commands[r][3],
+            ];
             for i in 0..5 {
                 for j in 0..5 {
                     gram[(i, j)] += x[i] * x[j];
@@ -95,10 +104,7 @@ fn fit_map(samples: &[(Vec<[f64; 3]>, Vec<[f64; 4]>, std::ops::Range<usize>)]) -
 }
 
 /// `1 − SSE / SST` per axis (SST about the mean) of the map on the given rows.
-fn explained(
-    samples: &[(Vec<[f64; 3]>, Vec<[f64; 4]>, std::ops::Range<usize>)],
-    map: &[[f64; 5]; 3],
-) -> [f64; 3] {
+fn explained(samples: &[Sample], map: &[[f64; 5]; 3]) -> [f64; 3] {
     let mut out = [0.0; 3];
     for c in 0..3 {
         let values: Vec<(f64, f64)> = samples
@@ -106,8 +112,7 @@ fn explained(
             .flat_map(|(target, commands, rows)| {
                 rows.clone().map(move |r| {
                     let u = commands[r];
-                    let predicted = map[c][0]
-                        + (0..4).map(|i| map[c][i + 1] * u[i]).sum::<f64>();
+                    let predicted = map[c][0] + (0..4).map(|i| map[c][i + 1] * u[i]).sum::<f64>();
                     (target[r][c], predicted)
                 })
             })
@@ -130,7 +135,12 @@ fn mean_pwm_law(flights: &[FleetFlight]) -> (f64, f64, usize, f64) {
             .iter()
             .flat_map(|f| {
                 let n = f.pwm.len();
-                (lag..n).map(move |k| (f.thrust_setpoint[k - lag], f.pwm[k].iter().sum::<f64>() / 4.0))
+                (lag..n).map(move |k| {
+                    (
+                        f.thrust_setpoint[k - lag],
+                        f.pwm[k].iter().sum::<f64>() / 4.0,
+                    )
+                })
             })
             .collect();
         let n = pairs.len().max(1) as f64;
@@ -162,7 +172,9 @@ pub fn check(flights: &[FleetFlight]) -> Option<AttitudeCheck> {
     let (lo, hi) = flights
         .iter()
         .flat_map(|f| f.pwm.iter().flatten())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
     let (offset, slope, pwm_lag, pwm_rms) = mean_pwm_law(flights);
     let samples_at = |lag: usize, calm: bool, part: fn(&FleetFlight) -> std::ops::Range<usize>| {
         flights

@@ -175,7 +175,10 @@ impl FleetPlan {
                 }),
             });
         }
-        if !flights.iter().any(|(_, index, _)| conditions.conditions[*index].calm) {
+        if !flights
+            .iter()
+            .any(|(_, index, _)| conditions.conditions[*index].calm)
+        {
             let calm: Vec<&str> = conditions
                 .conditions
                 .iter()

@@ -8,7 +8,9 @@ use physics::NominalModel;
 use plotters::prelude::*;
 use serde::Serialize;
 
-use super::{Air, AttitudeCheck, FleetFlight, FleetSettings, Identification, SelectionStep, Vehicle};
+use super::{
+    Air, AttitudeCheck, FleetFlight, FleetSettings, Identification, SelectionStep, Vehicle,
+};
 use crate::describe::describe;
 use crate::error::{MismatchError, Result, io_error};
 
@@ -432,7 +434,14 @@ impl FleetReport {
             1000.0 * a.mean_pwm_lag_s,
             a.mean_pwm_residual_rms
         );
-        let axes = |v: &[f64; 3]| format!("{:.0}% / {:.0}% / {:.0}%", 100.0 * v[0], 100.0 * v[1], 100.0 * v[2]);
+        let axes = |v: &[f64; 3]| {
+            format!(
+                "{:.0}% / {:.0}% / {:.0}%",
+                100.0 * v[0],
+                100.0 * v[1],
+                100.0 * v[2]
+            )
+        };
         let enough = a.explained_calm_heldout.iter().all(|e| *e >= 0.5);
         let _ = writeln!(
             md,

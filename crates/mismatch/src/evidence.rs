@@ -10,9 +10,9 @@
 //!   form's rows share samples, so `κ` neighbouring rows carry about one row's worth of
 //!   independent noise, and `ΔSSE` of a noise-only term is about `κ s² χ²_p`;
 //! - **size** (fit part): the mean gain per row and channel is at least `min_gain` noise variances;
-//! - **consistency** (fit part): the mean gain is still at least `min_gain` when the two blocks (of
-//!   about a second) that gain most are left out ([`crate::selection::trimmed_gain`]): not one
-//!   transient;
+//! - **consistency** (fit part): the mean gain is still at least `min_trimmed_gain` when the two
+//!   blocks (of about a second) that gain most are left out ([`crate::selection::trimmed_gain`]):
+//!   not one transient;
 //! - **held out**: on the held-out part, which no fit or choice has seen, the noise-normalised
 //!   residual sum of squares falls by at least `min_heldout_reduction` of its value without the
 //!   effect.
@@ -32,6 +32,7 @@ use crate::selection::trimmed_gain;
 pub struct EvidenceSettings {
     pub significance: f64,
     pub min_gain: f64,
+    pub min_trimmed_gain: f64,
     pub min_heldout_reduction: f64,
 }
 
@@ -40,6 +41,7 @@ impl Default for EvidenceSettings {
         Self {
             significance: 0.999,
             min_gain: 0.25,
+            min_trimmed_gain: 0.1,
             min_heldout_reduction: 0.15,
         }
     }
@@ -221,7 +223,7 @@ fn evidence_for(judge: &Judge, id: &str) -> (Evidence, FittedSet) {
     let reduction = 1.0 - full.heldout / without.heldout.max(1e-300);
     let passes = likelihood_ratio >= threshold
         && mean >= settings.min_gain
-        && trimmed >= settings.min_gain
+        && trimmed >= settings.min_trimmed_gain
         && reduction >= settings.min_heldout_reduction;
     (
         Evidence {

@@ -310,9 +310,10 @@ pub fn markdown_text(analysis: &Analysis) -> String {
     let rule = report.settings.evidence;
     let _ = writeln!(
         md,
-        "An effect is named only when, with the others refitted without it, it passes four tests: on the fit part, its likelihood ratio (corrected for the correlation of neighbouring rows) exceeds the {} quantile of χ², it lowers the noise-normalised residual by at least {} per row and channel, also when the two {} s blocks that gain most are left out (not one transient); and it lowers the held-out residual by at least {:.0}%.\n",
+        "An effect is named only when, with the others refitted without it, it passes four tests: on the fit part, its likelihood ratio (corrected for the correlation of neighbouring rows) exceeds the {} quantile of χ², it lowers the noise-normalised residual by at least {} per row and channel, and by at least {} when the two {} s blocks that gain most are left out (not one transient); and it lowers the held-out residual by at least {:.0}%.\n",
         rule.significance,
         rule.min_gain,
+        rule.min_trimmed_gain,
         report.settings.block_s,
         100.0 * rule.min_heldout_reduction
     );

@@ -5,17 +5,18 @@
 //! (sparse selection that finds nothing on noise alone), fit the effects' parameters — nonlinear
 //! ones included — and show the fit improve on a held-out part ([`analyze`], [`write_outputs`]);
 //! prove it on simulated recordings with concealed effects ([`demo`]) and run it on the real
-//! Neural-Fly flights ([`flights`]).
+//! Neural-Fly flights together ([`fleet`]).
 //!
 //! What it is not for: simulating (the `physics` crate) or reading logs (the `data` crate).
 //!
-//! Method in one paragraph: the target is a Savitzky–Golay derivative of the recorded velocity and
-//! body rate; the model's prediction is averaged over each sample interval (commands held, delays
-//! and lags applied exactly) and smoothed with the matched weights ([`filter`]), so a right model
-//! leaves only noise. Candidates are screened by forward stepwise selection with blocked
-//! cross-validation and kept by stability selection over block-bootstrap resamples; their
-//! parameters are then fitted with the exact model (profile search, Levenberg–Marquardt) on the
-//! first part of the recording.
+//! Method in one paragraph (the long version: `docs/mismatch.md`): the recording and the model are
+//! compared in the weak form ([`weak_form`]: the recorded velocity and body rate against the model's
+//! acceleration through the same smooth test function), the model's commands reconstructed as its
+//! logger says ([`forward`]). Candidates are screened by forward stepwise selection with blocked
+//! cross-validation and kept by stability selection over block-bootstrap resamples; their parameters
+//! are fitted jointly with the exact model on the first part of the recording; each effect is then
+//! named only when the evidence rule holds for it ([`evidence`]). Several flights of one vehicle are
+//! analysed together by [`fleet`].
 
 // Index loops over channels and 3-vectors read like the formulas they implement.
 #![allow(clippy::needless_range_loop)]

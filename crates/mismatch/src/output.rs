@@ -172,7 +172,7 @@ pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
     let (title, body) = root.split_vertically(50);
     title
         .titled(
-            "Residual (recorded smoothed derivative − model): nominal model in grey, with the found effects in blue; located windows shaded; held-out part right of the dashed line",
+            "Weak-form residual (recording − model): nominal model in grey, with the found effects in blue; located windows shaded; held-out part right of the dashed line",
             ("sans-serif", 15),
         )
         .map_err(|e| plot_error(&e))?;
@@ -253,7 +253,7 @@ pub fn markdown_text(analysis: &Analysis) -> String {
     let _ = writeln!(md, "# Sim-to-real mismatch: {}\n", report.recording);
     let _ = writeln!(
         md,
-        "Nominal model: `{}`. The recording's velocity and body rate were differentiated with a smoothed derivative and compared with what the nominal model predicts from the recorded attitude and commands (the prediction is smoothed with the same weights). Every mean squared error below is measured against that smoothed derivative.\n",
+        "Nominal model: `{}`. The recording's velocity and body rate are compared with what the nominal model predicts from the recorded attitude and commands in the weak form: both weighted by the same smooth test function over ±0.2 s, so that a right model leaves only noise. Every mean squared error below is of that weak-form residual.\n",
         report.model
     );
     let frame = match report.rate_frame.used {

@@ -546,6 +546,30 @@ mod tests {
     }
 
     #[test]
+    fn a_known_wind_speed_is_a_speed() {
+        rejected(
+            "negative-wind",
+            |s| {
+                s.replace(
+                    "\"label\": \"70psin20\"",
+                    "\"label\": \"70psin20\", \"mean_wind_m_s\": -8.5",
+                )
+            },
+            &["conditions[1].mean_wind_m_s", "-8.5"],
+        );
+        rejected(
+            "calm-text",
+            |s| {
+                s.replace(
+                    "\"label\": \"70psin20\"",
+                    "\"label\": \"70psin20\", \"calm\": \"no\"",
+                )
+            },
+            &["calm"],
+        );
+    }
+
+    #[test]
     fn names_and_labels_designate_one_condition_each() {
         rejected(
             "dup-label",

@@ -496,4 +496,96 @@ mod tests {
         assert!(effects.thrust_factor(5.0) < 1.001);
         assert_eq!(effects.thrust_factor(0.0), 2.0);
     }
+
+    fn model() -> NominalModel {
+        NominalModel::from_json(
+            r#"{"mass_kg": 2.0, "gravity_m_s2": 10.0, "inertia_kg_m2": [0.03, 0.03, 0.05], "thrust_source": "T_sp"}"#,
+            std::path::Path::new("m.json"),
+        )
+        .unwrap()
+    }
+
+    const LEVEL: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+    /// The effects found on real vehicles, each on its own: a thrust map, a tilted thrust axis,
+    /// rotor drag scaled by the thrust, translational lift, and air that varies in space.
+    #[test]
+    fn the_vehicle_effects_act_as_documented() {
+        let m = model();
+        let hover = 20.0;
+        let map = Effects {
+            thrust_map: Some(ThrustMap {
+                k: [0.98, 1.2, 0.5],
+            }),
+            ..Effects::default()
+        };
+        // Asking 1.5 m g gives 0.98 + 1.2 · 0.5 + 0.5 · 0.25 = 1.705 m g.
+        let a = map.translational_acceleration(&m, &LEVEL, [0.0; 3], [0.0, 0.0, 5.0], 1.5 * hover);
+        assert!((a[2] - (10.0 * 1.705 - 10.0)).abs() < 1e-12, "{a:?}");
+        let tilt = Effects {
+            thrust_tilt: Some(ThrustTilt {
+                angles_rad: [0.0, 0.1],
+            }),
+            ..Effects::default()
+        };
+        let a = tilt.translational_acceleration(&m, &LEVEL, [0.0; 3], [0.0, 0.0, 5.0], hover);
+        assert!((a[0] - 10.0 * 0.1f64.sin()).abs() < 1e-12 && a[1].abs() < 1e-12);
+        let drag = Effects {
+            rotor_drag: Some(RotorDrag { d: [0.3, 0.6] }),
+            wind: Some(Wind {
+                w_air: [1.0, 0.0, 0.0],
+            }),
+            ..Effects::default()
+        };
+        // At twice the hover thrust the drag doubles: −2 · 0.3 · (3 − 1) edgewise, −2 · 0.6 · 1 axial.
+        let a = drag.translational_acceleration(
+            &m,
+            &LEVEL,
+            [3.0, 0.0, 1.0],
+            [0.0, 0.0, 5.0],
+            2.0 * hover,
+        );
+        assert!(
+            (a[0] + 1.2).abs() < 1e-12 && (a[2] - (20.0 - 10.0 - 1.2)).abs() < 1e-12,
+            "{a:?}"
+        );
+        let lift = Effects {
+            translational_lift: Some(TranslationalLift { c: 0.01 }),
+            ..Effects::default()
+        };
+        let a =
+            lift.translational_acceleration(&m, &LEVEL, [3.0, 4.0, 0.0], [0.0, 0.0, 5.0], hover);
+        assert!((a[2] - 10.0 * 0.25).abs() < 1e-12, "{a:?}");
+        let field = Effects {
+            quadratic_drag: Some(QuadraticDrag { c: 0.1 }),
+            wind: Some(Wind {
+                w_air: [2.0, 0.0, 0.0],
+            }),
+            wind_gradient: Some(WindGradient {
+                per_m: [[0.0, 0.0, 0.5], [0.0; 3], [0.0; 3]],
+                reference_m: [0.0, 0.0, 1.0],
+            }),
+            ..Effects::default()
+        };
+        // At 3 m the air moves at 2 + 0.5 · 2 = 3 m/s: a vehicle at rest feels −0.1 · 3 · (−3).
+        assert_eq!(field.air_velocity_at([0.0, 0.0, 3.0]), [3.0, 0.0, 0.0]);
+        let a = field.drag_acceleration(&LEVEL, [0.0; 3], [0.0, 0.0, 3.0]);
+        assert!((a[0] - 0.9).abs() < 1e-12, "{a:?}");
+        assert!(field.validate().is_ok());
+        let without_wind = Effects {
+            wind: None,
+            ..field
+        };
+        assert_eq!(without_wind.validate().unwrap_err().0, "wind_gradient");
+        let tilted_far = Effects {
+            thrust_tilt: Some(ThrustTilt {
+                angles_rad: [0.0, 0.9],
+            }),
+            ..Effects::default()
+        };
+        assert_eq!(
+            tilted_far.validate().unwrap_err().0,
+            "thrust_tilt.angles_rad"
+        );
+    }
 }

@@ -10,6 +10,7 @@ use crate::library::{Candidate, TIMING};
 use crate::problem::{Channels, Problem};
 use crate::refine::{
     Parameter, effect_column, effects_from, levenberg_marquardt, profile_search, profile_wind,
+    unit_drag_in_wind,
 };
 use crate::selection::{Design, Selection};
 
@@ -149,16 +150,7 @@ pub fn profile_nonlinear(
         let others = others_of(candidate);
         let (w, _) = profile_wind(problem, before, columns, &others, range, block_rows);
         wind = w;
-        let effects = effects_from(
-            &[
-                Parameter::QuadraticDrag,
-                Parameter::Wind(0),
-                Parameter::Wind(1),
-                Parameter::Wind(2),
-            ],
-            &[1.0, w[0], w[1], w[2]],
-        );
-        columns[candidate.columns[0]] = effect_column(problem, &base, &effects, 1.0);
+        columns[candidate.columns[0]] = effect_column(problem, &base, &unit_drag_in_wind(w), 1.0);
     }
     wind
 }

@@ -281,6 +281,19 @@ pub fn effect_column(
         .collect()
 }
 
+/// A quadratic drag of coefficient 1 in air moving at `w`.
+pub fn unit_drag_in_wind(w: [f64; 3]) -> Effects {
+    effects_from(
+        &[
+            Parameter::QuadraticDrag,
+            Parameter::Wind(0),
+            Parameter::Wind(1),
+            Parameter::Wind(2),
+        ],
+        &[1.0, w[0], w[1], w[2]],
+    )
+}
+
 /// Air velocity that best explains `residual` with a free drag coefficient on the column
 /// `−|v − w| (v − w)` next to the other columns: coordinate-wise searches, coarse then fine.
 pub fn profile_wind(
@@ -294,15 +307,7 @@ pub fn profile_wind(
     use rayon::prelude::*;
     let base = problem.predict(&Effects::default());
     let score = |w: [f64; 3]| {
-        let effects = effects_from(
-            &[
-                Parameter::QuadraticDrag,
-                Parameter::Wind(0),
-                Parameter::Wind(1),
-                Parameter::Wind(2),
-            ],
-            &[1.0, w[0], w[1], w[2]],
-        );
+        let effects = unit_drag_in_wind(w);
         let column = effect_column(problem, &base, &effects, 1.0);
         projected_sse(
             problem,

@@ -314,16 +314,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 fn total_sse(flights: &[JointFlight], vehicle: &Vehicle, airs: &[Air], scale: &[f64; 3]) -> f64 {
-    flights
-        .par_iter()
-        .zip(airs)
-        .map(|(f, a)| {
-            scaled_residual(f, vehicle, a, scale)
-                .iter()
-                .map(|r| r * r)
-                .sum::<f64>()
-        })
-        .sum()
+    scaled_sse_on(flights, vehicle, airs, scale).iter().sum()
 }
 
 /// Fits the vehicle (its free parameters) and the air of the flights that are not calm.

@@ -442,40 +442,60 @@ fn calibrate_calm(
         .collect();
     let still = still_airs(flights, &Vehicle::default());
     let score = |vehicle: &Vehicle| heldout_error(flights, &calm, vehicle, &still);
-    let mut vehicle = Vehicle::default();
-    let mut error = score(&vehicle);
-    loop {
-        let mut best: Option<(String, Vehicle, f64)> = None;
-        for id in CALM_CANDIDATES {
-            if vehicle.ids().contains(&id) || (id == "drag_lag" && !vehicle.feels_wind()) {
-                continue;
-            }
-            for start in starts(id) {
-                let trial = vehicle.with(id, start.as_deref());
-                let fitted = fit_two_step(&fit_rows, &trial, &[], true, settings.iterations);
-                let trial_error = score(&fitted.vehicle);
-                if best.as_ref().is_none_or(|b| trial_error < b.2) {
-                    best = Some((id.to_string(), fitted.vehicle, trial_error));
+    let start = Vehicle::default();
+    let error = score(&start);
+    forward_select(
+        "calm",
+        start,
+        error,
+        settings.min_step,
+        selection,
+        |vehicle| {
+            let mut best: Option<(String, Vehicle, f64)> = None;
+            for id in CALM_CANDIDATES {
+                if vehicle.ids().contains(&id) || (id == "drag_lag" && !vehicle.feels_wind()) {
+                    continue;
+                }
+                for start in starts(id) {
+                    let trial = vehicle.with(id, start.as_deref());
+                    let fitted = fit_two_step(&fit_rows, &trial, &[], true, settings.iterations);
+                    let trial_error = score(&fitted.vehicle);
+                    if best.as_ref().is_none_or(|b| trial_error < b.2) {
+                        best = Some((id.to_string(), fitted.vehicle, trial_error));
+                    }
                 }
             }
-        }
-        let Some((id, candidate, candidate_error)) = best else {
-            return vehicle;
-        };
-        let accepted = candidate_error <= (1.0 - settings.min_step) * error;
+            best
+        },
+    )
+}
+
+/// Adds, one at a time, the candidate `best_candidate` proposes (id, vehicle with it, its error)
+/// while it lowers the error by at least `min_step`; records every step.
+fn forward_select(
+    stage: &str,
+    mut vehicle: Vehicle,
+    mut error: f64,
+    min_step: f64,
+    selection: &mut Vec<SelectionStep>,
+    best_candidate: impl Fn(&Vehicle) -> Option<(String, Vehicle, f64)>,
+) -> Vehicle {
+    while let Some((id, candidate, candidate_error)) = best_candidate(&vehicle) {
+        let accepted = candidate_error <= (1.0 - min_step) * error;
         selection.push(SelectionStep {
-            stage: "calm".into(),
+            stage: stage.into(),
             candidate: id,
             error_before: error,
             error_with: candidate_error,
             accepted,
         });
         if !accepted {
-            return vehicle;
+            break;
         }
         vehicle = candidate;
         error = candidate_error;
     }
+    vehicle
 }
 
 /// The parameters held at their calm-calibrated values once other flights join.
@@ -554,46 +574,38 @@ fn transfer_error(flights: &[FleetFlight], vehicle: &Vehicle, settings: &FleetSe
 /// Stage 2: effects that need airspeed added while the transfer error falls.
 fn add_wind_effects(
     flights: &[FleetFlight],
-    mut vehicle: Vehicle,
+    vehicle: Vehicle,
     settings: &FleetSettings,
     selection: &mut Vec<SelectionStep>,
 ) -> Vehicle {
     if windy_groups(flights).len() < 2 {
         return vehicle;
     }
-    let mut error = transfer_error(flights, &vehicle, settings);
-    loop {
-        let mut best: Option<(String, Vehicle, f64)> = None;
-        for id in WIND_CANDIDATES {
-            let needs_drag = matches!(id, "translational_lift" | "wind_gradient");
-            if vehicle.ids().contains(&id) || (needs_drag && !vehicle.feels_wind()) {
-                continue;
-            }
-            for start in starts(id) {
-                let trial = vehicle.with(id, start.as_deref());
-                let trial_error = transfer_error(flights, &trial, settings);
-                if best.as_ref().is_none_or(|b| trial_error < b.2) {
-                    best = Some((id.to_string(), trial, trial_error));
+    let error = transfer_error(flights, &vehicle, settings);
+    forward_select(
+        "transfer",
+        vehicle,
+        error,
+        settings.min_step,
+        selection,
+        |vehicle| {
+            let mut best: Option<(String, Vehicle, f64)> = None;
+            for id in WIND_CANDIDATES {
+                let needs_drag = matches!(id, "translational_lift" | "wind_gradient");
+                if vehicle.ids().contains(&id) || (needs_drag && !vehicle.feels_wind()) {
+                    continue;
+                }
+                for start in starts(id) {
+                    let trial = vehicle.with(id, start.as_deref());
+                    let trial_error = transfer_error(flights, &trial, settings);
+                    if best.as_ref().is_none_or(|b| trial_error < b.2) {
+                        best = Some((id.to_string(), trial, trial_error));
+                    }
                 }
             }
-        }
-        let Some((id, candidate, candidate_error)) = best else {
-            return vehicle;
-        };
-        let accepted = candidate_error <= (1.0 - settings.min_step) * error;
-        selection.push(SelectionStep {
-            stage: "transfer".into(),
-            candidate: id,
-            error_before: error,
-            error_with: candidate_error,
-            accepted,
-        });
-        if !accepted {
-            return vehicle;
-        }
-        vehicle = candidate;
-        error = candidate_error;
-    }
+            best
+        },
+    )
 }
 
 /// The whole joint analysis (see the module's documentation).

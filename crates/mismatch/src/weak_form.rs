@@ -35,6 +35,17 @@ impl Default for TestFunction {
     }
 }
 
+/// A number as it reads best in a message: plainly for ordinary magnitudes, in scientific
+/// notation (4 digits) for tiny or huge ones.
+fn short(value: f64) -> String {
+    let magnitude = value.abs();
+    if value == 0.0 || !value.is_finite() || (1e-4..1e9).contains(&magnitude) {
+        format!("{value}")
+    } else {
+        format!("{value:.3e}")
+    }
+}
+
 /// The fewest rows on each side of the centre.
 pub const MIN_HALF_WIDTH_ROWS: usize = 3;
 
@@ -62,8 +73,10 @@ impl TestFunction {
         let rows = (self.half_width_s / dt).round();
         if !(rows.is_finite() && rows >= MIN_HALF_WIDTH_ROWS as f64 && rows <= 1e6) {
             return Err(format!(
-                "the comparison's test function spans ±{} s, {rows} sample intervals of {dt} s on each side; it needs {MIN_HALF_WIDTH_ROWS} to 1e6",
-                self.half_width_s
+                "the comparison's test function spans ±{} s, {} sample intervals of {} s on each side; it needs {MIN_HALF_WIDTH_ROWS} to 1e6",
+                self.half_width_s,
+                short(rows),
+                short(dt)
             ));
         }
         let half = rows as usize;

@@ -89,7 +89,7 @@ fn an_overflowing_rate_is_an_error_even_on_channels_not_compared() {
     );
     let mut log = flight();
     log.body_rate[100] = [0.0, 0.0, 1e300];
-    let message = error_of(&log, "quad-a.json");
+    let message = error_of(&log, "vehicles/quad-a.json");
     assert!(message.contains("non-finite"), "{message}");
 }
 
@@ -101,7 +101,8 @@ fn times_scaled_by_1e_minus_300_do_not_overflow_the_window_arithmetic() {
         *t *= 1e-300;
     }
     let message = error_of(&log, "neural-fly.json");
-    assert!(message.contains("non-finite"), "{message}");
+    assert!(message.contains("test function"), "{message}");
+    assert!(message.len() < 250, "numbers print short: {message}");
 }
 
 fn valid_analysis() -> Analysis {

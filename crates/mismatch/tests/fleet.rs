@@ -5,20 +5,23 @@
 use std::path::PathBuf;
 
 use mismatch::fleet::FleetPlan;
-use physics::{Effects, NominalModel, RotorDrag, Scenario, ThrustTilt, Wind, simulate};
+use mismatch::fleet::FleetReport;
+use physics::{DragLag, Effects, NominalModel, RotorDrag, Scenario, ThrustTilt, Wind, simulate};
 
 mod common;
 
-fn scratch() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mismatch-fleet-{}", std::process::id()));
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mismatch-fleet-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(dir.join("data/experiment")).unwrap();
     dir
 }
 
-/// The vehicle's own effects, in air moving at `wind` (none: still air).
-fn vehicle_effects(wind: Option<[f64; 3]>) -> Effects {
+/// The vehicle's own effects, in air moving at `wind` (none: still air), the air forces lagging
+/// the velocity by `lag_s` when given.
+fn vehicle_effects(wind: Option<[f64; 3]>, lag_s: Option<f64>) -> Effects {
     Effects {
+        drag_lag: lag_s.map(|tau_s| DragLag { tau_s }),
         thrust_tilt: Some(ThrustTilt {
             angles_rad: [0.015, -0.03],
         }),
@@ -28,19 +31,18 @@ fn vehicle_effects(wind: Option<[f64; 3]>) -> Effects {
     }
 }
 
-#[test]
-fn the_winds_of_several_flights_come_out_of_one_vehicle() {
-    let dir = scratch();
+/// A condition: name, air velocity (none: calm), known speed.
+type Condition = (&'static str, Option<[f64; 3]>, f64);
+
+/// Simulates one flight per condition with the vehicle's effects (air forces lagging by
+/// `lag_s`), runs the joint analysis on them and returns its report.
+fn analyse(name: &str, conditions: &[Condition], lag_s: Option<f64>) -> FleetReport {
+    let dir = scratch(name);
     let vehicle = common::model("vehicles/quad-a.json");
-    let conditions = [
-        ("still", None, 0.0),
-        ("breeze", Some([-3.0, 0.5, 0.0]), 3.0),
-        ("gale", Some([-6.0, -1.0, 0.0]), 6.0),
-    ];
     for (k, (name, wind, _)) in conditions.iter().enumerate() {
         let scenario = Scenario {
             duration_s: 24.0,
-            effects: vehicle_effects(*wind),
+            effects: vehicle_effects(*wind, lag_s),
             ..common::scenario(Effects::default(), 40 + k as u64)
         };
         let log = simulate(&vehicle, &scenario, name).unwrap();
@@ -51,10 +53,10 @@ fn the_winds_of_several_flights_come_out_of_one_vehicle() {
         "file_pattern": "experiment/flight_{controller}_{condition}.csv",
         "controllers": ["only"],
         "evaluation_controller": "only",
-        "conditions": conditions.iter().map(|(name, _, speed)| serde_json::json!({
+        "conditions": conditions.iter().map(|(name, wind, speed)| serde_json::json!({
             "name": name, "wind_speed": format!("{speed} m/s"), "mean_wind_m_s": speed,
-            "calm": *name == "still",
-            "role": if *name == "still" { "meta-training" } else { "evaluation" }
+            "calm": wind.is_none(),
+            "role": if wind.is_none() { "meta-training" } else { "evaluation" }
         })).collect::<Vec<_>>(),
         "paper_training": {"file_pattern": "training/flight_{condition}.csv",
             "conditions": [{"name": "still", "wind_speed": "0 m/s", "role": "meta-training"}]}
@@ -76,18 +78,26 @@ fn the_winds_of_several_flights_come_out_of_one_vehicle() {
     )
     .unwrap();
     let (report, _) = plan.run(&model, "vehicle.json", false).unwrap();
-    let ids: Vec<&str> = report
+    for ext in ["json", "md", "svg"] {
+        assert!(out.join(format!("vehicle.{ext}")).exists());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+    report
+}
+
+fn effect_ids(report: &FleetReport) -> Vec<&str> {
+    report
         .vehicle
         .effects
         .iter()
         .map(|e| e.id.as_str())
-        .collect();
-    assert!(
-        ids.contains(&"thrust_tilt") && ids.contains(&"rotor_drag"),
-        "{ids:?}"
-    );
+        .collect()
+}
+
+/// Every flight's estimated air (both roles) within `tolerance` m/s of the truth, horizontally.
+fn assert_winds(report: &FleetReport, conditions: &[Condition], tolerance: f64) {
     for role in ["fit", "validation"] {
-        for (name, wind, _) in &conditions {
+        for (name, wind, _) in conditions {
             let found = report
                 .flights
                 .iter()
@@ -97,14 +107,58 @@ fn the_winds_of_several_flights_come_out_of_one_vehicle() {
             let error =
                 ((found.w_air[0] - truth[0]).powi(2) + (found.w_air[1] - truth[1]).powi(2)).sqrt();
             assert!(
-                error < 0.5,
+                error < tolerance,
                 "{role} {name}: {:?} for {truth:?}",
                 found.w_air
             );
         }
     }
-    for ext in ["json", "md", "svg"] {
-        assert!(out.join(format!("vehicle.{ext}")).exists());
+}
+
+#[test]
+fn the_winds_of_several_flights_come_out_of_one_vehicle() {
+    let conditions: [Condition; 3] = [
+        ("still", None, 0.0),
+        ("breeze", Some([-3.0, 0.5, 0.0]), 3.0),
+        ("gale", Some([-6.0, -1.0, 0.0]), 6.0),
+    ];
+    let report = analyse("plain", &conditions, None);
+    let ids = effect_ids(&report);
+    assert!(
+        ids.contains(&"thrust_tilt") && ids.contains(&"rotor_drag"),
+        "{ids:?}"
+    );
+    assert_winds(&report, &conditions, 0.5);
+}
+
+/// With air forces that lag the velocity, the lag is chosen on the calm flights' held-out parts,
+/// the winds come out at their scale, and the band of lags the calm flights leave open brackets
+/// every wind's true speed.
+#[test]
+fn a_lag_of_the_air_forces_is_found_in_still_air_and_bounds_the_winds_scale() {
+    let conditions: [Condition; 4] = [
+        ("still", None, 0.0),
+        ("calm", None, 0.0),
+        ("breeze", Some([-3.0, 0.5, 0.0]), 3.04),
+        ("gale", Some([-6.0, -1.0, 0.0]), 6.08),
+    ];
+    let report = analyse("lag", &conditions, Some(0.3));
+    let ids = effect_ids(&report);
+    assert!(ids.contains(&"drag_lag"), "{ids:?}");
+    let scale = report
+        .scale
+        .as_ref()
+        .expect("a scale section with a drag lag");
+    assert!(
+        (scale.chosen_lag_s - 0.3).abs() < 0.08,
+        "lag {}",
+        scale.chosen_lag_s
+    );
+    assert!(scale.lag_band_s.0 <= 0.3 && 0.3 <= scale.lag_band_s.1);
+    for f in &scale.flights {
+        let (low, high) = f.range();
+        let known = f.fan_speed_m_s.unwrap();
+        assert!(low - 0.2 <= known && known <= high + 0.2, "{f:?}");
     }
-    std::fs::remove_dir_all(&dir).unwrap();
+    assert_winds(&report, &conditions, 0.6);
 }

@@ -30,11 +30,14 @@
 mod attitude;
 mod joint;
 mod report;
+mod scale_report;
+mod sensitivity;
 
 use std::path::{Path, PathBuf};
 
 use data::ExperimentConditions;
 use physics::NominalModel;
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::{MismatchError, Result};
@@ -47,6 +50,8 @@ pub use attitude::AttitudeCheck;
 pub use joint::{Air, Vehicle, VehicleParameter};
 use joint::{JointFit, JointFlight, JointSettings};
 pub use report::{FleetReport, FlightWind, Targets};
+pub use scale_report::{FlightSpeedRange, ScaleReport};
+pub use sensitivity::{LAG_GRID_S, LagProfile, LagSensitivity};
 
 /// Settings of the joint analysis (recorded in the output).
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -340,6 +345,8 @@ pub struct Identification {
     /// Per flight: share of the weak-form `fa / m` mean square the held-out model removes.
     pub residual_force_explained: Vec<Option<f64>>,
     pub selection: Vec<SelectionStep>,
+    /// How the winds move with the drag lag across what the calm flights leave open.
+    pub lag_sensitivity: Option<LagSensitivity>,
 }
 
 fn joint_flights(flights: &[FleetFlight], rows: Rows) -> Vec<JointFlight<'_>> {
@@ -451,23 +458,32 @@ fn calibrate_calm(
         settings.min_step,
         selection,
         |vehicle| {
-            let mut best: Option<(String, Vehicle, f64)> = None;
-            for id in CALM_CANDIDATES {
-                if vehicle.ids().contains(&id) || (id == "drag_lag" && !vehicle.feels_wind()) {
-                    continue;
-                }
-                for start in starts(id) {
+            let trials: Vec<(&str, Option<Vec<f64>>)> = CALM_CANDIDATES
+                .into_iter()
+                .filter(|id| !vehicle.ids().contains(id))
+                .filter(|id| *id != "drag_lag" || vehicle.feels_wind())
+                .flat_map(|id| starts(id).into_iter().map(move |start| (id, start)))
+                .collect();
+            let scored: Vec<(String, Vehicle, f64)> = trials
+                .par_iter()
+                .map(|(id, start)| {
                     let trial = vehicle.with(id, start.as_deref());
                     let fitted = fit_two_step(&fit_rows, &trial, &[], true, settings.iterations);
                     let trial_error = score(&fitted.vehicle);
-                    if best.as_ref().is_none_or(|b| trial_error < b.2) {
-                        best = Some((id.to_string(), fitted.vehicle, trial_error));
-                    }
-                }
-            }
-            best
+                    (id.to_string(), fitted.vehicle, trial_error)
+                })
+                .collect();
+            first_lowest(scored)
         },
     )
+}
+
+/// The trial with the lowest error, the first in order among equals.
+fn first_lowest(trials: Vec<(String, Vehicle, f64)>) -> Option<(String, Vehicle, f64)> {
+    trials.into_iter().fold(None, |best, trial| match best {
+        Some(b) if b.2 <= trial.2 => Some(b),
+        _ => Some(trial),
+    })
 }
 
 /// Adds, one at a time, the candidate `best_candidate` proposes (id, vehicle with it, its error)
@@ -561,13 +577,14 @@ fn leave_out(
 /// flights with the vehicle fitted (fit rows) on the other flights and only their airs fitted.
 fn transfer_error(flights: &[FleetFlight], vehicle: &Vehicle, settings: &FleetSettings) -> f64 {
     let groups = windy_groups(flights);
-    let total: f64 = groups
-        .iter()
+    let errors: Vec<f64> = groups
+        .par_iter()
         .map(|(_, members)| {
             let (fitted, airs) = leave_out(flights, members, vehicle, settings, Rows::Fit);
             heldout_error(flights, members, &fitted, &airs)
         })
-        .sum();
+        .collect();
+    let total: f64 = errors.iter().sum();
     total / groups.len().max(1) as f64
 }
 
@@ -589,21 +606,21 @@ fn add_wind_effects(
         settings.min_step,
         selection,
         |vehicle| {
-            let mut best: Option<(String, Vehicle, f64)> = None;
-            for id in WIND_CANDIDATES {
-                let needs_drag = matches!(id, "translational_lift" | "wind_gradient");
-                if vehicle.ids().contains(&id) || (needs_drag && !vehicle.feels_wind()) {
-                    continue;
-                }
-                for start in starts(id) {
+            // Every wind candidate needs a drag for the air to act through.
+            let trials: Vec<(&str, Option<Vec<f64>>)> = WIND_CANDIDATES
+                .into_iter()
+                .filter(|id| !vehicle.ids().contains(id) && vehicle.feels_wind())
+                .flat_map(|id| starts(id).into_iter().map(move |start| (id, start)))
+                .collect();
+            let scored: Vec<(String, Vehicle, f64)> = trials
+                .par_iter()
+                .map(|(id, start)| {
                     let trial = vehicle.with(id, start.as_deref());
                     let trial_error = transfer_error(flights, &trial, settings);
-                    if best.as_ref().is_none_or(|b| trial_error < b.2) {
-                        best = Some((id.to_string(), trial, trial_error));
-                    }
-                }
-            }
-            best
+                    (id.to_string(), trial, trial_error)
+                })
+                .collect();
+            first_lowest(scored)
         },
     )
 }
@@ -611,7 +628,13 @@ fn add_wind_effects(
 /// The whole joint analysis (see the module's documentation).
 pub fn identify(flights: &[FleetFlight], settings: &FleetSettings) -> Identification {
     let mut selection = Vec::new();
-    let calm_vehicle = calibrate_calm(flights, settings, &mut selection);
+    let mut calm_vehicle = calibrate_calm(flights, settings, &mut selection);
+    // The lag is held from here on: at its calm held-out minimum, not its fit-part optimum.
+    let lag_profile = LagProfile::measure(flights, &calm_vehicle, settings);
+    if let Some(profile) = &lag_profile {
+        calm_vehicle =
+            LagProfile::vehicle_at(flights, &calm_vehicle, profile.best_lag_s(), settings);
+    }
     let structure = add_wind_effects(flights, calm_vehicle, settings, &mut selection);
     let fixed = timing_parameters(&structure);
     // Held-out check: fitted on the first part of every flight.
@@ -640,28 +663,34 @@ pub fn identify(flights: &[FleetFlight], settings: &FleetSettings) -> Identifica
         true,
         settings.iterations,
     );
+    // Left out in turn: each windy condition, then each calm flight that has calm siblings.
+    let mut groups = windy_groups(flights);
+    groups.extend(
+        (0..flights.len())
+            .filter(|&i| flights[i].calm)
+            .filter(|&i| flights.iter().enumerate().any(|(j, f)| j != i && f.calm))
+            .map(|i| {
+                let f = &flights[i];
+                (format!("{} {}", f.controller, f.condition), vec![i])
+            }),
+    );
+    let left_out: Vec<(Vehicle, Vec<Air>)> = groups
+        .par_iter()
+        .map(|(_, members)| leave_out(flights, members, &full.vehicle, settings, Rows::All))
+        .collect();
     let mut validation_airs = still_airs(flights, &full.vehicle);
     let mut validation_vehicles = Vec::new();
-    for (condition, members) in windy_groups(flights) {
-        let (vehicle, airs) = leave_out(flights, &members, &full.vehicle, settings, Rows::All);
+    for ((name, members), (vehicle, airs)) in groups.into_iter().zip(left_out) {
         for &i in &members {
             validation_airs[i] = airs[i].clone();
         }
-        validation_vehicles.push((condition, vehicle));
+        validation_vehicles.push((name, vehicle));
     }
-    for i in (0..flights.len()).filter(|&i| flights[i].calm) {
-        let others_calm = flights.iter().enumerate().any(|(j, f)| j != i && f.calm);
-        if !others_calm {
-            continue;
-        }
-        let (vehicle, airs) = leave_out(flights, &[i], &full.vehicle, settings, Rows::All);
-        validation_airs[i] = airs[i].clone();
-        validation_vehicles.push((
-            format!("{} {}", flights[i].controller, flights[i].condition),
-            vehicle,
-        ));
-    }
+    let lag_sensitivity = lag_profile
+        .as_ref()
+        .and_then(|p| p.sensitivity(flights, &full.vehicle, settings));
     Identification {
+        lag_sensitivity,
         vehicle: full.vehicle,
         airs: full.airs,
         validation_airs,

@@ -9,7 +9,8 @@ use plotters::prelude::*;
 use serde::Serialize;
 
 use super::{
-    Air, AttitudeCheck, FleetFlight, FleetSettings, Identification, SelectionStep, Vehicle,
+    Air, AttitudeCheck, FleetFlight, FleetSettings, Identification, ScaleReport, SelectionStep,
+    Vehicle,
 };
 use crate::describe::describe;
 use crate::error::{MismatchError, Result, io_error};
@@ -93,6 +94,8 @@ pub struct FleetReport {
     /// The angular channels, when the model predicts no torques.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub attitude: Option<AttitudeCheck>,
+    /// How the winds move with the drag lag across what the calm flights leave open.
+    pub scale: Option<ScaleReport>,
     /// Per validation group: the vehicle fitted without it.
     pub validation_vehicles: Vec<(String, serde_json::Value)>,
     pub settings: FleetSettings,
@@ -246,7 +249,7 @@ impl FleetReport {
         let notes = vec![
             "Known wind speeds (mean_wind_m_s of the conditions file) are compared with the estimates only; no fit or choice uses them.".to_string(),
             "The calm flights' air velocity is zero by declaration in the fit role; in the validation role each calm flight's air velocity is fitted with the vehicle identified from the other flights.".to_string(),
-            "The delay and the drag lag are chosen on the calm flights' held-out parts (all calm flights, including the one a calm validation leaves out) and then held; the effects are chosen once, by the transfer error over all windy conditions; each validation refits the vehicle's values without the left-out flights.".to_string(),
+            "The drag lag is the minimum of the calm flights' held-out error over a grid of lags, the delay is fitted on the calm flights' first part with that lag, and both are then held (all calm flights are used, including the one a calm validation leaves out); the effects are chosen once, by the transfer error over all windy conditions; each validation refits the vehicle's values without the left-out flights.".to_string(),
             "Speeds are horizontal (√(w_x² + w_y²)): a fan blows horizontally, and the vertical component is weakly identified.".to_string(),
         ];
         let targets = vec![targets(&winds, "fit"), targets(&winds, "validation")];
@@ -259,6 +262,10 @@ impl FleetReport {
             heldout,
             selection: found.selection.clone(),
             attitude,
+            scale: found
+                .lag_sensitivity
+                .as_ref()
+                .map(|s| ScaleReport::new(flights, s)),
             validation_vehicles: found
                 .validation_vehicles
                 .iter()
@@ -290,6 +297,19 @@ impl FleetReport {
                 )
             })
             .collect();
+        if let Some(scale) = &self.scale {
+            let covered = scale
+                .flights
+                .iter()
+                .filter(|f| f.covers_known() == Some(true))
+                .count();
+            lines.push(format!(
+                "scale: the calm flights leave the drag lag open from {:.1} to {:.1} s; {covered} of {} windy flights' known speeds lie between their speeds at the two ends",
+                scale.lag_band_s.0,
+                scale.lag_band_s.1,
+                scale.flights.len()
+            ));
+        }
         for t in &self.targets {
             lines.push(format!(
                 "{}: {} of {} windy flights within ±1.5 m/s (max error {:.2}), calm at most {:.2} m/s, directions within ±{:.1}° of {:.1}°",
@@ -349,6 +369,9 @@ impl FleetReport {
         self.targets_markdown(&mut md);
         self.flights_markdown(&mut md);
         let _ = writeln!(md, "\n![estimated against known wind speed]({figure})\n");
+        if let Some(scale) = &self.scale {
+            scale.markdown(self.settings.min_step, &mut md);
+        }
         self.heldout_markdown(&mut md);
         self.attitude_markdown(&mut md);
         let _ = writeln!(md, "\n## Notes\n");
@@ -547,6 +570,13 @@ fn write_figure(report: &FleetReport, path: &PathBuf) -> Result<()> {
         .iter()
         .map(|(f, s)| f.horizontal_speed_m_s.max(*s))
         .fold(1.0, f64::max)
+        .max(
+            report
+                .scale
+                .iter()
+                .flat_map(|s| s.flights.iter().map(|f| f.range().1))
+                .fold(0.0, f64::max),
+        )
         * 1.1;
     if !top.is_finite() {
         return Err(plot_error(&"a wind speed is not finite"));
@@ -584,6 +614,24 @@ fn write_figure(report: &FleetReport, path: &PathBuf) -> Result<()> {
             BLACK.stroke_width(1),
         ))
         .map_err(|e| plot_error(&e))?;
+    if let Some(scale) = &report.scale {
+        let (low, high) = scale.lag_band_s;
+        let grey = RGBColor(120, 120, 120);
+        chart
+            .draw_series(scale.flights.iter().filter_map(|f| {
+                let (a, b) = f.range();
+                f.fan_speed_m_s.map(|s| {
+                    PathElement::new(vec![(s - 0.12, a), (s - 0.12, b)], grey.stroke_width(2))
+                })
+            }))
+            .map_err(|e| plot_error(&e))?
+            .label(format!(
+                "joint fit with the drag lag from {low:.1} to {high:.1} s"
+            ))
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y - 6), (x, y + 6)], grey.stroke_width(2))
+            });
+    }
     for (role, color, dx) in [("fit", BLUE, -0.12), ("validation", RED, 0.12)] {
         chart
             .draw_series(

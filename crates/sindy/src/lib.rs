@@ -57,6 +57,7 @@ mod model;
 mod optimizer;
 mod persist;
 mod pipeline;
+mod reduced;
 mod regression;
 mod selection;
 mod variant;
@@ -65,13 +66,16 @@ pub use causal::{CausalLibrary, MAX_CONTROL_LAGS, first_order_lag};
 pub use error::{Result, SindyError};
 pub use library::{CustomFunction, FeatureLibrary, LibrarySpec, MAX_FEATURES};
 pub use linalg::least_squares;
-pub use model::{Score, SindyModel, SindyParams, Trajectory, mean_squared_error, r2_score};
+pub use model::{
+    LARGE_LIBRARY_ENTRIES, Score, SindyModel, SindyParams, Trajectory, mean_squared_error, r2_score,
+};
 pub use optimizer::{
     DEFAULT_ALPHA, DEFAULT_MAX_ITER, Lasso, Optimizer, OptimizerSpec, Stlsq, StlsqFit,
     kkt_violation,
 };
 pub use persist::MODEL_FORMAT;
 pub use pipeline::{SegmentEvaluation, SindyConfig, evaluate_flight, fit_and_evaluate};
+pub use reduced::{BLOCK_ROWS, ReducedProblem};
 pub use regression::{
     Bagging, EnsemblePrediction, LinearFit, MAX_BAGGING_BLOCK, MAX_BAGGING_MEMBERS, MAX_PENALTY,
     MAX_PENALTY_CANDIDATES, Penalty, RegressionFit, RegressionSpec, select_rows,

@@ -121,6 +121,14 @@ pub(crate) fn full_rank_triangular(a: MatRef<'_, f64>, r: MatRef<'_, f64>) -> bo
     largest > 0.0 && diagonal.iter().all(|&d| d > tolerance)
 }
 
+/// [`full_rank_triangular`] for the triangle R of a matrix with `rows` rows and R's columns.
+pub(crate) fn full_rank_triangular_rows(r: MatRef<'_, f64>, rows: usize) -> bool {
+    let diagonal: Vec<f64> = (0..r.ncols()).map(|i| r[(i, i)].abs()).collect();
+    let largest = diagonal.iter().copied().fold(0.0, f64::max);
+    let tolerance = 1e3 * f64::EPSILON * rows.max(r.ncols()) as f64 * largest;
+    rows >= r.ncols() && largest > 0.0 && diagonal.iter().all(|&d| d > tolerance)
+}
+
 fn rank_tolerance(a: MatRef<'_, f64>) -> f64 {
     f64::EPSILON * a.nrows().max(a.ncols()) as f64
 }

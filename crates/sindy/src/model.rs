@@ -6,6 +6,7 @@ use faer::{Mat, MatRef};
 use crate::error::{Result, SindyError, invalid, shape};
 use crate::library::{FeatureLibrary, LibrarySpec};
 use crate::optimizer::OptimizerSpec;
+use crate::reduced::{BLOCK_ROWS, ReducedProblem};
 
 /// One recorded trajectory: states x(t), optional controls u(t), optional derivatives ẋ(t).
 /// Samples must be uniformly spaced in time when derivatives are estimated from the states.
@@ -139,6 +140,10 @@ impl Score {
     }
 }
 
+/// Entries (rows × features) above which a library is evaluated by blocks of rows and the fit
+/// reduced as it is built ([`ReducedProblem`]) instead of forming Θ whole: 2²² entries, 32 MB.
+pub const LARGE_LIBRARY_ENTRIES: usize = 1 << 22;
+
 /// Settings of a SINDy fit, checked when [`SindyParams::fit`] runs.
 #[derive(Clone, Debug)]
 pub struct SindyParams {
@@ -216,12 +221,49 @@ impl SindyParams {
     }
 
     /// Fits on inputs X = [x, u] and targets ẋ given as matrices (one row per sample).
+    ///
+    /// A library of more than [`LARGE_LIBRARY_ENTRIES`] entries is never formed whole: it is
+    /// evaluated and reduced by blocks of rows ([`ReducedProblem`]), in memory independent of
+    /// the number of rows, with the same coefficients up to rounding.
     pub fn fit_matrices(
         &self,
         inputs: MatRef<'_, f64>,
         targets: MatRef<'_, f64>,
     ) -> Result<SindyModel> {
-        Ok(self.fit_with_library_matrix(inputs, targets)?.0)
+        let features = self.library.feature_count(inputs.ncols());
+        if inputs.nrows().saturating_mul(features) <= LARGE_LIBRARY_ENTRIES {
+            return Ok(self.fit_with_library_matrix(inputs, targets)?.0);
+        }
+        let optimizer = self.check_fit_inputs(inputs, targets)?;
+        let names = self.input_names();
+        let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let feature_names = self.library.feature_names(&input_names);
+        let reduced =
+            ReducedProblem::from_row_blocks(inputs.nrows(), features, targets.ncols(), |rows| {
+                let theta = self
+                    .library
+                    .transform(inputs.subrows(rows.start, rows.len()));
+                check_finite("library", theta.as_ref(), &|j| {
+                    format!("feature '{}'", feature_names[j])
+                })
+                .map_err(|error| match error {
+                    SindyError::NonFinite {
+                        what,
+                        row,
+                        column,
+                        value,
+                    } => SindyError::NonFinite {
+                        what,
+                        row: rows.start + row,
+                        column,
+                        value,
+                    },
+                    other => other,
+                })?;
+                Ok::<_, SindyError>((theta, targets.subrows(rows.start, rows.len()).to_owned()))
+            })?;
+        let coefficients = optimizer.fit_reduced(&reduced, &self.state_names)?;
+        Ok(self.model(feature_names, coefficients))
     }
 
     /// [`Self::fit_matrices`], also returning Θ(X) of the inputs (to predict on them for free).
@@ -230,6 +272,37 @@ impl SindyParams {
         inputs: MatRef<'_, f64>,
         targets: MatRef<'_, f64>,
     ) -> Result<(SindyModel, Mat<f64>)> {
+        let optimizer = self.check_fit_inputs(inputs, targets)?;
+        let names = self.input_names();
+        let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let feature_names = self.library.feature_names(&input_names);
+        let theta = self.library.transform(inputs);
+        check_finite("library", theta.as_ref(), &|j| {
+            format!("feature '{}'", feature_names[j])
+        })?;
+        let coefficients = optimizer.fit(theta.as_ref(), targets, &self.state_names)?;
+        Ok((self.model(feature_names, coefficients), theta))
+    }
+
+    fn model(&self, feature_names: Vec<String>, coefficients: Mat<f64>) -> SindyModel {
+        SindyModel {
+            feature_names,
+            state_names: self.state_names.clone(),
+            control_names: self.control_names.clone(),
+            library: self.library.clone(),
+            library_spec: self.library_spec.clone(),
+            optimizer: self.optimizer,
+            derivative: self.derivative,
+            coefficients,
+        }
+    }
+
+    /// The checked optimizer, once the names, shapes and values of a fit's inputs are checked.
+    fn check_fit_inputs(
+        &self,
+        inputs: MatRef<'_, f64>,
+        targets: MatRef<'_, f64>,
+    ) -> Result<crate::Optimizer> {
         self.check_names()?;
         let optimizer = self.optimizer.checked()?;
         let (dim_x, dim_u) = (self.state_names.len(), self.control_names.len());
@@ -255,28 +328,11 @@ impl SindyParams {
             ));
         }
         let names = self.input_names();
-        let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
         check_finite("inputs", inputs, &|j| format!("input '{}'", names[j]))?;
         check_finite("targets", targets, &|j| {
             format!("target {}'", self.state_names[j])
         })?;
-        let feature_names = self.library.feature_names(&input_names);
-        let theta = self.library.transform(inputs);
-        check_finite("library", theta.as_ref(), &|j| {
-            format!("feature '{}'", feature_names[j])
-        })?;
-        let coefficients = optimizer.fit(theta.as_ref(), targets, &self.state_names)?;
-        let model = SindyModel {
-            feature_names,
-            state_names: self.state_names.clone(),
-            control_names: self.control_names.clone(),
-            library: self.library.clone(),
-            library_spec: self.library_spec.clone(),
-            optimizer: self.optimizer,
-            derivative: self.derivative,
-            coefficients,
-        };
-        Ok((model, theta))
+        Ok(optimizer)
     }
 
     fn input_names(&self) -> Vec<String> {
@@ -372,9 +428,24 @@ impl SindyModel {
                 format!("{} input columns, the model has {expected}", inputs.ncols()),
             ));
         }
-        let theta = self.library.transform(inputs);
-        let prediction = theta * self.coefficients.transpose();
-        crate::linalg::clear_upper_vector_state();
+        let features = self.coefficients.ncols();
+        if inputs.nrows().saturating_mul(features) <= LARGE_LIBRARY_ENTRIES {
+            let theta = self.library.transform(inputs);
+            let prediction = theta * self.coefficients.transpose();
+            crate::linalg::clear_upper_vector_state();
+            return Ok(prediction);
+        }
+        // A large library is evaluated by blocks of rows, never whole.
+        let mut prediction = Mat::zeros(inputs.nrows(), self.coefficients.nrows());
+        for start in (0..inputs.nrows()).step_by(BLOCK_ROWS) {
+            let rows = BLOCK_ROWS.min(inputs.nrows() - start);
+            let theta = self.library.transform(inputs.subrows(start, rows));
+            prediction
+                .as_mut()
+                .subrows_mut(start, rows)
+                .copy_from(&theta * self.coefficients.transpose());
+            crate::linalg::clear_upper_vector_state();
+        }
         Ok(prediction)
     }
 

@@ -45,17 +45,27 @@ impl Lasso {
     ) -> Result<Mat<f64>> {
         let gram = theta.transpose() * theta;
         let moments = theta.transpose() * targets;
-        let columns = (0..targets.ncols())
+        self.fit_gram(gram.as_ref(), moments.as_ref(), target_names)
+    }
+
+    /// [`Self::fit`] from ΘᵀΘ and ΘᵀY (the objective up to a constant).
+    pub fn fit_gram(
+        &self,
+        gram: MatRef<'_, f64>,
+        moments: MatRef<'_, f64>,
+        target_names: &[String],
+    ) -> Result<Mat<f64>> {
+        let columns = (0..moments.ncols())
             .into_par_iter()
             .map(|i| {
                 let name = target_names
                     .get(i)
                     .cloned()
                     .unwrap_or_else(|| format!("column {i}"));
-                self.fit_one(gram.as_ref(), moments.col(i).as_mat(), &name)
+                self.fit_one(gram, moments.col(i).as_mat(), &name)
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Mat::from_fn(targets.ncols(), theta.ncols(), |i, j| {
+        Ok(Mat::from_fn(moments.ncols(), gram.ncols(), |i, j| {
             columns[i][j]
         }))
     }

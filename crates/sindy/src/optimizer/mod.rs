@@ -84,6 +84,23 @@ impl Optimizer {
             Self::Lasso(lasso) => lasso.fit(theta, targets, target_names),
         }
     }
+
+    /// [`Self::fit`] on a problem reduced by rows: the same coefficients up to rounding, without
+    /// the library's rows.
+    pub fn fit_reduced(
+        &self,
+        reduced: &crate::ReducedProblem,
+        target_names: &[String],
+    ) -> Result<Mat<f64>> {
+        match self {
+            Self::Stlsq(stlsq) => Ok(stlsq.fit_reduced(reduced).coefficients),
+            Self::Lasso(lasso) => lasso.fit_gram(
+                reduced.gram().as_ref(),
+                reduced.moments().as_ref(),
+                target_names,
+            ),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -17,8 +17,10 @@ use crate::error::{Result, invalid};
 use faer::linalg::solvers::SolveLstsq;
 
 use crate::linalg::{
-    CholeskyQr, clear_upper_vector_state, full_rank_qr, least_squares, ridge_from_gram,
+    CholeskyQr, clear_upper_vector_state, full_rank_qr, full_rank_triangular_rows, least_squares,
+    ridge_from_gram,
 };
+use crate::reduced::ReducedProblem;
 use faer::Par;
 use faer::linalg::triangular_solve::solve_upper_triangular_in_place;
 
@@ -71,7 +73,7 @@ impl Stlsq {
     pub fn fit(&self, theta: MatRef<'_, f64>, targets: MatRef<'_, f64>) -> StlsqFit {
         let gram = theta.transpose() * theta;
         let moments = theta.transpose() * targets;
-        let reduced = ReducedProblem::new(theta, targets, gram.as_ref());
+        let reduced = LibraryQr::new(theta, targets, gram.as_ref());
         let reference = match &reduced {
             Some(reduced) => reduced.solution.clone(),
             None => least_squares(theta, targets),
@@ -109,6 +111,50 @@ impl Stlsq {
         let coefficients = Mat::from_fn(targets.ncols(), theta.ncols(), |i, j| columns[i].0[j]);
         StlsqFit {
             coefficients,
+            iterations: columns.iter().map(|c| c.1).collect(),
+        }
+    }
+
+    /// Fits every target of a problem reduced by rows ([`ReducedProblem`]): the same steps on
+    /// RᵀR, RᵀZ and R instead of ΘᵀΘ, ΘᵀY and Θ.
+    pub fn fit_reduced(&self, reduced: &ReducedProblem) -> StlsqFit {
+        let r = reduced.triangular();
+        let projected = reduced.projected();
+        let (features, targets) = (r.ncols(), projected.ncols());
+        let gram = reduced.gram();
+        let moments = reduced.moments();
+        let reference = match full_rank_triangular_rows(r, reduced.rows()) {
+            true => {
+                let mut solution = projected.to_owned();
+                solve_upper_triangular_in_place(r, solution.as_mut(), Par::Seq);
+                solution
+            }
+            false => least_squares(r, projected),
+        };
+        clear_upper_vector_state();
+        let fit_target = |i: usize| -> (Vec<f64>, usize) {
+            let reference_pattern: Vec<bool> =
+                (0..features).map(|j| reference[(j, i)] != 0.0).collect();
+            let (support, iterations) =
+                self.select(gram.as_ref(), moments.col(i).as_mat(), reference_pattern);
+            let mut unbiased = vec![0.0; features];
+            if !support.is_empty() {
+                let sub = Mat::from_fn(features, support.len(), |k, a| r[(k, support[a])]);
+                let solution = least_squares(sub.as_ref(), projected.col(i).as_mat());
+                for (a, &j) in support.iter().enumerate() {
+                    unbiased[j] = solution[(a, 0)];
+                }
+            }
+            (unbiased, iterations)
+        };
+        let columns: Vec<(Vec<f64>, usize)> =
+            if features * features * features >= PARALLEL_WORK && targets > 1 {
+                (0..targets).into_par_iter().map(fit_target).collect()
+            } else {
+                (0..targets).map(fit_target).collect()
+            };
+        StlsqFit {
+            coefficients: Mat::from_fn(targets, features, |i, j| columns[i].0[j]),
             iterations: columns.iter().map(|c| c.1).collect(),
         }
     }
@@ -168,14 +214,14 @@ impl Stlsq {
 /// as stably as a QR of Θ_S. The QR comes from CholeskyQR2 on the Gram matrix already formed
 /// for the ridge steps, or from Householder when Θ is too ill-conditioned for it. `None` when Θ
 /// is wide or rank-deficient.
-struct ReducedProblem {
+struct LibraryQr {
     triangular: Mat<f64>,
     projected: Mat<f64>,
     /// The least-squares solution on all features, one column per target.
     solution: Mat<f64>,
 }
 
-impl ReducedProblem {
+impl LibraryQr {
     fn new(
         theta: MatRef<'_, f64>,
         targets: MatRef<'_, f64>,
@@ -208,7 +254,7 @@ impl ReducedProblem {
 fn refit(
     theta: MatRef<'_, f64>,
     target: MatRef<'_, f64>,
-    reduced: Option<&ReducedProblem>,
+    reduced: Option<&LibraryQr>,
     index: usize,
     support: &[usize],
 ) -> Vec<f64> {

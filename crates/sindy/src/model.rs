@@ -265,6 +265,7 @@ impl SindyParams {
         check_finite("library", theta.as_ref(), &|j| {
             format!("feature '{}'", feature_names[j])
         })?;
+        check_scale(theta.as_ref(), &feature_names)?;
         let coefficients = optimizer.fit(theta.as_ref(), targets, &self.state_names)?;
         let model = SindyModel {
             feature_names,
@@ -640,6 +641,37 @@ fn check_finite(what: &str, matrix: MatRef<'_, f64>, name: &dyn Fn(usize) -> Str
                 value: column[i],
             });
         }
+    }
+    Ok(())
+}
+
+/// The most the largest magnitudes of two features of one fit may differ by: beyond it a
+/// least-squares fit in double precision (16 digits) cannot resolve the smaller one.
+pub const MAX_FEATURE_SCALE_RATIO: f64 = 1e12;
+
+/// Refuses a library whose features differ in size by more than [`MAX_FEATURE_SCALE_RATIO`]
+/// (largest magnitude of each non-zero column): the fit would be noise or not finite.
+fn check_scale(theta: MatRef<'_, f64>, names: &[String]) -> Result<()> {
+    let sizes = (0..theta.ncols()).filter_map(|j| {
+        let size = theta.col(j).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        (size > 0.0).then_some((j, size))
+    });
+    let (mut small, mut large) = ((0, f64::INFINITY), (0, 0.0));
+    for (j, size) in sizes {
+        if size < small.1 {
+            small = (j, size);
+        }
+        if size > large.1 {
+            large = (j, size);
+        }
+    }
+    if large.1 > small.1 * MAX_FEATURE_SCALE_RATIO {
+        return Err(SindyError::Scale {
+            large_feature: names[large.0].clone(),
+            large: large.1,
+            small_feature: names[small.0].clone(),
+            small: small.1,
+        });
     }
     Ok(())
 }

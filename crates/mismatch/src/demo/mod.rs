@@ -288,6 +288,14 @@ impl DemoPlan {
         inputs
     }
 
+    /// The same plan writing its summary into `out` instead (a staging folder).
+    pub fn with_out(&self, out: &Path) -> Self {
+        Self {
+            out: out.to_path_buf(),
+            ..self.clone()
+        }
+    }
+
     /// The summary files, `out/summary.md` and `out/summary.json`.
     pub fn summary_paths(&self) -> [PathBuf; 2] {
         [self.out.join("summary.md"), self.out.join("summary.json")]

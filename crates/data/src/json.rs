@@ -44,7 +44,7 @@ pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, JsonEr
                 // A missing top-level field, or a document that is not an object at all.
                 None => format!("the document ({position})"),
             },
-            message: without_position(&inner),
+            message: plain_message(without_position(&inner)),
         }
     })?;
     // Trailing characters after the document are an error too (as in `serde_json::from_str`).
@@ -244,6 +244,16 @@ fn field_path(path: &serde_path_to_error::Path) -> Option<String> {
     (text != ".").then_some(text)
 }
 
+/// serde_json's `expected value` (its word for a number or other non-string where an enum's name
+/// is expected) in plain words.
+fn plain_message(message: String) -> String {
+    if message == "expected value" {
+        "expected one of this field's names, as a string in quotes".to_string()
+    } else {
+        message
+    }
+}
+
 /// serde_json's message without the ` at line L column C` it appends.
 fn without_position(error: &serde_json::Error) -> String {
     let text = error.to_string();
@@ -318,6 +328,19 @@ mod tests {
         assert!(error.field.starts_with("a[1] ("), "{error}");
         let error = checked_text("{\"m\": 1,\n \"m\": 2}").unwrap_err();
         assert!(error.field.starts_with("the document (line 2"), "{error}");
+    }
+
+    #[test]
+    fn a_number_where_a_name_is_expected_is_said_plainly() {
+        #[derive(Debug, Deserialize, Serialize)]
+        enum Kind {
+            A,
+        }
+        let error = from_str::<Vec<Kind>>("[42]").unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "[0] (line 1 column 2): expected one of this field's names, as a string in quotes"
+        );
     }
 
     #[test]

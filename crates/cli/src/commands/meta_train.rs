@@ -36,8 +36,8 @@ pub struct Args {
     /// all.
     #[arg(long)]
     pub condition: Option<String>,
-    /// Override the configuration's seed.
-    #[arg(long)]
+    /// Override the configuration's seed (a whole number from 0 to 2^64 - 1).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_seed)]
     pub seed: Option<u64>,
     /// Summary JSON of the run [default: results/.scratch/learn/learn.json, the tool's scratch,
     /// replaced on every run]. A file given here is not replaced without --force.
@@ -71,6 +71,16 @@ pub struct Args {
     /// with --force.
     #[arg(long)]
     pub force: bool,
+}
+
+/// A seed: a whole number from 0 to `u64::MAX`, said so when it is not.
+fn parse_seed(text: &str) -> Result<u64, String> {
+    text.parse().map_err(|_| {
+        format!(
+            "a seed is a whole number from 0 to {} (got {text:?})",
+            u64::MAX
+        )
+    })
 }
 
 /// `--out` when not given: the tool's own scratch, replaced on every run.

@@ -40,11 +40,11 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "stlsq")]
     pub optimizer: OptimizerKind,
     /// STLSQ threshold; `None`: the default.
-    #[arg(long, allow_negative_numbers = true,
+    #[arg(long, allow_hyphen_values = true,
           help = format!("STLSQ threshold (--optimizer stlsq only) [default: {DEFAULT_THRESHOLD}]"))]
     pub threshold: Option<f64>,
     /// STLSQ ridge strength; `None`: `sindy::DEFAULT_ALPHA`.
-    #[arg(long, allow_negative_numbers = true,
+    #[arg(long, allow_hyphen_values = true,
           help = format!("STLSQ ridge strength (--optimizer stlsq only) [default: {}]",
                          sindy::DEFAULT_ALPHA))]
     pub alpha: Option<f64>,
@@ -54,7 +54,7 @@ pub struct Args {
                          sindy::DEFAULT_MAX_ITER))]
     pub max_iter: Option<usize>,
     /// LASSO weight λ (required with --optimizer lasso).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub lambda: Option<f64>,
     /// Derivative estimator: forward, central, savgol or savgol:WINDOW:ORDER.
     #[arg(long, default_value = "central")]

@@ -25,21 +25,24 @@ test: data build
 # The paper's tables and figures from one command (experiments/reproduce.json): results/,
 # paper/tables/ and the README's tables block. Stage times are printed; see results/timings.json.
 reproduce: build
-	$(LEARN) $(QUIET) reproduce --config experiments/reproduce.json --out results --latex-dir paper/tables --readme README.md
+	$(LEARN) $(QUIET) reproduce --config experiments/reproduce.json --out results --latex-dir paper/tables --readme README.md --force
 
 # Variants beyond the paper (experiments/variants.json): every variant on every cell over 5 seeds,
 # model selection inside the support segment only; results/ablations/ablations.{md,json} and figures
 # with the ensemble band. Takes about 6 minutes on 2 cores (LeARN meta-training for the learned-basis
 # variants: three models per cell and seed for learn-ensemble3).
 ablations: build
-	$(LEARN) $(QUIET) ablations --config experiments/variants.json --out results/ablations
+	$(LEARN) $(QUIET) ablations --config experiments/variants.json --out results/ablations --force
 
 # The regression against the paper: the same protocol and LeARN budget without the variant columns
 # (experiments/ci.json), written to a git-ignored scratch directory, then compared with
 # paper/published.json under the tolerances of paper/tolerances.json (non-zero exit on regression).
+# The scratch is emptied first: files left there by an older tool have no output manifest, and a
+# command never replaces files it did not write.
 CI_RESULTS := results/.scratch/ci
 check-paper: build
-	$(LEARN) $(QUIET) reproduce --config experiments/ci.json --out $(CI_RESULTS) --latex-dir $(CI_RESULTS)/latex
+	rm -rf $(CI_RESULTS)
+	$(LEARN) $(QUIET) reproduce --config experiments/ci.json --out $(CI_RESULTS) --latex-dir $(CI_RESULTS)/latex --force
 	$(LEARN) check-paper --results $(CI_RESULTS)/tables
 
 lint:
@@ -51,9 +54,10 @@ fmt:
 
 # Speed against the Python references, in one run on this machine (needs `make data`; creates
 # .venv through scripts/python-env.sh if missing). One command per line: other parts append theirs.
-bench: data
+bench: data build
 	scripts/bench/sindy.sh
 	scripts/bench/learn.sh
+	scripts/bench/scaling.sh
 
 # Sim-to-real mismatch: the tool blind on simulated flights with concealed effects (every case under
 # every simulator/logger configuration of experiments/mismatch/demo.json: the matrix), then every

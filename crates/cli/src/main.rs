@@ -1,6 +1,31 @@
 //! `learn`: the command-line shell over the workspace's libraries. Each subcommand lives in its own
 //! module under `commands/` and only parses arguments, calls library functions and prints.
 
+/// Prints a line to standard output. A failed write (a closed or full output) is ignored: what
+/// is printed never changes the exit code nor stops a file from being written.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+/// As [`say!`], without the line end.
+macro_rules! say_part {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+/// Prints a line to standard error (progress, notes), ignoring a failed write as [`say!`] does.
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod commands;
 
 use std::process::ExitCode;
@@ -15,7 +40,7 @@ fn main() -> ExitCode {
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            eprintln!("error: {}", one_line(&error));
+            note!("error: {}", one_line(&error));
             ExitCode::FAILURE
         }
     }
@@ -43,8 +68,8 @@ fn report_output_failures() {
             .map(String::as_str)
             .or_else(|| payload.downcast_ref::<&str>().copied())
             .unwrap_or("");
-        if message.starts_with("failed printing to stdout") {
-            eprintln!("error: {message}");
+        if message.starts_with("failed printing to std") {
+            note!("error: {message}");
             std::process::exit(1);
         }
         default(info);
@@ -58,7 +83,7 @@ fn exit_on_usage_error(error: clap::Error) -> ! {
     if !error.use_stderr() || error.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
         error.exit();
     }
-    eprintln!("{}", one_line_usage(&error.render().to_string()));
+    note!("{}", one_line_usage(&error.render().to_string()));
     std::process::exit(error.exit_code());
 }
 
@@ -87,8 +112,33 @@ fn one_line(error: &anyhow::Error) -> String {
         }
         message.push_str(&text);
     }
-    message.replace("\r\n", " ").replace(['\n', '\r'], " ")
+    short_numbers(&message.replace("\r\n", " ").replace(['\n', '\r'], " "))
 }
+
+/// `message` with every decimal number longer than [`LONG_NUMBER`] characters (an `f64` printed
+/// in full: `1e-300` as 300 digits) written in short scientific notation.
+fn short_numbers(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
+        out.push_str(&rest[..start]);
+        let after = &rest[start..];
+        let end = after
+            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .unwrap_or(after.len());
+        let number = &after[..end];
+        match number.parse::<f64>() {
+            Ok(value) if number.len() > LONG_NUMBER => out.push_str(&format!("{value:e}")),
+            _ => out.push_str(number),
+        }
+        rest = &after[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// Numbers in messages longer than this are shortened (an `f64` has 17 significant digits).
+const LONG_NUMBER: usize = 24;
 
 #[cfg(test)]
 mod tests {
@@ -112,6 +162,19 @@ mod tests {
             line.contains("--csv"),
             "the missing arguments are named: {line}"
         );
+    }
+
+    #[test]
+    fn long_numbers_are_printed_short() {
+        let tiny = format!("{}", -1e-300);
+        assert!(tiny.len() > 300);
+        let error = anyhow::anyhow!("threshold {tiny} must be ≥ 0; cell {} at 1.5", 1e308);
+        assert_eq!(
+            one_line(&error),
+            "threshold -1e-300 must be ≥ 0; cell 1e308 at 1.5"
+        );
+        let error = anyhow::anyhow!("x.csv:12:v: 0.1 then 0.25, version 1.2.3");
+        assert_eq!(one_line(&error), "x.csv:12:v: 0.1 then 0.25, version 1.2.3");
     }
 
     #[test]

@@ -37,8 +37,10 @@ fn a_closed_output_ends_the_command_without_a_panic() {
     );
 }
 
+/// A full standard output changes nothing: what the command does (and its exit code) does not
+/// depend on whether its words can be printed (issue 18).
 #[test]
-fn an_unwritable_output_is_a_one_line_error() {
+fn an_unwritable_standard_output_changes_nothing() {
     let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
         return; // no /dev/full on this system
     };
@@ -52,10 +54,6 @@ fn an_unwritable_output_is_a_one_line_error() {
         .output()
         .expect("the learn binary runs");
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(1), "{stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
-    assert!(
-        stderr.starts_with("error: failed printing to stdout"),
-        "{stderr}"
-    );
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
 }

@@ -188,7 +188,10 @@ fn meta_train_reports_non_finite_results_instead_of_printing_nan() {
     let config = small_config(&dir, |v| v["adaptation"]["step"] = json!(1e308));
     let run = meta_train(&dir, &data, &["--config", path_str(&config)]);
     run.one_line_error(&["translational 35wind", "adaptation.step", "learn.json"]);
-    assert!(!dir.join("results").exists(), "nothing written");
+    assert!(
+        !dir.join("results").exists(),
+        "nothing written, no folder left"
+    );
 }
 
 #[test]
@@ -265,17 +268,26 @@ fn meta_train_refuses_to_replace_a_checkpoint_in_a_given_directory() {
         args.extend(extra);
         meta_train(&dir, &data, &args)
     };
+    // A file the command did not write is never replaced, even with --force (issue 18).
+    for extra in [&[][..], &["--force"]] {
+        let run = run_with(extra);
+        run.one_line_error(&[
+            "leave-condition-out-translational-35wind-seed1.json",
+            "not written by learn",
+        ]);
+    }
+    assert_eq!(std::fs::read_to_string(&existing).unwrap(), "mine");
+    assert!(!dir.join("a.json").exists());
+    std::fs::remove_file(&existing).unwrap();
     let run = run_with(&[]);
-    run.one_line_error(&[
+    let stdout = run.success();
+    assert!(MetaTrainedModel::load(&existing).is_ok());
+    // Its own checkpoint is replaced only with --force.
+    std::fs::remove_file(dir.join("a.json")).unwrap();
+    run_with(&[]).one_line_error(&[
         "leave-condition-out-translational-35wind-seed1.json",
         "--force",
     ]);
-    assert_eq!(std::fs::read_to_string(&existing).unwrap(), "mine");
-    assert!(!dir.join("a.json").exists());
-    // With --force both are written.
-    let run = run_with(&["--force"]);
-    let stdout = run.success();
-    assert!(MetaTrainedModel::load(&existing).is_ok());
     // The SINDy column is the published number (this command runs no SINDy), and says so.
     assert!(stdout.contains("| SINDy gen (paper) |"), "{stdout}");
     // No progress bar when standard error is not a terminal.

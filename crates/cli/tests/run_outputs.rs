@@ -59,7 +59,7 @@ fn ablations_refuse_an_output_directory_holding_their_configuration() {
         "out",
     ];
     learn_in(&dir, &args).one_line_error(&[
-        "out/ablations.json: is the --config input, and the run writes out/ablations.json",
+        "out/ablations.json: is the --config input, which this run reads",
         "refusing to write over it",
     ]);
     assert_eq!(std::fs::read_to_string(&config).unwrap(), before);
@@ -110,10 +110,10 @@ fn reproduce_refuses_inputs_among_the_files_it_writes_or_replaces() {
         learn_in(&dir, &args)
     };
 
-    // The configuration among the tables, which a run replaces (stale ones are removed).
-    std::fs::write(dir.join("res/tables/r.json"), run.to_string()).unwrap();
-    reproduce("res/tables/r.json", None).one_line_error(&[
-        "res/tables/r.json: is the --config input, and the run writes every *.json in res/tables",
+    // The configuration as one of the tables the run writes.
+    std::fs::write(dir.join("res/tables/translational.json"), run.to_string()).unwrap();
+    reproduce("res/tables/translational.json", None).one_line_error(&[
+        "res/tables/translational.json: is the --config input, which this run reads",
     ]);
 
     // The published numbers the configuration names, as the run's summary.
@@ -130,7 +130,7 @@ fn reproduce_refuses_inputs_among_the_files_it_writes_or_replaces() {
     // The README to update may be no input and no other output.
     std::fs::write(dir.join("r.json"), run.to_string()).unwrap();
     reproduce("r.json", Some("r.json"))
-        .one_line_error(&["r.json: is the --config input, refusing to write over it"]);
+        .one_line_error(&["r.json: is the --config input, which this run reads: refusing"]);
     reproduce("r.json", Some("res/timings.json"))
         .one_line_error(&["res/timings.json: the --readme to update is also an output of the run"]);
     // Nothing was made: no directory, no probe file.
@@ -139,7 +139,7 @@ fn reproduce_refuses_inputs_among_the_files_it_writes_or_replaces() {
         vec![
             PathBuf::from("r.json"),
             PathBuf::from("res/summary.json"),
-            PathBuf::from("res/tables/r.json")
+            PathBuf::from("res/tables/translational.json")
         ]
     );
 }

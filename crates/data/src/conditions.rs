@@ -91,7 +91,7 @@ pub struct FlightFile {
 impl ExperimentConditions {
     /// Reads and checks `conditions.json`.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| DataError::Io {
+        let text = crate::input::read_json_text(path).map_err(|source| DataError::Io {
             path: path.to_path_buf(),
             source,
         })?;

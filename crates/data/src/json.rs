@@ -30,9 +30,9 @@ impl std::fmt::Display for JsonError {
 }
 
 /// Deserialises `text` (a leading byte-order mark is ignored, as editors may write one), naming
-/// the field that fails.
+/// the field that fails; a key given twice in one object is refused (see [`checked_text`]).
 pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, JsonError> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let text = checked_text(text)?;
     let mut deserializer = serde_json::Deserializer::from_str(text);
     let value = serde_path_to_error::deserialize(&mut deserializer).map_err(|error| {
         let path = field_path(error.path());
@@ -44,7 +44,7 @@ pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, JsonEr
                 // A missing top-level field, or a document that is not an object at all.
                 None => format!("the document ({position})"),
             },
-            message: without_position(&inner),
+            message: plain_message(without_position(&inner)),
         }
     })?;
     // Trailing characters after the document are an error too (as in `serde_json::from_str`).
@@ -62,6 +62,124 @@ pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, JsonEr
     })?;
     objects_not_arrays(&document, &value)?;
     Ok(value)
+}
+
+/// The project's reading policy for any JSON text, before it is interpreted: a leading
+/// byte-order mark is dropped (returned text is without it), the text must be one JSON document
+/// (a CSV or other text is named as such), and no object may give a key twice (serde would keep
+/// the last value silently). Errors name the place; other syntax errors are left to the reader
+/// that interprets the text, which names the field they are in.
+pub fn checked_text(text: &str) -> Result<&str, JsonError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let duplicate = std::cell::RefCell::new(None);
+    let mut deserializer = serde_json::Deserializer::from_str(text);
+    let scanned = serde::de::DeserializeSeed::deserialize(
+        KeyScan {
+            path: String::new(),
+            duplicate: &duplicate,
+        },
+        &mut deserializer,
+    )
+    .and_then(|()| deserializer.end());
+    let Err(error) = scanned else {
+        return Ok(text);
+    };
+    let position = format!("line {} column {}", error.line(), error.column());
+    if let Some((path, key)) = duplicate.into_inner() {
+        return Err(JsonError {
+            field: format!("{} ({position})", display_path(&path)),
+            message: format!("key `{key}` is given twice (refused: which one is meant?)"),
+        });
+    }
+    if error.is_syntax() && !text.trim_start().starts_with(['{', '[']) {
+        let first = text.trim_start().lines().next().unwrap_or("");
+        let shown: String = first.chars().take(40).collect();
+        return Err(JsonError {
+            field: "the document (line 1 column 1)".to_string(),
+            message: format!("not JSON: it starts with {shown:?} (a CSV or other text?)"),
+        });
+    }
+    // Any other fault is reported by the reader that interprets the text, with its field.
+    Ok(text)
+}
+
+fn display_path(path: &str) -> &str {
+    if path.is_empty() {
+        "the document"
+    } else {
+        path
+    }
+}
+
+/// Walks a JSON document, refusing a key given twice in one object; the first such key and the
+/// path of its object are left in `duplicate`.
+struct KeyScan<'a> {
+    path: String,
+    duplicate: &'a std::cell::RefCell<Option<(String, String)>>,
+}
+
+impl<'de> serde::de::DeserializeSeed<'de> for KeyScan<'_> {
+    type Value = ();
+    fn deserialize<D: serde::Deserializer<'de>>(self, deserializer: D) -> Result<(), D::Error> {
+        deserializer.deserialize_any(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for KeyScan<'_> {
+    type Value = ();
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<(), A::Error> {
+        let mut seen = std::collections::HashSet::new();
+        while let Some(key) = map.next_key::<String>()? {
+            let inner = if self.path.is_empty() {
+                key.clone()
+            } else {
+                format!("{}.{key}", self.path)
+            };
+            if !seen.insert(key.clone()) {
+                *self.duplicate.borrow_mut() = Some((self.path.clone(), key));
+                return Err(serde::de::Error::custom("duplicate key"));
+            }
+            map.next_value_seed(KeyScan {
+                path: inner,
+                duplicate: self.duplicate,
+            })?;
+        }
+        Ok(())
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
+        let mut index = 0;
+        while seq
+            .next_element_seed(KeyScan {
+                path: format!("{}[{index}]", self.path),
+                duplicate: self.duplicate,
+            })?
+            .is_some()
+        {
+            index += 1;
+        }
+        Ok(())
+    }
+    fn visit_bool<E>(self, _: bool) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_i64<E>(self, _: i64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_u64<E>(self, _: u64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_f64<E>(self, _: f64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_str<E>(self, _: &str) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_unit<E>(self) -> Result<(), E> {
+        Ok(())
+    }
 }
 
 /// Deserialises an already parsed `value` (e.g. a configuration after a merge patch), naming the
@@ -126,6 +244,16 @@ fn field_path(path: &serde_path_to_error::Path) -> Option<String> {
     (text != ".").then_some(text)
 }
 
+/// serde_json's `expected value` (its word for a number or other non-string where an enum's name
+/// is expected) in plain words.
+fn plain_message(message: String) -> String {
+    if message == "expected value" {
+        "expected one of this field's names, as a string in quotes".to_string()
+    } else {
+        message
+    }
+}
+
 /// serde_json's message without the ` at line L column C` it appends.
 fn without_position(error: &serde_json::Error) -> String {
     let text = error.to_string();
@@ -187,6 +315,40 @@ mod tests {
         assert!(
             error.field.starts_with("the document (line 1 column"),
             "{error}"
+        );
+    }
+
+    #[test]
+    fn a_key_given_twice_is_refused_by_its_place() {
+        let error = from_str::<Outer>("{\"inner\": {\"count\": 1, \"count\": 2}, \"rules\": []}")
+            .unwrap_err();
+        assert!(error.field.starts_with("inner (line 1 column"), "{error}");
+        assert!(error.message.contains("`count` is given twice"), "{error}");
+        let error = checked_text("{\"a\": [{}, {\"b\": 1, \"b\": 1}]}").unwrap_err();
+        assert!(error.field.starts_with("a[1] ("), "{error}");
+        let error = checked_text("{\"m\": 1,\n \"m\": 2}").unwrap_err();
+        assert!(error.field.starts_with("the document (line 2"), "{error}");
+    }
+
+    #[test]
+    fn a_number_where_a_name_is_expected_is_said_plainly() {
+        #[derive(Debug, Deserialize, Serialize)]
+        enum Kind {
+            A,
+        }
+        let error = from_str::<Vec<Kind>>("[42]").unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "[0] (line 1 column 2): expected one of this field's names, as a string in quotes"
+        );
+    }
+
+    #[test]
+    fn a_csv_where_json_is_expected_is_named_as_such() {
+        let error = checked_text("t,x,y\n0,1,2\n").unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "the document (line 1 column 1): not JSON: it starts with \"t,x,y\" (a CSV or other text?)"
         );
     }
 

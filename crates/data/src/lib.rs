@@ -18,15 +18,19 @@ mod derivative;
 mod error;
 mod flight_log;
 mod formulation;
+pub mod input;
 pub mod json;
 mod noise_floor;
 mod numeric;
-pub mod paths;
 mod source;
 mod split;
 mod table;
 mod time;
 mod write;
+
+/// Comparing paths of files to read or write (kept in the `outputs` crate, the home of output
+/// checks).
+pub use outputs::paths;
 
 pub use conditions::{Condition, ExperimentConditions, FlightFile, PaperTraining, Role};
 pub use derivative::Derivative;

@@ -49,9 +49,10 @@ impl TextTable {
                 path: path.to_path_buf(),
             });
         }
-        let bytes = std::fs::read(path).map_err(io)?;
+        let bytes = crate::input::read_bytes(path, crate::input::InputKind::Csv).map_err(io)?;
         let text = check_text(path, &bytes)?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        check_width(path, text)?;
         let records = csv::ReaderBuilder::new()
             .has_headers(false)
             .flexible(true)
@@ -200,6 +201,32 @@ impl TextTable {
             reason: reason.to_string(),
         }
     }
+}
+
+/// Refuses a header of more than [`crate::input::MAX_CSV_COLUMNS`] names before any row is kept:
+/// the cost of a table grows with rows × columns.
+fn check_width(path: &Path, text: &str) -> Result<()> {
+    let header = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(text.as_bytes())
+        .into_records()
+        .next();
+    let columns = match header {
+        Some(Ok(record)) => record.len(),
+        _ => return Ok(()),
+    };
+    if columns > crate::input::MAX_CSV_COLUMNS {
+        return Err(DataError::BadRow {
+            path: path.to_path_buf(),
+            row: 1,
+            message: format!(
+                "{columns} columns in the header, more than the {} a CSV may have",
+                crate::input::MAX_CSV_COLUMNS
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Checks the text before the csv crate splits it (which accepts any bytes): UTF-8, and no control

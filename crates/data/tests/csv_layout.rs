@@ -58,16 +58,17 @@ fn wide(columns: usize, rows: usize) -> String {
 
 #[test]
 fn a_wide_file_is_read_and_a_duplicate_far_apart_is_named_with_both_positions() {
-    // 200 000 columns: the header check is one pass (it was quadratic: a minute at this width).
-    let columns = 200_000;
+    // The widest file read (10 000 columns): the header check is one pass (it was quadratic).
+    let columns = data::input::MAX_CSV_COLUMNS - 2;
     let good = write("wide.csv", wide(columns, 5).as_bytes());
-    let table = NumericTable::read_with_time(&good, "t", &["x", "c199999"]).unwrap();
+    let last = format!("c{}", columns - 1);
+    let table = NumericTable::read_with_time(&good, "t", &["x", &last]).unwrap();
     assert_eq!(table.1.rows(), 5);
     assert_eq!(table.1.columns[0], vec![0.0, 1.0, 2.0, 3.0, 4.0]);
     assert_eq!(table.1.columns[1], vec![1.0; 5]);
 
-    // The last column renamed to the first: fields 3 and 200 002, far apart.
-    let text = wide(columns, 5).replacen(",c199999\n", ",c0\n", 1);
+    // The last column renamed to the first: fields 3 and 10 000, far apart.
+    let text = wide(columns, 5).replacen(&format!(",{last}\n"), ",c0\n", 1);
     let path = write("wide-dup.csv", text.as_bytes());
     let message = numeric_error(&path, &["x"]);
     assert!(
@@ -87,6 +88,15 @@ fn a_wide_file_is_read_and_a_duplicate_far_apart_is_named_with_both_positions() 
         "{message}"
     );
     assert!(message.len() < 1000, "{message}");
+
+    // One column more is refused at once, by the header's line (issue 18: a 200 000-name header
+    // cost 5 GB).
+    let wider = write("wider.csv", wide(columns + 1, 5).as_bytes());
+    let message = numeric_error(&wider, &["x"]);
+    assert!(
+        message.contains("wider.csv:1: 10001 columns in the header, more than the 10000"),
+        "{message}"
+    );
 }
 
 #[test]

@@ -173,7 +173,7 @@ impl CheckedConfig {
 impl LearnConfig {
     /// Reads and checks a configuration file.
     pub fn load(path: &Path) -> Result<CheckedConfig> {
-        let text = std::fs::read_to_string(path).map_err(|cause| LearnError::Io {
+        let text = data::input::read_json_text(path).map_err(|cause| LearnError::Io {
             path: path.to_path_buf(),
             cause,
         })?;

@@ -100,7 +100,7 @@ impl MetaTrainedModel {
 
     /// Reads and checks a checkpoint.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|cause| LearnError::Io {
+        let text = data::input::read_json_text(path).map_err(|cause| LearnError::Io {
             path: path.to_path_buf(),
             cause,
         })?;

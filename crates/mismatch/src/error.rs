@@ -16,23 +16,9 @@ pub enum MismatchError {
     },
     #[error("{}: already exists (pass --force to overwrite)", path.display())]
     Exists { path: PathBuf },
-    #[error(
-        "{}: is {what}, which this run reads: refusing to write over it (even with --force)",
-        path.display()
-    )]
-    OutputIsInput { path: PathBuf, what: String },
-    #[error("{}: is a directory, not a file to write ({option})", path.display())]
-    OutputIsDirectory { path: PathBuf, option: String },
-    #[error(
-        "{}: {} is not a directory, nothing can be written below it ({option})",
-        path.display(),
-        parent.display()
-    )]
-    BelowNonDirectory {
-        path: PathBuf,
-        parent: PathBuf,
-        option: String,
-    },
+    /// An output refused by the output-set checks (see the `outputs` crate).
+    #[error(transparent)]
+    Output(#[from] outputs::OutputError),
     #[error(
         "{}: is both a demo case's directory (--work) and a summary file (--out)",
         path.display()

@@ -27,46 +27,23 @@ pub fn check_outputs(dir: &Path, force: bool) -> Result<()> {
     }
 }
 
-/// Checks every file a run will write (each with the option that places it), before any work:
-/// none is one of the run's `inputs` (what each is, its path; the same file whatever the spelling,
-/// see [`data::paths::same_file`]), whatever `force` says; then each can be written (not a
-/// directory, not below something that is not one); then none exists unless `force`. Each check
-/// runs on every output before the next.
+/// Checks every file a run will write (each with the option that places it), before any work,
+/// as named files of an output set (see the `outputs` crate, the home of these checks): none is
+/// one of the run's `inputs` (what each is, its path), whatever `force` says; each can be written
+/// (not a directory, not below something that is not one); none exists unless `force`.
 pub fn check_run_outputs(
     outputs: &[(PathBuf, &str)],
     inputs: &[(String, PathBuf)],
     force: bool,
 ) -> Result<()> {
-    for (output, _) in outputs {
-        if let Some((what, _)) = inputs
-            .iter()
-            .find(|(_, input)| data::paths::same_file(output, input))
-        {
-            return Err(MismatchError::OutputIsInput {
-                path: output.clone(),
-                what: what.clone(),
-            });
-        }
+    let mut set = outputs::OutputSet::new("mismatch");
+    for (what, path) in inputs {
+        set.input(what.clone(), path);
     }
-    for (output, option) in outputs {
-        if output.is_dir() {
-            return Err(MismatchError::OutputIsDirectory {
-                path: output.clone(),
-                option: option.to_string(),
-            });
-        }
-        if let Some(parent) = data::paths::non_directory_ancestor(output) {
-            return Err(MismatchError::BelowNonDirectory {
-                path: output.clone(),
-                parent: parent.to_path_buf(),
-                option: option.to_string(),
-            });
-        }
+    for (path, option) in outputs {
+        set.file(path, option, outputs::Existing::from_force(force));
     }
-    if !force && let Some((path, _)) = outputs.iter().find(|(p, _)| p.exists()) {
-        return Err(MismatchError::Exists { path: path.clone() });
-    }
-    Ok(())
+    Ok(set.check()?)
 }
 
 /// Fails if `dir` exists but is not a directory (checked before any work that would write there).

@@ -108,15 +108,20 @@ impl Mixer {
 impl NominalModel {
     /// Reads and validates a model file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| PhysicsError::Io {
+        let text = data::input::read_json_text(path).map_err(|source| PhysicsError::Io {
             path: path.to_path_buf(),
             source,
         })?;
         Self::from_json(&text, path)
     }
 
-    /// Parses and validates model JSON; `origin` names the file in errors.
+    /// Parses and validates model JSON under the project's reading policy (a byte-order mark
+    /// accepted, a key given twice refused); `origin` names the file in errors.
     pub fn from_json(text: &str, origin: &Path) -> Result<Self> {
+        let text = data::json::checked_text(text).map_err(|error| PhysicsError::Json {
+            path: origin.to_path_buf(),
+            message: format!("{}: {}", error.field, error.message),
+        })?;
         let value: Value = serde_json::from_str(text).map_err(|error| PhysicsError::Json {
             path: origin.to_path_buf(),
             message: error.to_string(),
@@ -486,6 +491,19 @@ mod tests {
 
     fn parse(text: &str) -> Result<NominalModel> {
         NominalModel::from_json(text, Path::new("model.json"))
+    }
+
+    #[test]
+    fn a_key_given_twice_is_refused_and_a_byte_order_mark_accepted() {
+        let twice = r#"{"mass_kg": 2.644, "mass_kg": 100.0, "gravity_m_s2": 9.81,
+            "inertia_kg_m2": [0.03, 0.03, 0.05], "thrust_source": "T_sp"}"#;
+        let message = parse(twice).unwrap_err().to_string();
+        assert!(
+            message.contains("model.json") && message.contains("mass_kg"),
+            "{message}"
+        );
+        let with_mark = format!("\u{feff}{}", twice.replacen(r#""mass_kg": 100.0, "#, "", 1));
+        assert_eq!(parse(&with_mark).unwrap().mass_kg, 2.644);
     }
 
     #[test]

@@ -96,6 +96,20 @@ impl CheckedRunConfig {
     }
 }
 
+/// `error`, met reading the file that `field` of the configuration at `path` names, with that
+/// field named unless the message names the configuration already.
+pub(crate) fn named_in(path: &Path, field: &str, error: PipelineError) -> PipelineError {
+    let message = error.to_string();
+    if message.contains(&path.display().to_string()) {
+        return error;
+    }
+    PipelineError::Config {
+        path: path.to_path_buf(),
+        field: field.to_string(),
+        message,
+    }
+}
+
 impl RunConfig {
     /// Reads and checks a run configuration; relative paths are taken from `root`.
     pub fn load(path: &Path, root: &Path) -> Result<CheckedRunConfig> {
@@ -163,6 +177,18 @@ impl RunConfig {
             .checked()
             .map_err(|e| error("sindy.optimizer", e.to_string()))?;
         let protocol = Protocol::parse(&self.learn.protocol)?;
+        // An empty path would resolve to the root directory: named by its field instead.
+        let paths = [
+            ("conditions", Some(&self.conditions)),
+            ("published", Some(&self.published)),
+            ("learn.config", Some(&self.learn.config)),
+            ("variants", self.variants.as_ref()),
+        ];
+        for (field, value) in paths {
+            if value.is_some_and(|p| p.as_os_str().is_empty()) {
+                return Err(error(field, "an empty path (name a file)".to_string()));
+            }
+        }
         let resolve = |p: &Path| {
             if p.is_absolute() {
                 p.to_path_buf()
@@ -173,18 +199,23 @@ impl RunConfig {
         let conditions_path = resolve(&self.conditions);
         let published_path = resolve(&self.published);
         let learn_config_path = resolve(&self.learn.config);
-        let conditions = ExperimentConditions::load(&conditions_path)?;
+        // A file a field names that cannot be read is named with that field.
+        let within = |field: &str, error: PipelineError| named_in(path, field, error);
+        let conditions = ExperimentConditions::load(&conditions_path)
+            .map_err(|e| within("conditions", e.into()))?;
         if conditions.evaluation().next().is_none() {
             return Err(error(
                 "conditions",
                 format!("{} has no evaluation condition", conditions_path.display()),
             ));
         }
-        let learn = load_learn_config(&learn_config_path, &self.learn.overrides, path)?;
-        report::PublishedTables::load(&published_path)?;
+        let learn = load_learn_config(&learn_config_path, &self.learn.overrides, path)
+            .map_err(|e| within("learn.config", e))?;
+        report::PublishedTables::load(&published_path)
+            .map_err(|e| within("published", e.into()))?;
         let variants_path = self.variants.as_deref().map(resolve);
         if let Some(variants) = &variants_path {
-            crate::variants::VariantsConfig::read(variants)?;
+            crate::variants::VariantsConfig::read(variants).map_err(|e| within("variants", e))?;
         }
         Ok(CheckedRunConfig {
             sha256: file_sha256(path)?,
@@ -225,7 +256,7 @@ pub(crate) fn check_seeds(seeds: &[u64]) -> std::result::Result<(), String> {
 }
 
 fn read(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|source| PipelineError::Io {
+    data::input::read_json_text(path).map_err(|source| PipelineError::Io {
         path: path.to_path_buf(),
         source,
     })

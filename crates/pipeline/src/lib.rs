@@ -27,8 +27,8 @@ mod variants;
 pub use config::{CheckedRunConfig, LearnRun, MAX_SEEDS, RunConfig, merge_patch};
 pub use error::{PipelineError, Result};
 pub use output::{
-    OutputPaths, PlannedOutputs, README_BEGIN, README_END, check_ablations_output, check_paper,
-    planned_ablations, update_readme, write_outputs,
+    OutputPaths, README_BEGIN, README_END, ablation_files, check_paper, check_readme, latex_files,
+    result_files, update_readme, updated_readme, write_outputs,
 };
 pub use run::{
     GENERATED_PATHS, RunOptions, RunOutcome, figure_file_name, git_commit, run, uncommitted_inputs,

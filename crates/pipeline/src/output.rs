@@ -5,8 +5,9 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 use report::{Comparison, PublishedTables, Tolerances, latex, load_tables, markdown};
 
+use crate::config::CheckedRunConfig;
 use crate::error::{PipelineError, Result, write_text};
-use crate::run::RunOutcome;
+use crate::run::{RunOutcome, figure_file_name};
 use crate::summary::{StageTiming, Timings};
 
 /// The marker lines between which the README shows the generated tables.
@@ -14,7 +15,8 @@ pub const README_BEGIN: &str = "<!-- tables:begin -->";
 /// See [`README_BEGIN`].
 pub const README_END: &str = "<!-- tables:end -->";
 
-/// Where a run writes.
+/// Where a run writes: the staging folders of its output set (see the `outputs` crate), whose
+/// contents are moved into place only when the whole run has been written.
 #[derive(Clone, Debug)]
 pub struct OutputPaths {
     /// `tables/*.{md,json}`, `figures/*.svg`, `summary.json` and `timings.json` go here
@@ -22,24 +24,9 @@ pub struct OutputPaths {
     pub results_dir: PathBuf,
     /// `<table>.tex` goes here (`paper/tables/` for `make reproduce`).
     pub latex_dir: PathBuf,
-    /// A README whose block between [`README_BEGIN`] and [`README_END`] is replaced by the tables.
-    pub readme: Option<PathBuf>,
 }
 
 impl OutputPaths {
-    /// Checks, before a run, that its outputs can be written: each directory is created and
-    /// written to (a probe file, removed again), and the README, if any, has the results block.
-    /// A run then never fails at its end for a reason known at its start.
-    pub fn check(&self) -> Result<()> {
-        for dir in [&self.results_dir, &self.latex_dir] {
-            check_writable(dir)?;
-        }
-        if let Some(readme) = &self.readme {
-            results_block(readme, &read_readme(readme)?)?;
-        }
-        Ok(())
-    }
-
     /// `results_dir/tables`.
     pub fn tables_dir(&self) -> PathBuf {
         self.results_dir.join("tables")
@@ -51,128 +38,51 @@ impl OutputPaths {
     }
 }
 
-/// What a run will write, known before it runs: files by name, and directories in which every
-/// file of some extensions is written or removed (a run's tables and figures, whose names depend
-/// on the conditions, and the stale ones of an earlier run).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct PlannedOutputs {
-    /// Files written (or rewritten), and the probe files of the writability checks.
-    pub files: Vec<PathBuf>,
-    /// A directory and the extensions of the files the run writes or removes directly in it.
-    pub owned: Vec<(PathBuf, Vec<&'static str>)>,
-}
-
-impl PlannedOutputs {
-    /// Whether `path` would be written or removed according to `same_file` (a comparison that
-    /// sees through spellings of the path): the output it would be, for an error message.
-    pub fn clobbers(
-        &self,
-        path: &Path,
-        same_file: &dyn Fn(&Path, &Path) -> bool,
-    ) -> Option<String> {
-        if let Some(file) = self.files.iter().find(|file| same_file(path, file)) {
-            return Some(file.display().to_string());
-        }
-        // An existing input is where its links lead: a link elsewhere to a file in an owned
-        // directory is that file.
-        let target = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
-        let parent = target.parent().filter(|p| !p.as_os_str().is_empty());
-        let parent = parent.unwrap_or(Path::new("."));
-        let extension = target.extension().and_then(|e| e.to_str())?;
-        self.owned
-            .iter()
-            .find(|(dir, extensions)| extensions.contains(&extension) && same_file(parent, dir))
-            .map(|(dir, _)| format!("every *.{extension} in {} (replaced)", dir.display()))
-    }
-}
-
-const PROBE: &str = ".learn-write-check";
-
-impl OutputPaths {
-    /// The files a run producing the tables `tables` writes and removes (see [`write_outputs`]):
-    /// the README is not among them (it is an input too, updated in place).
-    pub fn planned(&self, tables: &[&str]) -> PlannedOutputs {
-        let mut files: Vec<PathBuf> = tables
-            .iter()
-            .map(|table| self.latex_dir.join(format!("{table}.tex")))
-            .collect();
-        files.extend([
-            self.results_dir.join("summary.json"),
-            self.results_dir.join("timings.json"),
-            self.results_dir.join(PROBE),
-            self.latex_dir.join(PROBE),
-        ]);
-        PlannedOutputs {
-            files,
-            owned: vec![
-                (self.tables_dir(), vec!["json", "md"]),
-                (self.figures_dir(), vec!["svg"]),
-            ],
+/// The files a run of `config` writes below its results folder (relative): each table as JSON and
+/// Markdown, each figure, `summary.json` and `timings.json`.
+pub fn result_files(config: &CheckedRunConfig) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for formulation in &config.raw.formulations {
+        let table = formulation.name();
+        files.push(Path::new("tables").join(format!("{table}.json")));
+        files.push(Path::new("tables").join(format!("{table}.md")));
+        for condition in config.conditions.evaluation() {
+            files.push(Path::new("figures").join(figure_file_name(table, condition.label())));
         }
     }
+    files.extend([PathBuf::from("summary.json"), PathBuf::from("timings.json")]);
+    files
 }
 
-/// The files `learn ablations` writes under `dir` (see [`crate::write_ablations`]).
-pub fn planned_ablations(dir: &Path) -> PlannedOutputs {
-    PlannedOutputs {
-        files: vec![
-            dir.join("ablations.json"),
-            dir.join("ablations.md"),
-            dir.join(PROBE),
-            dir.join("figures").join(PROBE),
-        ],
-        owned: vec![(dir.join("figures"), vec!["svg"])],
-    }
+/// The files a run of `config` writes in its LaTeX folder: `<table>.tex`.
+pub fn latex_files(config: &CheckedRunConfig) -> Vec<PathBuf> {
+    config
+        .raw
+        .formulations
+        .iter()
+        .map(|f| PathBuf::from(format!("{}.tex", f.name())))
+        .collect()
 }
 
-/// Creates `dir` and writes a probe file in it (removed again): a run then never fails at its end
-/// for an output directory it could have checked at its start.
-fn check_writable(dir: &Path) -> Result<()> {
-    let probe = dir.join(PROBE);
-    write_text(&probe, "")?;
-    std::fs::remove_file(&probe).map_err(|source| PipelineError::Io {
-        path: probe.clone(),
-        source,
-    })
+/// The files `learn ablations` writes below its folder whose names are known before the run (the
+/// figures' names depend on the cells, and are checked when the set is committed).
+pub fn ablation_files() -> Vec<PathBuf> {
+    vec![
+        PathBuf::from("ablations.json"),
+        PathBuf::from("ablations.md"),
+    ]
 }
 
-/// Checks, before `learn ablations` fits anything, that [`crate::write_ablations`] can write
-/// under `dir` (`ablations.{json,md}` there, figures in `dir/figures`), as
-/// [`OutputPaths::check`] does for a run.
-pub fn check_ablations_output(dir: &Path) -> Result<()> {
-    check_writable(dir)?;
-    check_writable(&dir.join("figures"))
+/// Checks, before a run, that `readme` has the results block a run rewrites.
+pub fn check_readme(readme: &Path) -> Result<()> {
+    results_block(readme, &read_readme(readme)?).map(drop)
 }
 
-/// Removes the files with extension `extension` directly in `dir` (outputs of an earlier run that
-/// this run might not write again, e.g. a condition that was removed).
-fn remove_stale(dir: &Path, extensions: &[&str]) -> Result<()> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return Ok(());
-    };
-    for entry in entries.flatten() {
-        let path = entry.path();
-        let stale = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| extensions.contains(&e));
-        if stale && path.is_file() {
-            std::fs::remove_file(&path).map_err(|source| PipelineError::Io {
-                path: path.clone(),
-                source,
-            })?;
-        }
-    }
-    Ok(())
-}
-
-/// Writes every output of `outcome` and returns the files written. `write_seconds` is the time
-/// this takes, recorded in `timings.json` with the run's stages.
+/// Writes every output of `outcome` into `paths` (staging folders) and returns the files written.
+/// The time this takes is recorded in `timings.json` with the run's stages.
 pub fn write_outputs(outcome: &RunOutcome, paths: &OutputPaths) -> Result<Vec<PathBuf>> {
     let start = std::time::Instant::now();
     let mut written = Vec::new();
-    remove_stale(&paths.tables_dir(), &["json", "md"])?;
-    remove_stale(&paths.figures_dir(), &["svg"])?;
     for table in &outcome.tables {
         let json = paths.tables_dir().join(format!("{}.json", table.table));
         table.save(&json)?;
@@ -193,12 +103,8 @@ pub fn write_outputs(outcome: &RunOutcome, paths: &OutputPaths) -> Result<Vec<Pa
         .collect::<Result<_>>()?;
     written.extend(figures);
     let summary = paths.results_dir.join("summary.json");
-    write_text(&summary, &to_json(&outcome.summary))?;
+    write_text(&summary, &to_json(&outcome.summary)?)?;
     written.push(summary);
-    if let Some(readme) = &paths.readme {
-        update_readme(readme, &readme_block(outcome, paths, readme))?;
-        written.push(readme.clone());
-    }
     let mut stages = outcome.timings.clone();
     stages.push(StageTiming {
         stage: "write outputs".to_string(),
@@ -212,27 +118,51 @@ pub fn write_outputs(outcome: &RunOutcome, paths: &OutputPaths) -> Result<Vec<Pa
         stages,
     };
     let timings_path = paths.results_dir.join("timings.json");
-    write_text(&timings_path, &to_json(&timings))?;
+    write_text(&timings_path, &to_json(&timings)?)?;
     written.push(timings_path);
     Ok(written)
 }
 
-fn to_json<T: serde::Serialize>(value: &T) -> String {
-    let mut text = serde_json::to_string_pretty(value).expect("outputs serialise");
+/// The README at `readme` with its results block rewritten for `outcome`; `figures_dir` is where
+/// the figures will be once committed (linked relative to the README).
+pub fn updated_readme(outcome: &RunOutcome, readme: &Path, figures_dir: &Path) -> Result<String> {
+    let text = read_readme(readme)?;
+    with_block(readme, &text, &readme_block(outcome, figures_dir, readme))
+}
+
+/// `text` (of `readme`) with its results block replaced by `block`.
+fn with_block(readme: &Path, text: &str, block: &str) -> Result<String> {
+    let std::ops::Range {
+        start: after_begin,
+        end,
+    } = results_block(readme, text)?;
+    Ok(format!(
+        "{}\n\n{}\n{}",
+        &text[..after_begin],
+        block.trim_end(),
+        &text[end..]
+    ))
+}
+
+fn to_json<T: serde::Serialize>(value: &T) -> Result<String> {
+    let mut text = serde_json::to_string_pretty(value).map_err(|error| PipelineError::Config {
+        path: PathBuf::from("(output)"),
+        field: "serialisation".to_string(),
+        message: error.to_string(),
+    })?;
     text.push('\n');
-    text
+    Ok(text)
 }
 
 /// The README's generated block: every table, then a pointer to the figures.
-fn readme_block(outcome: &RunOutcome, paths: &OutputPaths, readme: &Path) -> String {
+fn readme_block(outcome: &RunOutcome, figures: &Path, readme: &Path) -> String {
     let mut block = String::new();
     for table in &outcome.tables {
         block.push_str(&markdown(table));
         block.push('\n');
     }
     let base = readme.parent().unwrap_or(Path::new(""));
-    let figures = paths.figures_dir();
-    let relative = figures.strip_prefix(base).unwrap_or(&figures);
+    let relative = figures.strip_prefix(base).unwrap_or(figures);
     if let Some((name, _)) = outcome
         .figures
         .iter()
@@ -271,16 +201,7 @@ fn results_block(readme: &Path, text: &str) -> Result<std::ops::Range<usize>> {
 /// Replaces the text between [`README_BEGIN`] and [`README_END`] in `readme` by `block`.
 pub fn update_readme(readme: &Path, block: &str) -> Result<()> {
     let text = read_readme(readme)?;
-    let std::ops::Range {
-        start: after_begin,
-        end,
-    } = results_block(readme, &text)?;
-    let updated = format!(
-        "{}\n\n{}\n{}",
-        &text[..after_begin],
-        block.trim_end(),
-        &text[end..]
-    );
+    let updated = with_block(readme, &text, block)?;
     if updated != text {
         write_text(readme, &updated)?;
     }
@@ -299,70 +220,6 @@ pub fn check_paper(tables_dir: &Path, published: &Path, tolerances: &Path) -> Re
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    #[cfg(unix)]
-    fn an_input_linked_into_a_replaced_directory_is_an_output() {
-        let dir = std::env::temp_dir().join(format!("pipeline-linked-{}", std::process::id()));
-        std::fs::create_dir_all(dir.join("res/tables")).unwrap();
-        std::fs::write(dir.join("res/tables/r.json"), "{}").unwrap();
-        std::os::unix::fs::symlink(dir.join("res/tables/r.json"), dir.join("c.json")).unwrap();
-        let paths = OutputPaths {
-            results_dir: dir.join("res"),
-            latex_dir: dir.join("tex"),
-            readme: None,
-        };
-        let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
-        };
-        let clobbers = paths
-            .planned(&["translational"])
-            .clobbers(&dir.join("c.json"), &same);
-        std::fs::remove_dir_all(&dir).unwrap();
-        assert!(clobbers.unwrap().starts_with("every *.json in "));
-    }
-
-    #[test]
-    fn planned_outputs_name_the_files_written_and_the_directories_replaced() {
-        let paths = OutputPaths {
-            results_dir: PathBuf::from("res"),
-            latex_dir: PathBuf::from("tex"),
-            readme: None,
-        };
-        let planned = paths.planned(&["translational"]);
-        let same = |a: &Path, b: &Path| a == b;
-        let clobbers = |path: &str| planned.clobbers(Path::new(path), &same);
-        assert_eq!(clobbers("res/summary.json").unwrap(), "res/summary.json");
-        assert_eq!(
-            clobbers("tex/translational.tex").unwrap(),
-            "tex/translational.tex"
-        );
-        assert_eq!(
-            clobbers("res/tables/mine.json").unwrap(),
-            "every *.json in res/tables (replaced)"
-        );
-        assert!(clobbers("res/figures/a.svg").is_some());
-        for untouched in [
-            "res/tables/mine.csv",
-            "res/other.json",
-            "tex/attitude.tex",
-            "x.json",
-        ] {
-            assert_eq!(clobbers(untouched), None, "{untouched}");
-        }
-        let ablations = planned_ablations(Path::new("out"));
-        assert!(
-            ablations
-                .clobbers(Path::new("out/ablations.json"), &same)
-                .is_some()
-        );
-        assert!(
-            ablations
-                .clobbers(Path::new("out/variants.json"), &same)
-                .is_none()
-        );
-    }
 
     #[test]
     fn readme_block_is_replaced_and_the_rest_kept() {
@@ -389,44 +246,11 @@ mod tests {
             message.contains("README.md") && message.contains("tables:begin"),
             "{message}"
         );
-        // The same is found before a run, and so is an output directory that cannot be made.
-        let paths = |results_dir: PathBuf| OutputPaths {
-            results_dir,
-            latex_dir: dir.join("latex"),
-            readme: Some(readme.clone()),
-        };
-        let message = paths(dir.join("results")).check().unwrap_err().to_string();
+        // The same is found before a run.
+        let message = check_readme(&readme).unwrap_err().to_string();
         assert!(message.contains("tables:begin"), "{message}");
         std::fs::write(&readme, &original).unwrap();
-        paths(dir.join("results")).check().unwrap();
-        assert!(dir.join("latex").is_dir() && !dir.join("results/.learn-write-check").exists());
-        let message = paths(readme.join("results"))
-            .check()
-            .unwrap_err()
-            .to_string();
-        assert!(message.contains("README.md/results"), "{message}");
-    }
-
-    #[test]
-    fn the_ablations_output_is_checked_before_any_work() {
-        let dir =
-            std::env::temp_dir().join(format!("pipeline-ablations-out-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        check_ablations_output(&dir.join("out")).unwrap();
-        assert!(dir.join("out/figures").is_dir());
-        assert!(!dir.join("out/.learn-write-check").exists());
-        // A file where the directory should be.
-        let file = dir.join("a-file");
-        std::fs::write(&file, "").unwrap();
-        let message = check_ablations_output(&file).unwrap_err().to_string();
-        assert!(message.contains("a-file"), "{message}");
-        // A directory where `figures/` cannot be made.
-        std::fs::create_dir_all(dir.join("blocked")).unwrap();
-        std::fs::write(dir.join("blocked/figures"), "").unwrap();
-        let message = check_ablations_output(&dir.join("blocked"))
-            .unwrap_err()
-            .to_string();
-        assert!(message.contains("blocked/figures"), "{message}");
-        assert!(!message.contains('\n'), "{message}");
+        check_readme(&readme).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -273,7 +273,7 @@ impl CheckedVariants {
 impl VariantsConfig {
     /// Reads and checks `path` alone (names, candidates, headline), without the run it names.
     pub fn read(path: &Path) -> Result<VariantsConfig> {
-        let text = std::fs::read_to_string(path).map_err(|source| PipelineError::Io {
+        let text = data::input::read_json_text(path).map_err(|source| PipelineError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -420,12 +420,20 @@ impl VariantsConfig {
     /// Reads and checks `path` and the run configuration it names; relative paths start at `root`.
     pub fn load(path: &Path, root: &Path) -> Result<CheckedVariants> {
         let raw = Self::read(path)?;
+        if raw.run.as_os_str().is_empty() {
+            return Err(PipelineError::Config {
+                path: path.to_path_buf(),
+                field: "run".to_string(),
+                message: "an empty path (name a file)".to_string(),
+            });
+        }
         let run_path = if raw.run.is_absolute() {
             raw.run.clone()
         } else {
             root.join(&raw.run)
         };
-        let run = RunConfig::load(&run_path, root)?;
+        let run = RunConfig::load(&run_path, root)
+            .map_err(|e| crate::config::named_in(path, "run", e))?;
         let checked = CheckedVariants {
             raw,
             path: path.to_path_buf(),

@@ -106,7 +106,6 @@ fn run_with(dir: &Path, data: &Path, conditions: &Value, out: &Path) {
     let paths = OutputPaths {
         results_dir: out.to_path_buf(),
         latex_dir: out.join("latex"),
-        readme: None,
     };
     write_outputs(&outcome, &paths).unwrap();
 }

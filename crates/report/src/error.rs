@@ -34,7 +34,7 @@ pub type Result<T> = std::result::Result<T, ReportError>;
 pub(crate) fn read_json<T: serde::de::DeserializeOwned + serde::Serialize>(
     path: &std::path::Path,
 ) -> Result<T> {
-    let text = std::fs::read_to_string(path).map_err(|source| ReportError::Io {
+    let text = data::input::read_json_text(path).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,
     })?;

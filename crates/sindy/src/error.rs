@@ -33,6 +33,19 @@ pub enum SindyError {
         column: String,
         value: f64,
     },
+    /// Library features of sizes too far apart for a least-squares fit in double precision.
+    #[error(
+        "the library's features differ in size by more than 1e12 (feature '{large_feature}' \
+         reaches {large:e}, feature '{small_feature}' only {small:e}): a fit in double precision \
+         cannot resolve them; rescale the data (e.g. to units where values lie between 1e-3 and \
+         1e3)"
+    )]
+    Scale {
+        large_feature: String,
+        large: f64,
+        small_feature: String,
+        small: f64,
+    },
     /// A solver that did not reach a solution.
     #[error("{solver} failed on target '{target}': {message}")]
     Solver {

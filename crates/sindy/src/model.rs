@@ -238,6 +238,8 @@ impl SindyParams {
         let names = self.input_names();
         let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
         let feature_names = self.library.feature_names(&input_names);
+        // The largest magnitude of each feature over all blocks (a maximum: any order gives it).
+        let sizes = std::sync::Mutex::new(vec![0.0f64; features]);
         let reduced =
             ReducedProblem::from_row_blocks(inputs.nrows(), features, targets.ncols(), |rows| {
                 let theta = self
@@ -260,8 +262,18 @@ impl SindyParams {
                     },
                     other => other,
                 })?;
+                let block_sizes = column_sizes(theta.as_ref());
+                if let Ok(mut sizes) = sizes.lock() {
+                    for (size, block) in sizes.iter_mut().zip(block_sizes) {
+                        *size = size.max(block);
+                    }
+                }
                 Ok::<_, SindyError>((theta, targets.subrows(rows.start, rows.len()).to_owned()))
             })?;
+        let sizes = sizes
+            .into_inner()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        check_scale(&sizes, &feature_names)?;
         let coefficients = optimizer.fit_reduced(&reduced, &self.state_names)?;
         Ok(self.model(feature_names, coefficients))
     }
@@ -280,6 +292,7 @@ impl SindyParams {
         check_finite("library", theta.as_ref(), &|j| {
             format!("feature '{}'", feature_names[j])
         })?;
+        check_scale(&column_sizes(theta.as_ref()), &feature_names)?;
         let coefficients = optimizer.fit(theta.as_ref(), targets, &self.state_names)?;
         Ok((self.model(feature_names, coefficients), theta))
     }
@@ -713,6 +726,44 @@ fn check_finite(what: &str, matrix: MatRef<'_, f64>, name: &dyn Fn(usize) -> Str
         }
     }
     Ok(())
+}
+
+/// The most the largest magnitudes of two features of one fit may differ by: beyond it a
+/// least-squares fit in double precision (16 digits) cannot resolve the smaller one.
+pub const MAX_FEATURE_SCALE_RATIO: f64 = 1e12;
+
+/// Refuses a library whose features differ in size by more than [`MAX_FEATURE_SCALE_RATIO`]
+/// (largest magnitude of each non-zero column): the fit would be noise or not finite.
+fn check_scale(sizes: &[f64], names: &[String]) -> Result<()> {
+    let sizes = sizes
+        .iter()
+        .enumerate()
+        .filter_map(|(j, &size)| (size > 0.0).then_some((j, size)));
+    let (mut small, mut large) = ((0, f64::INFINITY), (0, 0.0));
+    for (j, size) in sizes {
+        if size < small.1 {
+            small = (j, size);
+        }
+        if size > large.1 {
+            large = (j, size);
+        }
+    }
+    if large.1 > small.1 * MAX_FEATURE_SCALE_RATIO {
+        return Err(SindyError::Scale {
+            large_feature: names[large.0].clone(),
+            large: large.1,
+            small_feature: names[small.0].clone(),
+            small: small.1,
+        });
+    }
+    Ok(())
+}
+
+/// The largest magnitude of each column.
+fn column_sizes(theta: MatRef<'_, f64>) -> Vec<f64> {
+    (0..theta.ncols())
+        .map(|j| theta.col(j).iter().fold(0.0f64, |m, v| m.max(v.abs())))
+        .collect()
 }
 
 /// Whether `b` is a finite time strictly after `a`.

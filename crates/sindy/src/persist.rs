@@ -96,7 +96,7 @@ impl SindyModel {
     /// Reads a model written by [`SindyModel::save`], checking that names, library and
     /// coefficients agree.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| SindyError::Io {
+        let text = data::input::read_json_text(path).map_err(|source| SindyError::Io {
             path: path.to_path_buf(),
             source,
         })?;

@@ -19,7 +19,7 @@ pub struct Args {
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     let comparison = pipeline::check_paper(&args.results, &args.published, &args.tolerances)?;
-    print!("{}", comparison.render_text());
+    say_part!("{}", comparison.render_text());
     let failed = comparison.failures().count();
     if failed > 0 {
         anyhow::bail!(

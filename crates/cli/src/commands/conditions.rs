@@ -16,9 +16,12 @@ pub struct Args {
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let config = ExperimentConditions::load(&args.config)?;
     let data_dir = global.optional_data_dir()?;
-    println!(
+    say!(
         "{:<12} {:<10} {:<24} {:<14} files present",
-        "condition", "label", "wind speed", "role"
+        "condition",
+        "label",
+        "wind speed",
+        "role"
     );
     for condition in &config.conditions {
         let present = match &data_dir {
@@ -51,7 +54,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
             data::Role::Evaluation => "evaluation",
             data::Role::MetaTraining => "meta-training",
         };
-        println!(
+        say!(
             "{:<12} {:<10} {:<24} {:<14} {present}",
             condition.name,
             condition.label(),
@@ -61,7 +64,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     }
     if let Some(dir) = &data_dir {
         let paper = config.paper_training_present(dir);
-        println!(
+        say!(
             "paper meta-training flights ({}): {}",
             config.paper_training.file_pattern,
             if paper {
@@ -70,7 +73,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
                 "absent (protocol `leave-condition-out` is used)"
             }
         );
-        println!("data directory: {}", dir.display());
+        say!("data directory: {}", dir.display());
     }
     Ok(())
 }

@@ -1,13 +1,14 @@
 //! `learn explain`: the inputs that dominate each output through ℰ, and the learned equation.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Context;
 use data::{ExperimentConditions, FlightLog};
 use learn::{EquationRule, MetaTrainedModel, explain_flight};
 
+use outputs::{Existing, OutputSet};
+
 use super::Global;
-use super::refuse_input_as_output;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -45,16 +46,17 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     if args.max_terms == 0 {
         anyhow::bail!("--max-terms: must be at least 1");
     }
-    if let Some(path) = &args.json {
-        let mut inputs: Vec<(&str, &Path)> = vec![
-            ("checkpoint", args.checkpoint.as_path()),
-            ("--conditions", args.conditions.as_path()),
-        ];
-        if let Some(flight) = &args.flight {
-            inputs.push(("--flight", flight.as_path()));
-        }
-        super::check_output(path, "--json", args.force, &inputs)?;
+    let mut set = OutputSet::new("explain");
+    set.input("the checkpoint input", &args.checkpoint);
+    set.input("the --conditions input", &args.conditions);
+    if let Some(flight) = &args.flight {
+        set.input("the --flight input", flight);
     }
+    let json_file = args
+        .json
+        .as_ref()
+        .map(|path| set.file(path, "--json", Existing::from_force(args.force)));
+    set.check()?;
     let model = MetaTrainedModel::load(&args.checkpoint)?;
     let flight = match args.flight {
         Some(path) => path,
@@ -74,9 +76,8 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
             )
         }
     };
-    if let Some(path) = &args.json {
-        refuse_input_as_output(path, &[("flight", flight.as_path())])?;
-    }
+    set.input("the flight input", &flight);
+    let staged = set.prepare()?;
     let log = FlightLog::read(&flight)?;
     // Shown and recorded relative to the working directory when it lies below it.
     let flight = std::env::current_dir()
@@ -88,7 +89,21 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         ..EquationRule::default()
     };
     let explanation = explain_flight(&model, &log, !args.no_adapt, rule)?;
-    println!(
+    // Files first, then words.
+    if let (Some(path), Some(file)) = (&args.json, json_file) {
+        let value = serde_json::json!({
+            "checkpoint": args.checkpoint,
+            "flight": flight,
+            "protocol": model.protocol.name(),
+            "seed": model.seed,
+            "adapted": !args.no_adapt,
+            "explanation": explanation,
+        });
+        let text = serde_json::to_string_pretty(&value)? + "\n";
+        std::fs::write(staged.path(file), text).with_context(|| path.display().to_string())?;
+        staged.commit()?;
+    }
+    say!(
         "{} model ({} protocol, seed {}) over {} ({} samples, {})",
         model.formulation.name(),
         model.protocol.name(),
@@ -107,24 +122,11 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
             .iter()
             .map(|i| format!("{} {:.3}", i.input, i.mean_abs_coefficient))
             .collect();
-        println!("{}", output.equation);
-        println!("    mean |ℰ| per input: {}", inputs.join(", "));
+        say!("{}", output.equation);
+        say!("    mean |ℰ| per input: {}", inputs.join(", "));
     }
     if let Some(path) = &args.json {
-        let value = serde_json::json!({
-            "checkpoint": args.checkpoint,
-            "flight": flight,
-            "protocol": model.protocol.name(),
-            "seed": model.seed,
-            "adapted": !args.no_adapt,
-            "explanation": explanation,
-        });
-        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-            std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
-        }
-        std::fs::write(path, serde_json::to_string_pretty(&value)? + "\n")
-            .with_context(|| path.display().to_string())?;
-        println!("wrote {}", path.display());
+        say!("wrote {}", path.display());
     }
     Ok(())
 }

@@ -70,28 +70,31 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     let (log, columns) = FlightLog::read_with_columns(&args.file)?;
     let n = log.len();
     let dt = log.sample_interval();
-    println!("file:      {}", args.file.display());
+    say!("file:      {}", args.file.display());
     if let Some(meta) = &log.meta {
-        println!(
+        say!(
             "flight:    vehicle {}, trajectory {}, controller {}, condition {}",
-            meta.vehicle, meta.trajectory, meta.method, meta.condition
+            meta.vehicle,
+            meta.trajectory,
+            meta.method,
+            meta.condition
         );
     }
-    println!("samples:   {n}");
-    println!("duration:  {:.3} s", log.time[n - 1] - log.time[0]);
-    println!("rate:      {:.3} Hz (dt = {dt:.6} s)", 1.0 / dt);
-    println!("columns:   {}", column_summary(&columns));
-    println!("ranges:");
-    println!("{}", range3("p [m]", &log.position));
-    println!("{}", range3("v [m/s]", &log.velocity));
-    println!("{}", range3("w [rad/s]", &log.body_rate));
+    say!("samples:   {n}");
+    say!("duration:  {:.3} s", log.time[n - 1] - log.time[0]);
+    say!("rate:      {:.3} Hz (dt = {dt:.6} s)", 1.0 / dt);
+    say!("columns:   {}", column_summary(&columns));
+    say!("ranges:");
+    say!("{}", range3("p [m]", &log.position));
+    say!("{}", range3("v [m/s]", &log.velocity));
+    say!("{}", range3("w [rad/s]", &log.body_rate));
     let (lo, hi) = log
         .thrust_setpoint
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(*v), hi.max(*v))
         });
-    println!("  {:<16} [{lo:.4}, {hi:.4}]", "T_sp");
+    say!("  {:<16} [{lo:.4}, {hi:.4}]", "T_sp");
     let (lo, hi) = log
         .motor_command
         .iter()
@@ -99,7 +102,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(*v), hi.max(*v))
         });
-    println!("  {:<16} [{lo:.1}, {hi:.1}]", "pwm");
+    say!("  {:<16} [{lo:.1}, {hi:.1}]", "pwm");
     let (frame, body, world) = log.rate_frame();
     let mut problems = Vec::new();
     if frame == data::RateFrame::World {
@@ -115,13 +118,13 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     {
         problems.push(format!("a pwm value ({pwm:.1}) lies outside 500..2500"));
     }
-    println!("rate frame: {frame:?} (RMS against R: body {body:.4}, world {world:.4} rad/s)");
+    say!("rate frame: {frame:?} (RMS against R: body {body:.4}, world {world:.4} rad/s)");
     if problems.is_empty() {
-        println!("problems:  none found");
+        say!("problems:  none found");
     } else {
-        println!("problems:");
+        say!("problems:");
         for problem in problems {
-            println!("  - {problem}");
+            say!("  - {problem}");
         }
     }
     Ok(())

@@ -11,7 +11,12 @@ use learn::{CellSummary, Experiment, LearnConfig, Protocol, evaluation_condition
 use report::{Method, PublishedTables};
 use serde_json::{Value, json};
 
+use outputs::{Existing, FileId, FolderId, OutputSet};
+
 use super::Global;
+
+/// What the output manifests record as the writer of the checkpoints.
+const PRODUCER: &str = "meta-train";
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -31,8 +36,8 @@ pub struct Args {
     /// all.
     #[arg(long)]
     pub condition: Option<String>,
-    /// Override the configuration's seed.
-    #[arg(long)]
+    /// Override the configuration's seed (a whole number from 0 to 2^64 - 1).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_seed)]
     pub seed: Option<u64>,
     /// Summary JSON of the run [default: results/.scratch/learn/learn.json, the tool's scratch,
     /// replaced on every run]. A file given here is not replaced without --force.
@@ -66,6 +71,16 @@ pub struct Args {
     /// with --force.
     #[arg(long)]
     pub force: bool,
+}
+
+/// A seed: a whole number from 0 to `u64::MAX`, said so when it is not.
+fn parse_seed(text: &str) -> Result<u64, String> {
+    text.parse().map_err(|_| {
+        format!(
+            "a seed is a whole number from 0 to {} (got {text:?})",
+            u64::MAX
+        )
+    })
 }
 
 /// `--out` when not given: the tool's own scratch, replaced on every run.
@@ -103,11 +118,9 @@ fn formulations(names: &[String]) -> anyhow::Result<Vec<Formulation>> {
     Ok(formulations)
 }
 
-fn write_json(path: &Path, value: &Value) -> anyhow::Result<()> {
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
-    }
-    std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")
+/// Writes `value` as JSON to `staging`, the staging path of `path` (named in errors).
+fn write_json(staging: &Path, path: &Path, value: &Value) -> anyhow::Result<()> {
+    std::fs::write(staging, serde_json::to_string_pretty(value)? + "\n")
         .with_context(|| path.display().to_string())
 }
 
@@ -145,7 +158,7 @@ fn progress_bar(show: bool, cells: usize, message: &str) -> ProgressBar {
 const PUBLISHED_SINDY_HEADER: &str = "SINDy gen (paper)";
 
 fn print_cells(cells: &[CellSummary], table: &Option<PublishedTables>) {
-    println!(
+    say!(
         "{:<14} {:<10} {:>8} {:>8} {:>10} | {:>15} {:>12} | {:>17} | {:>13}",
         "formulation",
         "condition",
@@ -170,7 +183,7 @@ fn print_cells(cells: &[CellSummary], table: &Option<PublishedTables>) {
         let outside = cell.query_coverage.as_ref().map_or("-".to_string(), |c| {
             format!("{}/{}", c.samples_outside, c.samples)
         });
-        println!(
+        say!(
             "{:<14} {:<10} {:>8.3} {:>8.3} {:>14.3} | {:>15} {:>6} {:<5} | {:>17} | {:>13}",
             cell.formulation.name(),
             cell.label,
@@ -208,43 +221,45 @@ fn checkpoint_dir(args: &Args) -> PathBuf {
         .unwrap_or_else(|| PathBuf::from(DEFAULT_CHECKPOINTS))
 }
 
-/// Every checkpoint this run writes, checked before any work: never `--out` nor an input (whatever
-/// the spelling of either path), a place a file can be written, not an existing file in a
-/// directory given with --checkpoints unless --force.
-fn check_checkpoints(
-    args: &Args,
-    protocol: Protocol,
-    formulations: &[Formulation],
-    evaluated: &[String],
-    seed: u64,
-    out: &Path,
-    inputs: &[(&str, &Path)],
-) -> anyhow::Result<()> {
-    let dir = checkpoint_dir(args);
-    if super::same_file(out, &dir) {
+/// The run's output set: the summary (`--out`) and the checkpoints' folder, or with
+/// `--seed-spread` the spread file; the inputs, which no output may be.
+fn output_set(args: &Args, inputs: &[(&str, &Path)]) -> anyhow::Result<(OutputSet, Outputs)> {
+    let mut set = OutputSet::new(PRODUCER);
+    for (option, path) in inputs {
+        set.input(format!("the {option} input"), path);
+    }
+    let force = Existing::from_force(args.force);
+    if args.seed_spread {
+        let spread = set.file(&args.spread_out, "--spread-out", force);
+        return Ok((set, Outputs::Spread(spread)));
+    }
+    // The defaults are the tool's scratch, replaced on every run.
+    let out = match &args.out {
+        Some(out) => set.file(out, "--out", force),
+        None => set.file(DEFAULT_OUT, "--out", Existing::Replace),
+    };
+    let checkpoints = match &args.checkpoints {
+        Some(dir) => set.folder(dir, "--checkpoints", force),
+        None => set.folder(DEFAULT_CHECKPOINTS, "--checkpoints", Existing::Scratch),
+    };
+    let out_path = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT));
+    if super::same_file(&out_path, &checkpoint_dir(args)) {
         anyhow::bail!(
             "{}: is both --out and the --checkpoints directory",
-            out.display()
+            out_path.display()
         );
     }
-    for &formulation in formulations {
-        for condition in evaluated {
-            let path = checkpoint_path(&dir, protocol, formulation, condition, seed);
-            if super::same_file(&path, out) {
-                anyhow::bail!(
-                    "{}: is both --out and a checkpoint of this run ({}), refusing to write the summary over it",
-                    out.display(),
-                    path.display()
-                );
-            }
-            super::refuse_input_as_output(&path, inputs)?;
-            super::refuse_unwritable_file(&path, "--checkpoints")?;
-            if args.checkpoints.is_some() {
-                super::refuse_overwrite(&path, args.force)?;
-            }
-        }
-    }
-    Ok(())
+    Ok((set, Outputs::Run { out, checkpoints }))
+}
+
+/// Where the run writes, in its output set.
+#[derive(Clone, Copy)]
+enum Outputs {
+    Spread(FileId),
+    Run { out: FileId, checkpoints: FolderId },
 }
 
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
@@ -262,16 +277,8 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT));
     let checkpoint_dir = checkpoint_dir(&args);
-    if args.seed_spread {
-        super::check_output(&args.spread_out, "--spread-out", args.force, &inputs)?;
-    } else {
-        super::refuse_input_as_output(&out, &inputs)?;
-        super::refuse_unwritable_file(&out, "--out")?;
-        if args.out.is_some() {
-            super::refuse_overwrite(&out, args.force)?;
-        }
-        super::refuse_unwritable_dir(&checkpoint_dir, "--checkpoints")?;
-    }
+    let (mut set, outputs) = output_set(&args, &inputs)?;
+    set.check()?;
     let mut config = LearnConfig::load(&args.config)?;
     if let Some(seed) = args.seed {
         config = config.with_seed(seed);
@@ -297,20 +304,26 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     };
     let protocol = Protocol::resolve(protocol, &conditions, &data_dir);
 
-    if !args.seed_spread {
+    if let Outputs::Run { checkpoints, .. } = outputs {
         let seed = config.get().seed;
-        check_checkpoints(
-            &args,
-            protocol,
-            &formulations,
-            &evaluated,
-            seed,
-            &out,
-            &inputs,
-        )?;
+        for &formulation in &formulations {
+            for condition in &evaluated {
+                let name = checkpoint_path(Path::new(""), protocol, formulation, condition, seed);
+                let path = set.file_in(checkpoints, name);
+                if super::same_file(&path, &out) {
+                    anyhow::bail!(
+                        "{}: is both --out and a checkpoint of this run ({}), refusing to write the summary over it",
+                        out.display(),
+                        path.display()
+                    );
+                }
+            }
+        }
     }
+    // Every output is proven writable (and its folder locked) before any training.
+    let staged = set.prepare()?;
     let experiment = Experiment::load(config.clone(), conditions, &data_dir, Some(protocol))?;
-    println!("protocol: {}", protocol.name());
+    say!("protocol: {}", protocol.name());
 
     if args.seed_spread {
         let seeds = config.get().spread_seeds.clone();
@@ -320,16 +333,22 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         let spread = experiment.seed_spread_observed(&formulations, &seeds, &|_| bar.inc(1));
         bar.finish_and_clear();
         let spread = spread?;
-        println!(
+        say!(
             "seed spread over seeds {seeds:?} ({:.1} s)",
             started.elapsed().as_secs_f64()
         );
-        println!(
+        say!(
             "{:<14} {:<10} {:>9} {:>9} {:>9} {:>9} {:>9}",
-            "formulation", "condition", "gen mean", "gen std", "gen min", "gen max", "adapt std"
+            "formulation",
+            "condition",
+            "gen mean",
+            "gen std",
+            "gen min",
+            "gen max",
+            "adapt std"
         );
         for cell in &spread {
-            println!(
+            say!(
                 "{:<14} {:<10} {:>9.4} {:>9.4} {:>9.4} {:>9.4} {:>9.4}",
                 cell.formulation.name(),
                 cell.label,
@@ -340,7 +359,11 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
                 cell.adapt_mse.std
             );
         }
+        let Outputs::Spread(spread_file) = outputs else {
+            anyhow::bail!("--seed-spread without its output (a bug)");
+        };
         write_json(
+            staged.path(spread_file),
             &args.spread_out,
             &json!({
                 "what": "seed-to-seed spread of the LeARN adaptation and generalisation MSE per table cell",
@@ -354,7 +377,8 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
                 "cells": spread,
             }),
         )?;
-        println!("wrote {}", args.spread_out.display());
+        staged.commit()?;
+        say!("wrote {}", args.spread_out.display());
         return Ok(());
     }
 
@@ -379,25 +403,36 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let cells = cells?;
     let elapsed = started.elapsed().as_secs_f64();
-    println!(
+    say!(
         "meta-training and adaptation of {} cells: {elapsed:.1} s",
         cells.len()
     );
+    let Outputs::Run {
+        out: out_file,
+        checkpoints: checkpoint_folder,
+    } = outputs
+    else {
+        anyhow::bail!("a run without its outputs (a bug)");
+    };
     let mut checkpoints = Vec::new();
     for cell in &cells {
-        let path = checkpoint_path(
-            &checkpoint_dir,
-            protocol,
-            cell.summary.formulation,
-            &cell.summary.condition,
-            seed,
-        );
-        cell.model.save(&path)?;
-        checkpoints.push(path);
+        let at = |dir: &Path| {
+            checkpoint_path(
+                dir,
+                protocol,
+                cell.summary.formulation,
+                &cell.summary.condition,
+                seed,
+            )
+        };
+        super::staged_write(&staged, || {
+            cell.model.save(&at(staged.dir(checkpoint_folder)))
+        })?;
+        checkpoints.push(at(&checkpoint_dir));
     }
     let summaries: Vec<CellSummary> = cells.iter().map(|c| c.summary.clone()).collect();
-    print_cells(&summaries, &table);
     write_json(
+        staged.path(out_file),
         &out,
         &json!({
             "protocol": protocol.name(),
@@ -407,7 +442,9 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
             "checkpoints": checkpoints,
         }),
     )?;
-    println!(
+    staged.commit()?;
+    print_cells(&summaries, &table);
+    say!(
         "wrote {} and {} checkpoints under {}",
         out.display(),
         checkpoints.len(),

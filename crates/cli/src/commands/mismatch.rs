@@ -8,11 +8,14 @@
 //!   the data directory analysed together (one vehicle, one air velocity per flight) →
 //!   DIR/<model stem>.{json,md,svg}.
 //!
-//! Every mode works out every file it will write and checks them all before any work: none may be
-//! one of the files the run reads (even with `--force`), each must be writable, and none may exist
-//! unless `--force` is given.
+//! Every mode plans every file it will write in an output set (the `outputs` crate) and checks
+//! them all before any work: none may be one of the files the run reads (even with `--force`),
+//! each folder is proven writable and locked, and an existing file is replaced only when this
+//! command wrote it and `--force` is given. The results are staged and moved into place at the end.
 
 use std::path::{Path, PathBuf};
+
+use outputs::{Existing, OutputSet};
 
 use super::Global;
 
@@ -68,15 +71,40 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
 /// Where the demo writes its cases without `--work`.
 const DEFAULT_WORK: &str = "target/mismatch-demo";
 
+/// A nominal model under the project's JSON policy (bounded, BOM accepted, no key twice).
+fn load_model(path: &Path) -> anyhow::Result<physics::NominalModel> {
+    let text = super::read_policy_json(path)?;
+    Ok(physics::NominalModel::from_json(&text, path)?)
+}
+
+/// The name of `path` relative to `dir` (its file name when it is not below it).
+fn relative_to(path: &Path, dir: &Path) -> PathBuf {
+    path.strip_prefix(dir)
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|_| path.file_name().map(PathBuf::from).unwrap_or_default())
+}
+
+/// The demo: its summary (`--out`) is an output set; the cases' files in `--work` are a scratch
+/// of intermediate files (recordings, per-case analyses naming their paths), written in place
+/// after the same checks as before any work.
 fn run_demo(manifest: &Path, args: &Args) -> anyhow::Result<()> {
     let work = args.work.as_deref().unwrap_or(Path::new(DEFAULT_WORK));
-    super::refuse_unwritable_dir(&args.out, "--out")?;
-    super::refuse_unwritable_dir(work, "--work")?;
     let plan = mismatch::demo::DemoPlan::load(manifest, work, &args.out)?;
     plan.check_outputs(args.force)?;
-    let summary = plan.run(args.force)?;
-    print!("{}", summary.table_text());
-    println!("wrote {}", plan.summary_paths()[0].display());
+    let mut set = OutputSet::new("mismatch --demo");
+    for (what, path) in plan.inputs() {
+        set.input(what, path);
+    }
+    let out = set.folder(&args.out, "--out", Existing::from_force(args.force));
+    for path in plan.summary_paths() {
+        set.file_in(out, relative_to(&path, &args.out));
+    }
+    let staged = set.prepare()?;
+    let staged_plan = plan.with_out(staged.dir(out));
+    let summary = super::staged_write(&staged, || staged_plan.run(args.force))?;
+    staged.commit()?;
+    say_part!("{}", summary.table_text());
+    say!("wrote {}", plan.summary_paths()[0].display());
     Ok(())
 }
 
@@ -86,30 +114,47 @@ fn run_flights(
     model_path: &Path,
     args: &Args,
 ) -> anyhow::Result<()> {
-    super::refuse_unwritable_dir(&args.out, "--out")?;
     let data_dir = global.data_dir()?;
     let plan = mismatch::fleet::FleetPlan::load(conditions, &data_dir, model_path, &args.out)?;
-    plan.check_outputs(model_path, args.force)?;
-    let model = physics::NominalModel::load(model_path)?;
-    let (_, lines) = plan.run(&model, &model_path.display().to_string(), args.force)?;
+    let stem = model_path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut set = OutputSet::new(format!("mismatch --flights --model {stem}"));
+    for (what, path) in plan.inputs() {
+        set.input(what, path);
+    }
+    set.input("the --model file", model_path);
+    let out = set.folder(&args.out, "--out", Existing::from_force(args.force));
+    for path in plan.outputs() {
+        set.file_in(out, relative_to(&path, &args.out));
+    }
+    set.check()?;
+    let model = load_model(model_path)?;
+    let staged = set.prepare()?;
+    let staged_plan =
+        mismatch::fleet::FleetPlan::load(conditions, &data_dir, model_path, staged.dir(out))?;
+    let (_, lines) = super::staged_write(&staged, || {
+        staged_plan.run(&model, &model_path.display().to_string(), true)
+    })?;
+    staged.commit()?;
     for line in lines {
-        println!("{line}");
+        say!("{line}");
     }
     Ok(())
 }
 
 fn run_recording(recording: &Path, model_path: &Path, args: &Args) -> anyhow::Result<()> {
-    super::refuse_unwritable_dir(&args.out, "--out")?;
-    let inputs = [
-        ("the --model file".to_string(), model_path.to_path_buf()),
-        ("the --recording".to_string(), recording.to_path_buf()),
-    ];
-    let outputs: Vec<(PathBuf, &str)> = mismatch::output_paths(&args.out)
-        .into_iter()
-        .map(|p| (p, "--out"))
-        .collect();
-    mismatch::check_run_outputs(&outputs, &inputs, args.force)?;
-    let model = physics::NominalModel::load(model_path)?;
+    let mut set = OutputSet::new("mismatch --recording");
+    set.input("the --model file", model_path);
+    set.input("the --recording", recording);
+    let out = set.folder(&args.out, "--out", Existing::from_force(args.force));
+    for path in mismatch::output_paths(Path::new("")) {
+        set.file_in(out, path);
+    }
+    set.check()?;
+    let model = load_model(model_path)?;
+    let staged = set.prepare()?;
     let log = data::FlightLog::read(recording)?;
     let analysis = mismatch::analyze(
         &log,
@@ -117,10 +162,13 @@ fn run_recording(recording: &Path, model_path: &Path, args: &Args) -> anyhow::Re
         &model_path.display().to_string(),
         &mismatch::AnalysisSettings::default(),
     )?;
-    mismatch::write_outputs(&analysis, &args.out, args.force)?;
+    super::staged_write(&staged, || {
+        mismatch::write_outputs(&analysis, staged.dir(out), true)
+    })?;
+    staged.commit()?;
     let report = &analysis.report;
     let names: Vec<&str> = report.effects.iter().map(|e| e.id.as_str()).collect();
-    println!(
+    say!(
         "effects: {}; held-out MSE {:.5} -> {:.5}; wrote {}",
         if names.is_empty() {
             "none".to_string()

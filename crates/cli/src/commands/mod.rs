@@ -114,94 +114,22 @@ impl Global {
     }
 }
 
-/// Refuses to replace an existing file the user did not ask to overwrite (`--force`).
-pub fn refuse_overwrite(path: &Path, force: bool) -> anyhow::Result<()> {
-    if path.exists() && !force {
-        anyhow::bail!(
-            "{}: already exists (pass --force to overwrite)",
-            path.display()
-        );
-    }
-    Ok(())
+/// Runs `write` (a writer given the staging paths of `staged`), naming the final paths in its
+/// error rather than the staging ones.
+pub fn staged_write<T, E: std::fmt::Display>(
+    staged: &outputs::Staged,
+    write: impl FnOnce() -> Result<T, E>,
+) -> anyhow::Result<T> {
+    write().map_err(|error| anyhow::anyhow!(staged.in_final_terms(&error.to_string())))
 }
 
-/// Checks a file the command is about to write (given by `option`): never one of its `inputs`
-/// (option name, path), a place a file can be written, and not an existing file unless `force`.
-pub fn check_output(
-    output: &Path,
-    option: &str,
-    force: bool,
-    inputs: &[(&str, &Path)],
-) -> anyhow::Result<()> {
-    refuse_input_as_output(output, inputs)?;
-    refuse_unwritable_file(output, option)?;
-    refuse_overwrite(output, force)
-}
-
-/// Refuses, before any work, a file to write (given by `option`) where none can be written: an
-/// existing directory, or a path below something that is not a directory. `--force` cannot help.
-pub fn refuse_unwritable_file(output: &Path, option: &str) -> anyhow::Result<()> {
-    if output.is_dir() {
-        anyhow::bail!(
-            "{}: is a directory, not a file to write ({option})",
-            output.display()
-        );
-    }
-    refuse_below_a_non_directory(output, option)
-}
-
-/// Refuses, before any work, a directory to write files into (given by `option`) that cannot be
-/// one: something other than a directory, or a path below something that is not a directory.
-pub fn refuse_unwritable_dir(dir: &Path, option: &str) -> anyhow::Result<()> {
-    if dir.exists() && !dir.is_dir() {
-        anyhow::bail!(
-            "{}: is not a directory ({option} names the directory to write into)",
-            dir.display()
-        );
-    }
-    refuse_below_a_non_directory(dir, option)
-}
-
-/// Refuses `path` when the nearest of its parents that exists is not a directory (nothing can be
-/// created below it).
-fn refuse_below_a_non_directory(path: &Path, option: &str) -> anyhow::Result<()> {
-    if let Some(parent) = data::paths::non_directory_ancestor(path) {
-        anyhow::bail!(
-            "{}: {} is not a directory, nothing can be written below it ({option})",
-            path.display(),
-            parent.display()
-        );
-    }
-    Ok(())
-}
-
-/// Refuses an output that is one of the command's inputs (`inputs`: option name, path), whatever
-/// `--force` says: writing it would destroy what the run was made from.
-pub fn refuse_input_as_output(output: &Path, inputs: &[(&str, &Path)]) -> anyhow::Result<()> {
-    if let Some((option, _)) = inputs.iter().find(|(_, input)| same_file(output, input)) {
-        anyhow::bail!(
-            "{}: is the {option} input, refusing to write over it (even with --force)",
-            output.display()
-        );
-    }
-    Ok(())
-}
-
-/// Refuses, before any work, a run that would write over or remove one of its `inputs` (what names
-/// it, path): a configuration, conditions or published file inside an output directory. No
-/// option can allow it: the run would destroy what it was made from.
-pub fn refuse_inputs_as_outputs(
-    planned: &pipeline::PlannedOutputs,
-    inputs: &[(String, PathBuf)],
-) -> anyhow::Result<()> {
-    for (option, input) in inputs {
-        if let Some(output) = planned.clobbers(input, &same_file) {
-            anyhow::bail!(
-                "{}: is the {option} input, and the run writes {output}: refusing to write over \
-                 it (choose another output directory)",
-                input.display()
-            );
-        }
-    }
-    Ok(())
+/// Reads a JSON file the run will read through a library that does not apply the project's JSON
+/// policy itself (a nominal model): bounded size, a regular file, no key given twice. Returns the
+/// text without a byte-order mark.
+pub fn read_policy_json(path: &Path) -> anyhow::Result<String> {
+    let text = data::input::read_json_text(path)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let text =
+        data::json::checked_text(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(text.to_string())
 }

@@ -3,7 +3,8 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
+use outputs::{Existing, OutputSet};
 
 use super::Global;
 
@@ -21,25 +22,24 @@ pub struct Args {
 }
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
-    if args.out.is_dir() {
-        bail!("{}: is a directory, not a CSV file", args.out.display());
-    }
-    super::check_output(
-        &args.out,
-        "--out",
-        args.force,
-        &[("--scenario", &args.scenario)],
-    )?;
+    let mut set = OutputSet::new("simulate");
+    set.input("the --scenario input", &args.scenario);
+    let file = set.file(&args.out, "--out", Existing::from_force(args.force));
+    set.check()?;
+    // The model the scenario names is read as much as the scenario itself, under the project's
+    // JSON policy (no key given twice).
+    super::read_policy_json(&args.scenario)?;
     let (scenario, model) = physics::Scenario::load(&args.scenario)?;
-    // The model the scenario names is read as much as the scenario itself.
     let model_path = scenario.model_path(&args.scenario);
-    if super::same_file(&args.out, &model_path) {
-        bail!(
-            "{}: is the model that the --scenario {} reads, refusing to write over it (even with --force)",
-            args.out.display(),
+    super::read_policy_json(&model_path)?;
+    set.input(
+        format!(
+            "the model that the --scenario {} reads",
             args.scenario.display()
-        );
-    }
+        ),
+        &model_path,
+    );
+    let staged = set.prepare()?;
     let name = args
         .out
         .file_stem()
@@ -47,9 +47,12 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         .unwrap_or_else(|| "flight".to_string());
     let log = physics::simulate(&model, &scenario, &name)
         .with_context(|| format!("{}", args.scenario.display()))?;
-    physics::write_readable(&log, &args.out, &args.scenario)?;
+    super::staged_write(&staged, || {
+        physics::write_readable(&log, staged.path(file), &args.scenario)
+    })?;
+    staged.commit()?;
     let effects = scenario.effects.ids();
-    println!(
+    say!(
         "wrote {} ({} rows, {:.1} s, seed {}, effects: {})",
         args.out.display(),
         log.len(),

@@ -7,6 +7,8 @@ use anyhow::{Context, anyhow, bail};
 use data::{Derivative, NumericTable};
 use sindy::{FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, SindyError, SindyParams, Trajectory};
 
+use outputs::{Existing, OutputSet};
+
 use super::Global;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,11 +40,11 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "stlsq")]
     pub optimizer: OptimizerKind,
     /// STLSQ threshold; `None`: the default.
-    #[arg(long, allow_negative_numbers = true,
+    #[arg(long, allow_hyphen_values = true,
           help = format!("STLSQ threshold (--optimizer stlsq only) [default: {DEFAULT_THRESHOLD}]"))]
     pub threshold: Option<f64>,
     /// STLSQ ridge strength; `None`: `sindy::DEFAULT_ALPHA`.
-    #[arg(long, allow_negative_numbers = true,
+    #[arg(long, allow_hyphen_values = true,
           help = format!("STLSQ ridge strength (--optimizer stlsq only) [default: {}]",
                          sindy::DEFAULT_ALPHA))]
     pub alpha: Option<f64>,
@@ -52,7 +54,7 @@ pub struct Args {
                          sindy::DEFAULT_MAX_ITER))]
     pub max_iter: Option<usize>,
     /// LASSO weight λ (required with --optimizer lasso).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub lambda: Option<f64>,
     /// Derivative estimator: forward, central, savgol or savgol:WINDOW:ORDER.
     #[arg(long, default_value = "central")]
@@ -137,9 +139,16 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         }
     }
     let feature_count = library.unique_feature_names(&columns)?.len();
-    if let Some(out) = &args.out {
-        super::check_output(out, "--out", args.force, &[("--csv", &args.csv)])?;
-    }
+    // The model file is checked and staged (its folder proven writable) before the CSV is read.
+    let output = match &args.out {
+        Some(out) => {
+            let mut set = OutputSet::new("sindy");
+            set.input("the --csv input", &args.csv);
+            let file = set.file(out, "--out", Existing::from_force(args.force));
+            Some((set.prepare()?, file))
+        }
+        None => None,
+    };
 
     let (time, table) = NumericTable::read_with_time(&args.csv, &args.time, &columns)?;
     let n = table.rows();
@@ -198,8 +207,13 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
             args.time
         );
     }
+    // Files first, then words: an unwritable terminal never stops the model from being written.
+    if let Some((staged, file)) = output {
+        super::staged_write(&staged, || model.save(staged.path(file), true))?;
+        staged.commit()?;
+    }
     for line in model.equations(usize::from(args.precision)) {
-        println!("{line}");
+        say!("{line}");
     }
     // R² divides by the variance of the target: on a constant one it is rounding noise, so such
     // states are left out of it and named.
@@ -219,20 +233,14 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         ),
         None => "R² n/a (constant target)".to_string(),
     };
-    eprintln!(
+    note!(
         "{} samples, {} features; MSE {:.6}, {r2}",
         n,
         model.feature_names().len(),
         score.mse,
     );
     if let Some(out) = &args.out {
-        // As meta-train and reproduce do: missing parent directories are made (check_output
-        // refused, before the fit, a parent that cannot be one).
-        if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
-            std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
-        }
-        model.save(out, args.force)?;
-        eprintln!("model written to {}", out.display());
+        note!("model written to {}", out.display());
     }
     Ok(())
 }

@@ -54,7 +54,7 @@ pub struct DemoManifest {
 }
 
 fn load_manifest(path: &Path) -> Result<DemoManifest> {
-    let text = std::fs::read_to_string(path).map_err(io_error(path))?;
+    let text = data::input::read_json_text(path).map_err(io_error(path))?;
     let manifest: DemoManifest =
         data::json::from_str(&text).map_err(|e| MismatchError::Config {
             path: path.to_path_buf(),
@@ -286,6 +286,14 @@ impl DemoPlan {
             ));
         }
         inputs
+    }
+
+    /// The same plan writing its summary into `out` instead (a staging folder).
+    pub fn with_out(&self, out: &Path) -> Self {
+        Self {
+            out: out.to_path_buf(),
+            ..self.clone()
+        }
     }
 
     /// The summary files, `out/summary.md` and `out/summary.json`.

@@ -188,11 +188,11 @@ impl Stlsq {
             let kept: Vec<usize> = (0..features)
                 .filter(|&j| coefficients[j].abs() >= self.threshold)
                 .collect();
-            for (j, c) in coefficients.iter_mut().enumerate() {
-                if c.abs() < self.threshold {
+            // Zeroes exactly what `kept` leaves out (a NaN from a broken solve included).
+            for c in coefficients.iter_mut() {
+                if c.is_nan() || c.abs() < self.threshold {
                     *c = 0.0;
                 }
-                debug_assert!(*c == 0.0 || kept.contains(&j));
             }
             let pattern: Vec<bool> = coefficients.iter().map(|&c| c != 0.0).collect();
             let all_active = kept.len() == features;

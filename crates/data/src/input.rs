@@ -1,0 +1,169 @@
+//! Reading input files with bounded cost: what a command reads must be a regular file (or, for a
+//! CSV, a pipe such as `--csv <(…)`) of bounded size, so that `/dev/zero`, a FIFO where a
+//! configuration is expected or a 50 MB configuration is a quick one-line error, not a process
+//! that reads until memory runs out. Errors are `std::io::Error`s whose text says what is wrong;
+//! each crate's loader wraps them with the path as it does any I/O error.
+
+use std::io::Read;
+use std::path::Path;
+
+/// The largest JSON file read (configuration, model, table): 8 MiB, a thousand times the largest
+/// the project ships.
+pub const MAX_JSON_BYTES: u64 = 8 << 20;
+/// The largest CSV read: 1 GiB (the Neural-Fly flights are 1 to 3 MB).
+pub const MAX_CSV_BYTES: u64 = 1 << 30;
+/// The most columns a CSV may have (the Neural-Fly logs have about 20).
+pub const MAX_CSV_COLUMNS: usize = 10_000;
+
+/// What a file is read as, which sets its limits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputKind {
+    /// A JSON file: a regular file of at most [`MAX_JSON_BYTES`].
+    Json,
+    /// A CSV file: a regular file or a pipe, of at most [`MAX_CSV_BYTES`].
+    Csv,
+}
+
+impl InputKind {
+    fn limit(self) -> u64 {
+        match self {
+            Self::Json => MAX_JSON_BYTES,
+            Self::Csv => MAX_CSV_BYTES,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Self::Json => "a JSON file",
+            Self::Csv => "a CSV file",
+        }
+    }
+}
+
+fn refused(message: String) -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::InvalidInput, message)
+}
+
+/// Reads the bytes of `path` as `kind`: refuses what is not a regular file (a pipe is accepted
+/// for a CSV) and anything larger than the kind's limit, before or while reading.
+pub fn read_bytes(path: &Path, kind: InputKind) -> std::io::Result<Vec<u8>> {
+    if path.as_os_str().is_empty() {
+        return Err(refused("an empty path names no file".to_string()));
+    }
+    let metadata = std::fs::metadata(path)?;
+    let file_type = metadata.file_type();
+    check_file_type(&file_type, kind)?;
+    let limit = kind.limit();
+    if metadata.is_file() && metadata.len() > limit {
+        return Err(too_large(metadata.len(), kind));
+    }
+    let file = std::fs::File::open(path)?;
+    let capacity = if metadata.is_file() {
+        metadata.len() as usize
+    } else {
+        0
+    };
+    let mut bytes = Vec::with_capacity(capacity);
+    file.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(bytes.len() as u64, kind));
+    }
+    Ok(bytes)
+}
+
+/// Reads `path` as UTF-8 text of `kind` (see [`read_bytes`]).
+pub fn read_text(path: &Path, kind: InputKind) -> std::io::Result<String> {
+    let bytes = read_bytes(path, kind)?;
+    String::from_utf8(bytes).map_err(|error| {
+        let at = error.utf8_error().valid_up_to();
+        refused(format!(
+            "not UTF-8 text (byte {at} of {}): {} is expected",
+            error.as_bytes().len(),
+            kind.name()
+        ))
+    })
+}
+
+/// Reads a JSON file (see [`read_bytes`]).
+pub fn read_json_text(path: &Path) -> std::io::Result<String> {
+    read_text(path, InputKind::Json)
+}
+
+fn too_large(bytes: u64, kind: InputKind) -> std::io::Error {
+    let limit = kind.limit();
+    let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
+    refused(format!(
+        "{}{:.1} MiB, more than the {:.0} MiB that {} may have",
+        if bytes > limit { "over " } else { "" },
+        mib(bytes.min(limit)),
+        mib(limit),
+        kind.name()
+    ))
+}
+
+fn check_file_type(file_type: &std::fs::FileType, kind: InputKind) -> std::io::Result<()> {
+    if file_type.is_file() {
+        return Ok(());
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if file_type.is_fifo() && kind == InputKind::Csv {
+            return Ok(());
+        }
+        let what = if file_type.is_dir() {
+            "a directory"
+        } else if file_type.is_fifo() {
+            "a pipe (FIFO)"
+        } else if file_type.is_char_device() {
+            "a character device"
+        } else if file_type.is_block_device() {
+            "a block device"
+        } else if file_type.is_socket() {
+            "a socket"
+        } else {
+            "not a regular file"
+        };
+        Err(refused(format!("is {what}, not {}", kind.name())))
+    }
+    #[cfg(not(unix))]
+    Err(refused(format!(
+        "is not a regular file: {} is expected",
+        kind.name()
+    )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    #[cfg(unix)]
+    fn devices_and_directories_are_refused_quickly() {
+        let message = read_json_text(Path::new("/dev/zero"))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(message, "is a character device, not a JSON file");
+        let message = read_bytes(Path::new("/dev/zero"), InputKind::Csv)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(message, "is a character device, not a CSV file");
+        let message = read_json_text(Path::new("/")).unwrap_err().to_string();
+        assert_eq!(message, "is a directory, not a JSON file");
+        let message = read_json_text(Path::new("")).unwrap_err().to_string();
+        assert_eq!(message, "an empty path names no file");
+    }
+
+    #[test]
+    fn a_large_json_file_is_refused_before_it_is_read() {
+        let path = std::env::temp_dir().join(format!("data-large-{}.json", std::process::id()));
+        let file = std::fs::File::create(&path).unwrap();
+        file.set_len(MAX_JSON_BYTES + 1).unwrap();
+        let message = read_json_text(&path).unwrap_err().to_string();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(
+            message,
+            "over 8.0 MiB, more than the 8 MiB that a JSON file may have"
+        );
+    }
+}

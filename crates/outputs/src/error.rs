@@ -1,0 +1,70 @@
+//! Why an output set could not be planned, prepared or committed: each message names the path and
+//! the option that placed it, on one line.
+
+use std::path::PathBuf;
+
+/// An output set refused or failed.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error(
+        "{}: is {what}, which this run reads: refusing to write over it (even with --force)",
+        path.display()
+    )]
+    OutputIsInput { path: PathBuf, what: String },
+    #[error("{option}: an empty path (give the file or directory to write)")]
+    EmptyPath { option: String },
+    #[error("{}: is a directory, not a file to write ({option})", path.display())]
+    FileIsDirectory { path: PathBuf, option: String },
+    #[error("{}: is a file, not a directory ({option} names the directory to write into)", path.display())]
+    FolderIsFile { path: PathBuf, option: String },
+    #[error("{}: {} is not a directory, nothing can be written below it ({option})", path.display(), parent.display())]
+    BelowNonDirectory {
+        path: PathBuf,
+        parent: PathBuf,
+        option: String,
+    },
+    #[error("{}: already exists (pass --force to overwrite)", path.display())]
+    Exists { path: PathBuf },
+    #[error("{}: already exists, written by an earlier `learn {producer}` (pass --force to replace it)", path.display())]
+    OwnExists { path: PathBuf, producer: String },
+    #[error(
+        "{}: already exists and was not written by learn (it is not in {}): a command never \
+         replaces a file it did not write; move it away or choose another {option}",
+        path.display(), manifest.display()
+    )]
+    Foreign {
+        path: PathBuf,
+        manifest: PathBuf,
+        option: String,
+    },
+    #[error(
+        "{}: another learn run is writing into this directory ({option}); wait for it to end, \
+         or choose another directory",
+        dir.display()
+    )]
+    Locked { dir: PathBuf, option: String },
+    #[error("{}: cannot be written ({option}): {source}", path.display())]
+    NotWritable {
+        path: PathBuf,
+        option: String,
+        source: std::io::Error,
+    },
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: {message}", path.display())]
+    Manifest { path: PathBuf, message: String },
+}
+
+/// Results of this crate.
+pub type Result<T, E = OutputError> = std::result::Result<T, E>;
+
+/// Maps an I/O error on `path` to [`OutputError::Io`].
+pub(crate) fn io(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
+    move |source| OutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}

@@ -1,0 +1,71 @@
+//! Interrupts: on SIGINT, SIGTERM or SIGHUP the staging files and folders of the process are
+//! removed and it exits (128 + the signal), so an interrupted run leaves the old outputs as they
+//! were and nothing that looks like a result. A commit in progress is finished first: it holds the
+//! same lock as the handler.
+
+use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard, Once};
+
+/// Staging paths of this process that an interrupt removes.
+static STAGING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+static INSTALL: Once = Once::new();
+
+/// The staging registry, held for the length of a commit (the handler waits for it).
+pub(crate) fn hold() -> MutexGuard<'static, Vec<PathBuf>> {
+    STAGING
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// The registry unless this thread holds it already (a drop inside a commit).
+pub(crate) fn try_hold() -> Result<MutexGuard<'static, Vec<PathBuf>>, ()> {
+    match STAGING.try_lock() {
+        Ok(guard) => Ok(guard),
+        Err(std::sync::TryLockError::Poisoned(poisoned)) => Ok(poisoned.into_inner()),
+        Err(std::sync::TryLockError::WouldBlock) => Err(()),
+    }
+}
+
+/// Records a staging path, installing the handler on first use.
+pub(crate) fn register(path: PathBuf) {
+    install();
+    hold().push(path);
+}
+
+/// Forgets a staging path (committed or removed by its owner).
+pub(crate) fn unregister(staging: &mut Vec<PathBuf>, path: &std::path::Path) {
+    staging.retain(|p| p != path);
+}
+
+/// Starts the thread that waits for the signals. Without it (the handler cannot be installed)
+/// the signals keep their default action; SIGKILL always does, and then the staging names stay
+/// until the next run into the folder removes them.
+fn install() {
+    INSTALL.call_once(|| {
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+            return;
+        };
+        let _ = std::thread::Builder::new()
+            .name("learn-signals".to_string())
+            .spawn(move || {
+                if let Some(signal) = signals.forever().next() {
+                    let staging = hold();
+                    for path in staging.iter() {
+                        remove(path);
+                    }
+                    std::process::exit(128 + signal);
+                }
+            });
+    });
+}
+
+/// Removes a staging file or folder, whichever it is; errors are ignored (nothing more can be
+/// done on the way out).
+pub(crate) fn remove(path: &std::path::Path) {
+    if path.is_dir() {
+        let _ = std::fs::remove_dir_all(path);
+    } else {
+        let _ = std::fs::remove_file(path);
+    }
+}

@@ -494,3 +494,33 @@ fn a_constant_derivative_has_no_r2() {
         run.stderr
     );
 }
+
+/// `--stream` reads the file in blocks and fits as it reads: the same equations and score as the
+/// whole file, and bad input named by file, line and column as there.
+#[test]
+fn a_streamed_file_fits_as_the_whole_file_and_names_bad_lines() {
+    let dir = scratch("sindy-stream");
+    std::fs::write(dir.join("s.csv"), signal(3000)).unwrap();
+    for derivative in ["central", "savgol:11:3"] {
+        let extra = ["--derivative", derivative, "--precision", "9"];
+        let whole = sindy(&dir, "s.csv", "poly:2", &extra);
+        let mut streamed_args = extra.to_vec();
+        streamed_args.push("--stream");
+        let streamed = sindy(&dir, "s.csv", "poly:2", &streamed_args);
+        assert_eq!(streamed.success(), whole.success(), "{derivative}");
+    }
+    let text = with_line(&signal(3000), 2048, "20.46,0.5,oops,0.1");
+    std::fs::write(dir.join("bad.csv"), text).unwrap();
+    sindy(&dir, "bad.csv", "poly:2", &["--stream"]).one_line_error(&["bad.csv:2048:y", "oops"]);
+    let text = with_line(&signal(3000), 2900, "28.98,1e200,0.5,0.1");
+    std::fs::write(dir.join("huge.csv"), text).unwrap();
+    sindy(&dir, "huge.csv", "poly:2", &["--stream"]).one_line_error(&[
+        "huge.csv:2900:",
+        "feature 'x^2'",
+        "not finite",
+    ]);
+    let text = with_line(&signal(3000), 1500, "14.98,0.5,0.5");
+    std::fs::write(dir.join("short-row.csv"), text).unwrap();
+    sindy(&dir, "short-row.csv", "poly:2", &["--stream"])
+        .one_line_error(&["short-row.csv:1500", "3 fields"]);
+}

@@ -24,6 +24,7 @@ mod noise_floor;
 mod numeric;
 mod source;
 mod split;
+mod stream;
 mod table;
 mod time;
 mod write;
@@ -47,7 +48,8 @@ pub use source::{
     resolve_data_dir,
 };
 pub use split::{Split, SplitSpec};
-pub use time::{DEFAULT_UNIFORM_TOLERANCE, check_time_axis};
+pub use stream::{NumericBlock, NumericStream};
+pub use time::{DEFAULT_UNIFORM_TOLERANCE, check_time_axis, check_time_column};
 
 /// Re-exported so that downstream crates name the same matrix type.
 pub use faer::Mat;

@@ -16,6 +16,11 @@ pub fn check_time_axis(path: &Path, time: &[f64], tolerance: f64) -> Result<()> 
     check_time_axis_at(path, "t", time, tolerance, &file_row)
 }
 
+/// [`check_time_axis`] of the time column named `column` of a file with one line per row.
+pub fn check_time_column(path: &Path, column: &str, time: &[f64], tolerance: f64) -> Result<()> {
+    check_time_axis_at(path, column, time, tolerance, &file_row)
+}
+
 /// [`check_time_axis`] of the time column named `column`, with `line(k)` the line of the file that
 /// holds sample `k` (for files whose cells span lines). Errors name `column`.
 pub(crate) fn check_time_axis_at(

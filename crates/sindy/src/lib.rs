@@ -60,6 +60,7 @@ mod pipeline;
 mod reduced;
 mod regression;
 mod selection;
+mod stream;
 mod variant;
 
 pub use causal::{CausalLibrary, MAX_CONTROL_LAGS, first_order_lag};
@@ -75,12 +76,13 @@ pub use optimizer::{
 };
 pub use persist::MODEL_FORMAT;
 pub use pipeline::{SegmentEvaluation, SindyConfig, evaluate_flight, fit_and_evaluate};
-pub use reduced::{BLOCK_ROWS, ReducedProblem};
+pub use reduced::{BLOCK_ROWS, ReducedProblem, Reduction, SEGMENT_ROWS, segment_triangle};
 pub use regression::{
     Bagging, EnsemblePrediction, LinearFit, MAX_BAGGING_BLOCK, MAX_BAGGING_MEMBERS, MAX_PENALTY,
     MAX_PENALTY_CANDIDATES, Penalty, RegressionFit, RegressionSpec, select_rows,
 };
 pub use selection::{BlockedFolds, Fold, MAX_FOLDS, Selection, cross_validate};
+pub use stream::{RowBlock, StreamedFit};
 pub use variant::{LibraryRegression, SegmentPredictions, VariantEvaluation, evaluate_features};
 
 /// Re-exported so that users name the same matrix types.

@@ -297,7 +297,7 @@ impl SindyParams {
         Ok((self.model(feature_names, coefficients), theta))
     }
 
-    fn model(&self, feature_names: Vec<String>, coefficients: Mat<f64>) -> SindyModel {
+    pub(crate) fn model(&self, feature_names: Vec<String>, coefficients: Mat<f64>) -> SindyModel {
         SindyModel {
             feature_names,
             state_names: self.state_names.clone(),
@@ -346,6 +346,52 @@ impl SindyParams {
             format!("target {}'", self.state_names[j])
         })?;
         Ok(optimizer)
+    }
+
+    pub(crate) fn state_names(&self) -> &[String] {
+        &self.state_names
+    }
+
+    pub(crate) fn control_names(&self) -> &[String] {
+        &self.control_names
+    }
+
+    pub(crate) fn feature_library(&self) -> &FeatureLibrary {
+        &self.library
+    }
+
+    pub(crate) fn derivative_estimator(&self) -> Derivative {
+        self.derivative
+    }
+
+    pub(crate) fn library_feature_count(&self, inputs: usize) -> usize {
+        self.library.feature_count(inputs)
+    }
+
+    /// The names are checked and the optimizer with them.
+    pub(crate) fn checked_optimizer(&self) -> Result<crate::Optimizer> {
+        self.check_names()?;
+        self.optimizer.checked()
+    }
+
+    /// The library's feature names on the inputs [x, u].
+    pub(crate) fn feature_names_for_inputs(&self) -> Vec<String> {
+        let names = self.input_names();
+        let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
+        self.library.feature_names(&input_names)
+    }
+
+    /// Inputs and targets are finite (errors name the row within them).
+    pub(crate) fn check_values(
+        &self,
+        inputs: MatRef<'_, f64>,
+        targets: MatRef<'_, f64>,
+    ) -> Result<()> {
+        let names = self.input_names();
+        check_finite("inputs", inputs, &|j| format!("input '{}'", names[j]))?;
+        check_finite("targets", targets, &|j| {
+            format!("target {}'", self.state_names[j])
+        })
     }
 
     fn input_names(&self) -> Vec<String> {
@@ -707,7 +753,11 @@ fn stack_rows(blocks: &[Mat<f64>]) -> Mat<f64> {
     out
 }
 
-fn check_finite(what: &str, matrix: MatRef<'_, f64>, name: &dyn Fn(usize) -> String) -> Result<()> {
+pub(crate) fn check_finite(
+    what: &str,
+    matrix: MatRef<'_, f64>,
+    name: &dyn Fn(usize) -> String,
+) -> Result<()> {
     for j in 0..matrix.ncols() {
         let column = matrix.col(j);
         // The common case first: a contiguous column checked in one vectorised pass.
@@ -734,7 +784,7 @@ pub const MAX_FEATURE_SCALE_RATIO: f64 = 1e12;
 
 /// Refuses a library whose features differ in size by more than [`MAX_FEATURE_SCALE_RATIO`]
 /// (largest magnitude of each non-zero column): the fit would be noise or not finite.
-fn check_scale(sizes: &[f64], names: &[String]) -> Result<()> {
+pub(crate) fn check_scale(sizes: &[f64], names: &[String]) -> Result<()> {
     let sizes = sizes
         .iter()
         .enumerate()
@@ -760,7 +810,7 @@ fn check_scale(sizes: &[f64], names: &[String]) -> Result<()> {
 }
 
 /// The largest magnitude of each column.
-fn column_sizes(theta: MatRef<'_, f64>) -> Vec<f64> {
+pub(crate) fn column_sizes(theta: MatRef<'_, f64>) -> Vec<f64> {
     (0..theta.ncols())
         .map(|j| theta.col(j).iter().fold(0.0f64, |m, v| m.max(v.abs())))
         .collect()

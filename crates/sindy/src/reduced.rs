@@ -32,6 +32,9 @@ use crate::linalg::clear_upper_vector_state;
 pub const BLOCK_ROWS: usize = 4096;
 /// Blocks of one segment: segments are reduced in parallel, blocks within one in order.
 const SEGMENT_BLOCKS: usize = 8;
+/// Rows of one segment: the rows are cut into segments from the first row on, whatever the
+/// number of threads or the way they arrive, so the result is the same.
+pub const SEGMENT_ROWS: usize = BLOCK_ROWS * SEGMENT_BLOCKS;
 
 /// `Θ ξ ≈ Y` reduced to `R`, `Z = QᵀY` and the norms of the part of `Y` outside Θ's range.
 #[derive(Clone, Debug)]
@@ -52,28 +55,22 @@ impl ReducedProblem {
         targets: usize,
         block: impl Fn(Range<usize>) -> std::result::Result<(Mat<f64>, Mat<f64>), E> + Sync,
     ) -> std::result::Result<Self, E> {
-        let width = features + targets;
-        let segment_rows = BLOCK_ROWS * SEGMENT_BLOCKS;
-        let segments: Vec<Range<usize>> = (0..rows.div_ceil(segment_rows))
-            .map(|s| s * segment_rows..((s + 1) * segment_rows).min(rows))
+        let segments: Vec<Range<usize>> = (0..rows.div_ceil(SEGMENT_ROWS))
+            .map(|s| s * SEGMENT_ROWS..((s + 1) * SEGMENT_ROWS).min(rows))
             .collect();
         let triangles = segments
             .par_iter()
             .map(|segment| {
-                let mut triangle = Mat::<f64>::zeros(0, width);
-                for start in segment.clone().step_by(BLOCK_ROWS) {
-                    let (theta, y) = block(start..(start + BLOCK_ROWS).min(segment.end))?;
-                    triangle = stacked_triangle(triangle.as_ref(), theta.as_ref(), y.as_ref());
-                }
-                Ok(triangle)
+                segment_triangle(segment.len(), features + targets, |local| {
+                    block(segment.start + local.start..segment.start + local.end)
+                })
             })
             .collect::<std::result::Result<Vec<_>, E>>()?;
-        let mut triangle = Mat::<f64>::zeros(0, width);
-        for next in &triangles {
-            let (upper, lower) = next.split_at_col(features);
-            triangle = stacked_triangle(triangle.as_ref(), upper, lower);
+        let mut reduction = Reduction::new(features, targets);
+        for (segment, triangle) in segments.iter().zip(&triangles) {
+            reduction.merge(triangle, segment.len());
         }
-        Ok(Self::from_triangle(triangle.as_ref(), features, rows))
+        Ok(reduction.finish())
     }
 
     /// Reduces Θ and Y given whole.
@@ -157,6 +154,48 @@ impl ReducedProblem {
     }
 }
 
+/// The triangle of one segment's rows `0..rows` (at most [`SEGMENT_ROWS`]), its blocks in order.
+pub fn segment_triangle<E>(
+    rows: usize,
+    width: usize,
+    block: impl Fn(Range<usize>) -> std::result::Result<(Mat<f64>, Mat<f64>), E>,
+) -> std::result::Result<Mat<f64>, E> {
+    let mut triangle = Mat::<f64>::zeros(0, width);
+    for start in (0..rows).step_by(BLOCK_ROWS) {
+        let (theta, y) = block(start..(start + BLOCK_ROWS).min(rows))?;
+        triangle = stacked_triangle(triangle.as_ref(), theta.as_ref(), y.as_ref());
+    }
+    Ok(triangle)
+}
+
+/// Segments' triangles merged in row order into one reduced problem.
+pub struct Reduction {
+    triangle: Mat<f64>,
+    features: usize,
+    rows: usize,
+}
+
+impl Reduction {
+    pub fn new(features: usize, targets: usize) -> Self {
+        Self {
+            triangle: Mat::zeros(0, features + targets),
+            features,
+            rows: 0,
+        }
+    }
+
+    /// Merges the triangle of the next segment (of `rows` rows).
+    pub fn merge(&mut self, segment: &Mat<f64>, rows: usize) {
+        let (upper, lower) = segment.split_at_col(self.features);
+        self.triangle = stacked_triangle(self.triangle.as_ref(), upper, lower);
+        self.rows += rows;
+    }
+
+    pub fn finish(self) -> ReducedProblem {
+        ReducedProblem::from_triangle(self.triangle.as_ref(), self.features, self.rows)
+    }
+}
+
 /// The upper triangle (at most `width` rows) of the QR factorisation of
 /// `[[triangle], [theta, y]]`.
 fn stacked_triangle(
@@ -206,7 +245,7 @@ mod tests {
     #[test]
     fn the_reduced_problem_has_the_library_gram_matrix_and_residuals() {
         // More rows than one segment, with a short last block.
-        let (theta, y) = sample(BLOCK_ROWS * SEGMENT_BLOCKS + 3 * BLOCK_ROWS + 17, 6);
+        let (theta, y) = sample(SEGMENT_ROWS + 3 * BLOCK_ROWS + 17, 6);
         let reduced = ReducedProblem::new(theta.as_ref(), y.as_ref());
         let gram = theta.transpose() * &theta;
         let moments = theta.transpose() * &y;

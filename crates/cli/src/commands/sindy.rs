@@ -4,8 +4,11 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, anyhow, bail};
-use data::{Derivative, NumericTable};
-use sindy::{FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, SindyError, SindyParams, Trajectory};
+use data::{DEFAULT_UNIFORM_TOLERANCE, Derivative, NumericStream, NumericTable, check_time_column};
+use sindy::{
+    FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, RowBlock, Score, SindyError, SindyModel,
+    SindyParams, Trajectory,
+};
 
 use outputs::{Existing, OutputSet};
 
@@ -68,6 +71,10 @@ pub struct Args {
     /// Allow --out to replace an existing file.
     #[arg(long)]
     pub force: bool,
+    /// Read the CSV in blocks of rows and fit as it is read, in memory that does not grow with
+    /// the file (the default for files over 64 MiB; the file must be a regular file).
+    #[arg(long)]
+    pub stream: bool,
 }
 
 /// The STLSQ threshold when --threshold is not given.
@@ -113,6 +120,100 @@ fn optimizer(args: &Args) -> anyhow::Result<OptimizerSpec> {
     })
 }
 
+/// CSV files larger than this are read in blocks of rows and fitted as they are read
+/// ([`SindyParams::fit_streamed`]): memory then does not grow with the file.
+pub const STREAM_ABOVE_BYTES: u64 = 64 << 20;
+
+/// Rows per block read from a streamed CSV.
+const STREAM_BLOCK_ROWS: usize = 1 << 14;
+
+/// The fit of a file read whole; its model, score on all rows and number of rows.
+fn fit_whole(
+    args: &Args,
+    params: &SindyParams,
+    columns: &[&str],
+    feature_count: usize,
+) -> anyhow::Result<(SindyModel, Score, usize)> {
+    let (time, table) = NumericTable::read_with_time(&args.csv, &args.time, columns)?;
+    let n = table.rows();
+    check_rows(args, n, feature_count, columns)?;
+    let dim_x = args.state.len();
+    let states = Mat::from_fn(n, dim_x, |i, j| table.columns[j][i]);
+    let controls = Mat::from_fn(n, args.control.len(), |i, j| table.columns[dim_x + j][i]);
+    let trajectory = Trajectory::new(time, states)?.with_controls(controls)?;
+    let model = params
+        .fit(std::slice::from_ref(&trajectory))
+        .map_err(|error| fit_error(args, error, |row| table.line(row)))?;
+    let score = model.score(&trajectory)?;
+    Ok((model, score, n))
+}
+
+/// The fit of a file read in two passes of blocks: the time column (checked as a uniform axis,
+/// 8 bytes per row held), then the rows, fitted as they come.
+fn fit_streamed(
+    args: &Args,
+    params: &SindyParams,
+    columns: &[&str],
+    feature_count: usize,
+) -> anyhow::Result<(SindyModel, Score, usize)> {
+    let mut stream = NumericStream::open(&args.csv, &[args.time.as_str()])?;
+    let mut time = Vec::new();
+    while let Some(block) = stream.next_block(STREAM_BLOCK_ROWS)? {
+        time.extend(block.columns.into_iter().flatten());
+    }
+    check_time_column(&args.csv, &args.time, &time, DEFAULT_UNIFORM_TOLERANCE)?;
+    let n = time.len();
+    check_rows(args, n, feature_count, columns)?;
+    let dt = (time[n - 1] - time[0]) / (n - 1) as f64;
+    drop(time);
+    let mut stream = NumericStream::open(&args.csv, columns)?;
+    let fit = params
+        .fit_streamed(n, dt, || {
+            Ok(stream.next_block(STREAM_BLOCK_ROWS)?.map(|block| RowBlock {
+                columns: block.columns,
+            }))
+        })
+        .map_err(|error| fit_error(args, error, |row| row + 2))?;
+    Ok((fit.model, fit.score, n))
+}
+
+fn check_rows(args: &Args, n: usize, feature_count: usize, columns: &[&str]) -> anyhow::Result<()> {
+    if n < feature_count {
+        bail!(
+            "{}: {n} data rows, fewer than the {feature_count} features of library {} on {}: \
+             the fit needs at least one row per feature",
+            args.csv.display(),
+            args.library,
+            columns.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// A fit's error, a non-finite value named by the line of its row.
+fn fit_error(args: &Args, error: SindyError, line: impl Fn(usize) -> usize) -> anyhow::Error {
+    match error {
+        SindyError::NonFinite {
+            what,
+            row,
+            column,
+            value,
+        } => {
+            let hint = if what == "library" {
+                format!(" (values too large for library {}?)", args.library)
+            } else {
+                String::new()
+            };
+            anyhow!(
+                "{}:{}: {column} is not finite ({value}) on this row{hint}",
+                args.csv.display(),
+                line(row),
+            )
+        }
+        other => anyhow::Error::new(other).context(format!("fitting {}", args.csv.display())),
+    }
+}
+
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     // Everything that can be checked without reading the file is checked first.
     let library = FeatureLibrary::from_spec(&LibrarySpec::parse(&args.library)?)?;
@@ -150,51 +251,20 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         None => None,
     };
 
-    let (time, table) = NumericTable::read_with_time(&args.csv, &args.time, &columns)?;
-    let n = table.rows();
-    if n < feature_count {
-        bail!(
-            "{}: {n} data rows, fewer than the {feature_count} features of library {} on {}: \
-             the fit needs at least one row per feature",
-            args.csv.display(),
-            args.library,
-            columns.join(", ")
-        );
-    }
-    let dim_x = args.state.len();
-    let states = Mat::from_fn(n, dim_x, |i, j| table.columns[j][i]);
-    let controls = Mat::from_fn(n, args.control.len(), |i, j| table.columns[dim_x + j][i]);
-    let trajectory = Trajectory::new(time, states)?.with_controls(controls)?;
-
     let state_names: Vec<&str> = args.state.iter().map(String::as_str).collect();
     let control_names: Vec<&str> = args.control.iter().map(String::as_str).collect();
-    let model = SindyParams::new(&state_names, &control_names)
+    let params = SindyParams::new(&state_names, &control_names)
         .library(library)
         .optimizer(optimizer)
-        .derivative(derivative)
-        .fit(std::slice::from_ref(&trajectory))
-        .map_err(|error| match error {
-            // One sample is one row of the file: name its line.
-            SindyError::NonFinite {
-                what,
-                row,
-                column,
-                value,
-            } => {
-                let hint = if what == "library" {
-                    format!(" (values too large for library {}?)", args.library)
-                } else {
-                    String::new()
-                };
-                anyhow!(
-                    "{}:{}: {column} is not finite ({value}) on this row{hint}",
-                    args.csv.display(),
-                    table.line(row),
-                )
-            }
-            other => anyhow::Error::new(other).context(format!("fitting {}", args.csv.display())),
-        })?;
-    let score = model.score(&trajectory)?;
+        .derivative(derivative);
+    let streamed = args.stream
+        || std::fs::metadata(&args.csv)
+            .is_ok_and(|metadata| metadata.is_file() && metadata.len() > STREAM_ABOVE_BYTES);
+    let (model, score, n) = if streamed {
+        fit_streamed(&args, &params, &columns, feature_count)?
+    } else {
+        fit_whole(&args, &params, &columns, feature_count)?
+    };
     // Finite inputs can still give an unusable fit (e.g. time steps so small that the derivative
     // estimates overflow): an error, not equations and a score of inf or NaN.
     if !(score.mse.is_finite() && (score.r2.is_finite() || !score.r2_defined())) {

@@ -1,0 +1,300 @@
+//! Fitting a recording too long to hold whole: its rows arrive in blocks, each state's derivative
+//! is estimated with the neighbouring rows its stencil reads, and the library is evaluated and
+//! reduced segment by segment ([`crate::ReducedProblem`]). Memory is a few segments whatever the
+//! length; the coefficients are those of [`SindyParams::fit_matrices`] on the whole recording (the
+//! same segments, merged in the same order), and the score follows from the reduced problem.
+
+use data::Derivative;
+use faer::Mat;
+use rayon::prelude::*;
+
+use crate::error::{Result, SindyError, shape};
+use crate::model::{CONSTANT_RELATIVE_SPREAD, Score, SindyModel, SindyParams};
+use crate::reduced::{Reduction, SEGMENT_ROWS, segment_triangle};
+
+/// Consecutive rows of a recording: one vector per state, then one per control.
+#[derive(Clone, Debug, Default)]
+pub struct RowBlock {
+    pub columns: Vec<Vec<f64>>,
+}
+
+/// A model fitted on a streamed recording, with its score on all rows.
+#[derive(Clone, Debug)]
+pub struct StreamedFit {
+    pub model: SindyModel,
+    pub score: Score,
+    pub rows: usize,
+}
+
+/// Rows before and after a sample that its derivative estimate may read (edge formulas included).
+fn context(derivative: Derivative) -> (usize, usize) {
+    match derivative {
+        Derivative::Forward => (1, 1),
+        Derivative::Central => (2, 2),
+        Derivative::SavitzkyGolay { window, .. } => (window, window),
+    }
+}
+
+/// Count, mean, sum of squared deviations and largest magnitude of one target column.
+#[derive(Clone, Copy, Debug, Default)]
+struct Moments {
+    count: f64,
+    mean: f64,
+    spread: f64,
+    largest: f64,
+}
+
+impl Moments {
+    fn of(values: &[f64]) -> Self {
+        let count = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / count.max(1.0);
+        let spread = values.iter().map(|v| (v - mean).powi(2)).sum();
+        let largest = values.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+        Self {
+            count,
+            mean,
+            spread,
+            largest,
+        }
+    }
+
+    /// Chan, Golub and LeVeque's pairwise update.
+    fn merge(self, other: Self) -> Self {
+        let count = self.count + other.count;
+        if count == 0.0 {
+            return self;
+        }
+        let delta = other.mean - self.mean;
+        Self {
+            count,
+            mean: self.mean + delta * other.count / count,
+            spread: self.spread + other.spread + delta * delta * self.count * other.count / count,
+            largest: self.largest.max(other.largest),
+        }
+    }
+}
+
+/// One segment ready to reduce: inputs [x, u] and targets ẋ, from global row `start`.
+struct Segment {
+    start: usize,
+    inputs: Mat<f64>,
+    targets: Mat<f64>,
+}
+
+/// What a reduced segment hands to the merge: its triangle, target moments, feature sizes.
+type Reduced = (Mat<f64>, Vec<Moments>, Vec<f64>, usize);
+
+impl SindyParams {
+    /// Fits on a recording of `rows` rows sampled every `dt` seconds whose blocks `next` yields in
+    /// order (any block sizes; `None` at the end). Its derivatives are those of
+    /// [`crate::Trajectory`] with the same `dt`. Errors name rows 0-based from the first.
+    pub fn fit_streamed(
+        &self,
+        rows: usize,
+        dt: f64,
+        mut next: impl FnMut() -> Result<Option<RowBlock>>,
+    ) -> Result<StreamedFit> {
+        let (dim_x, dim_u) = (self.state_names().len(), self.control_names().len());
+        let width = dim_x + dim_u;
+        let features = self.library_feature_count(width);
+        let derivative = self.derivative_estimator();
+        derivative.validate()?;
+        if rows < derivative.min_samples().max(2) {
+            return Err(shape(
+                "recording",
+                format!("{rows} rows, too few for the {derivative} derivative"),
+            ));
+        }
+        let (left, right) = context(derivative);
+        let optimizer = self.checked_optimizer()?;
+        let mut buffer: Vec<Vec<f64>> = vec![Vec::new(); width];
+        let mut buffer_start = 0;
+        let mut read = 0;
+        let mut reduction = Reduction::new(features, dim_x);
+        let mut moments = vec![Moments::default(); dim_x];
+        let mut sizes = vec![0.0f64; features];
+        let batch = rayon::current_num_threads().max(1);
+        let mut pending: Vec<Segment> = Vec::new();
+        for start in (0..rows).step_by(SEGMENT_ROWS) {
+            let end = (start + SEGMENT_ROWS).min(rows);
+            let needed = (end + right).min(rows);
+            while read < needed {
+                let block = next()?.ok_or_else(|| {
+                    shape(
+                        "recording",
+                        format!("ended after {read} rows, {rows} were counted"),
+                    )
+                })?;
+                if block.columns.len() != width {
+                    return Err(shape(
+                        "recording",
+                        format!(
+                            "a block of {} columns, {width} expected",
+                            block.columns.len()
+                        ),
+                    ));
+                }
+                read += block.columns[0].len();
+                for (column, values) in buffer.iter_mut().zip(block.columns) {
+                    column.extend(values);
+                }
+            }
+            pending.push(self.segment(&buffer, buffer_start, start..end, needed, dt)?);
+            // Keep the rows the next segment's left context needs.
+            let keep_from = end.saturating_sub(left).max(buffer_start);
+            for column in &mut buffer {
+                column.drain(..keep_from - buffer_start);
+            }
+            buffer_start = keep_from;
+            if pending.len() == batch || end == rows {
+                let reduced = pending
+                    .par_iter()
+                    .map(|segment| self.reduce_segment(segment, features))
+                    .collect::<Result<Vec<Reduced>>>()?;
+                for (triangle, segment_moments, segment_sizes, count) in reduced {
+                    reduction.merge(&triangle, count);
+                    for (total, part) in moments.iter_mut().zip(segment_moments) {
+                        *total = total.merge(part);
+                    }
+                    for (total, part) in sizes.iter_mut().zip(segment_sizes) {
+                        *total = total.max(part);
+                    }
+                }
+                pending.clear();
+            }
+        }
+        let names = self.feature_names_for_inputs();
+        crate::model::check_scale(&sizes, &names)?;
+        let reduced = reduction.finish();
+        let coefficients = optimizer.fit_reduced(&reduced, self.state_names())?;
+        let residuals = reduced.residual_sum_of_squares(coefficients.as_ref());
+        let model = self.model(names, coefficients);
+        Ok(StreamedFit {
+            model,
+            score: score(&residuals, &moments, rows),
+            rows,
+        })
+    }
+
+    /// Inputs and targets of the rows `range`, from the buffer (global rows from `buffer_start`)
+    /// that holds the rows up to `available`.
+    fn segment(
+        &self,
+        buffer: &[Vec<f64>],
+        buffer_start: usize,
+        range: std::ops::Range<usize>,
+        available: usize,
+        dt: f64,
+    ) -> Result<Segment> {
+        let dim_x = self.state_names().len();
+        let (left, _) = context(self.derivative_estimator());
+        let from = range.start.saturating_sub(left).max(buffer_start);
+        let local = |global: usize| global - buffer_start;
+        let rows = range.len();
+        let mut targets = Mat::zeros(rows, dim_x);
+        for (j, column) in buffer.iter().take(dim_x).enumerate() {
+            let window = &column[local(from)..local(available)];
+            let derivative = self.derivative_estimator().apply(window, dt)?;
+            for k in 0..rows {
+                targets[(k, j)] = derivative[range.start - from + k];
+            }
+        }
+        let inputs = Mat::from_fn(rows, buffer.len(), |k, j| buffer[j][local(range.start + k)]);
+        Ok(Segment {
+            start: range.start,
+            inputs,
+            targets,
+        })
+    }
+
+    /// One segment's triangle, target moments and feature sizes; non-finite values are errors
+    /// naming their global row.
+    fn reduce_segment(&self, segment: &Segment, features: usize) -> Result<Reduced> {
+        let at_row = |error: SindyError| match error {
+            SindyError::NonFinite {
+                what,
+                row,
+                column,
+                value,
+            } => SindyError::NonFinite {
+                what,
+                row: segment.start + row,
+                column,
+                value,
+            },
+            other => other,
+        };
+        self.check_values(segment.inputs.as_ref(), segment.targets.as_ref())
+            .map_err(at_row)?;
+        let names = self.feature_names_for_inputs();
+        let sizes = std::sync::Mutex::new(vec![0.0f64; features]);
+        let rows = segment.inputs.nrows();
+        let triangle = segment_triangle(rows, features + segment.targets.ncols(), |block| {
+            let theta = self
+                .feature_library()
+                .transform(segment.inputs.subrows(block.start, block.len()));
+            crate::model::check_finite("library", theta.as_ref(), &|j| {
+                format!("feature '{}'", names[j])
+            })
+            .map_err(|e| match e {
+                SindyError::NonFinite {
+                    what,
+                    row,
+                    column,
+                    value,
+                } => at_row(SindyError::NonFinite {
+                    what,
+                    row: block.start + row,
+                    column,
+                    value,
+                }),
+                other => other,
+            })?;
+            if let Ok(mut sizes) = sizes.lock() {
+                for (size, block_size) in sizes
+                    .iter_mut()
+                    .zip(crate::model::column_sizes(theta.as_ref()))
+                {
+                    *size = size.max(block_size);
+                }
+            }
+            Ok::<_, SindyError>((
+                theta,
+                segment.targets.subrows(block.start, block.len()).to_owned(),
+            ))
+        })?;
+        let moments = (0..segment.targets.ncols())
+            .map(|j| Moments::of(&segment.targets.col(j).iter().copied().collect::<Vec<_>>()))
+            .collect();
+        let sizes = sizes
+            .into_inner()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        Ok((triangle, moments, sizes, rows))
+    }
+}
+
+/// The score from each target's residual sum of squares and moments (as [`SindyModel::score`]).
+fn score(residuals: &[f64], moments: &[Moments], rows: usize) -> Score {
+    let constant_states: Vec<usize> = (0..moments.len())
+        .filter(|&j| {
+            let m = moments[j];
+            (m.spread / m.count.max(1.0)).sqrt() <= CONSTANT_RELATIVE_SPREAD * m.largest
+        })
+        .collect();
+    let r2_of = |j: usize| match (moments[j].spread > 0.0, residuals[j] > 0.0) {
+        (true, _) => 1.0 - residuals[j] / moments[j].spread,
+        (false, false) => 1.0,
+        (false, true) => 0.0,
+    };
+    let varying: Vec<usize> = (0..moments.len())
+        .filter(|j| !constant_states.contains(j))
+        .collect();
+    let m = moments.len().max(1) as f64;
+    Score {
+        mse: residuals.iter().sum::<f64>() / (rows as f64 * m),
+        r2: (0..moments.len()).map(r2_of).sum::<f64>() / m,
+        r2_varying: (!varying.is_empty())
+            .then(|| varying.iter().map(|&j| r2_of(j)).sum::<f64>() / varying.len() as f64),
+        constant_states,
+    }
+}

@@ -12,8 +12,9 @@
 //!    second run into it is refused), and a staging folder (`.learn-staging-<pid>-*`) is made in
 //!    it, which proves it writable; every subfolder of a planned file gets a probe file;
 //! 4. the work writes into the staging paths ([`Staged::dir`], [`Staged::path`]);
-//! 5. **commit** ([`Staged::commit`]): per folder, a journal, renames into place, stale own files
-//!    removed, the manifest (`.learn-outputs.json`) rewritten. An interrupt (SIGINT, SIGTERM) or a
+//! 5. **commit** ([`Staged::commit`]): a journal in every folder of the set first (if one cannot be
+//!    written, the others are withdrawn and nothing moves), then per folder the renames into
+//!    place, stale own files removed, the manifest (`.learn-outputs.json`) rewritten. An interrupt (SIGINT, SIGTERM) or a
 //!    failure before the commit removes the staging and leaves the old set as it was; SIGKILL
 //!    leaves a hidden staging folder that the next run into the folder removes, and a journal that
 //!    it finishes.

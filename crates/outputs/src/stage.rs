@@ -299,9 +299,27 @@ impl Staged {
     pub fn commit(mut self) -> Result<Vec<PathBuf>> {
         self.committed = true;
         let mut registry = signals::hold();
-        let mut written = Vec::new();
+        // Every folder's journal first, then the moves: a run killed during the moves leaves a
+        // journal in every folder of the set, and the next run into them completes all of them.
+        let mut journals = Vec::with_capacity(self.folders.len());
         for folder in &self.folders {
-            written.extend(commit_folder(folder, &self.producer, self.remove_stale)?);
+            match write_journal(folder, &self.producer, self.remove_stale) {
+                Ok(journal) => journals.push(journal),
+                Err(error) => {
+                    // Nothing has moved yet: withdrawing the journals leaves every folder as it was.
+                    for done in &self.folders[..journals.len()] {
+                        let _ = std::fs::remove_file(done.plan.dir.join(JOURNAL));
+                    }
+                    self.committed = false;
+                    return Err(error);
+                }
+            }
+        }
+        let mut written = Vec::new();
+        for (folder, journal) in self.folders.iter().zip(&journals) {
+            let dir = &folder.plan.dir;
+            apply(dir, journal)?;
+            written.extend(journal.moves.iter().map(|key| manifest::path_of(dir, key)));
             signals::unregister(&mut registry, folder.staging.path());
         }
         for file in std::mem::take(&mut self.files) {
@@ -316,12 +334,9 @@ impl Staged {
     }
 }
 
-/// One folder's commit: every staged file must be planned or at least not foreign.
-fn commit_folder(
-    folder: &StagedFolder,
-    producer: &str,
-    remove_stale: bool,
-) -> Result<Vec<PathBuf>> {
+/// One folder's commit journal, written: every staged file must be planned or at least not
+/// foreign.
+fn write_journal(folder: &StagedFolder, producer: &str, remove_stale: bool) -> Result<Journal> {
     let dir = &folder.plan.dir;
     let moves = staged_files(folder.staging.path())?;
     let old = Manifest::read(dir)?;
@@ -356,12 +371,7 @@ fn commit_folder(
         message: error.to_string(),
     })?;
     write_atomically(&dir.join(JOURNAL), &text)?;
-    apply(dir, &journal)?;
-    Ok(journal
-        .moves
-        .iter()
-        .map(|key| manifest::path_of(dir, key))
-        .collect())
+    Ok(journal)
 }
 
 impl Drop for Staged {

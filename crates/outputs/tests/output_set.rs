@@ -200,3 +200,34 @@ fn a_manifest_cannot_reach_outside_its_folder() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A set of two folders whose second cannot take its commit journal: the first folder keeps its
+/// old files (no folder of the set is committed alone) and no journal is left to finish later.
+#[test]
+fn a_commit_that_fails_in_one_folder_changes_none() {
+    let dir = scratch("two-folders");
+    let (first, second) = (dir.join("a"), dir.join("b"));
+    for (folder, content) in [(&first, "old a"), (&second, "old b")] {
+        run(folder, "p", &[("x.json", content)], Existing::Refuse).unwrap();
+    }
+    let mut set = OutputSet::new("p");
+    let folder_a = set.folder(&first, "--out", Existing::Replace);
+    let folder_b = set.folder(&second, "--latex-dir", Existing::Replace);
+    set.file_in(folder_a, "x.json");
+    set.file_in(folder_b, "x.json");
+    let staged = set.prepare().unwrap();
+    std::fs::write(staged.dir(folder_a).join("x.json"), "new a").unwrap();
+    std::fs::write(staged.dir(folder_b).join("x.json"), "new b").unwrap();
+    // A directory where the second folder's journal goes: its atomic write cannot rename onto it.
+    std::fs::create_dir_all(second.join(".learn-commit.json/blocked")).unwrap();
+    assert!(staged.commit().is_err());
+    assert_eq!(
+        std::fs::read_to_string(first.join("x.json")).unwrap(),
+        "old a"
+    );
+    assert_eq!(
+        std::fs::read_to_string(second.join("x.json")).unwrap(),
+        "old b"
+    );
+    assert!(!first.join(".learn-commit.json").exists());
+}

@@ -36,7 +36,7 @@ pub enum SindyError {
     /// Library features of sizes too far apart for a least-squares fit in double precision.
     #[error(
         "the library's features differ in size by more than 1e12 (feature '{large_feature}' \
-         reaches {large:e}, feature '{small_feature}' only {small:e}): a fit in double precision \
+         reaches {large:.2e}, feature '{small_feature}' only {small:.2e}): a fit in double precision \
          cannot resolve them; rescale the data (e.g. to units where values lie between 1e-3 and \
          1e3)"
     )]

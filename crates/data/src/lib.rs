@@ -49,7 +49,7 @@ pub use source::{
 };
 pub use split::{Split, SplitSpec};
 pub use stream::{NumericBlock, NumericStream};
-pub use time::{DEFAULT_UNIFORM_TOLERANCE, check_time_axis, check_time_column};
+pub use time::{DEFAULT_UNIFORM_TOLERANCE, StreamedTimeAxis, check_time_axis};
 
 /// Re-exported so that downstream crates name the same matrix type.
 pub use faer::Mat;

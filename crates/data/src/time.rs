@@ -16,11 +16,6 @@ pub fn check_time_axis(path: &Path, time: &[f64], tolerance: f64) -> Result<()> 
     check_time_axis_at(path, "t", time, tolerance, &file_row)
 }
 
-/// [`check_time_axis`] of the time column named `column` of a file with one line per row.
-pub fn check_time_column(path: &Path, column: &str, time: &[f64], tolerance: f64) -> Result<()> {
-    check_time_axis_at(path, column, time, tolerance, &file_row)
-}
-
 /// [`check_time_axis`] of the time column named `column`, with `line(k)` the line of the file that
 /// holds sample `k` (for files whose cells span lines). Errors name `column`.
 pub(crate) fn check_time_axis_at(
@@ -176,5 +171,111 @@ mod tests {
         assert!(message.contains("sample interval 20 s"), "{message}");
         let t: Vec<f64> = (0..5).map(|k| k as f64 * 0.02).collect();
         check_interval_range(Path::new("f.csv"), "t", &t, (1e-4, 10.0), &file_row).unwrap();
+    }
+}
+
+/// Gaps from which [`StreamedTimeAxis`] takes its reference step.
+const REFERENCE_GAPS: usize = 4096;
+
+/// The checks of [`check_time_column`] on a time column read in blocks, in constant memory:
+/// strictly increasing, and every gap within `tolerance` of a reference step, the median of the
+/// first [`REFERENCE_GAPS`] gaps (the whole column's median would need every gap at once). Errors
+/// name the line (one line per row).
+pub struct StreamedTimeAxis {
+    path: std::path::PathBuf,
+    column: String,
+    tolerance: f64,
+    first: f64,
+    last: f64,
+    rows: usize,
+    reference: Option<f64>,
+    /// The first gaps, with the row each ends on, until the reference is known.
+    pending: Vec<(usize, f64)>,
+}
+
+impl StreamedTimeAxis {
+    pub fn new(path: &Path, column: &str, tolerance: f64) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            column: column.to_string(),
+            tolerance,
+            first: f64::NAN,
+            last: f64::NAN,
+            rows: 0,
+            reference: None,
+            pending: Vec::new(),
+        }
+    }
+
+    /// The next values of the column.
+    pub fn push(&mut self, values: &[f64]) -> Result<()> {
+        for &value in values {
+            let row = self.rows;
+            self.rows += 1;
+            if row == 0 {
+                (self.first, self.last) = (value, value);
+                continue;
+            }
+            if value <= self.last {
+                return Err(DataError::TimeNotIncreasing {
+                    path: self.path.clone(),
+                    row: file_row(row),
+                    column: self.column.clone(),
+                    previous: self.last,
+                    current: value,
+                });
+            }
+            let gap = value - self.last;
+            self.last = value;
+            match self.reference {
+                Some(step) => self.check_gap(row, gap, step)?,
+                None => {
+                    self.pending.push((row, gap));
+                    if self.pending.len() == REFERENCE_GAPS {
+                        self.settle()?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The number of rows and the mean step `(t_last − t_first) / (rows − 1)`.
+    pub fn finish(mut self) -> Result<(usize, f64)> {
+        if self.rows < 2 {
+            return Err(DataError::TooShort {
+                path: self.path.clone(),
+                rows: self.rows,
+                needed: 2,
+            });
+        }
+        if self.reference.is_none() {
+            self.settle()?;
+        }
+        Ok((self.rows, (self.last - self.first) / (self.rows - 1) as f64))
+    }
+
+    fn settle(&mut self) -> Result<()> {
+        let mut gaps: Vec<f64> = self.pending.iter().map(|p| p.1).collect();
+        gaps.sort_by(f64::total_cmp);
+        let step = gaps[gaps.len() / 2];
+        self.reference = Some(step);
+        for (row, gap) in std::mem::take(&mut self.pending) {
+            self.check_gap(row, gap, step)?;
+        }
+        Ok(())
+    }
+
+    fn check_gap(&self, row: usize, gap: f64, step: f64) -> Result<()> {
+        if (gap - step).abs() > self.tolerance * step {
+            return Err(DataError::NonUniformSampling {
+                path: self.path.clone(),
+                row: file_row(row),
+                column: self.column.clone(),
+                gap,
+                median: step,
+            });
+        }
+        Ok(())
     }
 }

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, anyhow, bail};
-use data::{DEFAULT_UNIFORM_TOLERANCE, Derivative, NumericStream, NumericTable, check_time_column};
+use data::{DEFAULT_UNIFORM_TOLERANCE, Derivative, NumericStream, NumericTable, StreamedTimeAxis};
 use sindy::{
     FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, RowBlock, Score, SindyError, SindyModel,
     SindyParams, Trajectory,
@@ -72,7 +72,7 @@ pub struct Args {
     #[arg(long)]
     pub force: bool,
     /// Read the CSV in blocks of rows and fit as it is read, in memory that does not grow with
-    /// the file (the default for files over 64 MiB; the file must be a regular file).
+    /// the file (the default for files over 8 MiB; the file must be a regular file).
     #[arg(long)]
     pub stream: bool,
 }
@@ -122,7 +122,7 @@ fn optimizer(args: &Args) -> anyhow::Result<OptimizerSpec> {
 
 /// CSV files larger than this are read in blocks of rows and fitted as they are read
 /// ([`SindyParams::fit_streamed`]): memory then does not grow with the file.
-pub const STREAM_ABOVE_BYTES: u64 = 64 << 20;
+pub const STREAM_ABOVE_BYTES: u64 = 8 << 20;
 
 /// Rows per block read from a streamed CSV.
 const STREAM_BLOCK_ROWS: usize = 1 << 14;
@@ -148,8 +148,8 @@ fn fit_whole(
     Ok((model, score, n))
 }
 
-/// The fit of a file read in two passes of blocks: the time column (checked as a uniform axis,
-/// 8 bytes per row held), then the rows, fitted as they come.
+/// The fit of a file read in two passes of blocks: the time column (checked as a uniform axis),
+/// then the rows, fitted as they come.
 fn fit_streamed(
     args: &Args,
     params: &SindyParams,
@@ -157,15 +157,12 @@ fn fit_streamed(
     feature_count: usize,
 ) -> anyhow::Result<(SindyModel, Score, usize)> {
     let mut stream = NumericStream::open(&args.csv, &[args.time.as_str()])?;
-    let mut time = Vec::new();
+    let mut axis = StreamedTimeAxis::new(&args.csv, &args.time, DEFAULT_UNIFORM_TOLERANCE);
     while let Some(block) = stream.next_block(STREAM_BLOCK_ROWS)? {
-        time.extend(block.columns.into_iter().flatten());
+        axis.push(&block.columns[0])?;
     }
-    check_time_column(&args.csv, &args.time, &time, DEFAULT_UNIFORM_TOLERANCE)?;
-    let n = time.len();
+    let (n, dt) = axis.finish()?;
     check_rows(args, n, feature_count, columns)?;
-    let dt = (time[n - 1] - time[0]) / (n - 1) as f64;
-    drop(time);
     let mut stream = NumericStream::open(&args.csv, columns)?;
     let fit = params
         .fit_streamed(n, dt, || {

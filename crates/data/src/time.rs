@@ -95,85 +95,6 @@ pub(crate) fn check_interval_range(
     Ok(())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn uniform_axis_passes() {
-        let t: Vec<f64> = (0..100).map(|k| k as f64 * 0.02).collect();
-        check_time_axis(Path::new("f.csv"), &t, DEFAULT_UNIFORM_TOLERANCE).unwrap();
-    }
-
-    #[test]
-    fn reports_the_worst_gap_and_its_row() {
-        let mut t: Vec<f64> = (0..100).map(|k| k as f64 * 0.02).collect();
-        for v in t.iter_mut().skip(40) {
-            *v += 0.03;
-        }
-        for v in t.iter_mut().skip(70) {
-            *v += 0.01;
-        }
-        let message = check_time_axis(Path::new("f.csv"), &t, 0.01)
-            .unwrap_err()
-            .to_string();
-        // Sample 40 is data row 40 (0-based), line 42 of the file.
-        assert!(message.starts_with("f.csv:42:t:"), "{message}");
-        assert!(message.contains("worst gap 0.05"), "{message}");
-    }
-
-    #[test]
-    fn repeated_time_is_not_increasing() {
-        let t = [0.0, 0.02, 0.02, 0.06];
-        let message = check_time_axis(Path::new("f.csv"), &t, 0.01)
-            .unwrap_err()
-            .to_string();
-        assert!(
-            message.contains("f.csv:4:t: time is not strictly increasing"),
-            "{message}"
-        );
-    }
-
-    #[test]
-    fn errors_name_the_time_column_they_check() {
-        let t = [0.0, 0.02, 0.01, 0.06];
-        let message = check_time_axis_at(Path::new("f.csv"), "time", &t, 0.01, &file_row)
-            .unwrap_err()
-            .to_string();
-        assert!(
-            message.starts_with("f.csv:4:time: time is not strictly increasing"),
-            "{message}"
-        );
-        let t = [0.0, 0.02, 0.04, 0.1];
-        let message = check_time_axis_at(Path::new("f.csv"), "time", &t, 0.01, &file_row)
-            .unwrap_err()
-            .to_string();
-        assert!(
-            message.starts_with("f.csv:5:time: sample interval is not uniform"),
-            "{message}"
-        );
-    }
-
-    #[test]
-    fn intervals_outside_the_range_are_named_compactly() {
-        let t: Vec<f64> = (0..5).map(|k| k as f64 * 2e-302).collect();
-        let message = check_interval_range(Path::new("f.csv"), "t", &t, (1e-4, 10.0), &file_row)
-            .unwrap_err()
-            .to_string();
-        assert_eq!(
-            message,
-            "f.csv:3:t: sample interval 2e-302 s is outside the plausible range [0.0001, 10] s of a flight log (is the time in seconds?)"
-        );
-        let t = [0.0, 20.0, 40.0];
-        let message = check_interval_range(Path::new("f.csv"), "t", &t, (1e-4, 10.0), &file_row)
-            .unwrap_err()
-            .to_string();
-        assert!(message.contains("sample interval 20 s"), "{message}");
-        let t: Vec<f64> = (0..5).map(|k| k as f64 * 0.02).collect();
-        check_interval_range(Path::new("f.csv"), "t", &t, (1e-4, 10.0), &file_row).unwrap();
-    }
-}
-
 /// Gaps from which [`StreamedTimeAxis`] takes its reference step.
 const REFERENCE_GAPS: usize = 4096;
 
@@ -277,5 +198,84 @@ impl StreamedTimeAxis {
             });
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_axis_passes() {
+        let t: Vec<f64> = (0..100).map(|k| k as f64 * 0.02).collect();
+        check_time_axis(Path::new("f.csv"), &t, DEFAULT_UNIFORM_TOLERANCE).unwrap();
+    }
+
+    #[test]
+    fn reports_the_worst_gap_and_its_row() {
+        let mut t: Vec<f64> = (0..100).map(|k| k as f64 * 0.02).collect();
+        for v in t.iter_mut().skip(40) {
+            *v += 0.03;
+        }
+        for v in t.iter_mut().skip(70) {
+            *v += 0.01;
+        }
+        let message = check_time_axis(Path::new("f.csv"), &t, 0.01)
+            .unwrap_err()
+            .to_string();
+        // Sample 40 is data row 40 (0-based), line 42 of the file.
+        assert!(message.starts_with("f.csv:42:t:"), "{message}");
+        assert!(message.contains("worst gap 0.05"), "{message}");
+    }
+
+    #[test]
+    fn repeated_time_is_not_increasing() {
+        let t = [0.0, 0.02, 0.02, 0.06];
+        let message = check_time_axis(Path::new("f.csv"), &t, 0.01)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("f.csv:4:t: time is not strictly increasing"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn errors_name_the_time_column_they_check() {
+        let t = [0.0, 0.02, 0.01, 0.06];
+        let message = check_time_axis_at(Path::new("f.csv"), "time", &t, 0.01, &file_row)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.starts_with("f.csv:4:time: time is not strictly increasing"),
+            "{message}"
+        );
+        let t = [0.0, 0.02, 0.04, 0.1];
+        let message = check_time_axis_at(Path::new("f.csv"), "time", &t, 0.01, &file_row)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.starts_with("f.csv:5:time: sample interval is not uniform"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn intervals_outside_the_range_are_named_compactly() {
+        let t: Vec<f64> = (0..5).map(|k| k as f64 * 2e-302).collect();
+        let message = check_interval_range(Path::new("f.csv"), "t", &t, (1e-4, 10.0), &file_row)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            message,
+            "f.csv:3:t: sample interval 2e-302 s is outside the plausible range [0.0001, 10] s of a flight log (is the time in seconds?)"
+        );
+        let t = [0.0, 20.0, 40.0];
+        let message = check_interval_range(Path::new("f.csv"), "t", &t, (1e-4, 10.0), &file_row)
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("sample interval 20 s"), "{message}");
+        let t: Vec<f64> = (0..5).map(|k| k as f64 * 0.02).collect();
+        check_interval_range(Path::new("f.csv"), "t", &t, (1e-4, 10.0), &file_row).unwrap();
     }
 }

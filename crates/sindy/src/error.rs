@@ -121,3 +121,23 @@ pub(crate) fn shape(what: &str, message: impl Into<String>) -> SindyError {
         message: message.into(),
     }
 }
+
+impl SindyError {
+    /// A non-finite value's row counted from `offset` rows earlier (a block's row in its fit).
+    pub(crate) fn offset_row(self, offset: usize) -> Self {
+        match self {
+            Self::NonFinite {
+                what,
+                row,
+                column,
+                value,
+            } => Self::NonFinite {
+                what,
+                row: offset + row,
+                column,
+                value,
+            },
+            other => other,
+        }
+    }
+}

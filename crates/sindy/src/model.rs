@@ -238,44 +238,35 @@ impl SindyParams {
         let names = self.input_names();
         let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
         let feature_names = self.library.feature_names(&input_names);
-        // The largest magnitude of each feature over all blocks (a maximum: any order gives it).
-        let sizes = std::sync::Mutex::new(vec![0.0f64; features]);
+        let sizes = FeatureSizes::new(features);
         let reduced =
             ReducedProblem::from_row_blocks(inputs.nrows(), features, targets.ncols(), |rows| {
-                let theta = self
-                    .library
-                    .transform(inputs.subrows(rows.start, rows.len()));
-                check_finite("library", theta.as_ref(), &|j| {
-                    format!("feature '{}'", feature_names[j])
-                })
-                .map_err(|error| match error {
-                    SindyError::NonFinite {
-                        what,
-                        row,
-                        column,
-                        value,
-                    } => SindyError::NonFinite {
-                        what,
-                        row: rows.start + row,
-                        column,
-                        value,
-                    },
-                    other => other,
-                })?;
-                let block_sizes = column_sizes(theta.as_ref());
-                if let Ok(mut sizes) = sizes.lock() {
-                    for (size, block) in sizes.iter_mut().zip(block_sizes) {
-                        *size = size.max(block);
-                    }
-                }
+                let inputs = inputs.subrows(rows.start, rows.len());
+                let theta = self.library_block(inputs, rows.start, &feature_names, &sizes)?;
                 Ok::<_, SindyError>((theta, targets.subrows(rows.start, rows.len()).to_owned()))
             })?;
-        let sizes = sizes
-            .into_inner()
-            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        let sizes = sizes.into_vec();
         check_scale(&sizes, &feature_names)?;
         let coefficients = optimizer.fit_reduced(&reduced, &self.state_names)?;
         Ok(self.model(feature_names, coefficients))
+    }
+
+    /// The library on a block of rows whose first is row `first_row` of the fit: checked finite
+    /// (an error names the row of the fit), its features' sizes recorded in `sizes`.
+    pub(crate) fn library_block(
+        &self,
+        inputs: MatRef<'_, f64>,
+        first_row: usize,
+        feature_names: &[String],
+        sizes: &FeatureSizes,
+    ) -> Result<Mat<f64>> {
+        let theta = self.library.transform(inputs);
+        check_finite("library", theta.as_ref(), &|j| {
+            format!("feature '{}'", feature_names[j])
+        })
+        .map_err(|error| error.offset_row(first_row))?;
+        sizes.record(theta.as_ref());
+        Ok(theta)
     }
 
     /// [`Self::fit_matrices`], also returning Θ(X) of the inputs (to predict on them for free).
@@ -354,10 +345,6 @@ impl SindyParams {
 
     pub(crate) fn control_names(&self) -> &[String] {
         &self.control_names
-    }
-
-    pub(crate) fn feature_library(&self) -> &FeatureLibrary {
-        &self.library
     }
 
     pub(crate) fn derivative_estimator(&self) -> Derivative {
@@ -807,6 +794,32 @@ pub(crate) fn check_scale(sizes: &[f64], names: &[String]) -> Result<()> {
         });
     }
     Ok(())
+}
+
+/// The largest magnitude of each feature over blocks of rows evaluated in any order (a maximum).
+pub(crate) struct FeatureSizes(std::sync::Mutex<Vec<f64>>);
+
+impl FeatureSizes {
+    pub(crate) fn new(features: usize) -> Self {
+        Self(std::sync::Mutex::new(vec![0.0; features]))
+    }
+
+    pub(crate) fn record(&self, theta: MatRef<'_, f64>) {
+        let block = column_sizes(theta);
+        let mut sizes = self
+            .0
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        for (size, block) in sizes.iter_mut().zip(block) {
+            *size = size.max(block);
+        }
+    }
+
+    pub(crate) fn into_vec(self) -> Vec<f64> {
+        self.0
+            .into_inner()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
 }
 
 /// The largest magnitude of each column.

@@ -9,7 +9,7 @@ use faer::Mat;
 use rayon::prelude::*;
 
 use crate::error::{Result, SindyError, shape};
-use crate::model::{CONSTANT_RELATIVE_SPREAD, Score, SindyModel, SindyParams};
+use crate::model::{CONSTANT_RELATIVE_SPREAD, FeatureSizes, Score, SindyModel, SindyParams};
 use crate::reduced::{Reduction, SEGMENT_ROWS, segment_triangle};
 
 /// Consecutive rows of a recording: one vector per state, then one per control.
@@ -210,54 +210,14 @@ impl SindyParams {
     /// One segment's triangle, target moments and feature sizes; non-finite values are errors
     /// naming their global row.
     fn reduce_segment(&self, segment: &Segment, features: usize) -> Result<Reduced> {
-        let at_row = |error: SindyError| match error {
-            SindyError::NonFinite {
-                what,
-                row,
-                column,
-                value,
-            } => SindyError::NonFinite {
-                what,
-                row: segment.start + row,
-                column,
-                value,
-            },
-            other => other,
-        };
         self.check_values(segment.inputs.as_ref(), segment.targets.as_ref())
-            .map_err(at_row)?;
+            .map_err(|error| error.offset_row(segment.start))?;
         let names = self.feature_names_for_inputs();
-        let sizes = std::sync::Mutex::new(vec![0.0f64; features]);
+        let sizes = FeatureSizes::new(features);
         let rows = segment.inputs.nrows();
         let triangle = segment_triangle(rows, features + segment.targets.ncols(), |block| {
-            let theta = self
-                .feature_library()
-                .transform(segment.inputs.subrows(block.start, block.len()));
-            crate::model::check_finite("library", theta.as_ref(), &|j| {
-                format!("feature '{}'", names[j])
-            })
-            .map_err(|e| match e {
-                SindyError::NonFinite {
-                    what,
-                    row,
-                    column,
-                    value,
-                } => at_row(SindyError::NonFinite {
-                    what,
-                    row: block.start + row,
-                    column,
-                    value,
-                }),
-                other => other,
-            })?;
-            if let Ok(mut sizes) = sizes.lock() {
-                for (size, block_size) in sizes
-                    .iter_mut()
-                    .zip(crate::model::column_sizes(theta.as_ref()))
-                {
-                    *size = size.max(block_size);
-                }
-            }
+            let inputs = segment.inputs.subrows(block.start, block.len());
+            let theta = self.library_block(inputs, segment.start + block.start, &names, &sizes)?;
             Ok::<_, SindyError>((
                 theta,
                 segment.targets.subrows(block.start, block.len()).to_owned(),
@@ -266,10 +226,7 @@ impl SindyParams {
         let moments = (0..segment.targets.ncols())
             .map(|j| Moments::of(&segment.targets.col(j).iter().copied().collect::<Vec<_>>()))
             .collect();
-        let sizes = sizes
-            .into_inner()
-            .unwrap_or_else(|poisoned| poisoned.into_inner());
-        Ok((triangle, moments, sizes, rows))
+        Ok((triangle, moments, sizes.into_vec(), rows))
     }
 }
 

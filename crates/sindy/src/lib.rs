@@ -27,6 +27,14 @@
 //! assert_eq!(model.equations(3), vec!["x' = -0.500 x"]);
 //! ```
 //!
+//! `examples/lorenz.rs` does the same for the Lorenz system, from simulation to equations
+//! (`cargo run -p sindy --example lorenz`).
+//!
+//! # Large libraries and long recordings
+//! A library of more than [`LARGE_LIBRARY_ENTRIES`] entries is evaluated by row blocks and
+//! reduced as it is built ([`ReducedProblem`]); [`SindyParams::fit_streamed`] fits a recording
+//! whose rows arrive in blocks, in memory that does not grow with its length.
+//!
 //! # The paper's SINDy columns
 //! [`fit_and_evaluate`]`(config, support, query)` takes two `data::Segment`s (states, controls,
 //! targets already estimated on each segment), fits `config` on the support segment, predicts ẋ on

@@ -460,3 +460,78 @@ fn mutated_configurations_are_read_or_refused_in_one_line() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Mutated numeric recordings (the CSV mutations above, on `t,x,y,u`) through `learn sindy`,
+/// read whole and with `--stream`: each run succeeds or fails with one line naming the file, and
+/// the two readings agree: both fail, or both print the same equations to 4 decimals (the two
+/// paths reduce the library differently, so a badly conditioned mutation differs near 1e-10).
+#[test]
+fn mutated_recordings_fit_the_same_whole_and_streamed() {
+    let dir = flight::temp_dir("hostile-stream");
+    let mut text = String::from("t,x,y,u\n");
+    for k in 0..400 {
+        let t = k as f64 * 0.01;
+        let decay = (-0.1 * t).exp();
+        text.push_str(&format!(
+            "{t:.2},{},{},{}\n",
+            decay * t.cos(),
+            -decay * t.sin(),
+            (0.5 * t).sin()
+        ));
+    }
+    let path = dir.join("mutated.csv");
+    runner(STREAM_CASES, 20)
+        .run(&csv_mutation(), |mutation| {
+            std::fs::write(&path, mutate_csv(&text, &mutation)).unwrap();
+            let whole = fit_through_the_binary(&path, false).map_err(TestCaseError::fail)?;
+            let streamed = fit_through_the_binary(&path, true).map_err(TestCaseError::fail)?;
+            match (whole, streamed) {
+                (Some(a), Some(b)) if a != b => Err(TestCaseError::fail(format!(
+                    "{mutation:?}: whole and streamed fits differ:\n{a}\n{b}"
+                ))),
+                (a, b) if a.is_some() != b.is_some() => Err(TestCaseError::fail(format!(
+                    "{mutation:?}: read whole {}, streamed {}",
+                    if a.is_some() { "fits" } else { "is refused" },
+                    if b.is_some() { "fits" } else { "is refused" },
+                ))),
+                _ => Ok(()),
+            }
+        })
+        .unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Recordings `learn sindy` reads whole and streamed per run.
+const STREAM_CASES: u32 = 64;
+
+/// `learn sindy` on the file: `Some(equations)` on success, `None` after a one-line error naming
+/// the file; anything else (a panic, several lines, another exit) is the error.
+fn fit_through_the_binary(path: &Path, stream: bool) -> Result<Option<String>, String> {
+    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_learn"));
+    command
+        .args([
+            "sindy",
+            "--quiet",
+            "--state",
+            "x,y",
+            "--control",
+            "u",
+            "--precision",
+            "4",
+        ])
+        .arg("--csv")
+        .arg(path)
+        .env("RUST_BACKTRACE", "0");
+    if stream {
+        command.arg("--stream");
+    }
+    let output = command.output().map_err(|e| e.to_string())?;
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    match output.status.code() {
+        Some(0) => Ok(Some(String::from_utf8_lossy(&output.stdout).into_owned())),
+        Some(1) if stderr.trim_end().lines().count() == 1 && stderr.contains("mutated.csv") => {
+            Ok(None)
+        }
+        code => Err(format!("stream {stream}: exit {code:?}: {stderr}")),
+    }
+}

@@ -61,9 +61,12 @@ impl NumericStream {
             )));
         }
         let file = File::open(path).map_err(io)?;
+        // Records end at '\n' only, so that the line count is exact with '\r\n' line ends too
+        // (each record's last field then ends in '\r', dropped below).
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(false)
             .flexible(true)
+            .terminator(csv::Terminator::Any(b'\n'))
             .from_reader(BufReader::with_capacity(1 << 20, file));
         let mut header = csv::StringRecord::new();
         let csv_error = |error: csv::Error| DataError::Csv {
@@ -84,7 +87,7 @@ impl NumericStream {
                 } else {
                     name
                 };
-                name.to_string()
+                name.strip_suffix('\r').unwrap_or(name).to_string()
             })
             .collect();
         if names.len() > MAX_CSV_COLUMNS {
@@ -160,6 +163,7 @@ impl NumericStream {
             }
             for (k, &index) in self.indices.iter().enumerate() {
                 let cell = &self.record[index];
+                let cell = cell.strip_suffix('\r').unwrap_or(cell);
                 values.clear();
                 let parsed = parse_numbers(cell, &mut values);
                 let value = match (parsed, values.as_slice()) {

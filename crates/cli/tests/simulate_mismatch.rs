@@ -679,3 +679,61 @@ fn flights_need_a_flight_and_a_calm_one() {
     flights(&dir, &[]).one_line_error(&["conditions.json", "calm", "nowind"]);
     assert!(!dir.join("o").exists());
 }
+
+/// `--flights` names the files it wrote by their final paths (the run writes them in a staging
+/// folder first); two short simulated flights, one in still air and one in wind.
+#[test]
+fn flights_name_the_files_they_wrote_by_their_final_paths() {
+    let dir = setup("mm-flights-wrote");
+    std::fs::create_dir_all(dir.join("data/experiment")).unwrap();
+    for (condition, effects) in [
+        ("still", json!({"linear_drag": {"d": [0.3, 0.3, 0.1]}})),
+        (
+            "breeze",
+            json!({"linear_drag": {"d": [0.3, 0.3, 0.1]}, "wind": {"w_air": [-3.0, 0.0, 0.0]}}),
+        ),
+    ] {
+        write_scenario(&dir, "s.json", |s| {
+            s["duration_s"] = json!(16.0);
+            s["effects"] = effects;
+        });
+        let out = format!("data/experiment/flight_only_{condition}.csv");
+        learn_in(&dir, &["simulate", "--scenario", "s.json", "--out", &out]).success();
+    }
+    let conditions = json!({
+        "file_pattern": "experiment/flight_{controller}_{condition}.csv",
+        "controllers": ["only"],
+        "evaluation_controller": "only",
+        "conditions": [
+            {"name": "still", "wind_speed": "0 m/s", "calm": true, "role": "meta-training"},
+            {"name": "breeze", "wind_speed": "3 m/s", "mean_wind_m_s": 3.0, "role": "evaluation"}
+        ],
+        "paper_training": {"file_pattern": "training/flight_{condition}.csv",
+            "conditions": [{"name": "still", "wind_speed": "0 m/s", "role": "meta-training"}]}
+    });
+    std::fs::write(dir.join("c.json"), conditions.to_string()).unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "--data",
+            "data",
+            "mismatch",
+            "--flights",
+            "c.json",
+            "--model",
+            "quad.json",
+            "--out",
+            "o",
+            "--quiet",
+        ],
+    );
+    let printed = run.success();
+    for ext in ["json", "md", "svg"] {
+        assert!(
+            printed.contains(&format!("wrote o/quad.{ext}")),
+            "{printed}"
+        );
+        assert!(dir.join(format!("o/quad.{ext}")).exists());
+    }
+    assert!(!printed.contains(".learn-staging"), "{printed}");
+}

@@ -141,6 +141,10 @@ fn run_flights(
     for line in lines {
         say!("{line}");
     }
+    // The files by their final names (the run wrote them in the staging folder).
+    for path in plan.outputs() {
+        say!("wrote {}", path.display());
+    }
     Ok(())
 }
 

@@ -286,7 +286,8 @@ impl FleetPlan {
             .collect()
     }
 
-    /// Runs the analysis and writes the outputs; returns one line per flight and the file names.
+    /// Runs the analysis and writes the outputs; returns the report and one line per flight and
+    /// target.
     pub fn run(
         &self,
         model: &NominalModel,
@@ -308,10 +309,8 @@ impl FleetPlan {
             &self.conditions_path.display().to_string(),
             settings,
         );
-        let outputs = self.outputs();
-        report::write(&report, &outputs, force)?;
-        let mut lines = report.lines();
-        lines.extend(outputs.iter().map(|p| format!("wrote {}", p.display())));
+        report::write(&report, &self.outputs(), force)?;
+        let lines = report.lines();
         Ok((report, lines))
     }
 }

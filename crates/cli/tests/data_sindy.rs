@@ -7,23 +7,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{learn_in, scratch};
-
-/// `t,x,y,u` for t = 0, 0.01, ...: a damped rotation driven by u.
-fn signal(rows: usize) -> String {
-    let mut text = String::from("t,x,y,u\n");
-    for k in 0..rows {
-        let t = k as f64 * 0.01;
-        let decay = (-0.1 * t).exp();
-        text.push_str(&format!(
-            "{t:.2},{},{},{}\n",
-            decay * t.cos(),
-            -decay * t.sin(),
-            (0.5 * t).sin()
-        ));
-    }
-    text
-}
+use common::{learn_in, scratch, signal};
 
 /// `text` with line `line` (1-based) replaced by `new` (which may hold several lines).
 fn with_line(text: &str, line: usize, new: &str) -> String {

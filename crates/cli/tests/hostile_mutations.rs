@@ -4,6 +4,7 @@
 //! mutated file is read or refused with one line naming it; nothing panics. Seeded: every run
 //! tries the same cases ([`FLIGHT_CASES`] + [`CONFIG_CASES`] per kind, a few seconds).
 
+mod common;
 #[path = "../../data/tests/common/mod.rs"]
 mod flight;
 
@@ -468,17 +469,7 @@ fn mutated_configurations_are_read_or_refused_in_one_line() {
 #[test]
 fn mutated_recordings_fit_the_same_whole_and_streamed() {
     let dir = flight::temp_dir("hostile-stream");
-    let mut text = String::from("t,x,y,u\n");
-    for k in 0..400 {
-        let t = k as f64 * 0.01;
-        let decay = (-0.1 * t).exp();
-        text.push_str(&format!(
-            "{t:.2},{},{},{}\n",
-            decay * t.cos(),
-            -decay * t.sin(),
-            (0.5 * t).sin()
-        ));
-    }
+    let text = common::signal(400);
     let path = dir.join("mutated.csv");
     runner(STREAM_CASES, 20)
         .run(&csv_mutation(), |mutation| {

@@ -70,3 +70,19 @@ pub fn scratch(test: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).expect("scratch directory");
     dir
 }
+
+/// `t,x,y,u` for t = 0, 0.01, ...: a damped rotation driven by u.
+pub fn signal(rows: usize) -> String {
+    let mut text = String::from("t,x,y,u\n");
+    for k in 0..rows {
+        let t = k as f64 * 0.01;
+        let decay = (-0.1 * t).exp();
+        text.push_str(&format!(
+            "{t:.2},{},{},{}\n",
+            decay * t.cos(),
+            -decay * t.sin(),
+            (0.5 * t).sin()
+        ));
+    }
+    text
+}

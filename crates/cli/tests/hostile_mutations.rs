@@ -297,8 +297,8 @@ fn err(e: impl std::fmt::Display) -> String {
 
 /// A nominal model read as the `learn` command reads it: bounded, under the JSON policy.
 fn load_model(path: &Path) -> Result<(), String> {
-    let text = data::input::read_json_text(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let text = data::json::checked_text(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text = inputs::read_json_text(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text = inputs::json::checked_text(&text).map_err(|e| format!("{}: {e}", path.display()))?;
     physics::NominalModel::from_json(text, path)
         .map(drop)
         .map_err(err)

@@ -153,6 +153,9 @@ pub enum DataError {
     },
     #[error("{what}: {message}")]
     Invalid { what: String, message: String },
+    /// A derivative estimator misconfigured or given too few samples.
+    #[error(transparent)]
+    Differentiation(#[from] sindy::DifferentiationError),
 }
 
 /// A number as it reads best in a one-line message: plainly for ordinary magnitudes (so `0.02`

@@ -14,9 +14,9 @@ use std::ops::Range;
 use faer::Mat;
 use serde::{Deserialize, Serialize};
 
-use crate::derivative::Derivative;
 use crate::error::{DataError, Result};
 use crate::flight_log::FlightLog;
+use sindy::Derivative;
 
 /// Which part of the quadrotor dynamics is identified.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]

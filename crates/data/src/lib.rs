@@ -2,11 +2,11 @@
 //!
 //! What it is for: reading Neural-Fly flight logs into a typed, validated [`FlightLog`]; reading plain
 //! numeric CSVs by column name ([`NumericTable`]); the paper's three [`Formulation`]s as data (which
-//! state, which inputs, with which scalings); derivative estimators ([`Derivative`]); support/query
+//! state, which inputs, with which scalings) and their segments, with targets estimated by
+//! `sindy::Derivative`; support/query
 //! splits ([`SplitSpec`]); the experiment's wind conditions ([`ExperimentConditions`]); finding the
 //! data directory ([`resolve_data_dir`]); telling whether two spellings name the same file
-//! ([`paths::same_file`]); and reading the workspace's JSON files with errors that
-//! name the failing field ([`json`]).
+//! ([`paths::same_file`]).
 //!
 //! What it is not for: fitting anything. Models live in `sindy` and `learn`, tables in `report`.
 //!
@@ -14,12 +14,9 @@
 //! the row (line number in the file, header = line 1) and column: `file:row:column: message`.
 
 mod conditions;
-mod derivative;
 mod error;
 mod flight_log;
 mod formulation;
-pub mod input;
-pub mod json;
 mod noise_floor;
 mod numeric;
 mod source;
@@ -34,7 +31,6 @@ mod write;
 pub use outputs::paths;
 
 pub use conditions::{Condition, ExperimentConditions, FlightFile, PaperTraining, Role};
-pub use derivative::Derivative;
 pub use error::{DataError, Result};
 pub use flight_log::{
     FlightLog, FlightMeta, REQUIRED_COLUMNS, RateFrame, quaternion_from_rotation,

@@ -15,9 +15,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::derivative::Derivative;
 use crate::error::Result;
 use crate::formulation::Segment;
+use sindy::Derivative;
 
 /// The noise-floor estimates of one segment's forward-difference targets.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

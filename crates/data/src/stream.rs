@@ -9,8 +9,8 @@ use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use crate::error::{DataError, Result};
-use crate::input::MAX_CSV_COLUMNS;
 use crate::table::parse_numbers;
+use inputs::MAX_CSV_COLUMNS;
 
 /// A reader of named numeric columns, row blocks in file order.
 pub struct NumericStream {

@@ -49,7 +49,7 @@ impl TextTable {
                 path: path.to_path_buf(),
             });
         }
-        let bytes = crate::input::read_bytes(path, crate::input::InputKind::Csv).map_err(io)?;
+        let bytes = inputs::read_bytes(path, inputs::InputKind::Csv).map_err(io)?;
         let text = check_text(path, &bytes)?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         check_width(path, text)?;
@@ -203,7 +203,7 @@ impl TextTable {
     }
 }
 
-/// Refuses a header of more than [`crate::input::MAX_CSV_COLUMNS`] names before any row is kept:
+/// Refuses a header of more than [`inputs::MAX_CSV_COLUMNS`] names before any row is kept:
 /// the cost of a table grows with rows × columns.
 fn check_width(path: &Path, text: &str) -> Result<()> {
     let header = csv::ReaderBuilder::new()
@@ -216,13 +216,13 @@ fn check_width(path: &Path, text: &str) -> Result<()> {
         Some(Ok(record)) => record.len(),
         _ => return Ok(()),
     };
-    if columns > crate::input::MAX_CSV_COLUMNS {
+    if columns > inputs::MAX_CSV_COLUMNS {
         return Err(DataError::BadRow {
             path: path.to_path_buf(),
             row: 1,
             message: format!(
                 "{columns} columns in the header, more than the {} a CSV may have",
-                crate::input::MAX_CSV_COLUMNS
+                inputs::MAX_CSV_COLUMNS
             ),
         });
     }

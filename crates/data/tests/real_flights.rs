@@ -2,7 +2,8 @@
 
 mod common;
 
-use data::{Derivative, ExperimentConditions, FlightLog, Formulation, RateFrame, SplitSpec};
+use data::{ExperimentConditions, FlightLog, Formulation, RateFrame, SplitSpec};
+use sindy::Derivative;
 
 #[test]
 fn all_thirty_shared_flights_load() {

@@ -173,11 +173,11 @@ impl CheckedConfig {
 impl LearnConfig {
     /// Reads and checks a configuration file.
     pub fn load(path: &Path) -> Result<CheckedConfig> {
-        let text = data::input::read_json_text(path).map_err(|cause| LearnError::Io {
+        let text = inputs::read_json_text(path).map_err(|cause| LearnError::Io {
             path: path.to_path_buf(),
             cause,
         })?;
-        let config: Self = data::json::from_str(&text).map_err(|error| LearnError::Config {
+        let config: Self = inputs::json::from_str(&text).map_err(|error| LearnError::Config {
             path: path.to_path_buf(),
             field: error.field,
             message: error.message,

@@ -2,8 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-use data::{Derivative, ExperimentConditions, FlightLog, Formulation, Mat, Segment, SplitSpec};
+use data::{ExperimentConditions, FlightLog, Formulation, Mat, Segment, SplitSpec};
 use serde::{Deserialize, Serialize};
+use sindy::Derivative;
 
 use crate::error::{LearnError, Result};
 use crate::maml::Batch;

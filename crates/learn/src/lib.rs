@@ -29,7 +29,7 @@
 //!
 //! Split, inputs and targets are those of the SINDy columns: support = first half of the flight,
 //! query = second half ([`data::SplitSpec::Halves`]), targets the forward difference of the state on
-//! each segment ([`data::Derivative::Forward`]). **Adaptation MSE**: the model adapted online on the
+//! each segment ([`sindy::Derivative::Forward`]). **Adaptation MSE**: the model adapted online on the
 //! support segment, evaluated on that segment; **generalisation MSE**: the same model, frozen, on the
 //! query segment. MSE = mean over all samples and all output dimensions. Inputs are z-scored with
 //! the meta-training statistics (stored in the checkpoint).

@@ -108,7 +108,7 @@ impl Mixer {
 impl NominalModel {
     /// Reads and validates a model file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = data::input::read_json_text(path).map_err(|source| PhysicsError::Io {
+        let text = inputs::read_json_text(path).map_err(|source| PhysicsError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -118,7 +118,7 @@ impl NominalModel {
     /// Parses and validates model JSON under the project's reading policy (a byte-order mark
     /// accepted, a key given twice refused); `origin` names the file in errors.
     pub fn from_json(text: &str, origin: &Path) -> Result<Self> {
-        let text = data::json::checked_text(text).map_err(|error| PhysicsError::Json {
+        let text = inputs::json::checked_text(text).map_err(|error| PhysicsError::Json {
             path: origin.to_path_buf(),
             message: format!("{}: {}", error.field, error.message),
         })?;

@@ -188,7 +188,7 @@ impl Scenario {
             path: path.to_path_buf(),
             source,
         })?;
-        let scenario: Self = data::json::from_str(&text).map_err(|error| PhysicsError::Json {
+        let scenario: Self = inputs::json::from_str(&text).map_err(|error| PhysicsError::Json {
             path: path.to_path_buf(),
             message: error.to_string(),
         })?;

@@ -4,10 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use data::{Derivative, ExperimentConditions, Formulation, SplitSpec, file_sha256};
+use crate::sindy_column::SindyConfig;
+use data::{ExperimentConditions, Formulation, SplitSpec, file_sha256};
 use learn::{CheckedConfig, LearnConfig, Protocol};
 use serde::{Deserialize, Serialize};
-use sindy::SindyConfig;
+use sindy::Derivative;
 
 use crate::error::{PipelineError, Result};
 
@@ -115,7 +116,7 @@ impl RunConfig {
     pub fn load(path: &Path, root: &Path) -> Result<CheckedRunConfig> {
         let text = read(path)?;
         let raw: RunConfig =
-            data::json::from_str(&text).map_err(|error| PipelineError::json(path, error))?;
+            inputs::json::from_str(&text).map_err(|error| PipelineError::json(path, error))?;
         raw.check(path, root)
     }
 
@@ -256,7 +257,7 @@ pub(crate) fn check_seeds(seeds: &[u64]) -> std::result::Result<(), String> {
 }
 
 fn read(path: &Path) -> Result<String> {
-    data::input::read_json_text(path).map_err(|source| PipelineError::Io {
+    inputs::read_json_text(path).map_err(|source| PipelineError::Io {
         path: path.to_path_buf(),
         source,
     })
@@ -277,7 +278,7 @@ fn load_learn_config(
     }
     let text = read(path)?;
     let mut value: serde_json::Value =
-        data::json::from_str(&text).map_err(|error| PipelineError::json(path, error))?;
+        inputs::json::from_str(&text).map_err(|error| PipelineError::json(path, error))?;
     merge_patch(&mut value, overrides);
     // With overrides, a bad value may be the override's: the error names both files.
     let with_overrides = |message: String| PipelineError::Config {
@@ -287,9 +288,9 @@ fn load_learn_config(
     };
     // Without overrides a fault is the file's own: named with its line and column.
     let config: LearnConfig = if overrides.is_null() {
-        data::json::from_str(&text).map_err(|error| PipelineError::json(path, error))?
+        inputs::json::from_str(&text).map_err(|error| PipelineError::json(path, error))?
     } else {
-        data::json::from_value(value).map_err(|error| with_overrides(error.to_string()))?
+        inputs::json::from_value(value).map_err(|error| with_overrides(error.to_string()))?
     };
     match config.check(path) {
         Ok(checked) => Ok(checked),

@@ -36,7 +36,7 @@ pub enum PipelineError {
 
 impl PipelineError {
     /// A JSON document at `path` that did not deserialise, with the failing field.
-    pub(crate) fn json(path: &std::path::Path, error: data::json::JsonError) -> Self {
+    pub(crate) fn json(path: &std::path::Path, error: inputs::json::JsonError) -> Self {
         Self::Config {
             path: path.to_path_buf(),
             field: error.field,

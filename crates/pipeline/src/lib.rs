@@ -17,13 +17,17 @@
 //! fitted (SINDy) or adapted online (LeARN) on the support segment, scored on that segment.
 //! **Generalisation MSE**: the same model, unchanged, scored on the query segment.
 
+mod causal_library;
 mod config;
 mod error;
 mod output;
 mod run;
+mod sindy_column;
+mod sindy_variant;
 mod summary;
 mod variants;
 
+pub use causal_library::{CausalLibrary, MAX_CONTROL_LAGS, first_order_lag};
 pub use config::{CheckedRunConfig, LearnRun, MAX_SEEDS, RunConfig, merge_patch};
 pub use error::{PipelineError, Result};
 pub use output::{
@@ -32,6 +36,10 @@ pub use output::{
 };
 pub use run::{
     GENERATED_PATHS, RunOptions, RunOutcome, figure_file_name, git_commit, run, uncommitted_inputs,
+};
+pub use sindy_column::{SegmentEvaluation, SindyConfig, evaluate_flight, fit_and_evaluate};
+pub use sindy_variant::{
+    LibraryRegression, SegmentPredictions, VariantEvaluation, evaluate_features,
 };
 pub use summary::{
     CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,

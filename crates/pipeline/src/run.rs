@@ -3,12 +3,13 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use data::{Condition, Derivative, FlightLog, Formulation, Mat, Segment, SplitSpec, file_sha256};
+use crate::sindy_column::SegmentEvaluation;
+use data::{Condition, FlightLog, Formulation, Mat, Segment, SplitSpec, file_sha256};
 use indicatif::{ProgressBar, ProgressStyle};
 use learn::{CellResult, DataFile, EquationRule, Experiment, RangeCoverage, explain, row_major};
 use rayon::prelude::*;
 use report::{MethodTrace, Mse, OutputAxis, PublishedTables, QualitativeFigure, ResultsTable, Row};
-use sindy::SegmentEvaluation;
+use sindy::Derivative;
 
 use crate::config::CheckedRunConfig;
 use crate::error::{PipelineError, Result, in_flight};
@@ -247,7 +248,7 @@ fn sindy_cell<'a>(
         config.raw.split,
         config.raw.derivative,
     )?;
-    let sindy = sindy::fit_and_evaluate(&config.raw.sindy, &support, &query)
+    let sindy = crate::sindy_column::fit_and_evaluate(&config.raw.sindy, &support, &query)
         .map_err(|error| in_flight(&flight.log.path, error))?;
     Ok(Cell {
         formulation,

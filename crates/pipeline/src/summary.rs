@@ -3,11 +3,12 @@
 
 use std::path::PathBuf;
 
-use data::{Derivative, SplitSpec};
+use crate::sindy_column::SindyConfig;
+use data::SplitSpec;
 use learn::{DataFile, Explanation, LearnConfig, RangeCoverage};
 use report::ResultsTable;
 use serde::Serialize;
-use sindy::SindyConfig;
+use sindy::Derivative;
 
 /// The format tag of `summary.json`.
 pub const SUMMARY_FORMAT: &str = "learn-results/1";

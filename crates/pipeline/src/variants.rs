@@ -8,7 +8,7 @@
 //! cross-validation inside the support segment; the query segment is only ever scored.
 //!
 //! Variant kinds:
-//! - `library`: a [`sindy::CausalLibrary`] and a [`sindy::RegressionSpec`];
+//! - `library`: a [`crate::CausalLibrary`] and a [`sindy::RegressionSpec`];
 //! - `select`: per cell, the candidate variant (by name) with the lowest support cross-validation
 //!   error (mean over outputs of each output's best penalty score);
 //! - `learned_basis`: the meta-trained LeARN library Θ(X; ψ) as features, optionally beside a fixed
@@ -30,14 +30,15 @@ use learn::{Experiment, MetaTrainedModel};
 use rayon::prelude::*;
 use report::{MethodTrace, PublishedTables, QualitativeFigure};
 use serde::{Deserialize, Serialize};
-use sindy::{
-    CausalLibrary, EnsemblePrediction, LibraryRegression, Mat, RegressionFit, RegressionSpec,
-    SegmentPredictions, VariantEvaluation, evaluate_features,
-};
+use sindy::{EnsemblePrediction, Mat, RegressionFit, RegressionSpec};
 
+use crate::causal_library::CausalLibrary;
 use crate::config::{CheckedRunConfig, RunConfig, check_seeds, merge_patch};
 use crate::error::{PipelineError, Result, write_text};
 use crate::run::flight_segments;
+use crate::sindy_variant::{
+    LibraryRegression, SegmentPredictions, VariantEvaluation, evaluate_features,
+};
 
 /// The most variants a variants file may declare (every variant runs on every cell and seed; the
 /// committed file declares 14).
@@ -273,7 +274,7 @@ impl CheckedVariants {
 impl VariantsConfig {
     /// Reads and checks `path` alone (names, candidates, headline), without the run it names.
     pub fn read(path: &Path) -> Result<VariantsConfig> {
-        let text = data::input::read_json_text(path).map_err(|source| PipelineError::Io {
+        let text = inputs::read_json_text(path).map_err(|source| PipelineError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -283,7 +284,7 @@ impl VariantsConfig {
             message,
         };
         let raw: VariantsConfig =
-            data::json::from_str(&text).map_err(|e| PipelineError::json(path, e))?;
+            inputs::json::from_str(&text).map_err(|e| PipelineError::json(path, e))?;
         check_seeds(&raw.seeds).map_err(|message| error("seeds", message))?;
         if raw.variants.len() > MAX_VARIANTS {
             return Err(error(
@@ -752,7 +753,8 @@ pub fn run_variants(
             .par_iter()
             .map(|&seed| evaluate_all(config, experiment.as_ref(), cell, seed))
             .collect::<Result<Vec<_>>>()?;
-        let sindy = sindy::fit_and_evaluate(&run.raw.sindy, &cell.support, &cell.query)?;
+        let sindy =
+            crate::sindy_column::fit_and_evaluate(&run.raw.sindy, &cell.support, &cell.query)?;
         let pair = published
             .get(cell.formulation.name(), cell.condition.label())
             .copied();
@@ -840,7 +842,7 @@ fn learned_basis_config(config: &CheckedVariants) -> Result<learn::CheckedConfig
     let mut value = serde_json::to_value(run.learn.get()).map_err(|e| error(e.to_string()))?;
     merge_patch(&mut value, &config.raw.learn_overrides);
     let learn_config: learn::LearnConfig =
-        data::json::from_value(value).map_err(|e| with_overrides(e.to_string()))?;
+        inputs::json::from_value(value).map_err(|e| with_overrides(e.to_string()))?;
     learn_config.check(&config.path).map_err(|e| match e {
         learn::LearnError::Config { field, message, .. } => {
             with_overrides(format!("field '{field}': {message}"))

@@ -6,9 +6,10 @@
 
 use std::path::{Path, PathBuf};
 
-use data::{Derivative, FlightLog, Formulation, Segment, SplitSpec};
+use data::{FlightLog, Formulation, Segment, SplitSpec};
 use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Protocol, Standardiser};
 use pipeline::{VariantKind, VariantsConfig, evaluate_variants};
+use sindy::Derivative;
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")

@@ -34,11 +34,11 @@ pub type Result<T> = std::result::Result<T, ReportError>;
 pub(crate) fn read_json<T: serde::de::DeserializeOwned + serde::Serialize>(
     path: &std::path::Path,
 ) -> Result<T> {
-    let text = data::input::read_json_text(path).map_err(|source| ReportError::Io {
+    let text = inputs::read_json_text(path).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    data::json::from_str(&text).map_err(|error| ReportError::Json {
+    inputs::json::from_str(&text).map_err(|error| ReportError::Json {
         path: path.to_path_buf(),
         field: error.field,
         message: error.message,

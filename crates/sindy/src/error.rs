@@ -69,9 +69,12 @@ pub enum SindyError {
         path: PathBuf,
         source: std::io::Error,
     },
-    /// Errors from the data crate (derivatives, segments, flight logs).
+    /// A derivative estimator misconfigured or given too few samples.
     #[error(transparent)]
-    Data(#[from] data::DataError),
+    Differentiation(#[from] crate::differentiation::DifferentiationError),
+    /// The caller's source of rows failed (e.g. a streamed file with a bad line), as it said.
+    #[error(transparent)]
+    Source(Box<dyn std::error::Error + Send + Sync>),
 }
 
 impl SindyError {
@@ -108,14 +111,16 @@ pub(crate) fn invalid(name: &str, message: impl Into<String>) -> SindyError {
     }
 }
 
-pub(crate) fn field(field: &str, message: impl Into<String>) -> SindyError {
+/// A [`SindyError::Field`]: the specification's field `field` (empty: the whole) is wrong.
+pub fn field(field: &str, message: impl Into<String>) -> SindyError {
     SindyError::Field {
         field: field.to_string(),
         message: message.into(),
     }
 }
 
-pub(crate) fn shape(what: &str, message: impl Into<String>) -> SindyError {
+/// A [`SindyError::Shape`]: the sizes of `what` do not agree.
+pub fn shape(what: &str, message: impl Into<String>) -> SindyError {
     SindyError::Shape {
         what: what.to_string(),
         message: message.into(),

@@ -1,6 +1,6 @@
 //! SINDy models: fit on trajectories with controls, predict, score, print, simulate.
 
-use data::Derivative;
+use crate::differentiation::Derivative;
 use faer::{Mat, MatRef};
 
 use crate::error::{Result, SindyError, invalid, shape};
@@ -76,16 +76,6 @@ impl Trajectory {
         }
         self.derivatives = Some(derivatives);
         Ok(self)
-    }
-
-    /// The states, controls and (already estimated) targets of a data-crate segment.
-    pub fn from_segment(segment: &data::Segment) -> Self {
-        Self {
-            time: segment.time.clone(),
-            states: segment.states.clone(),
-            controls: segment.controls.clone(),
-            derivatives: Some(segment.targets.clone()),
-        }
     }
 
     fn len(&self) -> usize {
@@ -286,6 +276,19 @@ impl SindyParams {
         check_scale(&column_sizes(theta.as_ref()), &feature_names)?;
         let coefficients = optimizer.fit(theta.as_ref(), targets, &self.state_names)?;
         Ok((self.model(feature_names, coefficients), theta))
+    }
+
+    /// Fits on inputs X = [x, u] and targets ẋ, and returns the model with its prediction of ẋ on
+    /// the same inputs (Θ(X)·Ξᵀ, from the library matrix the fit built: no second evaluation).
+    pub fn fit_and_predict(
+        &self,
+        inputs: MatRef<'_, f64>,
+        targets: MatRef<'_, f64>,
+    ) -> Result<(SindyModel, Mat<f64>)> {
+        let (model, theta) = self.fit_with_library_matrix(inputs, targets)?;
+        let prediction = theta * model.coefficients().transpose();
+        crate::linalg::clear_upper_vector_state();
+        Ok((model, prediction))
     }
 
     pub(crate) fn model(&self, feature_names: Vec<String>, coefficients: Mat<f64>) -> SindyModel {

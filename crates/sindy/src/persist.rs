@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::Path;
 
-use data::Derivative;
+use crate::differentiation::Derivative;
 use faer::Mat;
 use serde::{Deserialize, Serialize};
 
@@ -96,7 +96,7 @@ impl SindyModel {
     /// Reads a model written by [`SindyModel::save`], checking that names, library and
     /// coefficients agree.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = data::input::read_json_text(path).map_err(|source| SindyError::Io {
+        let text = inputs::read_json_text(path).map_err(|source| SindyError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -110,7 +110,8 @@ impl SindyModel {
             field: field.to_string(),
             message,
         };
-        let file: ModelFile = data::json::from_str(text).map_err(|e| error(&e.field, e.message))?;
+        let file: ModelFile =
+            inputs::json::from_str(text).map_err(|e| error(&e.field, e.message))?;
         if file.format != MODEL_FORMAT {
             return Err(error(
                 "format",

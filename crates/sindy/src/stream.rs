@@ -4,7 +4,7 @@
 //! length; the coefficients are those of [`SindyParams::fit_matrices`] on the whole recording (the
 //! same segments, merged in the same order), and the score follows from the reduced problem.
 
-use data::Derivative;
+use crate::differentiation::Derivative;
 use faer::Mat;
 use rayon::prelude::*;
 

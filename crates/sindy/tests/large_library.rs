@@ -119,7 +119,7 @@ fn a_streamed_recording_fits_as_the_whole_one() {
         .unwrap();
     for derivative in ["forward", "central", "savgol:9:3"] {
         let params = params(OptimizerSpec::stlsq(0.05))
-            .derivative(data::Derivative::parse(derivative).unwrap());
+            .derivative(sindy::Derivative::parse(derivative).unwrap());
         let whole = params.fit(std::slice::from_ref(&trajectory)).unwrap();
         let whole_score = whole.score(&trajectory).unwrap();
         let step = (time[rows - 1] - time[0]) / (rows - 1) as f64;
@@ -153,7 +153,7 @@ fn a_streamed_recording_fits_as_the_whole_one() {
         let mut y = Mat::zeros(rows, 3);
         for j in 0..3 {
             let column: Vec<f64> = (0..rows).map(|i| states[(i, j)]).collect();
-            let estimate = data::Derivative::parse(derivative)
+            let estimate = sindy::Derivative::parse(derivative)
                 .unwrap()
                 .apply(&column, step)
                 .unwrap();

@@ -5,7 +5,7 @@
 mod common;
 
 use common::integrate;
-use data::Derivative;
+use sindy::Derivative;
 use sindy::{FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, SindyParams, Trajectory};
 
 fn trajectory(

@@ -79,10 +79,10 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
 /// `--render-only`: `ablations.md` again from the `ablations.json` of an earlier run.
 fn render_only(args: &Args) -> anyhow::Result<()> {
     let json = args.out.join("ablations.json");
-    let text = data::input::read_json_text(&json)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
+    let text =
+        inputs::read_json_text(&json).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
     let ablations: pipeline::Ablations =
-        data::json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
+        inputs::json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
     let markdown = pipeline::ablations_markdown(&ablations);
     // Only ablations.md is rewritten: the run's other files stay its own.
     let mut set = OutputSet::new(PRODUCER).updating_only_its_files();

@@ -127,9 +127,9 @@ pub fn staged_write<T, E: std::fmt::Display>(
 /// policy itself (a nominal model): bounded size, a regular file, no key given twice. Returns the
 /// text without a byte-order mark.
 pub fn read_policy_json(path: &Path) -> anyhow::Result<String> {
-    let text = data::input::read_json_text(path)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let text =
-        data::json::checked_text(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        inputs::read_json_text(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let text = inputs::json::checked_text(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     Ok(text.to_string())
 }

@@ -4,7 +4,8 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, anyhow, bail};
-use data::{DEFAULT_UNIFORM_TOLERANCE, Derivative, NumericStream, NumericTable, StreamedTimeAxis};
+use data::{DEFAULT_UNIFORM_TOLERANCE, NumericStream, NumericTable, StreamedTimeAxis};
+use sindy::Derivative;
 use sindy::{
     FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, RowBlock, Score, SindyError, SindyModel,
     SindyParams, Trajectory,
@@ -166,7 +167,10 @@ fn fit_streamed(
     let mut stream = NumericStream::open(&args.csv, columns)?;
     let fit = params
         .fit_streamed(n, dt, || {
-            Ok(stream.next_block(STREAM_BLOCK_ROWS)?.map(|block| RowBlock {
+            let block = stream
+                .next_block(STREAM_BLOCK_ROWS)
+                .map_err(|error| SindyError::Source(Box::new(error)))?;
+            Ok(block.map(|block| RowBlock {
                 columns: block.columns,
             }))
         })

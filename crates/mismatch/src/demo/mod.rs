@@ -54,9 +54,9 @@ pub struct DemoManifest {
 }
 
 fn load_manifest(path: &Path) -> Result<DemoManifest> {
-    let text = data::input::read_json_text(path).map_err(io_error(path))?;
+    let text = inputs::read_json_text(path).map_err(io_error(path))?;
     let manifest: DemoManifest =
-        data::json::from_str(&text).map_err(|e| MismatchError::Config {
+        inputs::json::from_str(&text).map_err(|e| MismatchError::Config {
             path: path.to_path_buf(),
             field: e.field,
             message: e.message,

@@ -28,11 +28,6 @@ pub fn matrix(value: &serde_json::Value) -> Mat<f64> {
     Mat::from_fn(rows.len(), rows[0].len(), |i, j| rows[i][j])
 }
 
-/// The real data directory (see `data::real_data_dir_for_tests`: skips locally, fails under CI).
-pub fn real_data_dir() -> Option<PathBuf> {
-    data::real_data_dir_for_tests(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
-}
-
 /// Fixed-step RK4 of `f` from `x0`, `steps` steps of `h`, returning every state (row per step).
 pub fn integrate(
     f: impl Fn(f64, &[f64]) -> Vec<f64>,

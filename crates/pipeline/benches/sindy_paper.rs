@@ -1,5 +1,5 @@
 //! Timing of the paper's SINDy baseline (run by `make bench` through `scripts/bench/sindy.sh`;
-//! `cargo bench --profile dev -p sindy`). Prints readable lines, then one `BENCH_JSON {...}` line.
+//! `cargo bench --profile dev -p pipeline --bench sindy_paper`). Prints readable lines, then one `BENCH_JSON {...}` line.
 //!
 //! - one fit (library + STLSQ + refit) of each formulation on the 35wind support segment;
 //! - the whole 12-cell table: reading and parsing the four CSV files (in parallel), building the
@@ -11,9 +11,10 @@ use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use data::{Derivative, ExperimentConditions, FlightLog, Formulation, SplitSpec, resolve_data_dir};
+use data::{ExperimentConditions, FlightLog, Formulation, SplitSpec, resolve_data_dir};
+use pipeline::{SindyConfig, evaluate_flight};
 use rayon::prelude::*;
-use sindy::{FeatureLibrary, SindyConfig, SindyParams, evaluate_flight};
+use sindy::{Derivative, FeatureLibrary, SindyParams};
 
 fn median_seconds(runs: usize, mut work: impl FnMut()) -> f64 {
     let mut times: Vec<f64> = (0..runs)

@@ -1,4 +1,5 @@
-//! Derivative estimators for uniformly sampled signals.
+//! Differentiation: derivative estimators for uniformly sampled signals (PySINDy's
+//! `differentiation` module), the targets ẋ that SINDy regresses on.
 //!
 //! - forward difference: `(x[k+1] − x[k]) / dt`, the last sample backward `(x[n−1] − x[n−2]) / dt`;
 //!   first order, error `dt/2·|x''|`. The paper's SINDy target.
@@ -10,7 +11,28 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{DataError, Result};
+/// A derivative estimator that is misconfigured or given too few samples.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DifferentiationError {
+    /// A name [`Derivative::parse`] does not know.
+    #[error("unknown derivative '{0}' (known: forward, central, savgol, savgol:WINDOW:ORDER)")]
+    UnknownName(String),
+    /// A Savitzky–Golay window that is even, too short, or not longer than the order.
+    #[error(
+        "Savitzky-Golay derivative: window {window} must be odd, at least 3 and larger than the \
+         order {order}"
+    )]
+    BadWindow { window: usize, order: usize },
+    /// A signal shorter than the estimator's stencil.
+    #[error("derivative: {samples} samples, the {estimator} estimator needs at least {needed}")]
+    TooFewSamples {
+        samples: usize,
+        estimator: Derivative,
+        needed: usize,
+    },
+}
+
+type Result<T> = std::result::Result<T, DifferentiationError>;
 
 /// How a derivative is estimated from samples.
 ///
@@ -56,11 +78,7 @@ impl Derivative {
 
     /// Parses `forward`, `central`, `savgol` (window 21, order 3) or `savgol:W:O`.
     pub fn parse(text: &str) -> Result<Self> {
-        let unknown = || DataError::UnknownName {
-            kind: "derivative",
-            name: text.to_string(),
-            known: "forward, central, savgol, savgol:WINDOW:ORDER".to_string(),
-        };
+        let unknown = || DifferentiationError::UnknownName(text.to_string());
         match text {
             "forward" => Ok(Self::Forward),
             "central" => Ok(Self::Central),
@@ -82,12 +100,7 @@ impl Derivative {
         if let Self::SavitzkyGolay { window, order } = *self
             && (window % 2 == 0 || window <= order || window < 3)
         {
-            return Err(DataError::Invalid {
-                what: "Savitzky-Golay derivative".to_string(),
-                message: format!(
-                    "window {window} must be odd, at least 3 and larger than the order {order}"
-                ),
-            });
+            return Err(DifferentiationError::BadWindow { window, order });
         }
         Ok(())
     }
@@ -105,14 +118,10 @@ impl Derivative {
     pub fn apply(&self, x: &[f64], dt: f64) -> Result<Vec<f64>> {
         self.validate()?;
         if x.len() < self.min_samples() {
-            return Err(DataError::Invalid {
-                what: "derivative".to_string(),
-                message: format!(
-                    "{} samples, the {} estimator needs at least {}",
-                    x.len(),
-                    self,
-                    self.min_samples()
-                ),
+            return Err(DifferentiationError::TooFewSamples {
+                samples: x.len(),
+                estimator: *self,
+                needed: self.min_samples(),
             });
         }
         Ok(match *self {
@@ -326,7 +335,7 @@ mod tests {
 
     #[test]
     fn unknown_fields_are_errors_in_every_kind() {
-        let read = |text: &str| crate::json::from_str::<Derivative>(text);
+        let read = |text: &str| inputs::json::from_str::<Derivative>(text);
         assert_eq!(read(r#"{"kind": "forward"}"#).unwrap(), Derivative::Forward);
         assert_eq!(read(r#"{"kind": "central"}"#).unwrap(), Derivative::Central);
         assert_eq!(

@@ -1,11 +1,28 @@
 //! The paper's SINDy columns on the real baseline flights: the 12 cells against the published
 //! values (paper/published.json) and against PySINDy (scripts/golden/sindy_paper.json).
 
-mod common;
+use std::path::{Path, PathBuf};
 
-use common::{golden, real_data_dir, workspace};
-use data::{Derivative, ExperimentConditions, FlightLog, Formulation, SplitSpec};
-use sindy::{SindyConfig, evaluate_flight};
+use data::{ExperimentConditions, FlightLog, Formulation, SplitSpec};
+use pipeline::{SindyConfig, evaluate_flight};
+use sindy::{Derivative, Mat};
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// A JSON file of the workspace, by relative path.
+fn json(relative: &str) -> serde_json::Value {
+    let path = workspace().join(relative);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
+/// A matrix from a JSON array of rows.
+fn matrix(value: &serde_json::Value) -> Mat<f64> {
+    let rows: Vec<Vec<f64>> = serde_json::from_value(value.clone()).unwrap();
+    Mat::from_fn(rows.len(), rows[0].len(), |i, j| rows[i][j])
+}
 
 /// Allowed distance from the published value, per formulation (issue 3).
 fn paper_tolerance(formulation: Formulation) -> f64 {
@@ -40,13 +57,13 @@ fn fitting_on_central_differences_closes_most_of_the_attitude_gap() {
 }
 
 fn check_cells(config: &SindyConfig, table: &str, tolerance: fn(Formulation) -> f64) {
-    let Some(data_dir) = real_data_dir() else {
+    let Some(data_dir) = data::real_data_dir_for_tests(&workspace()) else {
         return;
     };
     let conditions =
         ExperimentConditions::load(&workspace().join("experiments/conditions.json")).unwrap();
-    let published = common::json("paper/published.json");
-    let pysindy = golden("sindy_paper.json");
+    let published = json("paper/published.json");
+    let pysindy = json("scripts/golden/sindy_paper.json");
     let mut cells = 0;
     for condition in conditions.evaluation() {
         let path = conditions.flight_path(&data_dir, condition, &conditions.evaluation_controller);
@@ -83,7 +100,7 @@ fn check_cells(config: &SindyConfig, table: &str, tolerance: fn(Formulation) -> 
             let features: Vec<String> =
                 serde_json::from_value(reference["features"].clone()).unwrap();
             assert_eq!(features.len(), evaluation.model.feature_names().len());
-            let coefficients = common::matrix(&reference["coefficients"]);
+            let coefficients = matrix(&reference["coefficients"]);
             let ours = evaluation.model.coefficients();
             for i in 0..coefficients.nrows() {
                 for j in 0..coefficients.ncols() {

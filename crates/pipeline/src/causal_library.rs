@@ -3,7 +3,7 @@
 //!
 //! Features, in this order (names in brackets):
 //! - `linear`: every input [`x_j`], [`u_j`];
-//! - `fourier` K: `sin(k·z)`, `cos(k·z)` of every input z, k = 1..=K (as [`crate::LibrarySpec`]);
+//! - `fourier` K: `sin(k·z)`, `cos(k·z)` of every input z, k = 1..=K (as [`sindy::LibrarySpec`]);
 //! - `control_squares`: [`u_j^2`];
 //! - `control_lags` a ∈ [0, 1): `s[k] = a·s[k−1] + (1 − a)·u[k]`, `s[0] = u[0]`
 //!   [`lag0.80(u_j)`], a discrete first-order lag with time constant −dt/ln a.
@@ -13,11 +13,10 @@
 //! the regression (its intercept).
 
 use data::{Formulation, Segment};
-use faer::Mat;
+
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, field};
-use crate::library::MAX_FEATURES;
+use sindy::{MAX_FEATURES, Mat, Result, field};
 
 /// The most control lags a causal library may hold (each adds one feature per control; the
 /// committed variants use 3).
@@ -42,15 +41,15 @@ pub struct CausalLibrary {
 
 impl CausalLibrary {
     /// Checks the settings: at most [`MAX_CONTROL_LAGS`] lags, each pole in [0, 1) and none listed
-    /// twice, at least one feature, and at most [`crate::MAX_FEATURES`] features on every
-    /// formulation. Errors are [`crate::SindyError::Field`] naming the field (`control_lags`,
+    /// twice, at least one feature, and at most [`sindy::MAX_FEATURES`] features on every
+    /// formulation. Errors are [`sindy::SindyError::Field`] naming the field (`control_lags`,
     /// `fourier`; empty for the library as a whole).
     pub fn validate(&self) -> Result<()> {
         if self.control_lags.len() > MAX_CONTROL_LAGS {
             return Err(field(
                 "control_lags",
                 format!(
-                    "{} lags, more than the limit of {MAX_CONTROL_LAGS} (sindy::MAX_CONTROL_LAGS)",
+                    "{} lags, more than the limit of {MAX_CONTROL_LAGS} (pipeline::MAX_CONTROL_LAGS)",
                     self.control_lags.len()
                 ),
             ));
@@ -207,6 +206,8 @@ pub fn first_order_lag(signal: &[f64], pole: f64) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use data::{Formulation, Segment};
+    use sindy::SindyError;
 
     #[test]
     fn lags_are_causal_first_order_filters() {
@@ -323,7 +324,7 @@ mod tests {
         ];
         for (library, expected_field, expected) in cases {
             match library.validate().unwrap_err() {
-                crate::SindyError::Field { field, message } => {
+                SindyError::Field { field, message } => {
                     assert_eq!(field, expected_field, "{message}");
                     assert!(message.contains(expected), "{message}");
                 }

@@ -2,13 +2,15 @@
 //! penalty is chosen inside the support segment, scored on support (adapt) and query (gen).
 
 use data::Segment;
-use faer::{Mat, MatRef};
+
 use serde::{Deserialize, Serialize};
 
-use crate::causal::CausalLibrary;
-use crate::error::{Result, shape};
-use crate::model::mean_squared_error;
-use crate::regression::{EnsemblePrediction, RegressionFit, RegressionSpec};
+use sindy::{
+    EnsemblePrediction, Mat, MatRef, RegressionFit, RegressionSpec, Result, mean_squared_error,
+    shape,
+};
+
+use crate::causal_library::CausalLibrary;
 
 /// A library and a regression (serialisable, e.g. in `experiments/variants.json`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -61,7 +63,7 @@ pub struct VariantEvaluation {
 
 impl LibraryRegression {
     /// Checks the library ([`CausalLibrary::validate`]) and the regression
-    /// ([`RegressionSpec::validate`]); errors are [`crate::SindyError::Field`] naming the field,
+    /// ([`RegressionSpec::validate`]); errors are [`sindy::SindyError::Field`] naming the field,
     /// e.g. `regression.penalty.lambdas` or `library.control_lags`.
     pub fn validate(&self) -> Result<()> {
         self.library.validate().map_err(|e| e.within("library"))?;

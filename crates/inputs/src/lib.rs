@@ -1,0 +1,20 @@
+//! Reading input files safely.
+//!
+//! What it is for: reading a file a command was given with bounded cost ([`read_bytes`],
+//! [`read_text`], [`read_json_text`]: a regular file, or a pipe for a CSV, within a size limit per
+//! [`InputKind`]), and deserialising JSON under one policy ([`json`]: a byte-order mark ignored, a
+//! duplicated key or an array in place of an object refused, errors naming the failing field).
+//!
+//! What it is not for: what the files mean. Flight logs and numeric tables are read by `data`,
+//! models by `sindy` and `learn`; writing results is the `outputs` crate's.
+//!
+//! Errors are `std::io::Error`s (reading) and [`json::JsonError`]s (deserialising); each crate's
+//! loader wraps them with the file's path in its own error type.
+
+mod bounded;
+pub mod json;
+
+pub use bounded::{
+    InputKind, MAX_CSV_BYTES, MAX_CSV_COLUMNS, MAX_JSON_BYTES, read_bytes, read_json_text,
+    read_text,
+};

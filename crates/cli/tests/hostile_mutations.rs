@@ -156,7 +156,6 @@ fn mutated_flights_are_read_or_refused_in_one_line() {
             Ok(())
         })
         .unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `learn data inspect` on the file: success, or exit 1 with one line naming it; never a panic.
@@ -459,7 +458,6 @@ fn mutated_configurations_are_read_or_refused_in_one_line() {
             })
             .unwrap();
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Mutated numeric recordings (the CSV mutations above, on `t,x,y,u`) through `learn sindy`,
@@ -489,7 +487,6 @@ fn mutated_recordings_fit_the_same_whole_and_streamed() {
             }
         })
         .unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Recordings `learn sindy` reads whole and streamed per run.

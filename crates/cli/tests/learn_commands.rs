@@ -300,7 +300,7 @@ fn meta_train_never_writes_the_summary_over_one_of_its_checkpoints_whatever_the_
     let config = small_config(&dir, |_| {});
     std::fs::create_dir_all(dir.join("ck")).unwrap();
     // Without the real flights the refusal must come all the same: it comes before any work.
-    let data = real_data().unwrap_or_else(|| dir.clone());
+    let data = real_data().unwrap_or_else(|| dir.to_path_buf());
     let name = "leave-condition-out-translational-35wind-seed1.json";
     let mut spellings = vec![format!("./ck/{name}"), format!("ck/../ck/{name}")];
     #[cfg(unix)]
@@ -346,7 +346,7 @@ fn meta_train_never_writes_the_summary_over_one_of_its_checkpoints_whatever_the_
 fn meta_train_refuses_a_condition_that_is_not_an_evaluation_condition() {
     let dir = scratch("meta-train-meta-training-condition");
     let config = small_config(&dir, |_| {});
-    let data = real_data().unwrap_or_else(|| dir.clone());
+    let data = real_data().unwrap_or_else(|| dir.to_path_buf());
     let conditions = workspace().join("experiments/conditions.json");
     let run = learn_in(
         &dir,
@@ -436,7 +436,7 @@ fn meta_train_refuses_outputs_it_cannot_write_before_any_work() {
     std::fs::write(dir.join("file"), "mine").unwrap();
     std::fs::create_dir_all(dir.join("folder")).unwrap();
     // With the real flights the run could start: it must not, not even load them.
-    let data = real_data().unwrap_or_else(|| dir.clone());
+    let data = real_data().unwrap_or_else(|| dir.to_path_buf());
     let conditions = workspace().join("experiments/conditions.json");
     let cases: [(&[&str], &[&str]); 5] = [
         (

@@ -6,7 +6,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{learn_in, scratch};
+use common::{Scratch, learn_in, scratch};
 use serde_json::{Value, json};
 
 fn workspace() -> PathBuf {
@@ -15,7 +15,7 @@ fn workspace() -> PathBuf {
 
 /// A scratch directory holding the demo model (`quad.json`) and the committed control scenario
 /// (`control.json`) pointing at it.
-fn setup(test: &str) -> PathBuf {
+fn setup(test: &str) -> Scratch {
     let dir = scratch(test);
     std::fs::copy(
         workspace().join("experiments/mismatch/vehicles/quad-a.json"),

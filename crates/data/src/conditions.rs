@@ -480,9 +480,11 @@ mod tests {
 
     #[test]
     fn reads_patterns_labels_and_explicit_files() {
-        let dir = std::env::temp_dir().join(format!("conditions-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("conditions.json");
+        let dir = tempfile::Builder::new()
+            .prefix("conditions-")
+            .tempdir()
+            .unwrap();
+        let path = dir.path().join("conditions.json");
         std::fs::write(&path, sample()).unwrap();
         let config = ExperimentConditions::load(&path).unwrap();
         let labels: Vec<&str> = config.evaluation().map(|c| c.label()).collect();
@@ -499,9 +501,11 @@ mod tests {
 
     #[test]
     fn bad_json_names_the_file_and_field() {
-        let dir = std::env::temp_dir().join(format!("conditions-bad-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("conditions.json");
+        let dir = tempfile::Builder::new()
+            .prefix("conditions-bad-")
+            .tempdir()
+            .unwrap();
+        let path = dir.path().join("conditions.json");
         std::fs::write(
             &path,
             sample().replace("\"role\": \"evaluation\"}", "\"rol\": 1}"),
@@ -529,9 +533,11 @@ mod tests {
 
     /// Loads `sample()` edited by `edit`, expecting an error that names the file and `needles`.
     fn rejected(name: &str, edit: impl Fn(&str) -> String, needles: &[&str]) {
-        let dir = std::env::temp_dir().join(format!("conditions-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("conditions.json");
+        let dir = tempfile::Builder::new()
+            .prefix(&format!("conditions-{name}-"))
+            .tempdir()
+            .unwrap();
+        let path = dir.path().join("conditions.json");
         let text = edit(sample());
         assert_ne!(text, sample(), "{name}: the edit changed nothing");
         std::fs::write(&path, text).unwrap();
@@ -714,9 +720,11 @@ mod tests {
             &["controllers[1]", "'..'"],
         );
         // One controller: its flights are the only ones, {controller} may be left out.
-        let dir = std::env::temp_dir().join(format!("conditions-one-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("conditions.json");
+        let dir = tempfile::Builder::new()
+            .prefix("conditions-one-")
+            .tempdir()
+            .unwrap();
+        let path = dir.path().join("conditions.json");
         let one = sample()
             .replace("[\"baseline\", \"NF\"]", "[\"baseline\"]")
             .replace("custom_figure8_{controller}_", "custom_figure8_baseline_");
@@ -770,9 +778,11 @@ mod tests {
 
     #[test]
     fn an_unknown_condition_names_the_file() {
-        let dir = std::env::temp_dir().join(format!("conditions-unknown-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("conditions.json");
+        let dir = tempfile::Builder::new()
+            .prefix("conditions-unknown-")
+            .tempdir()
+            .unwrap();
+        let path = dir.path().join("conditions.json");
         std::fs::write(&path, sample()).unwrap();
         let mut config = ExperimentConditions::load(&path).unwrap();
         let message = config.condition("200wind").unwrap_err().to_string();

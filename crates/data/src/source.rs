@@ -120,11 +120,15 @@ mod tests {
 
     #[test]
     fn a_flag_naming_a_file_is_an_error_naming_it() {
-        let path = std::env::temp_dir().join(format!("not-a-data-dir-{}", std::process::id()));
-        std::fs::write(&path, b"x").unwrap();
+        let file = tempfile::Builder::new()
+            .prefix("not-a-data-dir-")
+            .tempfile()
+            .unwrap();
+        let path = file.path();
+        std::fs::write(path, b"x").unwrap();
         for result in [
-            resolve_data_dir(Some(&path)).map(Some),
-            find_data_dir(Some(&path)),
+            resolve_data_dir(Some(path)).map(Some),
+            find_data_dir(Some(path)),
         ] {
             let message = result.unwrap_err().to_string();
             assert_eq!(
@@ -135,15 +139,14 @@ mod tests {
                 )
             );
         }
-        std::fs::remove_file(&path).unwrap();
     }
 
     #[test]
     fn hashes_are_sha256() {
-        let path = std::env::temp_dir().join(format!("hash-{}", std::process::id()));
-        std::fs::write(&path, b"abc").unwrap();
+        let file = tempfile::Builder::new().prefix("hash-").tempfile().unwrap();
+        std::fs::write(file.path(), b"abc").unwrap();
         assert_eq!(
-            file_sha256(&path).unwrap(),
+            file_sha256(file.path()).unwrap(),
             "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
         );
     }

@@ -385,7 +385,8 @@ fn implausible_sample_intervals_are_rejected() {
         for t in &mut log.time {
             *t *= factor;
         }
-        let path = temp_dir(name).join("ok.csv");
+        let dir = temp_dir(name);
+        let path = dir.join("ok.csv");
         log.write_csv(&path).unwrap();
         FlightLog::read(&path).unwrap();
     }

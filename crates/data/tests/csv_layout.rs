@@ -5,13 +5,27 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::temp_dir;
+use common::{Scratch, temp_dir};
 use data::{FlightLog, NumericTable};
 
-fn write(name: &str, text: &[u8]) -> PathBuf {
-    let path = temp_dir("layout").join(name);
+/// A file written in a temporary directory of its own (both removed when dropped).
+struct Written {
+    path: PathBuf,
+    _dir: Scratch,
+}
+
+impl std::ops::Deref for Written {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.path
+    }
+}
+
+fn write(name: &str, text: &[u8]) -> Written {
+    let dir = temp_dir("layout");
+    let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
-    path
+    Written { path, _dir: dir }
 }
 
 fn numeric_error(path: &Path, columns: &[&str]) -> String {

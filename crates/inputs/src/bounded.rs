@@ -156,11 +156,13 @@ mod tests {
 
     #[test]
     fn a_large_json_file_is_refused_before_it_is_read() {
-        let path = std::env::temp_dir().join(format!("data-large-{}.json", std::process::id()));
-        let file = std::fs::File::create(&path).unwrap();
-        file.set_len(MAX_JSON_BYTES + 1).unwrap();
-        let message = read_json_text(&path).unwrap_err().to_string();
-        std::fs::remove_file(&path).unwrap();
+        let file = tempfile::Builder::new()
+            .prefix("data-large-")
+            .suffix(".json")
+            .tempfile()
+            .unwrap();
+        file.as_file().set_len(MAX_JSON_BYTES + 1).unwrap();
+        let message = read_json_text(file.path()).unwrap_err().to_string();
         assert_eq!(
             message,
             "over 8.0 MiB, more than the 8 MiB that a JSON file may have"

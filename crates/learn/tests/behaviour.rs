@@ -258,8 +258,9 @@ fn example_model() -> MetaTrainedModel {
 
 #[test]
 fn checkpoints_round_trip_and_bad_ones_name_the_file() {
-    let dir = std::env::temp_dir().join(format!("learn-checkpoint-{}", std::process::id()));
-    let path = dir.join("model.json");
+    let dir = common::temp_dir("learn-checkpoint");
+    // In a folder that does not exist yet: saving makes it.
+    let path = dir.path().join("checkpoints/model.json");
     let model = example_model();
     model.save(&path).unwrap();
     assert_eq!(MetaTrainedModel::load(&path).unwrap(), model);
@@ -301,8 +302,9 @@ fn checkpoints_round_trip_and_bad_ones_name_the_file() {
 
 #[test]
 fn checkpoints_with_unknown_fields_anywhere_are_refused() {
-    let dir = std::env::temp_dir().join(format!("learn-checkpoint-fields-{}", std::process::id()));
-    let path = dir.join("model.json");
+    let dir = common::temp_dir("learn-checkpoint-fields");
+    // In a folder that does not exist yet: saving makes it.
+    let path = dir.path().join("checkpoints/model.json");
     let mut model = example_model();
     model.data_files = vec![learn::DataFile {
         path: "experiment/a.csv".into(),
@@ -339,9 +341,8 @@ fn checkpoints_with_unknown_fields_anywhere_are_refused() {
 
 #[test]
 fn bad_configurations_name_the_file_and_field() {
-    let dir = std::env::temp_dir().join(format!("learn-config-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("learn.json");
+    let dir = common::temp_dir("learn-config");
+    let path = dir.path().join("learn.json");
     let text = std::fs::read_to_string(common::workspace().join("experiments/learn.json")).unwrap();
     std::fs::write(
         &path,
@@ -423,8 +424,9 @@ fn an_overflow_in_the_last_meta_update_is_divergence_not_a_result() {
 
 #[test]
 fn checkpoints_with_unusable_standardisers_or_settings_are_refused() {
-    let dir = std::env::temp_dir().join(format!("learn-checkpoint-check-{}", std::process::id()));
-    let path = dir.join("model.json");
+    let dir = common::temp_dir("learn-checkpoint-check");
+    // In a folder that does not exist yet: saving makes it.
+    let path = dir.path().join("checkpoints/model.json");
     let model = example_model();
     let mut cases: Vec<(MetaTrainedModel, &str)> = Vec::new();
     let mut zero_std = model.clone();

@@ -89,7 +89,8 @@ fn leave_condition_out_cell_runs_end_to_end() {
             "{error}"
         );
     }
-    let path = std::env::temp_dir().join(format!("learn-real-{}.json", std::process::id()));
+    let dir = common::temp_dir("learn-real");
+    let path = dir.path().join("learn-real.json");
     model.save(&path).unwrap();
     let loaded = MetaTrainedModel::load(&path).unwrap();
     assert_eq!(&loaded, model);

@@ -79,8 +79,9 @@ fn names_a_torque_bias_and_writes_outputs_once() {
     for (found, truth) in b.iter().zip([0.6, -0.4, 0.25]) {
         assert!((found - truth).abs() < 0.05, "{b:?}");
     }
-    let dir = std::env::temp_dir().join(format!("mismatch-test-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let tmp = common::temp_dir("test");
+    // A folder that does not exist yet.
+    let dir = tmp.path().join("out");
     write_outputs(&analysis, &dir, false).unwrap();
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("mismatch.json")).unwrap()).unwrap();
@@ -93,7 +94,6 @@ fn names_a_torque_bias_and_writes_outputs_once() {
         Err(MismatchError::Exists { .. })
     ));
     assert!(write_outputs(&analysis, &dir, true).is_ok());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

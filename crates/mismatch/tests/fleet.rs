@@ -2,18 +2,16 @@
 //! calm flight calibrates a tilted thrust axis and the rotor drag, and each windy flight's air
 //! velocity comes out of the joint fit, also with the vehicle fitted without that flight's condition.
 
-use std::path::PathBuf;
-
 use mismatch::fleet::FleetPlan;
 use mismatch::fleet::FleetReport;
 use physics::{DragLag, Effects, NominalModel, RotorDrag, Scenario, ThrustTilt, Wind, simulate};
 
 mod common;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mismatch-fleet-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(dir.join("data/experiment")).unwrap();
+/// A temporary directory (removed when dropped) with an empty `data/experiment`.
+fn scratch(name: &str) -> tempfile::TempDir {
+    let dir = common::temp_dir(&format!("fleet-{name}"));
+    std::fs::create_dir_all(dir.path().join("data/experiment")).unwrap();
     dir
 }
 
@@ -37,7 +35,8 @@ type Condition = (&'static str, Option<[f64; 3]>, f64);
 /// Simulates one flight per condition with the vehicle's effects (air forces lagging by
 /// `lag_s`), runs the joint analysis on them and returns its report.
 fn analyse(name: &str, conditions: &[Condition], lag_s: Option<f64>) -> FleetReport {
-    let dir = scratch(name);
+    let tmp = scratch(name);
+    let dir = tmp.path();
     let vehicle = common::model("vehicles/quad-a.json");
     for (k, (name, wind, _)) in conditions.iter().enumerate() {
         let scenario = Scenario {
@@ -81,7 +80,6 @@ fn analyse(name: &str, conditions: &[Condition], lag_s: Option<f64>) -> FleetRep
     for ext in ["json", "md", "svg"] {
         assert!(out.join(format!("vehicle.{ext}")).exists());
     }
-    std::fs::remove_dir_all(&dir).unwrap();
     report
 }
 

@@ -109,18 +109,11 @@ fn valid_analysis() -> Analysis {
     analyze(&flight(), &model("neural-fly.json"), "test", &settings()).unwrap()
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("mismatch-robustness-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 #[test]
 fn figures_are_never_drawn_from_non_finite_or_undrawable_data() {
     let valid = valid_analysis();
-    let dir = temp_dir("figure");
+    let tmp = common::temp_dir("robustness-figure");
+    let dir = tmp.path();
     write_figure(&valid, &dir.join("valid.svg")).unwrap();
 
     let mut nan = valid.clone();
@@ -182,7 +175,8 @@ fn figures_are_never_drawn_from_non_finite_or_undrawable_data() {
 fn outputs_are_not_written_from_non_finite_results() {
     let mut analysis = valid_analysis();
     analysis.report.fit.after.mse = f64::INFINITY;
-    let dir = temp_dir("outputs").join("out");
+    let tmp = common::temp_dir("robustness-outputs");
+    let dir = tmp.path().join("out");
     let message = write_outputs(&analysis, &dir, false)
         .unwrap_err()
         .to_string();

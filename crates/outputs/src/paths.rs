@@ -64,8 +64,11 @@ mod tests {
 
     #[test]
     fn same_file_sees_through_spellings_of_paths_that_do_not_exist_yet() {
-        let dir = std::env::temp_dir().join(format!("data-same-file-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+        let tmp = tempfile::Builder::new()
+            .prefix("data-same-file-")
+            .tempdir()
+            .unwrap();
+        let dir = tmp.path();
         std::fs::create_dir_all(dir.join("ck")).unwrap();
         let plain = dir.join("ck/a.json");
         assert!(same_file(&plain, &dir.join("ck/./a.json")));
@@ -92,14 +95,15 @@ mod tests {
             assert!(!same_file(&dir.join("l/../x"), &dir.join("x")));
             assert!(same_file(&dir.join("l/../new/../x"), &dir.join("other/x")));
         }
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn a_file_among_the_ancestors_is_found() {
-        let dir = std::env::temp_dir().join(format!("data-ancestor-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let tmp = tempfile::Builder::new()
+            .prefix("data-ancestor-")
+            .tempdir()
+            .unwrap();
+        let dir = tmp.path();
         assert_eq!(non_directory_ancestor(&dir.join("a/b.csv")), None);
         std::fs::write(dir.join("a"), "").unwrap();
         assert_eq!(
@@ -107,6 +111,5 @@ mod tests {
             Some(dir.join("a").as_path())
         );
         assert_eq!(non_directory_ancestor(Path::new("b.csv")), None);
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1,15 +1,16 @@
 //! The output-set protocol on real folders: ownership, --force, stale files, locks, staging,
 //! journals.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use outputs::{Existing, OutputError, OutputSet};
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("outputs-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty temporary directory, removed with everything in it when dropped.
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("outputs-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// Runs `producer` into `dir`, writing `files` (relative name, content).
@@ -51,7 +52,8 @@ fn listing(dir: &Path) -> Vec<String> {
 
 #[test]
 fn own_files_are_replaced_only_with_force_and_foreign_ones_never() {
-    let dir = scratch("own");
+    let tmp = scratch("own");
+    let dir = tmp.path().to_path_buf();
     run(
         &dir,
         "p",
@@ -87,12 +89,12 @@ fn own_files_are_replaced_only_with_force_and_foreign_ones_never() {
     run(&dir, "q", &[("q.json", "q")], Existing::Refuse).unwrap();
     run(&dir, "p", &[("a.json", "3")], Existing::Replace).unwrap();
     assert!(dir.join("q.json").exists());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn a_failed_or_dropped_run_leaves_the_old_set_and_no_staging() {
-    let dir = scratch("dropped");
+    let tmp = scratch("dropped");
+    let dir = tmp.path().to_path_buf();
     run(
         &dir,
         "p",
@@ -108,12 +110,12 @@ fn a_failed_or_dropped_run_leaves_the_old_set_and_no_staging() {
     drop(staged);
     assert_eq!(std::fs::read_to_string(dir.join("a.json")).unwrap(), "old");
     assert_eq!(listing(&dir), [".learn-outputs.json", "a.json", "b.json"]);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn a_second_run_into_a_locked_folder_is_refused() {
-    let dir = scratch("locked");
+    let tmp = scratch("locked");
+    let dir = tmp.path().to_path_buf();
     let mut first = OutputSet::new("p");
     let folder = first.folder(&dir, "--out", Existing::Refuse);
     first.file_in(folder, "a.json");
@@ -125,12 +127,12 @@ fn a_second_run_into_a_locked_folder_is_refused() {
     assert!(matches!(error, OutputError::Locked { .. }), "{error}");
     assert!(error.to_string().contains("another learn run"), "{error}");
     drop(staged);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn named_files_need_force_and_outputs_are_never_inputs() {
-    let dir = scratch("named");
+    let tmp = scratch("named");
+    let dir = tmp.path().to_path_buf();
     let target = dir.join("m.json");
     std::fs::write(&target, "old").unwrap();
     let mut set = OutputSet::new("sindy");
@@ -161,12 +163,12 @@ fn named_files_need_force_and_outputs_are_never_inputs() {
         error.contains("is a file, not a directory (--latex-dir"),
         "{error}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn a_killed_commit_is_finished_and_dead_staging_removed_by_the_next_run() {
-    let dir = scratch("journal");
+    let tmp = scratch("journal");
+    let dir = tmp.path().to_path_buf();
     run(&dir, "p", &[("a.json", "old")], Existing::Refuse).unwrap();
     // What a commit killed after its journal and before its renames leaves behind (pid 0 is never
     // a user process's staging: take an unused high pid for the dead one).
@@ -182,12 +184,12 @@ fn a_killed_commit_is_finished_and_dead_staging_removed_by_the_next_run() {
     run(&dir, "q", &[("q.json", "q")], Existing::Refuse).unwrap();
     assert_eq!(std::fs::read_to_string(dir.join("a.json")).unwrap(), "new");
     assert_eq!(listing(&dir), [".learn-outputs.json", "a.json", "q.json"]);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn a_manifest_cannot_reach_outside_its_folder() {
-    let dir = scratch("reach");
+    let tmp = scratch("reach");
+    let dir = tmp.path().to_path_buf();
     std::fs::write(
         dir.join(".learn-outputs.json"),
         r#"{"format": "learn-outputs/1", "files": {"../x": "p"}}"#,
@@ -198,14 +200,14 @@ fn a_manifest_cannot_reach_outside_its_folder() {
         error.to_string().contains("not a plain relative path"),
         "{error}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// A set of two folders whose second cannot take its commit journal: the first folder keeps its
 /// old files (no folder of the set is committed alone) and no journal is left to finish later.
 #[test]
 fn a_commit_that_fails_in_one_folder_changes_none() {
-    let dir = scratch("two-folders");
+    let tmp = scratch("two-folders");
+    let dir = tmp.path().to_path_buf();
     let (first, second) = (dir.join("a"), dir.join("b"));
     for (folder, content) in [(&first, "old a"), (&second, "old b")] {
         run(folder, "p", &[("x.json", content)], Existing::Refuse).unwrap();

@@ -38,7 +38,7 @@ fn tracks_the_figure8_and_writes_a_readable_body_rate_log() {
         max_tracking_error(&log)
     );
     let dir = common::temp_dir("roundtrip");
-    let path = dir.join("nominal.csv");
+    let path = dir.path().join("nominal.csv");
     log.write_csv(&path).unwrap();
     let back = data::FlightLog::read(&path).unwrap();
     assert_eq!(back.position, log.position);
@@ -103,7 +103,7 @@ fn a_scenario_at_its_bounds_gives_a_log_the_data_tools_accept() {
         .unwrap();
     let log = simulate(&model, &scenario, "edge").unwrap();
     let dir = common::temp_dir("edge");
-    let path = dir.join("edge.csv");
+    let path = dir.path().join("edge.csv");
     physics::write_readable(&log, &path, std::path::Path::new("edge.json")).unwrap();
     let back = data::FlightLog::read(&path).unwrap();
     assert_eq!(back.len(), log.len());

@@ -223,9 +223,11 @@ mod tests {
 
     #[test]
     fn readme_block_is_replaced_and_the_rest_kept() {
-        let dir = std::env::temp_dir().join(format!("pipeline-readme-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let readme = dir.join("README.md");
+        let dir = tempfile::Builder::new()
+            .prefix("pipeline-readme-")
+            .tempdir()
+            .unwrap();
+        let readme = dir.path().join("README.md");
         let original =
             format!("# Title\n\nintro\n\n{README_BEGIN}\nold\n{README_END}\n\n## After\n");
         std::fs::write(&readme, &original).unwrap();
@@ -251,6 +253,5 @@ mod tests {
         assert!(message.contains("tables:begin"), "{message}");
         std::fs::write(&readme, &original).unwrap();
         check_readme(&readme).unwrap();
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1587,13 +1587,15 @@ mod tests {
         }
     }
 
-    fn write(name: &str, text: &str) -> PathBuf {
-        let path = std::env::temp_dir().join(format!(
-            "pipeline-variants-{}-{name}.json",
-            std::process::id()
-        ));
-        std::fs::write(&path, text).unwrap();
-        path
+    /// A temporary `.json` file holding `text`, removed when dropped.
+    fn write(name: &str, text: &str) -> tempfile::TempPath {
+        let mut file = tempfile::Builder::new()
+            .prefix(&format!("pipeline-variants-{name}-"))
+            .suffix(".json")
+            .tempfile()
+            .unwrap();
+        std::io::Write::write_all(&mut file, text.as_bytes()).unwrap();
+        file.into_temp_path()
     }
 
     fn config(variants: &str, extra: &str) -> String {

@@ -13,10 +13,22 @@ fn committed(name: &str) -> Value {
     serde_json::from_str(&std::fs::read_to_string(workspace().join(name)).unwrap()).unwrap()
 }
 
+/// A fresh temporary directory, removed with everything in it when dropped.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("pipeline-{name}-"))
+        .tempdir()
+        .unwrap()
+}
+
 /// Writes `config` to a temporary file and loads it against the workspace root.
 fn load(name: &str, config: &Value) -> Result<pipeline::CheckedRunConfig, String> {
-    let dir = std::env::temp_dir().join(format!("pipeline-config-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("config");
+    load_in(dir.path(), name, config)
+}
+
+/// Writes `config` as `{name}.json` in `dir` and loads it against the workspace root.
+fn load_in(dir: &Path, name: &str, config: &Value) -> Result<pipeline::CheckedRunConfig, String> {
     let path = dir.join(format!("{name}.json"));
     std::fs::write(&path, config.to_string()).unwrap();
     RunConfig::load(&path, &workspace()).map_err(|e| e.to_string())
@@ -64,14 +76,12 @@ fn overrides_are_merged_before_the_learn_configuration_is_checked() {
 fn a_bad_value_set_by_the_overrides_is_blamed_on_the_overrides() {
     let mut config = committed("experiments/reproduce.json");
     config["learn"]["overrides"] = json!({"meta_training": {"iterations": 0}});
-    let message = load("zero-iterations", &config).unwrap_err();
+    let dir = temp_dir("config");
+    let message = load_in(dir.path(), "zero-iterations", &config).unwrap_err();
     assert!(
         message.starts_with(&format!(
             "{}: learn.overrides: ",
-            std::env::temp_dir()
-                .join(format!("pipeline-config-{}", std::process::id()))
-                .join("zero-iterations.json")
-                .display()
+            dir.path().join("zero-iterations.json").display()
         )) && message
             .contains("learn.json with these overrides: field 'meta_training.iterations': "),
         "{message}"
@@ -231,11 +241,10 @@ fn seeds_are_capped() {
 
 #[test]
 fn a_fault_of_the_learn_configuration_itself_is_named_in_that_file() {
-    let dir = std::env::temp_dir().join(format!("pipeline-learn-own-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("learn-own");
     let mut learn = committed("experiments/learn.json");
     learn.as_object_mut().unwrap().remove("seed");
-    let learn_path = dir.join("noseed.json");
+    let learn_path = dir.path().join("noseed.json");
     std::fs::write(&learn_path, learn.to_string()).unwrap();
     let mut config = committed("experiments/reproduce.json");
     config["learn"]["config"] = learn_path.to_str().unwrap().into();

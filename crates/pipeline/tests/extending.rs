@@ -16,11 +16,13 @@ fn real_data_dir() -> Option<PathBuf> {
     data::real_data_dir_for_tests(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("pipeline-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh temporary directory, removed with everything in it when dropped (a symbolic link in it
+/// is removed, not followed).
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("pipeline-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// A data directory whose `experiment/` is the real one and whose `extra/` holds a copy of the
@@ -126,7 +128,8 @@ fn conditions_of(table: &Value) -> Vec<String> {
 #[test]
 fn a_new_condition_is_a_new_row_of_every_table_and_a_new_figure() {
     let Some(real) = real_data_dir() else { return };
-    let dir = temp_dir("extending");
+    let tmp = temp_dir("extending");
+    let dir = tmp.path().to_path_buf();
     let data = data_dir_with_new_flight(&real, &dir);
     run_with(&dir, &data, &conditions(false), &dir.join("before"));
     run_with(&dir, &data, &conditions(true), &dir.join("after"));
@@ -203,5 +206,4 @@ fn a_new_condition_is_a_new_row_of_every_table_and_a_new_figure() {
         compared += 1;
     }
     assert_eq!(compared, 6);
-    let _ = std::fs::remove_dir_all(&dir);
 }

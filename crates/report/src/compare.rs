@@ -571,9 +571,11 @@ mod tests {
             "{message}"
         );
         // Two rules for exactly the same cells.
-        let dir = std::env::temp_dir().join(format!("report-tolerances-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("tolerances.json");
+        let dir = tempfile::Builder::new()
+            .prefix("report-tolerances-")
+            .tempdir()
+            .unwrap();
+        let path = dir.path().join("tolerances.json");
         let mut value = serde_json::to_value(tolerances()).unwrap();
         let first = value["rules"][0].clone();
         value["rules"].as_array_mut().unwrap().push(first);

@@ -104,9 +104,11 @@ mod tests {
 
     #[test]
     fn nothing_to_check_and_implausible_values_are_refused_naming_the_field() {
-        let dir = std::env::temp_dir().join(format!("report-published-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("published.json");
+        let dir = tempfile::Builder::new()
+            .prefix("report-published-")
+            .tempdir()
+            .unwrap();
+        let path = dir.path().join("published.json");
         let message = |text: &str| {
             std::fs::write(&path, text).unwrap();
             PublishedTables::load(&path).unwrap_err().to_string()
@@ -136,6 +138,5 @@ mod tests {
         );
         let text = message(r#"{"source": "s", "tables": {}}"#);
         assert!(text.contains("published.json: tables: no table"), "{text}");
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -350,8 +350,12 @@ mod tests {
 
     #[test]
     fn a_table_in_two_files_is_an_error_naming_both() {
-        let dir = std::env::temp_dir().join(format!("report-two-files-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+        let tmp = tempfile::Builder::new()
+            .prefix("report-two-files-")
+            .tempdir()
+            .unwrap();
+        // A folder that does not exist yet: saving the first table makes it.
+        let dir = tmp.path().join("tables");
         let table = |generalisation: f64| ResultsTable {
             table: "translational".to_string(),
             protocol: "p".to_string(),
@@ -367,13 +371,16 @@ mod tests {
                 && message.contains("translational.json (one file per table)"),
             "{message}"
         );
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn negative_errors_are_rejected_with_the_field() {
-        let dir = std::env::temp_dir().join(format!("report-table-{}", std::process::id()));
-        let path = dir.join("t.json");
+        let tmp = tempfile::Builder::new()
+            .prefix("report-table-")
+            .tempdir()
+            .unwrap();
+        // In a folder that does not exist yet: saving makes it.
+        let path = tmp.path().join("tables/t.json");
         let table = ResultsTable {
             table: "full".to_string(),
             protocol: "p".to_string(),

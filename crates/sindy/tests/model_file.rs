@@ -40,12 +40,12 @@ fn model() -> SindyModel {
         .unwrap()
 }
 
-fn temp_path(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("sindy-tests-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    let _ = std::fs::remove_file(&path);
-    path
+/// A fresh temporary directory, removed with everything in it when dropped.
+fn temp_dir() -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix("sindy-tests-")
+        .tempdir()
+        .unwrap()
 }
 
 #[test]
@@ -59,7 +59,8 @@ fn equations_print_like_pysindy_with_signs_folded() {
 #[test]
 fn a_saved_model_loads_and_predicts_identically() {
     let model = model();
-    let path = temp_path("model.json");
+    let dir = temp_dir();
+    let path = dir.path().join("model.json");
     model.save(&path, false).unwrap();
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();

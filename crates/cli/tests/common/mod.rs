@@ -3,7 +3,7 @@
 
 #![allow(dead_code)]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 /// What one run of `learn` gave.
@@ -63,12 +63,31 @@ impl Run {
     }
 }
 
-/// A fresh, empty scratch directory for one test (named after it and the process).
-pub fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("learn-cli-{test}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch directory");
-    dir
+/// A fresh, empty scratch directory for one test (named after it), removed with everything in it
+/// when dropped: keep it alive for as long as the test uses the path.
+pub fn scratch(test: &str) -> Scratch {
+    Scratch(
+        tempfile::Builder::new()
+            .prefix(&format!("learn-cli-{test}-"))
+            .tempdir()
+            .expect("scratch directory"),
+    )
+}
+
+/// A temporary directory, used as its path.
+pub struct Scratch(tempfile::TempDir);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        self.0.path()
+    }
 }
 
 /// `t,x,y,u` for t = 0, 0.01, ...: a damped rotation driven by u.

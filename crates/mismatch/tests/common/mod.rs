@@ -11,6 +11,14 @@ pub fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
+/// A fresh temporary directory for one test, removed with everything in it when dropped.
+pub fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("mismatch-{name}-"))
+        .tempdir()
+        .unwrap()
+}
+
 /// A nominal model of `experiments/mismatch/`, e.g. `vehicles/quad-a.json`.
 pub fn model(name: &str) -> NominalModel {
     NominalModel::load(&workspace().join("experiments/mismatch").join(name)).unwrap()

@@ -153,6 +153,10 @@ pub enum DataError {
     },
     #[error("{what}: {message}")]
     Invalid { what: String, message: String },
+    /// A task that does not fit with the others (e.g. sampled at another interval), named by
+    /// its file.
+    #[error("{}: {message}", path.display())]
+    Task { path: PathBuf, message: String },
 }
 
 /// A number as it reads best in a one-line message: plainly for ordinary magnitudes (so `0.02`

@@ -52,6 +52,10 @@ pub enum LearnError {
     /// non-finite number: reported instead of printing NaN.
     #[error("{cell}: {message}")]
     NotFinite { cell: String, message: String },
+    /// A CSV task or recording that cannot serve LeARN (too few rows, another sampling
+    /// interval), named by its file.
+    #[error("{}: {message}", path.display())]
+    Task { path: PathBuf, message: String },
     /// A flight that cannot serve LeARN (e.g. too short to split), named by its file.
     #[error("{}: {message}", path.display())]
     Flight { path: PathBuf, message: String },

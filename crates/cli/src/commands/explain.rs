@@ -58,13 +58,17 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         .map(|path| set.file(path, "--json", Existing::from_force(args.force)));
     set.check()?;
     let model = MetaTrainedModel::load(&args.checkpoint)?;
+    let flights = model
+        .flights()
+        .cloned()
+        .context("a model of CSV tasks has no flight to explain over")?;
     let flight = match args.flight {
         Some(path) => path,
         None => {
             let conditions = ExperimentConditions::load(&args.conditions)?;
             let name = args
                 .condition
-                .or(model.held_out_condition.clone())
+                .or(flights.held_out_condition.clone())
                 .context(
                     "the checkpoint names no held-out condition: pass --condition or --flight",
                 )?;
@@ -94,7 +98,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         let value = serde_json::json!({
             "checkpoint": args.checkpoint,
             "flight": flight,
-            "protocol": model.protocol.name(),
+            "protocol": flights.protocol.name(),
             "seed": model.seed,
             "adapted": !args.no_adapt,
             "explanation": explanation,
@@ -105,8 +109,8 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     }
     say!(
         "{} model ({} protocol, seed {}) over {} ({} samples, {})",
-        model.formulation.name(),
-        model.protocol.name(),
+        flights.formulation.name(),
+        flights.protocol.name(),
         model.seed,
         flight.display(),
         explanation.samples,

@@ -305,3 +305,28 @@ fn bad_evaluations_are_one_line_errors_naming_the_file_and_rows() {
     // The model is never replaced without --force.
     meta_train(&dir, "train-*.csv", &[]).one_line_error(&["model.json"]);
 }
+
+#[test]
+fn sindy_reads_list_elements_alike_whole_and_streamed() {
+    let dir = scratch("own-data-sindy-elements");
+    std::fs::write(dir.join("list.csv"), oscillator(2.0, 0.25, 300, 0.05, true)).unwrap();
+    let args = [
+        "sindy",
+        "--csv",
+        "list.csv",
+        "--state",
+        "s[0],s[1]",
+        "--control",
+        "u",
+    ];
+    let whole = learn_in(&dir, &args).success().to_string();
+    assert!(whole.contains("s[1]' = -1.998 s[0]"), "{whole}");
+    let mut streamed = args.to_vec();
+    streamed.push("--stream");
+    assert_eq!(learn_in(&dir, &streamed).success(), whole);
+    let missing = ["sindy", "--csv", "list.csv", "--state", "s[2]"];
+    learn_in(&dir, &missing).one_line_error(&["list.csv:2:s[2]", "no element [2]"]);
+    let mut missing_streamed = missing.to_vec();
+    missing_streamed.push("--stream");
+    learn_in(&dir, &missing_streamed).one_line_error(&["list.csv:2:s[2]", "no element [2]"]);
+}

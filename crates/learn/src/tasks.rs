@@ -143,102 +143,35 @@ pub fn meta_train_tasks(
     config: &TaskConfig,
     iteration_done: &dyn Fn(usize),
 ) -> Result<MetaTrainedModel> {
-    let TaskSet {
-        source,
-        spec,
-        tasks,
-        files,
-    } = set;
     let config_error = |field: &str, message: String| LearnError::Config {
         path: config.origin_path(),
         field: field.to_string(),
         message,
     };
-    spec.check().map_err(|message| LearnError::Mismatch {
+    set.spec.check().map_err(|message| LearnError::Mismatch {
         what: "columns".to_string(),
         message,
     })?;
-    let Some(first) = tasks.first() else {
+    if set.tasks.is_empty() {
         return Err(LearnError::Mismatch {
             what: "meta-training".to_string(),
             message: "no tasks".to_string(),
         });
-    };
+    }
     if config.get().meta_training.tasks == TaskGrouping::Condition {
         return Err(config_error(
             "meta_training.tasks",
             "'condition' pools the flights of a wind condition; each CSV task is one task: use 'flight'".to_string(),
         ));
     }
-    let raw: Vec<(Batch, Batch)> = tasks
+    let raw: Vec<(Batch, Batch)> = set
+        .tasks
         .iter()
-        .map(|task| task_halves(task, spec))
+        .map(|task| task_halves(task, set.spec))
         .collect::<Result<_>>()?;
-    let dim = spec.state.len() + spec.control.len();
-    let all_inputs = raw
-        .iter()
-        .flat_map(|(s, q)| [s.inputs.as_slice(), q.inputs.as_slice()]);
-    let settings = config.fit_to(
-        tasks.len(),
-        tasks.iter().map(|t| t.rows() / 2).min().unwrap_or(0),
-        tasks
-            .iter()
-            .map(|t| t.rows() - t.rows() / 2)
-            .min()
-            .unwrap_or(0),
-    );
-    let standardiser = if settings.standardise_inputs {
-        Standardiser::fit(all_inputs.clone(), dim)
-    } else {
-        Standardiser::identity(dim)
-    }
-    .with_range(InputRange::spanned(all_inputs, dim), settings.clamp_inputs);
-    let target_scale = column_scale(
-        raw.iter()
-            .flat_map(|(s, q)| [s.targets.as_slice(), q.targets.as_slice()]),
-        spec.state.len(),
-    );
-    let trained_on = ColumnTraining {
-        time: spec.time.clone(),
-        state: spec.state.clone(),
-        control: spec.control.clone(),
-        derivative: spec.derivative,
-        sampling_interval: first.interval,
-        target_scale,
-        source: source.clone(),
-        tasks: tasks
-            .iter()
-            .map(|t| TaskRows {
-                name: t.name.clone(),
-                rows: t.rows(),
-            })
-            .collect(),
-    };
-    let architecture = spec.architecture(&settings);
-    if architecture.parameter_count() > limits::PARAMETERS {
-        return Err(config_error(
-            "hidden_layers",
-            format!(
-                "the networks for {} inputs and {} outputs would have {} parameters, more than {}",
-                architecture.input_dim,
-                architecture.state_dim,
-                architecture.parameter_count(),
-                limits::PARAMETERS
-            ),
-        ));
-    }
-    let mut model = MetaTrainedModel {
-        format: CHECKPOINT_FORMAT.to_string(),
-        trained_on: TrainedOn::Columns(trained_on),
-        seed: settings.seed,
-        config: settings,
-        parameters: Vec::new(),
-        standardiser,
-        architecture,
-        data_files: files,
-        meta_loss_history: Vec::new(),
-    };
-    let task_data: Vec<TaskData> = tasks
+    let mut model = untrained_model(&set, config, &raw)?;
+    let task_data: Vec<TaskData> = set
+        .tasks
         .iter()
         .zip(raw)
         .map(|(task, (support, query))| TaskData {
@@ -248,7 +181,7 @@ pub fn meta_train_tasks(
         })
         .collect();
     let meta = &model.config.meta_training;
-    check_sampling(meta, &task_data, dim)
+    check_sampling(meta, &task_data, model.architecture.input_dim)
         .map_err(|(field, message)| config_error(field, message))?;
     let outcome = meta_train_observed(
         &model.architecture,
@@ -270,6 +203,82 @@ pub fn meta_train_tasks(
     model.parameters = outcome.parameters;
     model.meta_loss_history = outcome.meta_loss_history;
     Ok(model)
+}
+
+/// The model before meta-training (no parameters yet): the settings fitted to the tasks, the
+/// input standardiser and target scales of their raw `(support, query)` data, the architecture
+/// of the paper's rule (refused beyond [`limits::PARAMETERS`]) and what it is trained on.
+fn untrained_model(
+    set: &TaskSet<'_>,
+    config: &TaskConfig,
+    raw: &[(Batch, Batch)],
+) -> Result<MetaTrainedModel> {
+    let (spec, tasks) = (set.spec, set.tasks);
+    let dim = spec.state.len() + spec.control.len();
+    let settings = config.fit_to(
+        tasks.len(),
+        tasks.iter().map(|t| t.rows() / 2).min().unwrap_or(0),
+        tasks
+            .iter()
+            .map(|t| t.rows() - t.rows() / 2)
+            .min()
+            .unwrap_or(0),
+    );
+    let all_inputs = raw
+        .iter()
+        .flat_map(|(s, q)| [s.inputs.as_slice(), q.inputs.as_slice()]);
+    let standardiser = if settings.standardise_inputs {
+        Standardiser::fit(all_inputs.clone(), dim)
+    } else {
+        Standardiser::identity(dim)
+    }
+    .with_range(InputRange::spanned(all_inputs, dim), settings.clamp_inputs);
+    let target_scale = column_scale(
+        raw.iter()
+            .flat_map(|(s, q)| [s.targets.as_slice(), q.targets.as_slice()]),
+        spec.state.len(),
+    );
+    let architecture = spec.architecture(&settings);
+    if architecture.parameter_count() > limits::PARAMETERS {
+        return Err(LearnError::Config {
+            path: config.origin_path(),
+            field: "hidden_layers".to_string(),
+            message: format!(
+                "the networks for {} inputs and {} outputs would have {} parameters, more than {}",
+                architecture.input_dim,
+                architecture.state_dim,
+                architecture.parameter_count(),
+                limits::PARAMETERS
+            ),
+        });
+    }
+    let trained_on = ColumnTraining {
+        time: spec.time.clone(),
+        state: spec.state.clone(),
+        control: spec.control.clone(),
+        derivative: spec.derivative,
+        sampling_interval: tasks[0].interval,
+        target_scale,
+        source: set.source.clone(),
+        tasks: tasks
+            .iter()
+            .map(|t| TaskRows {
+                name: t.name.clone(),
+                rows: t.rows(),
+            })
+            .collect(),
+    };
+    Ok(MetaTrainedModel {
+        format: CHECKPOINT_FORMAT.to_string(),
+        trained_on: TrainedOn::Columns(trained_on),
+        seed: settings.seed,
+        config: settings,
+        parameters: Vec::new(),
+        standardiser,
+        architecture,
+        data_files: set.files.clone(),
+        meta_loss_history: Vec::new(),
+    })
 }
 
 /// Raw data in the units the networks learn: standardised inputs, scaled targets.

@@ -7,9 +7,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use outputs::{Existing, OutputSet};
+use pipeline::own_data::SimulatedTask;
 use pipeline::own_data::example::{
     CurveMethod, CurvePoint, ExampleConfig, LearningCurve, run_example,
 };
@@ -68,14 +68,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let staged = set.prepare()?;
     let (train, test) = config.simulate();
     let staging = staged.dir(work).to_path_buf();
-    for (kind, tasks) in [("train", &train), ("test", &test)] {
-        std::fs::create_dir_all(staging.join(kind))
-            .with_context(|| args.work.join(kind).display().to_string())?;
-        for (index, task) in tasks.iter().enumerate() {
-            let path = staging.join(task_file(kind, index));
-            super::staged_write(&staged, || std::fs::write(&path, task.csv()))?;
-        }
-    }
+    write_tasks(&staged, &staging, &[("train", &train), ("test", &test)])?;
     let staged_test: Vec<(PathBuf, _)> = test
         .iter()
         .enumerate()
@@ -112,6 +105,23 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         CURVE_FILES.join(", "),
         args.out.display()
     );
+    Ok(())
+}
+
+/// Each kind's tasks as `kind/task-NNN.csv` under the staging folder `staging`.
+fn write_tasks(
+    staged: &outputs::Staged,
+    staging: &Path,
+    kinds: &[(&str, &Vec<SimulatedTask>)],
+) -> anyhow::Result<()> {
+    for (kind, tasks) in kinds {
+        let folder = staging.join(kind);
+        super::staged_write(staged, || std::fs::create_dir_all(&folder))?;
+        for (index, task) in tasks.iter().enumerate() {
+            let path = staging.join(task_file(kind, index));
+            super::staged_write(staged, || std::fs::write(&path, task.csv()))?;
+        }
+    }
     Ok(())
 }
 

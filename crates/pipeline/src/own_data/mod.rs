@@ -19,7 +19,7 @@ use sindy::{FeatureLibrary, OptimizerSpec, SindyModel, SindyParams};
 
 use crate::error::{PipelineError, Result};
 
-pub use family::{FamilyConfig, ParameterRange, simulate_task};
+pub use family::{FamilyConfig, ParameterRange, SimulatedTask, TaskParameters, simulate_task};
 
 /// Adaptation (support rows) and generalisation (query rows) MSE of one method.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -170,9 +170,14 @@ impl CurveFigure {
 }
 
 /// A Markdown table: one row per sample count, one column per series, the lowest value of each
-/// row in bold, numbers with four decimals (in scientific notation from 10⁴ on); `notes[i][row]`
-/// (if given and not empty) appended to that cell as ` (note)`.
-pub fn curve_markdown(samples: &[usize], series: &[CurveSeries], notes: &[Vec<String>]) -> String {
+/// row in bold when `bold_lowest`, numbers with four decimals (in scientific notation from 10⁴
+/// on); `notes[i][row]` (if given and not empty) appended to that cell as ` (note)`.
+pub fn curve_markdown(
+    samples: &[usize],
+    series: &[CurveSeries],
+    notes: &[Vec<String>],
+    bold_lowest: bool,
+) -> String {
     let mut text = String::from("| support samples |");
     for s in series {
         text.push_str(&format!(" {} |", s.label));
@@ -193,7 +198,7 @@ pub fn curve_markdown(samples: &[usize], series: &[CurveSeries], notes: &[Vec<St
             } else {
                 format!("{value:.4}")
             };
-            let number = if value == lowest {
+            let number = if bold_lowest && value == lowest {
                 format!("**{number}**")
             } else {
                 number
@@ -256,7 +261,7 @@ mod tests {
     fn the_table_bolds_the_lowest_of_each_row() {
         let f = figure();
         let notes = vec![vec![String::new(), "2/3".to_string(), String::new()]];
-        let text = curve_markdown(&f.samples, &f.series, &notes);
+        let text = curve_markdown(&f.samples, &f.series, &notes, true);
         assert!(text.contains("| 20 | **1.0000** | 2.0000 |"), "{text}");
         assert!(
             text.contains("| 100 | 0.5000 (2/3) | **0.4000** |"),

@@ -58,8 +58,11 @@ pub struct ExampleConfig {
     pub data_seed: u64,
     /// LeARN settings over the defaults (`learn meta-train --tasks --config`); none: the defaults.
     pub learn_config: Option<PathBuf>,
-    /// The meta-training seed.
+    /// The meta-training seed of the curve.
     pub seed: u64,
+    /// Further meta-training seeds, for LeARN's seed-to-seed spread alone.
+    #[serde(default)]
+    pub spread_seeds: Vec<u64>,
     /// Support rows: the first N rows of each test task, for each N.
     pub support_sizes: Vec<usize>,
     /// The query rows of every test task, `[start, end)`, after the largest support.
@@ -207,11 +210,14 @@ pub struct LearningCurve {
     pub final_meta_loss: f64,
     pub test_tasks: Vec<TestTask>,
     pub points: Vec<CurvePoint>,
+    /// LeARN's medians for `seed` then each of `spread_seeds`.
+    pub seed_spread: Vec<SeedCurve>,
 }
 
 /// Meta-trains on the training task files matched by `training_pattern`, then measures the
-/// learning curve on `test_files` (the tasks written from [`ExampleConfig::simulate`]).
-/// `iteration_done` is called after each meta-iteration.
+/// learning curve on `test_files` (the tasks written from [`ExampleConfig::simulate`]), and
+/// LeARN's alone for each of `spread_seeds`. `iteration_done` is called after each
+/// meta-iteration of the first model.
 pub fn run_example(
     config: &ExampleConfig,
     training_pattern: &str,
@@ -223,18 +229,18 @@ pub fn run_example(
         pattern: training_pattern.to_string(),
     };
     let tasks = learn::read_column_tasks(&source, &spec)?;
-    let settings = TaskConfig::load(config.learn_config.as_deref())?.with_seed(config.seed);
-    let started = std::time::Instant::now();
-    let model = learn::meta_train_tasks(
-        TaskSet {
+    let settings = TaskConfig::load(config.learn_config.as_deref())?;
+    let meta_train = |seed: u64, observe: &dyn Fn(usize)| {
+        let set = TaskSet {
             source: &source,
             spec: &spec,
             tasks: &tasks,
             files: Vec::new(),
-        },
-        &settings,
-        iteration_done,
-    )?;
+        };
+        learn::meta_train_tasks(set, &settings.with_seed(seed), observe)
+    };
+    let started = std::time::Instant::now();
+    let model = meta_train(config.seed, iteration_done)?;
     let meta_training_seconds = started.elapsed().as_secs_f64();
     let recordings: Vec<TaskTable> = test
         .iter()
@@ -253,6 +259,12 @@ pub fn run_example(
                 .collect::<Result<Vec<_>>>()
         })
         .collect::<Result<_>>()?;
+    let mut seed_spread = vec![SeedCurve::of(config.seed, &scores)];
+    for &seed in &config.spread_seeds {
+        let model = meta_train(seed, &|_| {})?;
+        let scores = learn_scores(&model, &recordings, &config.support_sizes, &query)?;
+        seed_spread.push(SeedCurve::of(seed, &scores));
+    }
     Ok(LearningCurve {
         config: config.clone(),
         learn_settings: model.config.clone(),
@@ -266,7 +278,52 @@ pub fn run_example(
             })
             .collect(),
         points: curve_points(&config.support_sizes, &scores),
+        seed_spread,
     })
+}
+
+/// LeARN's generalisation MSE alone, per task and size: `[adapted, NaN, NaN, unadapted]` (the
+/// layout of the full scores, without the baselines).
+fn learn_scores(
+    model: &MetaTrainedModel,
+    recordings: &[TaskTable],
+    sizes: &[usize],
+    query: &Range<usize>,
+) -> Result<Vec<Vec<[f64; 4]>>> {
+    recordings
+        .par_iter()
+        .map(|recording| {
+            sizes
+                .iter()
+                .map(|&n| {
+                    let e = learn::evaluate_recording(model, recording, 0..n, query.clone())?;
+                    Ok([e.gen_mse, f64::NAN, f64::NAN, e.unadapted_gen_mse])
+                })
+                .collect::<Result<Vec<_>>>()
+        })
+        .collect()
+}
+
+/// LeARN's medians over the test tasks for one meta-training seed.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SeedCurve {
+    pub seed: u64,
+    /// Adapted, per support size.
+    pub learn_median: Vec<f64>,
+    /// Before adaptation (the same at every size).
+    pub unadapted_median: Vec<f64>,
+}
+
+impl SeedCurve {
+    fn of(seed: u64, scores: &[Vec<[f64; 4]>]) -> Self {
+        let sizes = scores.first().map_or(0, Vec::len);
+        let column = |s: usize, m: usize| -> Vec<f64> { scores.iter().map(|t| t[s][m]).collect() };
+        Self {
+            seed,
+            learn_median: (0..sizes).map(|s| median(&column(s, 0))).collect(),
+            unadapted_median: (0..sizes).map(|s| median(&column(s, 3))).collect(),
+        }
+    }
 }
 
 /// The two baselines' fitted forms.

@@ -1,5 +1,5 @@
 //! The worked example of LeARN on your own data (`make own-data-example`): a family of forced,
-//! damped Duffing oscillators ([`super::family`]), meta-trained on some parameter draws and
+//! damped Duffing oscillators ([`super::simulate_task`]), meta-trained on some parameter draws and
 //! evaluated on unseen ones, as a learning curve of the generalisation MSE against the number of
 //! support samples, for LeARN (adapted online on the support rows), SINDy fitted on the same
 //! rows, a ridge regression on a fixed library fitted on the same rows, and LeARN before
@@ -137,7 +137,7 @@ impl ExampleConfig {
     }
 
     /// The training draws (stream 0, 1, …) and the test draws (streams after
-    /// [`TEST_STREAM_OFFSET`]), in parallel.
+    /// `TEST_STREAM_OFFSET`), in parallel.
     pub fn simulate(&self) -> (Vec<SimulatedTask>, Vec<SimulatedTask>) {
         let draw = |offset: u64, count: usize| -> Vec<SimulatedTask> {
             (0..count as u64)

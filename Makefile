@@ -5,7 +5,7 @@ CARGO ?= cargo
 LEARN := target/debug/learn
 QUIET := $(if $(CI),--quiet,)
 
-.PHONY: all data build test reproduce ablations check-paper bench mismatch-demo lint fmt clean-results
+.PHONY: all data build test reproduce ablations check-paper bench mismatch-demo own-data-example lint fmt clean-results
 
 all: build
 
@@ -44,6 +44,14 @@ check-paper: build
 	rm -rf $(CI_RESULTS)
 	$(LEARN) $(QUIET) reproduce --config experiments/ci.json --out $(CI_RESULTS) --latex-dir $(CI_RESULTS)/latex --force
 	$(LEARN) check-paper --results $(CI_RESULTS)/tables
+
+# LeARN on your own data, the worked example (experiments/own-data/example.json): a simulated family
+# of forced, damped Duffing oscillators written as CSV tasks to target/own-data-example (try the
+# three commands of docs/own-data.md on them), meta-trained with the default settings, and the
+# learning curve against SINDy and ridge: results/own-data/learning-curve.{svg,md,json}. About 10 s
+# after the build; not part of `make test`.
+own-data-example: build
+	$(LEARN) $(QUIET) own-data-example --config experiments/own-data/example.json --work target/own-data-example --out results/own-data --force
 
 lint:
 	$(CARGO) fmt --all -- --check

@@ -62,9 +62,11 @@ fn checkpoint(dir: &Path, name: &str, edit: impl FnOnce(&mut MetaTrainedModel)) 
     let architecture = learn::architecture(formulation, config.get());
     let mut model = MetaTrainedModel {
         format: CHECKPOINT_FORMAT.to_string(),
-        formulation,
-        protocol: Protocol::LeaveConditionOut,
-        held_out_condition: Some("35wind".to_string()),
+        trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
+            formulation,
+            protocol: Protocol::LeaveConditionOut,
+            held_out_condition: Some("35wind".to_string()),
+        }),
         seed: 1,
         config: config.get().clone(),
         parameters: architecture.initial_parameters(1),

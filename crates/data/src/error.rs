@@ -156,6 +156,10 @@ pub enum DataError {
     /// A derivative estimator misconfigured or given too few samples.
     #[error(transparent)]
     Differentiation(#[from] sindy::DifferentiationError),
+    /// A task that does not fit with the others (e.g. sampled at another interval), named by
+    /// its file.
+    #[error("{}: {message}", path.display())]
+    Task { path: PathBuf, message: String },
 }
 
 /// A number as it reads best in a one-line message: plainly for ordinary magnitudes (so `0.02`

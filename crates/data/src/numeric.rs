@@ -17,19 +17,38 @@ pub struct NumericTable {
 }
 
 impl NumericTable {
-    /// Reads the named columns of `path`, in the order given.
+    /// Reads the named columns of `path`, in the order given. A name `v[k]` that is not a column
+    /// of the file reads element k of the list cells of column `v` ([`crate::ColumnRef`]).
     pub fn read(path: &Path, columns: &[&str]) -> Result<Self> {
-        let table = TextTable::read(path)?;
+        Self::from_text(&TextTable::read(path)?, columns)
+    }
+
+    /// The named columns of a table already read.
+    pub(crate) fn from_text(table: &TextTable, columns: &[&str]) -> Result<Self> {
         let parsed = columns
             .iter()
-            .map(|name| table.scalars(name))
+            .map(|name| table.numbers(name))
             .collect::<Result<Vec<_>>>()?;
         Ok(Self {
-            path: path.to_path_buf(),
+            path: table.path().to_path_buf(),
             names: columns.iter().map(|s| s.to_string()).collect(),
             columns: parsed,
             lines: table.lines().to_vec(),
         })
+    }
+
+    /// The rows `rows` of every column, each keeping its line of the file.
+    pub fn rows_subset(&self, rows: std::ops::Range<usize>) -> Self {
+        Self {
+            path: self.path.clone(),
+            names: self.names.clone(),
+            columns: self
+                .columns
+                .iter()
+                .map(|c| c[rows.clone()].to_vec())
+                .collect(),
+            lines: (rows.start..rows.end).map(|row| self.line(row)).collect(),
+        }
     }
 
     /// Reads the named columns and checks that `time` is a strictly increasing, uniform time axis.

@@ -1,15 +1,15 @@
 //! Named numeric columns of a CSV file read a block of rows at a time, in memory bounded by the
 //! block, for recordings too long to hold whole (see [`NumericTable`](crate::NumericTable) for
 //! files that fit). The same layout rules as the whole-file reader: a header of unique names,
-//! every row as wide as the header, one line per row, plain numbers in the named columns; errors
-//! name the file, line and column.
+//! every row as wide as the header, one line per row, plain numbers in the named columns (or one
+//! element `v[k]` of a list column, as [`crate::ColumnRef`]); errors name the file, line and column.
 
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use crate::error::{DataError, Result};
-use crate::table::parse_numbers;
+use crate::table::{ColumnRef, parse_numbers};
 use inputs::MAX_CSV_COLUMNS;
 
 /// A reader of named numeric columns, row blocks in file order.
@@ -17,8 +17,9 @@ pub struct NumericStream {
     path: PathBuf,
     reader: csv::Reader<BufReader<File>>,
     names: Vec<String>,
-    /// Field index of each named column.
-    indices: Vec<usize>,
+    /// Field index of each named column, and the element of its list cells for a name `v[k]`
+    /// ([`crate::ColumnRef::Element`]).
+    indices: Vec<(usize, Option<usize>)>,
     width: usize,
     record: csv::StringRecord,
     /// Rows returned so far.
@@ -100,12 +101,17 @@ impl NumericStream {
                 ),
             });
         }
+        let position = |name: &str| names.iter().position(|n| n == name);
         let indices = columns
             .iter()
             .map(|column| {
-                names
-                    .iter()
-                    .position(|n| n == column)
+                let (field, element) =
+                    match ColumnRef::resolve(column, |name| position(name).is_some()) {
+                        ColumnRef::Whole(name) => (name, None),
+                        ColumnRef::Element { base, index } => (base, Some(index)),
+                    };
+                position(field)
+                    .map(|index| (index, element))
                     .ok_or_else(|| DataError::MissingColumn {
                         path: path.to_path_buf(),
                         column: column.to_string(),
@@ -161,12 +167,24 @@ impl NumericStream {
                     ),
                 });
             }
-            for (k, &index) in self.indices.iter().enumerate() {
+            for (k, &(index, element)) in self.indices.iter().enumerate() {
                 let cell = &self.record[index];
                 let cell = cell.strip_suffix('\r').unwrap_or(cell);
                 values.clear();
                 let parsed = parse_numbers(cell, &mut values);
-                let value = match (parsed, values.as_slice()) {
+                let selected = match element {
+                    None => values.as_slice(),
+                    Some(element) if parsed.is_ok() => {
+                        let Some(value) = values.get(element) else {
+                            let reason =
+                                format!("{} value(s), no element [{element}]", values.len());
+                            return Err(self.bad_cell(line, k, cell, &reason));
+                        };
+                        std::slice::from_ref(value)
+                    }
+                    Some(_) => &[],
+                };
+                let value = match (parsed, selected) {
                     (Ok(()), [value]) if value.is_finite() => *value,
                     (Ok(()), [value]) => {
                         return Err(DataError::NonFinite {

@@ -151,6 +151,56 @@ impl TextTable {
         })
     }
 
+    /// The cells of column `name` as text (labels, e.g. a task column); an empty cell is an error.
+    pub fn labels(&self, name: &str) -> Result<Vec<String>> {
+        let column = self.text_column(name)?;
+        column
+            .iter()
+            .enumerate()
+            .map(|(index, cell)| {
+                cell.map(str::to_string)
+                    .ok_or_else(|| self.bad_cell(self.line(index), name, "", "empty cell"))
+            })
+            .collect()
+    }
+
+    /// Parses the column `name` ([`ColumnRef`]): a column of that name holding plain numbers, or,
+    /// when there is none, element `k` of the list cells of column `base` for a name `base[k]`.
+    pub fn numbers(&self, name: &str) -> Result<Vec<f64>> {
+        match ColumnRef::resolve(name, |column| self.has_column(column)) {
+            ColumnRef::Whole(column) => self.scalars(column),
+            ColumnRef::Element { base, index } => self.elements(name, base, index),
+        }
+    }
+
+    /// Element `index` of every list cell of column `base`, errors naming the column `name`.
+    fn elements(&self, name: &str, base: &str, index: usize) -> Result<Vec<f64>> {
+        let column = self.text_column(base)?;
+        let mut out = Vec::with_capacity(column.len());
+        let mut buffer = Vec::new();
+        for (position, cell) in column.iter().enumerate() {
+            let row = self.line(position);
+            let cell = cell.ok_or_else(|| self.bad_cell(row, name, "", "empty cell"))?;
+            buffer.clear();
+            parse_numbers(cell, &mut buffer)
+                .map_err(|reason| self.bad_cell(row, name, cell, &reason))?;
+            let value = *buffer.get(index).ok_or_else(|| {
+                let reason = format!("{} value(s), no element [{index}]", buffer.len());
+                self.bad_cell(row, name, cell, &reason)
+            })?;
+            if !value.is_finite() {
+                return Err(DataError::NonFinite {
+                    path: self.path.clone(),
+                    row,
+                    column: name.to_string(),
+                    value: value.to_string(),
+                });
+            }
+            out.push(value);
+        }
+        Ok(out)
+    }
+
     /// Parses a column of plain numbers (a one-element list such as `[0.5]` is accepted too).
     pub fn scalars(&self, name: &str) -> Result<Vec<f64>> {
         Ok(self.arrays::<1>(name)?.into_iter().map(|[v]| v).collect())
@@ -199,6 +249,38 @@ impl TextTable {
             column: column.to_string(),
             value: value.to_string(),
             reason: reason.to_string(),
+        }
+    }
+}
+
+/// What a column name given by the user refers to: a column of the file, or one element of the
+/// list cells (`[1.0, 2.0, 3.0]`, the flight-log layout) of a column.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColumnRef<'a> {
+    /// The column of this name, plain numbers.
+    Whole(&'a str),
+    /// Element `index` (0-based) of each cell of column `base`: written `base[index]`.
+    Element { base: &'a str, index: usize },
+}
+
+impl<'a> ColumnRef<'a> {
+    /// `name` as a column of the file when `exists(name)`; otherwise `base[k]` (k a whole
+    /// number) as element k of column `base` when `exists(base)`; otherwise the whole column
+    /// `name` (which the reader then reports missing).
+    pub fn resolve(name: &'a str, exists: impl Fn(&str) -> bool) -> Self {
+        if exists(name) {
+            return Self::Whole(name);
+        }
+        let element = name
+            .strip_suffix(']')
+            .and_then(|rest| rest.rsplit_once('['))
+            .filter(|(base, digits)| {
+                !base.is_empty() && !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
+            })
+            .and_then(|(base, digits)| Some((base, digits.parse().ok()?)));
+        match element {
+            Some((base, index)) if exists(base) => Self::Element { base, index },
+            _ => Self::Whole(name),
         }
     }
 }
@@ -459,6 +541,26 @@ mod tests {
         );
         assert!(parse_numbers("[1.0, 2.0", &mut out).is_err());
         assert!(parse_numbers("[]", &mut Vec::new()).is_err());
+    }
+
+    #[test]
+    fn a_column_name_with_an_index_selects_an_element_unless_a_column_has_that_name() {
+        let exists = |name: &str| ["v", "w[1]"].contains(&name);
+        assert_eq!(
+            ColumnRef::resolve("v[2]", exists),
+            ColumnRef::Element {
+                base: "v",
+                index: 2
+            }
+        );
+        assert_eq!(ColumnRef::resolve("w[1]", exists), ColumnRef::Whole("w[1]"));
+        assert_eq!(ColumnRef::resolve("v", exists), ColumnRef::Whole("v"));
+        for missing in ["u[0]", "v[]", "v[x]", "[0]", "v[-1]"] {
+            assert_eq!(
+                ColumnRef::resolve(missing, exists),
+                ColumnRef::Whole(missing)
+            );
+        }
     }
 
     #[test]

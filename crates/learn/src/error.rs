@@ -8,6 +8,9 @@ use std::path::PathBuf;
 pub enum LearnError {
     #[error(transparent)]
     Data(#[from] data::DataError),
+    /// A derivative estimator misconfigured or given too few samples.
+    #[error(transparent)]
+    Differentiation(#[from] sindy::DifferentiationError),
     /// The I/O error is part of the message, not a separate cause, so it is printed once.
     #[error("{}: {cause}", path.display())]
     Io {
@@ -52,6 +55,10 @@ pub enum LearnError {
     /// non-finite number: reported instead of printing NaN.
     #[error("{cell}: {message}")]
     NotFinite { cell: String, message: String },
+    /// A CSV task or recording that cannot serve LeARN (too few rows, another sampling
+    /// interval), named by its file.
+    #[error("{}: {message}", path.display())]
+    Task { path: PathBuf, message: String },
     /// A flight that cannot serve LeARN (e.g. too short to split), named by its file.
     #[error("{}: {message}", path.display())]
     Flight { path: PathBuf, message: String },

@@ -16,7 +16,7 @@ use crate::dataset::{
 };
 use crate::error::{LearnError, Result};
 use crate::maml::Batch;
-use crate::model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel};
+use crate::model::{CHECKPOINT_FORMAT, DataFile, FlightTraining, MetaTrainedModel, TrainedOn};
 use crate::network::{Architecture, mean_squared_error};
 use crate::train::{MetaTrainingOutcome, TaskData, check_sampling, meta_train};
 
@@ -203,9 +203,12 @@ impl Experiment {
             .collect::<Result<_>>()?;
         Ok(MetaTrainedModel {
             format: CHECKPOINT_FORMAT.to_string(),
-            formulation,
-            protocol: self.protocol,
-            held_out_condition: (self.protocol == Protocol::LeaveConditionOut).then_some(held_out),
+            trained_on: TrainedOn::Flights(FlightTraining {
+                formulation,
+                protocol: self.protocol,
+                held_out_condition: (self.protocol == Protocol::LeaveConditionOut)
+                    .then_some(held_out),
+            }),
             seed,
             config: config.clone(),
             architecture,
@@ -505,7 +508,12 @@ impl Experiment {
         evaluation_condition: &str,
     ) -> Result<CellResult> {
         let condition = evaluation_condition_of(&self.conditions, evaluation_condition)?;
-        if let Some(held_out) = &model.held_out_condition
+        let flights = model.flights().ok_or_else(|| LearnError::Mismatch {
+            what: format!("evaluation on '{}'", condition.name),
+            message: "the model was meta-trained on CSV tasks, not on the flights".to_string(),
+        })?;
+        let formulation = flights.formulation;
+        if let Some(held_out) = &flights.held_out_condition
             && held_out != &condition.name
         {
             return Err(LearnError::Mismatch {
@@ -521,16 +529,16 @@ impl Experiment {
             &self.conditions.evaluation_controller,
         );
         let log = &self.flight(&path)?.log;
-        let (support, query) = flight_segments(log, model.formulation)?;
+        let (support, query) = flight_segments(log, formulation)?;
         let (raw_support, raw_query) = (segment_batch(&support), segment_batch(&query));
-        let input_names = model.formulation.input_names();
+        let input_names = formulation.input_names();
         let support_batch = standardised(&model.standardiser, raw_support.clone());
         let query_batch = standardised(&model.standardiser, raw_query.clone());
         let architecture = &model.architecture;
         let origin = self.config.origin();
         let adaptation = &self.config.get().adaptation;
         check_window(adaptation, &support, &path, origin)?;
-        let cell = format!("{} {}", model.formulation.name(), condition.name);
+        let cell = format!("{} {}", formulation.name(), condition.name);
         // The meta-trained model before adaptation: when it already gives non-finite numbers the
         // adaptation settings are not the cause.
         let unadapted_adapt_mse = architecture.loss(
@@ -576,10 +584,10 @@ impl Experiment {
         );
         let state_dim = architecture.state_dim;
         let summary = CellSummary {
-            formulation: model.formulation,
+            formulation,
             condition: condition.name.clone(),
             label: condition.label().to_string(),
-            protocol: model.protocol,
+            protocol: flights.protocol,
             seed: model.seed,
             adapt_mse: mean_squared_error(&support_predictions, &support_batch.targets),
             gen_mse: mean_squared_error(&query_predictions, &query_batch.targets),
@@ -840,14 +848,11 @@ pub fn explain_flight(
     adapt: bool,
     rule: crate::explain::EquationRule,
 ) -> Result<crate::explain::Explanation> {
-    let (support, query) = flight_segments(log, model.formulation)?;
+    let formulation = model.formulation_for(&format!("explaining over {}", log.path.display()))?;
+    let (support, query) = flight_segments(log, formulation)?;
     let support_batch = standardised(&model.standardiser, segment_batch(&support));
     let query_batch = standardised(&model.standardiser, segment_batch(&query));
-    let cell = format!(
-        "{} model over {}",
-        model.formulation.name(),
-        log.path.display()
-    );
+    let cell = format!("{} model over {}", formulation.name(), log.path.display());
     let mut inputs = support_batch.inputs;
     inputs.extend(query_batch.inputs);
     // The checkpoint itself, before any adaptation: non-finite numbers here come from its
@@ -910,13 +915,8 @@ pub fn explain_flight(
     } else {
         model.parameters.clone()
     };
-    let explanation = crate::explain::explain(
-        model.formulation,
-        &model.architecture,
-        &parameters,
-        &inputs,
-        rule,
-    );
+    let explanation =
+        crate::explain::explain(formulation, &model.architecture, &parameters, &inputs, rule);
     let finite = explanation.outputs.iter().all(|output| {
         output
             .inputs

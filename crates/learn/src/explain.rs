@@ -47,10 +47,12 @@ pub struct OutputExplanation {
     pub equation: String,
 }
 
-/// The explanation of every output of a model over a flight.
+/// The explanation of every output of a model over a flight or recording.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Explanation {
-    pub formulation: Formulation,
+    /// The formulation of a flight model (absent for a model of CSV tasks).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub formulation: Option<Formulation>,
     /// Rows the statistics are taken over.
     pub samples: usize,
     pub outputs: Vec<OutputExplanation>,
@@ -72,9 +74,43 @@ impl Default for EquationRule {
     }
 }
 
-/// Explains `parameters` over `inputs` (standardised, rows × (I+U), row-major).
+/// Explains `parameters` of a flight model of `formulation` over `inputs` (standardised,
+/// rows × (I+U), row-major).
 pub fn explain(
     formulation: Formulation,
+    architecture: &Architecture,
+    parameters: &[f64],
+    inputs: &[f64],
+    rule: EquationRule,
+) -> Explanation {
+    let names = ModelNames {
+        inputs: formulation
+            .input_names()
+            .into_iter()
+            .map(str::to_string)
+            .collect(),
+        outputs: formulation.target_names(),
+        output_scale: None,
+    };
+    Explanation {
+        formulation: Some(formulation),
+        ..explain_named(&names, architecture, parameters, inputs, rule)
+    }
+}
+
+/// The names of a model's inputs and outputs, and the factor its outputs are multiplied by.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelNames {
+    pub inputs: Vec<String>,
+    pub outputs: Vec<String>,
+    /// Per output (`None`: 1): the coefficients are reported multiplied by it, in the units of
+    /// the targets.
+    pub output_scale: Option<Vec<f64>>,
+}
+
+/// [`explain`] for any named inputs and outputs (a model of CSV tasks).
+pub fn explain_named(
+    names: &ModelNames,
     architecture: &Architecture,
     parameters: &[f64],
     inputs: &[f64],
@@ -85,18 +121,20 @@ pub fn explain(
     let per_input = architecture.basis_per_input;
     let width = architecture.state_dim * basis;
     let rows = selection.len() / width;
-    let input_names = formulation.input_names();
-    let outputs = formulation
-        .target_names()
-        .into_iter()
+    let input_names = &names.inputs;
+    let outputs = names
+        .outputs
+        .iter()
+        .cloned()
         .enumerate()
         .map(|(state, output)| {
+            let scale = names.output_scale.as_ref().map_or(1.0, |s| s[state]);
             let mut mean = vec![0.0; basis];
             let mut mean_abs = vec![0.0; basis];
             for row in selection.chunks_exact(width) {
                 for (k, &e) in row[state * basis..(state + 1) * basis].iter().enumerate() {
-                    mean[k] += e / rows as f64;
-                    mean_abs[k] += e.abs() / rows as f64;
+                    mean[k] += scale * e / rows as f64;
+                    mean_abs[k] += scale * e.abs() / rows as f64;
                 }
             }
             let mut terms: Vec<Term> = (0..basis)
@@ -130,7 +168,7 @@ pub fn explain(
         })
         .collect();
     Explanation {
-        formulation,
+        formulation: None,
         samples: rows,
         outputs,
     }

@@ -3,7 +3,8 @@
 //! What it is for: the paper's model y = Θ(X; ψ)·ℰ(X; φ)ᵀ (two GELU networks, [`Architecture`]),
 //! meta-trained with MAML (exact second order by default, [`meta_train`]), adapted online on a new
 //! flight with the Lipschitz regulariser ([`adapt_online`]), explained through ℰ ([`explain`]), and
-//! the experiment behind the paper's LeARN columns ([`Experiment`]).
+//! the experiment behind the paper's LeARN columns ([`Experiment`]), and the same model on any
+//! multi-task CSV set ([`meta_train_tasks`], [`evaluate_recording`], [`explain_recording`]).
 //!
 //! What it is not for: reading flight files or estimating derivatives (the `data` crate), SINDy
 //! (`sindy`), tables and figures (`report`), the command line (`cli`).
@@ -19,6 +20,12 @@
 //!   [`Experiment::evaluate`] → [`CellResult`] (adaptation MSE, generalisation MSE, predictions on
 //!   both segments, adapted θ); [`Experiment::run_cell`] does both; [`Experiment::run_cells`] runs a
 //!   set of cells in parallel (rayon), [`Experiment::seed_spread`] repeats them over seeds.
+//! - CSV tasks: [`read_column_tasks`] reads the tasks of a [`data::TaskSource`] with the columns
+//!   of a [`ColumnSpec`]; [`TaskConfig::load`] gives the settings (the paper's by default, any
+//!   subset overridden by a file); [`meta_train_tasks`] → [`MetaTrainedModel`] whose
+//!   [`TrainedOn::Columns`] records the columns, derivative, sampling interval, target scales and
+//!   tasks; [`evaluate_recording`] adapts it on support rows of a new recording and scores the query
+//!   rows ([`RecordingEvaluation`]); [`explain_recording`]. See `docs/own-data.md`.
 //! - Building blocks: [`Architecture`] (forward, gradient, prediction), [`meta_gradient`]
 //!   ([`meta_gradient_in`] with reusable [`MetaWorkspace`] buffers, [`meta_gradients_into`] for a
 //!   batch of tasks in parallel into reused results), [`hessian_vector_product`],
@@ -57,6 +64,7 @@
 mod adapt;
 mod averaging;
 mod batched;
+mod columns;
 mod config;
 mod dataset;
 mod error;
@@ -67,11 +75,13 @@ mod maml;
 mod model;
 mod network;
 mod scalar;
+mod tasks;
 mod train;
 pub mod variants;
 
 pub use adapt::adapt_online;
 pub use batched::ModelWorkspace;
+pub use columns::{ColumnSpec, ColumnTraining, TaskConfig, TaskRows};
 pub use config::{
     AdaptationConfig, CheckedConfig, LearnConfig, MetaTrainingConfig, Optimizer, TaskGrouping,
     limits,
@@ -86,14 +96,19 @@ pub use experiment::{
     architecture, evaluation_condition_of, explain_flight,
 };
 pub use explain::{
-    EquationRule, Explanation, InputImportance, OutputExplanation, Term, explain, output_symbol,
+    EquationRule, Explanation, InputImportance, ModelNames, OutputExplanation, Term, explain,
+    explain_named, output_symbol,
 };
 pub use maml::{
     Batch, InnerLoop, MetaGradient, MetaOrder, MetaWorkspace, Task, hessian_vector_product,
     inner_updates, meta_gradient, meta_gradient_in, meta_gradient_into, meta_gradients,
     meta_gradients_into, reference_hessian_vector_product, reference_meta_gradient,
 };
-pub use model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel};
+pub use model::{CHECKPOINT_FORMAT, DataFile, FlightTraining, MetaTrainedModel, TrainedOn};
 pub use network::{Architecture, PAPER_HIDDEN, mean_squared_error};
 pub use scalar::{Dual, Scalar, gelu, gelu_derivative, gelu_second_derivative};
-pub use train::{MetaTrainingOutcome, TaskData, meta_train, meta_train_from};
+pub use tasks::{
+    RecordingEvaluation, TaskSet, column_training, evaluate_recording, explain_recording,
+    meta_train_tasks, read_column_tasks, read_recording, segment_data,
+};
+pub use train::{MetaTrainingOutcome, TaskData, meta_train, meta_train_from, meta_train_observed};

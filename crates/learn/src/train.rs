@@ -214,10 +214,23 @@ pub fn meta_train(
 /// Meta-trains from given parameters (the task stream is still seeded by `seed`).
 pub fn meta_train_from(
     architecture: &Architecture,
+    parameters: Vec<f64>,
+    tasks: &[TaskData],
+    config: &MetaTrainingConfig,
+    seed: u64,
+) -> Result<MetaTrainingOutcome> {
+    meta_train_observed(architecture, parameters, tasks, config, seed, &|_| {})
+}
+
+/// [`meta_train_from`], calling `iteration_done` with the number of iterations finished after
+/// each one (for a progress bar).
+pub fn meta_train_observed(
+    architecture: &Architecture,
     mut parameters: Vec<f64>,
     tasks: &[TaskData],
     config: &MetaTrainingConfig,
     seed: u64,
+    iteration_done: &dyn Fn(usize),
 ) -> Result<MetaTrainingOutcome> {
     if tasks.is_empty() {
         return Err(LearnError::Mismatch {
@@ -289,6 +302,7 @@ pub fn meta_train_from(
         if iteration >= first_averaged {
             average.add(&parameters);
         }
+        iteration_done(iteration + 1);
     }
     let parameters = average.finish(parameters);
     // The last update can overflow although every gradient was finite.

@@ -39,7 +39,7 @@ pub fn learned_features(
         architecture.basis_count(),
         architecture.state_dim,
     );
-    let input_names = model.formulation.input_names();
+    let input_names = model.input_names();
     let basis_names: Vec<String> = (0..k)
         .map(|index| {
             let (input, p) = (
@@ -52,7 +52,7 @@ pub fn learned_features(
     match features {
         LearnedFeatures::Basis => (Mat::from_fn(n, k, |i, j| library[i * k + j]), basis_names),
         LearnedFeatures::Terms => {
-            let outputs = model.formulation.target_names();
+            let outputs = model.output_names();
             let names = outputs
                 .iter()
                 .flat_map(|o| basis_names.iter().map(move |b| format!("{o}:{b}")))
@@ -94,9 +94,11 @@ mod tests {
         };
         let model = MetaTrainedModel {
             format: crate::model::CHECKPOINT_FORMAT.to_string(),
-            formulation,
-            protocol: crate::dataset::Protocol::LeaveConditionOut,
-            held_out_condition: None,
+            trained_on: crate::model::TrainedOn::Flights(crate::model::FlightTraining {
+                formulation,
+                protocol: crate::dataset::Protocol::LeaveConditionOut,
+                held_out_condition: None,
+            }),
             seed: 3,
             config: serde_json::from_str(include_str!("../../../experiments/learn.json")).unwrap(),
             architecture: architecture.clone(),

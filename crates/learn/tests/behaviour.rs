@@ -243,9 +243,11 @@ fn example_model() -> MetaTrainedModel {
     let architecture = learn::architecture(data::Formulation::Translational, config.get());
     MetaTrainedModel {
         format: CHECKPOINT_FORMAT.to_string(),
-        formulation: data::Formulation::Translational,
-        protocol: Protocol::LeaveConditionOut,
-        held_out_condition: Some("35wind".to_string()),
+        trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
+            formulation: data::Formulation::Translational,
+            protocol: Protocol::LeaveConditionOut,
+            held_out_condition: Some("35wind".to_string()),
+        }),
         seed: 9,
         config: config.get().clone(),
         parameters: architecture.initial_parameters(9),

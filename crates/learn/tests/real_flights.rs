@@ -42,8 +42,9 @@ fn leave_condition_out_cell_runs_end_to_end() {
         .run_cell(Formulation::Translational, "70psin20", 5)
         .unwrap();
     let model = &cell.model;
-    assert_eq!(model.protocol, Protocol::LeaveConditionOut);
-    assert_eq!(model.held_out_condition.as_deref(), Some("70p20sint"));
+    let flights = model.flights().expect("a flight model");
+    assert_eq!(flights.protocol, Protocol::LeaveConditionOut);
+    assert_eq!(flights.held_out_condition.as_deref(), Some("70p20sint"));
     // 4 other conditions × 6 controllers; none of them the held-out condition.
     assert_eq!(model.data_files.len(), 24);
     assert!(

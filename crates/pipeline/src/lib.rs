@@ -6,6 +6,10 @@
 //! predictions into the paper's tables and figures and a `summary.json` with full provenance
 //! ([`write_outputs`]); and the check of the results against the paper ([`check_paper`]).
 //!
+//! LeARN on your own data ([`own_data`]): a model of CSV tasks next to SINDy on the same rows of a
+//! new recording ([`own_data::compare_on_recording`], `learn evaluate`) and the worked example's
+//! learning curve ([`own_data::example`], `make own-data-example`).
+//!
 //! What it is not for: any model or metric (those live in `sindy` and `learn`), rendering (the
 //! `report` crate), argument parsing (the `learn` binary).
 //!
@@ -21,6 +25,7 @@ mod causal_library;
 mod config;
 mod error;
 mod output;
+pub mod own_data;
 mod run;
 mod sindy_column;
 mod sindy_variant;

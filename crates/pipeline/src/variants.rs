@@ -1441,9 +1441,11 @@ mod tests {
         let architecture = learn::architecture(Formulation::Attitude, &config);
         MetaTrainedModel {
             format: CHECKPOINT_FORMAT.to_string(),
-            formulation: Formulation::Attitude,
-            protocol: Protocol::LeaveConditionOut,
-            held_out_condition: None,
+            trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
+                formulation: Formulation::Attitude,
+                protocol: Protocol::LeaveConditionOut,
+                held_out_condition: None,
+            }),
             seed: 2,
             parameters: architecture.initial_parameters(2),
             standardiser: Standardiser::identity(architecture.input_dim),

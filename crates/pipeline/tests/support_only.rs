@@ -41,9 +41,11 @@ fn untrained_model(formulation: Formulation, config: &LearnConfig) -> MetaTraine
     let architecture = learn::architecture(formulation, config);
     MetaTrainedModel {
         format: CHECKPOINT_FORMAT.to_string(),
-        formulation,
-        protocol: Protocol::LeaveConditionOut,
-        held_out_condition: None,
+        trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
+            formulation,
+            protocol: Protocol::LeaveConditionOut,
+            held_out_condition: None,
+        }),
         seed: 1,
         config: config.clone(),
         parameters: architecture.initial_parameters(1),

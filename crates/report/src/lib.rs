@@ -5,12 +5,14 @@
 //! them as Markdown ([`markdown`]), LaTeX in the paper's booktabs layout ([`latex`]) and JSON;
 //! the paper's published numbers ([`PublishedTables`]); the regression check against them with
 //! declared per-cell tolerances ([`Tolerances`], [`Comparison`]); and the paper's qualitative
-//! figure as SVG ([`QualitativeFigure`]).
+//! figure as SVG ([`QualitativeFigure`]); learning curves as SVG and Markdown ([`CurveFigure`],
+//! [`curve_markdown`]).
 //!
 //! What it is not for: computing any number. It knows nothing of flights, SINDy or LeARN: the
 //! `pipeline` crate runs the experiments and hands the numbers and traces to this crate.
 
 mod compare;
+mod curve;
 mod error;
 mod figure;
 mod published;
@@ -18,6 +20,7 @@ mod render;
 mod table;
 
 pub use compare::{CellComparison, CellStatus, Comparison, Direction, ToleranceRule, Tolerances};
+pub use curve::{CurveFigure, CurveSeries, curve_markdown};
 pub use error::{ReportError, Result};
 pub use figure::{
     ADAPTATION, Band, GENERALISATION, GROUND_TRUTH, MethodTrace, OutputAxis, QualitativeFigure,

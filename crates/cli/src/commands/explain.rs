@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use data::{ExperimentConditions, FlightLog};
-use learn::{EquationRule, MetaTrainedModel, explain_flight};
+use learn::{EquationRule, Explanation, MetaTrainedModel, explain_flight};
 
 use outputs::{Existing, OutputSet};
 
@@ -12,12 +12,16 @@ use super::Global;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// A checkpoint written by `learn meta-train`.
+    /// A checkpoint written by `learn meta-train` (flights) or `learn meta-train --tasks`.
     pub checkpoint: PathBuf,
     /// The flight to explain over (default: the evaluation flight of the checkpoint's held-out
-    /// condition).
-    #[arg(long)]
+    /// condition); for a model of CSV tasks, the recording (a CSV with its columns; required).
+    #[arg(long, alias = "csv")]
     pub flight: Option<PathBuf>,
+    /// For a model of CSV tasks: the rows it adapts on before the explanation, A:B (data rows
+    /// from 0, B excluded) [default: the first half of the recording].
+    #[arg(long, value_parser = super::evaluate::parse_rows, conflicts_with = "no_adapt")]
+    pub support_rows: Option<std::ops::Range<usize>>,
     /// The evaluation condition whose flight to explain over (name or label).
     #[arg(long, conflicts_with = "flight")]
     pub condition: Option<String>,
@@ -58,13 +62,21 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         .map(|path| set.file(path, "--json", Existing::from_force(args.force)));
     set.check()?;
     let model = MetaTrainedModel::load(&args.checkpoint)?;
+    let Some(flights) = model.flights().cloned() else {
+        return explain_columns(&args, set, json_file, &model);
+    };
+    if args.support_rows.is_some() {
+        anyhow::bail!(
+            "--support-rows applies to models of CSV tasks only (a flight model adapts on the first half of the flight)"
+        );
+    }
     let flight = match args.flight {
         Some(path) => path,
         None => {
             let conditions = ExperimentConditions::load(&args.conditions)?;
             let name = args
                 .condition
-                .or(model.held_out_condition.clone())
+                .or(flights.held_out_condition.clone())
                 .context(
                     "the checkpoint names no held-out condition: pass --condition or --flight",
                 )?;
@@ -94,7 +106,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         let value = serde_json::json!({
             "checkpoint": args.checkpoint,
             "flight": flight,
-            "protocol": model.protocol.name(),
+            "protocol": flights.protocol.name(),
             "seed": model.seed,
             "adapted": !args.no_adapt,
             "explanation": explanation,
@@ -105,8 +117,8 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     }
     say!(
         "{} model ({} protocol, seed {}) over {} ({} samples, {})",
-        model.formulation.name(),
-        model.protocol.name(),
+        flights.formulation.name(),
+        flights.protocol.name(),
         model.seed,
         flight.display(),
         explanation.samples,
@@ -116,6 +128,11 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
             "adapted online on the support half"
         }
     );
+    print_explanation(&explanation, args.json.as_deref());
+    Ok(())
+}
+
+fn print_explanation(explanation: &Explanation, json: Option<&std::path::Path>) {
     for output in &explanation.outputs {
         let inputs: Vec<String> = output
             .inputs
@@ -125,8 +142,64 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         say!("{}", output.equation);
         say!("    mean |ℰ| per input: {}", inputs.join(", "));
     }
-    if let Some(path) = &args.json {
+    if let Some(path) = json {
         say!("wrote {}", path.display());
     }
+}
+
+/// The explanation of a model of CSV tasks over the recording `--flight`/`--csv`: adapted on
+/// `--support-rows` (default the first half) unless `--no-adapt`.
+fn explain_columns(
+    args: &Args,
+    mut set: OutputSet,
+    json_file: Option<outputs::FileId>,
+    model: &MetaTrainedModel,
+) -> anyhow::Result<()> {
+    let Some(recording_path) = &args.flight else {
+        anyhow::bail!(
+            "{}: a model of CSV tasks: pass --csv FILE, a recording with its columns",
+            args.checkpoint.display()
+        );
+    };
+    if args.condition.is_some() {
+        anyhow::bail!("--condition applies to flight models only");
+    }
+    let columns = learn::column_training(model, &args.checkpoint.display().to_string())?;
+    set.input("the --csv input", recording_path);
+    let staged = set.prepare()?;
+    let recording = learn::read_recording(recording_path, &columns.spec())?;
+    let support = match (&args.support_rows, args.no_adapt) {
+        (_, true) => None,
+        (Some(rows), false) => Some(rows.clone()),
+        (None, false) => Some(0..recording.rows() / 2),
+    };
+    let rule = EquationRule {
+        max_terms: args.max_terms,
+        ..EquationRule::default()
+    };
+    let explanation = learn::explain_recording(model, &recording, support.clone(), rule)?;
+    if let (Some(path), Some(file)) = (&args.json, json_file) {
+        let value = serde_json::json!({
+            "checkpoint": args.checkpoint,
+            "recording": recording_path,
+            "seed": model.seed,
+            "adapted_on_rows": support.as_ref().map(|rows| [rows.start, rows.end]),
+            "explanation": explanation,
+        });
+        let text = serde_json::to_string_pretty(&value)? + "\n";
+        std::fs::write(staged.path(file), text).with_context(|| path.display().to_string())?;
+        staged.commit()?;
+    }
+    say!(
+        "model of CSV tasks (seed {}) over {} ({} samples, {}); coefficients in the units of the targets",
+        model.seed,
+        recording_path.display(),
+        explanation.samples,
+        match &support {
+            Some(rows) => format!("adapted online on rows {}:{}", rows.start, rows.end),
+            None => "meta-trained, not adapted".to_string(),
+        }
+    );
+    print_explanation(&explanation, args.json.as_deref());
     Ok(())
 }

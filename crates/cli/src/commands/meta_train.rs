@@ -20,9 +20,12 @@ const PRODUCER: &str = "meta-train";
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// LeARN hyper-parameters.
-    #[arg(long, default_value = "experiments/learn.json")]
-    pub config: PathBuf,
+    /// LeARN hyper-parameters [default: experiments/learn.json for the flights; with --tasks, the
+    /// paper's settings built in, any subset overridden by this file].
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    #[command(flatten)]
+    pub tasks: super::meta_train_tasks::TaskArgs,
     /// Wind conditions and flight files.
     #[arg(long, default_value = "experiments/conditions.json")]
     pub conditions: PathBuf,
@@ -40,7 +43,8 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true, value_parser = parse_seed)]
     pub seed: Option<u64>,
     /// Summary JSON of the run [default: results/.scratch/learn/learn.json, the tool's scratch,
-    /// replaced on every run]. A file given here is not replaced without --force.
+    /// replaced on every run]; with --tasks, the model (required). A file given here is not
+    /// replaced without --force.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Directory of the JSON checkpoints, one per formulation and fold [default:
@@ -74,7 +78,7 @@ pub struct Args {
 }
 
 /// A seed: a whole number from 0 to `u64::MAX`, said so when it is not.
-fn parse_seed(text: &str) -> Result<u64, String> {
+pub(crate) fn parse_seed(text: &str) -> Result<u64, String> {
     text.parse().map_err(|_| {
         format!(
             "a seed is a whole number from 0 to {} (got {text:?})",
@@ -139,7 +143,7 @@ fn published(
 
 /// A bar over `cells` cells on standard error, drawn only when `show` (a terminal, not --quiet), in
 /// the style of `learn reproduce`.
-fn progress_bar(show: bool, cells: usize, message: &str) -> ProgressBar {
+pub(crate) fn progress_bar(show: bool, cells: usize, message: &str) -> ProgressBar {
     if !show {
         return ProgressBar::hidden();
     }
@@ -262,13 +266,24 @@ enum Outputs {
     Run { out: FileId, checkpoints: FolderId },
 }
 
+/// `--config` for the flights when not given.
+const DEFAULT_CONFIG: &str = "experiments/learn.json";
+
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
+    if args.tasks.tasks.is_some() {
+        return super::meta_train_tasks::run(global, &args);
+    }
+    args.tasks.refuse_without_tasks()?;
+    let config_path = args
+        .config
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_CONFIG));
     let published_path = args
         .published
         .clone()
         .unwrap_or_else(|| PathBuf::from(DEFAULT_PUBLISHED));
     let inputs: [(&str, &Path); 3] = [
-        ("--config", &args.config),
+        ("--config", &config_path),
         ("--conditions", &args.conditions),
         ("--published", &published_path),
     ];
@@ -279,7 +294,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let checkpoint_dir = checkpoint_dir(&args);
     let (mut set, outputs) = output_set(&args, &inputs)?;
     set.check()?;
-    let mut config = LearnConfig::load(&args.config)?;
+    let mut config = LearnConfig::load(&config_path)?;
     if let Some(seed) = args.seed {
         config = config.with_seed(seed);
     }
@@ -369,7 +384,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
                 "what": "seed-to-seed spread of the LeARN adaptation and generalisation MSE per table cell",
                 "how": format!(
                     "learn meta-train --seed-spread --config {} (every cell meta-trained and adapted once per seed; std is the sample standard deviation over seeds)",
-                    args.config.display()
+                    config_path.display()
                 ),
                 "protocol": protocol.name(),
                 "config": config.get(),

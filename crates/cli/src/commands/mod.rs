@@ -3,10 +3,13 @@
 mod ablations;
 mod check_paper;
 mod conditions;
+mod evaluate;
 mod explain;
 mod inspect;
 mod meta_train;
+mod meta_train_tasks;
 mod mismatch;
+mod own_data_example;
 mod reproduce;
 mod simulate;
 mod sindy;
@@ -47,8 +50,12 @@ pub enum Command {
     Reproduce(reproduce::Args),
     /// Compare the latest results with the paper's numbers within declared tolerances.
     CheckPaper(check_paper::Args),
-    /// Meta-train LeARN, adapt online on each evaluation flight, print and save the LeARN columns.
+    /// Meta-train LeARN, adapt online on each evaluation flight, print and save the LeARN columns;
+    /// with --tasks, meta-train on your own CSV recordings and save the model.
     MetaTrain(meta_train::Args),
+    /// Adapt a model of `meta-train --tasks` on rows of a new recording, score other rows, next
+    /// to SINDy fitted on the same rows.
+    Evaluate(evaluate::Args),
     /// The inputs that dominate each output of a LeARN checkpoint through ℰ, and its equations.
     Explain(explain::Args),
     /// Simulate a closed-loop flight of the plant (nominal model plus effects) as a Neural-Fly log.
@@ -57,6 +64,9 @@ pub enum Command {
     Mismatch(mismatch::Args),
     /// Every variant of experiments/variants.json on every cell over its seeds: ablation tables.
     Ablations(ablations::Args),
+    /// The worked example of LeARN on your own data: a simulated family of oscillators, its
+    /// learning curve against SINDy and ridge.
+    OwnDataExample(own_data_example::Args),
 }
 
 #[derive(Subcommand, Debug)]
@@ -80,10 +90,12 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Reproduce(args) => reproduce::run(&global, args),
         Command::CheckPaper(args) => check_paper::run(&global, args),
         Command::MetaTrain(args) => meta_train::run(&global, args),
+        Command::Evaluate(args) => evaluate::run(&global, args),
         Command::Explain(args) => explain::run(&global, args),
         Command::Simulate(args) => simulate::run(&global, args),
         Command::Mismatch(args) => mismatch::run(&global, args),
         Command::Ablations(args) => ablations::run(&global, args),
+        Command::OwnDataExample(args) => own_data_example::run(&global, args),
     }
 }
 

@@ -37,6 +37,29 @@ pub struct Args {
     /// Control columns, comma-separated (u).
     #[arg(long, value_delimiter = ',')]
     pub control: Vec<String>,
+    #[command(flatten)]
+    pub fit: FitArgs,
+    /// Derivative estimator: forward, central, savgol or savgol:WINDOW:ORDER.
+    #[arg(long, default_value = "central")]
+    pub derivative: String,
+    /// Decimals printed in the equations (at most 17: an f64 has no more).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=17))]
+    pub precision: u8,
+    /// Write the model as JSON here (never overwrites an existing file without --force).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Allow --out to replace an existing file.
+    #[arg(long)]
+    pub force: bool,
+    /// Read the CSV in blocks of rows and fit as it is read, in memory that does not grow with
+    /// the file (the default for files over 8 MiB; the file must be a regular file).
+    #[arg(long)]
+    pub stream: bool,
+}
+
+/// The library and optimizer of a SINDy fit (shared by `learn sindy` and `learn evaluate`).
+#[derive(clap::Args, Debug)]
+pub struct FitArgs {
     /// Library: parts joined by '+', each poly:D, poly:D:noconstant or fourier:K.
     #[arg(long, default_value = "poly:2")]
     pub library: String,
@@ -60,28 +83,28 @@ pub struct Args {
     /// LASSO weight λ (required with --optimizer lasso).
     #[arg(long, allow_hyphen_values = true)]
     pub lambda: Option<f64>,
-    /// Derivative estimator: forward, central, savgol or savgol:WINDOW:ORDER.
-    #[arg(long, default_value = "central")]
-    pub derivative: String,
-    /// Decimals printed in the equations (at most 17: an f64 has no more).
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=17))]
-    pub precision: u8,
-    /// Write the model as JSON here (never overwrites an existing file without --force).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Allow --out to replace an existing file.
-    #[arg(long)]
-    pub force: bool,
-    /// Read the CSV in blocks of rows and fit as it is read, in memory that does not grow with
-    /// the file (the default for files over 8 MiB; the file must be a regular file).
-    #[arg(long)]
-    pub stream: bool,
 }
 
 /// The STLSQ threshold when --threshold is not given.
 const DEFAULT_THRESHOLD: f64 = 0.1;
 
-fn optimizer(args: &Args) -> anyhow::Result<OptimizerSpec> {
+impl FitArgs {
+    /// The library, checked.
+    pub fn library(&self) -> anyhow::Result<FeatureLibrary> {
+        Ok(FeatureLibrary::from_spec(&LibrarySpec::parse(
+            &self.library,
+        )?)?)
+    }
+
+    /// The optimizer, checked; flags of the other optimizer are refused.
+    pub fn optimizer(&self) -> anyhow::Result<OptimizerSpec> {
+        let optimizer = optimizer(self)?;
+        optimizer.checked()?;
+        Ok(optimizer)
+    }
+}
+
+fn optimizer(args: &FitArgs) -> anyhow::Result<OptimizerSpec> {
     Ok(match args.optimizer {
         OptimizerKind::Stlsq => {
             if args.lambda.is_some() {
@@ -184,7 +207,7 @@ fn check_rows(args: &Args, n: usize, feature_count: usize, columns: &[&str]) -> 
             "{}: {n} data rows, fewer than the {feature_count} features of library {} on {}: \
              the fit needs at least one row per feature",
             args.csv.display(),
-            args.library,
+            args.fit.library,
             columns.join(", ")
         );
     }
@@ -201,7 +224,7 @@ fn fit_error(args: &Args, error: SindyError, line: impl Fn(usize) -> usize) -> a
             value,
         } => {
             let hint = if what == "library" {
-                format!(" (values too large for library {}?)", args.library)
+                format!(" (values too large for library {}?)", args.fit.library)
             } else {
                 String::new()
             };
@@ -217,9 +240,8 @@ fn fit_error(args: &Args, error: SindyError, line: impl Fn(usize) -> usize) -> a
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     // Everything that can be checked without reading the file is checked first.
-    let library = FeatureLibrary::from_spec(&LibrarySpec::parse(&args.library)?)?;
-    let optimizer = optimizer(&args)?;
-    optimizer.checked()?;
+    let library = args.fit.library()?;
+    let optimizer = args.fit.optimizer()?;
     let derivative = Derivative::parse(&args.derivative)?;
     let columns: Vec<&str> = args
         .state

@@ -1,0 +1,308 @@
+//! Several recordings of one system, each a task of meta-learning (a robot arm with different
+//! payloads, a vehicle on different surfaces): every CSV file matched by a glob pattern, or the
+//! runs of one CSV that share a value of a task column. Each task is read as `learn sindy` reads
+//! its file ([`NumericTable`]: columns by name, `v[k]` for an element of a list column, a strictly
+//! increasing, uniformly sampled time column), and all tasks must share one sampling interval.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{DataError, Result};
+use crate::numeric::NumericTable;
+use crate::table::TextTable;
+use crate::time::{DEFAULT_UNIFORM_TOLERANCE, check_time_axis_at};
+
+/// The most tasks read at once.
+pub const MAX_TASKS: usize = 10_000;
+
+/// Where the tasks come from. JSON: `{"kind": "files", "pattern": "tasks/*.csv"}` or
+/// `{"kind": "column", "file": "all.csv", "column": "task"}`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum TaskSource {
+    /// Every regular file matched by a glob pattern (`*`, `?`, `[…]`, `**`), one task each, in
+    /// sorted path order.
+    Files { pattern: String },
+    /// One CSV file, one task per run of consecutive rows with the same value of `column`.
+    Column { file: PathBuf, column: String },
+}
+
+/// One task: its rows of the time column and of the named columns.
+#[derive(Clone, Debug)]
+pub struct TaskTable {
+    /// The file name, or `file[column=value]` for a task of a task column.
+    pub name: String,
+    /// The file the task was read from.
+    pub path: PathBuf,
+    pub time: Vec<f64>,
+    /// The named columns, in the order given.
+    pub table: NumericTable,
+    /// The median sampling interval, seconds.
+    pub interval: f64,
+}
+
+impl TaskTable {
+    /// Reads one recording as a task: the column `time` and `columns` of the CSV at `path`.
+    pub fn read(path: &Path, time: &str, columns: &[&str]) -> Result<Self> {
+        read_file_task(path, time, columns)
+    }
+
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.time.len()
+    }
+}
+
+/// Reads every task of `source`: the column `time` and `columns` of each. Errors name the file,
+/// row and column: a pattern that matches no file, a task without a named column, a time axis
+/// that is not uniform, tasks sampled at different intervals, a task column whose values return
+/// after another's.
+pub fn read_tasks(source: &TaskSource, time: &str, columns: &[&str]) -> Result<Vec<TaskTable>> {
+    let tasks = match source {
+        TaskSource::Files { pattern } => matched_files(pattern)?
+            .iter()
+            .map(|path| read_file_task(path, time, columns))
+            .collect::<Result<Vec<_>>>()?,
+        TaskSource::Column { file, column } => read_column_tasks(file, column, time, columns)?,
+    };
+    check_common_interval(&tasks, time)?;
+    Ok(tasks)
+}
+
+/// The regular files matched by `pattern`, sorted; an error when there is none.
+fn matched_files(pattern: &str) -> Result<Vec<PathBuf>> {
+    let invalid = |message: String| DataError::Invalid {
+        what: format!("--tasks '{pattern}'"),
+        message,
+    };
+    let paths = glob::glob(pattern).map_err(|error| invalid(error.to_string()))?;
+    let mut files = Vec::new();
+    for entry in paths {
+        let path = entry.map_err(|error| DataError::Io {
+            path: error.path().to_path_buf(),
+            source: std::io::Error::new(error.error().kind(), error.error().to_string()),
+        })?;
+        if path.is_file() {
+            files.push(path);
+        }
+        if files.len() > MAX_TASKS {
+            return Err(invalid(format!(
+                "matches more than {MAX_TASKS} files, the most tasks read at once"
+            )));
+        }
+    }
+    if files.is_empty() {
+        return Err(invalid(
+            "matches no file (quote the pattern so that the shell does not expand it)".to_string(),
+        ));
+    }
+    files.sort();
+    Ok(files)
+}
+
+fn read_file_task(path: &Path, time: &str, columns: &[&str]) -> Result<TaskTable> {
+    let (time_values, table) = NumericTable::read_with_time(path, time, columns)?;
+    Ok(TaskTable {
+        name: path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into(),
+        ),
+        path: path.to_path_buf(),
+        interval: median_interval(&time_values),
+        time: time_values,
+        table,
+    })
+}
+
+/// The tasks of one file split by the value of `column`: each a run of consecutive rows.
+fn read_column_tasks(
+    path: &Path,
+    column: &str,
+    time: &str,
+    columns: &[&str],
+) -> Result<Vec<TaskTable>> {
+    let text = TextTable::read(path)?;
+    let labels = text.labels(column)?;
+    let mut names = vec![time];
+    names.extend_from_slice(columns);
+    let whole = NumericTable::from_text(&text, &names)?;
+    let mut runs: Vec<(String, std::ops::Range<usize>)> = Vec::new();
+    for (row, label) in labels.iter().enumerate() {
+        match runs.last_mut() {
+            Some((last, rows)) if last == label => rows.end = row + 1,
+            _ => {
+                if runs.iter().any(|(seen, _)| seen == label) {
+                    return Err(DataError::BadCell {
+                        path: path.to_path_buf(),
+                        row: text.line(row),
+                        column: column.to_string(),
+                        value: label.clone(),
+                        reason: format!(
+                            "task '{label}' appears again after task '{}': a task's rows must be consecutive",
+                            runs.last().map_or("", |(name, _)| name.as_str())
+                        ),
+                    });
+                }
+                if runs.len() == MAX_TASKS {
+                    return Err(DataError::Invalid {
+                        what: format!("{}: column '{column}'", path.display()),
+                        message: format!("more than {MAX_TASKS} tasks, the most read at once"),
+                    });
+                }
+                runs.push((label.clone(), row..row + 1));
+            }
+        }
+    }
+    runs.into_iter()
+        .map(|(label, rows)| {
+            let mut table = whole.rows_subset(rows);
+            let time_values = table.columns.remove(0);
+            table.names.remove(0);
+            check_time_axis_at(path, time, &time_values, DEFAULT_UNIFORM_TOLERANCE, &|k| {
+                table.line(k)
+            })?;
+            Ok(TaskTable {
+                name: format!(
+                    "{}[{column}={label}]",
+                    path.file_name().map_or_else(
+                        || path.display().to_string(),
+                        |n| n.to_string_lossy().into()
+                    )
+                ),
+                path: path.to_path_buf(),
+                interval: median_interval(&time_values),
+                time: time_values,
+                table,
+            })
+        })
+        .collect()
+}
+
+/// The median gap of a time axis of at least two samples.
+fn median_interval(time: &[f64]) -> f64 {
+    let mut gaps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+    gaps.sort_by(f64::total_cmp);
+    gaps.get(gaps.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// A sampling interval in seconds as a person writes it: 0.1, not the median gap
+/// 0.09999999999999987 the time column's rounding gives.
+pub fn interval_text(seconds: f64) -> String {
+    let text = format!("{seconds:.9}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "0" || text == "-0" {
+        format!("{seconds:e}")
+    } else {
+        text.to_string()
+    }
+}
+
+/// Every task sampled at the first task's interval, within the uniform-sampling tolerance.
+fn check_common_interval(tasks: &[TaskTable], time: &str) -> Result<()> {
+    let Some(first) = tasks.first() else {
+        return Ok(());
+    };
+    let reference = first.interval;
+    match tasks
+        .iter()
+        .find(|task| (task.interval - reference).abs() > DEFAULT_UNIFORM_TOLERANCE * reference)
+    {
+        Some(task) => Err(DataError::Task {
+            path: task.path.clone(),
+            message: format!(
+                "{time}: task '{}' is sampled every {} s, task '{}' every {} s: all tasks must share one sampling interval",
+                task.name,
+                interval_text(task.interval),
+                first.name,
+                interval_text(reference)
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+        std::fs::create_dir_all(dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("data-tasks-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    #[test]
+    fn a_glob_reads_one_task_per_file_in_sorted_order_with_list_elements() {
+        let dir = scratch("glob");
+        write(
+            &dir,
+            "b.csv",
+            "t,v,u\n0,\"[1, 2]\",5\n0.1,\"[3, 4]\",6\n0.2,\"[5, 6]\",7\n",
+        );
+        write(&dir, "a.csv", "t,v,u\n0,\"[0, 1]\",1\n0.1,\"[0, 2]\",1\n");
+        write(&dir, "notes.txt", "not a task");
+        let pattern = format!("{}/*.csv", dir.display());
+        let tasks = read_tasks(&TaskSource::Files { pattern }, "t", &["v[1]", "u"]).unwrap();
+        let names: Vec<&str> = tasks.iter().map(|t| t.name.as_str()).collect();
+        assert_eq!(names, ["a.csv", "b.csv"]);
+        assert_eq!(
+            tasks[1].table.columns,
+            vec![vec![2.0, 4.0, 6.0], vec![5.0, 6.0, 7.0]]
+        );
+        assert!((tasks[1].interval - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_pattern_that_matches_nothing_or_tasks_sampled_differently_are_named() {
+        let dir = scratch("bad");
+        let pattern = format!("{}/*.csv", dir.display());
+        let source = TaskSource::Files { pattern };
+        let message = read_tasks(&source, "t", &["x"]).unwrap_err().to_string();
+        assert!(message.contains("matches no file"), "{message}");
+        write(&dir, "a.csv", "t,x\n0,1\n0.1,2\n0.2,3\n");
+        write(&dir, "b.csv", "t,x\n0,1\n0.2,2\n0.4,3\n");
+        let message = read_tasks(&source, "t", &["x"]).unwrap_err().to_string();
+        assert!(
+            message.contains("b.csv") && message.contains("a.csv"),
+            "{message}"
+        );
+        write(&dir, "b.csv", "t,y\n0,1\n0.1,2\n");
+        let message = read_tasks(&source, "t", &["x"]).unwrap_err().to_string();
+        assert!(message.contains("b.csv: missing column 'x'"), "{message}");
+    }
+
+    #[test]
+    fn a_task_column_splits_one_file_into_runs_and_refuses_a_returning_task() {
+        let dir = scratch("column");
+        let file = write(
+            &dir,
+            "all.csv",
+            "task,t,x\nslow,0,1\nslow,0.1,2\nfast,5,3\nfast,5.1,4\nfast,5.2,5\n",
+        );
+        let source = TaskSource::Column {
+            file: file.clone(),
+            column: "task".to_string(),
+        };
+        let tasks = read_tasks(&source, "t", &["x"]).unwrap();
+        assert_eq!(tasks.len(), 2);
+        assert_eq!(tasks[1].name, "all.csv[task=fast]");
+        assert_eq!(tasks[1].table.columns[0], vec![3.0, 4.0, 5.0]);
+        assert_eq!(tasks[1].table.line(0), 4);
+        write(
+            &dir,
+            "all.csv",
+            "task,t,x\na,0,1\na,0.1,2\nb,0,3\nb,0.1,3\na,0.2,4\n",
+        );
+        let message = read_tasks(&source, "t", &["x"]).unwrap_err().to_string();
+        assert!(message.contains("all.csv:6:task"), "{message}");
+        assert!(message.contains("consecutive"), "{message}");
+    }
+}

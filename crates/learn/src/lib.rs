@@ -18,7 +18,9 @@
 //!   weights, configuration, seed, protocol, SHA-256 of the data files), and
 //!   [`Experiment::evaluate`] → [`CellResult`] (adaptation MSE, generalisation MSE, predictions on
 //!   both segments, adapted θ); [`Experiment::run_cell`] does both; [`Experiment::run_cells`] runs a
-//!   set of cells in parallel (rayon), [`Experiment::seed_spread`] repeats them over seeds.
+//!   set of cells in parallel (rayon), [`Experiment::seed_spread`] repeats them over seeds. Both
+//!   enumerate their work as [`WorkItem`]s ([`Experiment::work_items`]: one meta-training and the
+//!   cells it serves) and run each with [`Experiment::run_item`], as a sharded sweep does.
 //! - Building blocks: [`Architecture`] (forward, gradient, prediction), [`meta_gradient`]
 //!   ([`meta_gradient_in`] with reusable [`MetaWorkspace`] buffers, [`meta_gradients_into`] for a
 //!   batch of tasks in parallel into reused results), [`hessian_vector_product`],
@@ -69,6 +71,7 @@ mod network;
 mod scalar;
 mod train;
 pub mod variants;
+mod work;
 
 pub use adapt::adapt_online;
 pub use batched::ModelWorkspace;
@@ -82,8 +85,8 @@ pub use dataset::{
 };
 pub use error::{LearnError, Result};
 pub use experiment::{
-    CellResult, CellSummary, Experiment, SegmentPrediction, Spread, SpreadCell, ValidationDetail,
-    architecture, evaluation_condition_of, explain_flight,
+    CellResult, CellSummary, Experiment, SegmentPrediction, ValidationDetail, architecture,
+    evaluation_condition_of, explain_flight,
 };
 pub use explain::{
     EquationRule, Explanation, InputImportance, OutputExplanation, Term, explain, output_symbol,
@@ -97,3 +100,4 @@ pub use model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel};
 pub use network::{Architecture, PAPER_HIDDEN, mean_squared_error};
 pub use scalar::{Dual, Scalar, gelu, gelu_derivative, gelu_second_derivative};
 pub use train::{MetaTrainingOutcome, TaskData, meta_train, meta_train_from};
+pub use work::{Cells, Spread, SpreadCell, WorkItem, spread_cells};

@@ -6,14 +6,15 @@ use std::path::PathBuf;
 use data::{Derivative, SplitSpec};
 use learn::{DataFile, Explanation, LearnConfig, RangeCoverage};
 use report::ResultsTable;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use sindy::SindyConfig;
 
 /// The format tag of `summary.json`.
 pub const SUMMARY_FORMAT: &str = "learn-results/1";
 
 /// A configuration file a run read.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FileRef {
     /// As written in the run configuration (relative to the project root).
     pub path: PathBuf,
@@ -127,7 +128,8 @@ pub struct Summary {
 }
 
 /// Wall time of one stage.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StageTiming {
     pub stage: String,
     pub seconds: f64,

@@ -5,9 +5,12 @@ mod check_paper;
 mod conditions;
 mod explain;
 mod inspect;
+mod merge;
 mod meta_train;
 mod mismatch;
 mod reproduce;
+mod seed_spread;
+mod shard;
 mod simulate;
 mod sindy;
 
@@ -57,6 +60,8 @@ pub enum Command {
     Mismatch(mismatch::Args),
     /// Every variant of experiments/variants.json on every cell over its seeds: ablation tables.
     Ablations(ablations::Args),
+    /// Put the shards of a sharded run (`--shard K/N`) together: the unsharded run's files.
+    Merge(merge::Args),
 }
 
 #[derive(Subcommand, Debug)]
@@ -84,6 +89,21 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Simulate(args) => simulate::run(&global, args),
         Command::Mismatch(args) => mismatch::run(&global, args),
         Command::Ablations(args) => ablations::run(&global, args),
+        Command::Merge(args) => merge::run(&global, args),
+    }
+}
+
+impl Cli {
+    /// Combinations of options that clap cannot express, refused as usage errors (exit code 2)
+    /// as clap's own are.
+    pub fn validated(self) -> Result<Self, clap::Error> {
+        if let Command::MetaTrain(args) = &self.command
+            && let Some(message) = args.out_without_shard()
+        {
+            let mut command = <Self as clap::CommandFactory>::command();
+            return Err(command.error(clap::error::ErrorKind::ArgumentConflict, message));
+        }
+        Ok(self)
     }
 }
 

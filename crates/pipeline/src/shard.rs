@@ -280,6 +280,9 @@ pub fn read_shard(dir: &Path) -> Result<ShardDocument> {
         field: "shard".to_string(),
         message,
     };
+    if !dir.exists() {
+        return Err(not_a_shard("no such folder".to_string()));
+    }
     if dir.is_dir() && !path.exists() {
         return Err(not_a_shard(format!(
             "not a shard folder: it has no {SHARD_FILE} (written by learn reproduce, ablations \

@@ -36,7 +36,9 @@ use clap::error::ErrorKind;
 fn main() -> ExitCode {
     restore_default_sigpipe();
     report_output_failures();
-    let cli = commands::Cli::try_parse().unwrap_or_else(|error| exit_on_usage_error(error));
+    let cli = commands::Cli::try_parse()
+        .and_then(commands::Cli::validated)
+        .unwrap_or_else(|error| exit_on_usage_error(error));
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
@@ -151,7 +153,9 @@ mod tests {
             &["learn", "sindy"],
             &["learn", "nope"],
         ] {
-            let error = commands::Cli::try_parse_from(args).unwrap_err();
+            let error = commands::Cli::try_parse_from(args)
+                .and_then(commands::Cli::validated)
+                .unwrap_err();
             let line = one_line_usage(&error.render().to_string());
             assert!(line.starts_with("error: "), "{args:?}: {line}");
             assert!(!line.contains('\n') && !line.contains("Usage:"), "{line}");

@@ -42,8 +42,8 @@ pub use formulation::{Formulation, Segment};
 pub use noise_floor::{NoiseFloor, forward_difference_noise_floor};
 pub use numeric::NumericTable;
 pub use source::{
-    DATA_DIR_VARIABLE, DEFAULT_DATA_DIR, file_sha256, find_data_dir, real_data_dir_for_tests,
-    resolve_data_dir,
+    DATA_DIR_VARIABLE, DEFAULT_DATA_DIR, bytes_sha256, file_sha256, find_data_dir,
+    real_data_dir_for_tests, resolve_data_dir,
 };
 pub use split::{Split, SplitSpec};
 pub use stream::{NumericBlock, NumericStream};

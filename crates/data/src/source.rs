@@ -99,8 +99,13 @@ pub fn file_sha256(path: &Path) -> Result<String> {
         path: path.to_path_buf(),
         source,
     })?;
-    let digest = Sha256::digest(&bytes);
-    Ok(digest.iter().map(|b| format!("{b:02x}")).collect())
+    Ok(bytes_sha256(&bytes))
+}
+
+/// SHA-256 of `bytes`, hex encoded (as [`file_sha256`] gives it for a file's bytes).
+pub fn bytes_sha256(bytes: &[u8]) -> String {
+    let digest = Sha256::digest(bytes);
+    digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 #[cfg(test)]

@@ -233,15 +233,18 @@ mod tests {
         path
     }
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("data-tasks-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        dir
+    /// A temporary folder, removed when dropped.
+    fn scratch(name: &str) -> tempfile::TempDir {
+        tempfile::Builder::new()
+            .prefix(&format!("data-tasks-{name}-"))
+            .tempdir()
+            .unwrap()
     }
 
     #[test]
     fn a_glob_reads_one_task_per_file_in_sorted_order_with_list_elements() {
-        let dir = scratch("glob");
+        let scratch_dir = scratch("glob");
+        let dir = scratch_dir.path().to_path_buf();
         write(
             &dir,
             "b.csv",
@@ -262,7 +265,8 @@ mod tests {
 
     #[test]
     fn a_pattern_that_matches_nothing_or_tasks_sampled_differently_are_named() {
-        let dir = scratch("bad");
+        let scratch_dir = scratch("bad");
+        let dir = scratch_dir.path().to_path_buf();
         let pattern = format!("{}/*.csv", dir.display());
         let source = TaskSource::Files { pattern };
         let message = read_tasks(&source, "t", &["x"]).unwrap_err().to_string();
@@ -281,7 +285,8 @@ mod tests {
 
     #[test]
     fn a_task_column_splits_one_file_into_runs_and_refuses_a_returning_task() {
-        let dir = scratch("column");
+        let scratch_dir = scratch("column");
+        let dir = scratch_dir.path().to_path_buf();
         let file = write(
             &dir,
             "all.csv",

@@ -12,6 +12,9 @@ use std::path::Path;
 pub const MAX_JSON_BYTES: u64 = 8 << 20;
 /// The largest CSV read: 1 GiB (the Neural-Fly flights are 1 to 3 MB).
 pub const MAX_CSV_BYTES: u64 = 1 << 30;
+/// The largest shard result read (`shard.json` of `learn … --shard K/N`, machine-written JSON that
+/// carries each item's traces for the figures): 1 GiB.
+pub const MAX_SHARD_BYTES: u64 = 1 << 30;
 /// The most columns a CSV may have (the Neural-Fly logs have about 20).
 pub const MAX_CSV_COLUMNS: usize = 10_000;
 
@@ -22,6 +25,8 @@ pub enum InputKind {
     Json,
     /// A CSV file: a regular file or a pipe, of at most [`MAX_CSV_BYTES`].
     Csv,
+    /// A shard result: a regular JSON file of at most [`MAX_SHARD_BYTES`].
+    ShardResult,
 }
 
 impl InputKind {
@@ -29,6 +34,7 @@ impl InputKind {
         match self {
             Self::Json => MAX_JSON_BYTES,
             Self::Csv => MAX_CSV_BYTES,
+            Self::ShardResult => MAX_SHARD_BYTES,
         }
     }
 
@@ -36,6 +42,7 @@ impl InputKind {
         match self {
             Self::Json => "a JSON file",
             Self::Csv => "a CSV file",
+            Self::ShardResult => "a shard result",
         }
     }
 }

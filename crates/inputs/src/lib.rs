@@ -15,6 +15,6 @@ mod bounded;
 pub mod json;
 
 pub use bounded::{
-    InputKind, MAX_CSV_BYTES, MAX_CSV_COLUMNS, MAX_JSON_BYTES, read_bytes, read_json_text,
-    read_text,
+    InputKind, MAX_CSV_BYTES, MAX_CSV_COLUMNS, MAX_JSON_BYTES, MAX_SHARD_BYTES, read_bytes,
+    read_json_text, read_text,
 };

@@ -315,11 +315,15 @@ fn merge(base: &mut Value, patch: Value) {
 mod tests {
     use super::*;
 
-    fn scratch(name: &str, text: &str) -> PathBuf {
-        let path =
-            std::env::temp_dir().join(format!("learn-columns-{name}-{}.json", std::process::id()));
-        std::fs::write(&path, text).unwrap();
-        path
+    /// A temporary `.json` file holding `text`, removed when dropped.
+    fn scratch(name: &str, text: &str) -> tempfile::TempPath {
+        let mut file = tempfile::Builder::new()
+            .prefix(&format!("learn-columns-{name}-"))
+            .suffix(".json")
+            .tempfile()
+            .unwrap();
+        std::io::Write::write_all(&mut file, text.as_bytes()).unwrap();
+        file.into_temp_path()
     }
 
     #[test]

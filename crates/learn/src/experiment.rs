@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use data::{Condition, ExperimentConditions, FlightLog, Formulation, Mat, Role, file_sha256};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::adapt::adapt_online;
 use crate::config::{AdaptationConfig, CheckedConfig, LearnConfig, TaskGrouping};
@@ -46,7 +46,7 @@ pub struct SegmentPrediction {
 }
 
 /// The numbers of one table cell, as written to JSON.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CellSummary {
     pub formulation: Formulation,
     /// The condition's file name, e.g. `70p20sint`.
@@ -158,6 +158,21 @@ impl Experiment {
         self.conditions
             .evaluation()
             .map(|c| c.name.clone())
+            .collect()
+    }
+
+    /// Every flight this experiment read (relative to the data directory), with its SHA-256, in
+    /// path order.
+    pub fn data_files(&self) -> Vec<DataFile> {
+        self.flights
+            .iter()
+            .map(|(path, flight)| DataFile {
+                path: path
+                    .strip_prefix(&self.data_dir)
+                    .unwrap_or(path)
+                    .to_path_buf(),
+                sha256: flight.sha256.clone(),
+            })
             .collect()
     }
 
@@ -635,135 +650,6 @@ impl Experiment {
         let model = self.meta_train(formulation, evaluation_condition, seed)?;
         self.evaluate(&model, evaluation_condition)
     }
-
-    /// Every cell of the given formulations (× every evaluation condition), in parallel, returned
-    /// in table order. Under `paper` one model per formulation serves all conditions.
-    pub fn run_cells(&self, formulations: &[Formulation], seed: u64) -> Result<Vec<CellResult>> {
-        self.run_cells_observed(formulations, seed, &|_| {})
-    }
-
-    /// [`Self::run_cells`], calling `cell_done` (from any thread) as each cell is finished.
-    pub fn run_cells_observed(
-        &self,
-        formulations: &[Formulation],
-        seed: u64,
-        cell_done: &(dyn Fn(&CellSummary) + Sync),
-    ) -> Result<Vec<CellResult>> {
-        let observed = |result: Result<CellResult>| {
-            if let Ok(cell) = &result {
-                cell_done(&cell.summary);
-            }
-            result
-        };
-        let conditions = self.evaluation_conditions();
-        if self.protocol == Protocol::Paper {
-            let models: Vec<MetaTrainedModel> = formulations
-                .par_iter()
-                .map(|&f| self.meta_train(f, &conditions[0], seed))
-                .collect::<Result<_>>()?;
-            let jobs: Vec<(&MetaTrainedModel, &String)> = models
-                .iter()
-                .flat_map(|m| conditions.iter().map(move |c| (m, c)))
-                .collect();
-            return jobs
-                .par_iter()
-                .map(|(model, condition)| observed(self.evaluate(model, condition)))
-                .collect();
-        }
-        let jobs: Vec<(Formulation, &String)> = formulations
-            .iter()
-            .flat_map(|&f| conditions.iter().map(move |c| (f, c)))
-            .collect();
-        jobs.par_iter()
-            .map(|(formulation, condition)| observed(self.run_cell(*formulation, condition, seed)))
-            .collect()
-    }
-
-    /// Generalisation and adaptation MSE of every cell for each seed (the seed-to-seed spread).
-    pub fn seed_spread(
-        &self,
-        formulations: &[Formulation],
-        seeds: &[u64],
-    ) -> Result<Vec<SpreadCell>> {
-        self.seed_spread_observed(formulations, seeds, &|_| {})
-    }
-
-    /// [`Self::seed_spread`], calling `cell_done` (from any thread) as each cell of each seed is
-    /// finished.
-    pub fn seed_spread_observed(
-        &self,
-        formulations: &[Formulation],
-        seeds: &[u64],
-        cell_done: &(dyn Fn(&CellSummary) + Sync),
-    ) -> Result<Vec<SpreadCell>> {
-        let mut runs: Vec<Vec<CellSummary>> = Vec::with_capacity(seeds.len());
-        for &seed in seeds {
-            let cells = self.run_cells_observed(formulations, seed, cell_done)?;
-            runs.push(cells.into_iter().map(|c| c.summary).collect());
-        }
-        let cell_count = runs.first().map_or(0, Vec::len);
-        Ok((0..cell_count)
-            .map(|cell| {
-                let first = &runs[0][cell];
-                let gen_values: Vec<f64> = runs.iter().map(|r| r[cell].gen_mse).collect();
-                let adapt_values: Vec<f64> = runs.iter().map(|r| r[cell].adapt_mse).collect();
-                SpreadCell {
-                    formulation: first.formulation,
-                    condition: first.condition.clone(),
-                    label: first.label.clone(),
-                    protocol: first.protocol,
-                    seeds: seeds.to_vec(),
-                    gen_mse: Spread::of(gen_values),
-                    adapt_mse: Spread::of(adapt_values),
-                }
-            })
-            .collect())
-    }
-}
-
-/// Statistics of one MSE over seeds.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Spread {
-    pub values: Vec<f64>,
-    pub mean: f64,
-    /// Sample standard deviation (n − 1).
-    pub std: f64,
-    pub min: f64,
-    pub max: f64,
-}
-
-impl Spread {
-    /// The statistics of `values`.
-    pub fn of(values: Vec<f64>) -> Self {
-        let n = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / n;
-        let std = if values.len() > 1 {
-            (values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0)).sqrt()
-        } else {
-            0.0
-        };
-        let min = values.iter().copied().fold(f64::INFINITY, f64::min);
-        let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        Self {
-            values,
-            mean,
-            std,
-            min,
-            max,
-        }
-    }
-}
-
-/// The seed-to-seed spread of one table cell.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SpreadCell {
-    pub formulation: Formulation,
-    pub condition: String,
-    pub label: String,
-    pub protocol: Protocol,
-    pub seeds: Vec<u64>,
-    pub gen_mse: Spread,
-    pub adapt_mse: Spread,
 }
 
 /// The evaluation condition `name` (name or label) of `conditions`. A condition that exists but is

@@ -9,12 +9,12 @@
 //! dominant inputs; it is not a closed form of m_p, which takes the whole X.
 
 use data::Formulation;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::network::Architecture;
 
 /// One term m_p(x_j) of an output.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Term {
     /// p, 1-based: m1, m2, …
     pub basis: usize,
@@ -27,7 +27,7 @@ pub struct Term {
 }
 
 /// Importance of one input feature for one output.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct InputImportance {
     pub input: String,
     /// Σ_p mean |ℰ_{i,(j,p)}|.
@@ -35,7 +35,7 @@ pub struct InputImportance {
 }
 
 /// The explanation of one output.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct OutputExplanation {
     /// The target's column name, e.g. `vdot_x`.
     pub output: String,
@@ -48,7 +48,7 @@ pub struct OutputExplanation {
 }
 
 /// The explanation of every output of a model over a flight or recording.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Explanation {
     /// The formulation of a flight model (absent for a model of CSV tasks).
     #[serde(skip_serializing_if = "Option::is_none")]

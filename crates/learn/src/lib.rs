@@ -19,7 +19,9 @@
 //!   weights, configuration, seed, protocol, SHA-256 of the data files), and
 //!   [`Experiment::evaluate`] → [`CellResult`] (adaptation MSE, generalisation MSE, predictions on
 //!   both segments, adapted θ); [`Experiment::run_cell`] does both; [`Experiment::run_cells`] runs a
-//!   set of cells in parallel (rayon), [`Experiment::seed_spread`] repeats them over seeds.
+//!   set of cells in parallel (rayon), [`Experiment::seed_spread`] repeats them over seeds. Both
+//!   enumerate their work as [`WorkItem`]s ([`Experiment::work_items`]: one meta-training and the
+//!   cells it serves) and run each with [`Experiment::run_item`], as a sharded sweep does.
 //! - CSV tasks: [`read_column_tasks`] reads the tasks of a [`data::TaskSource`] with the columns
 //!   of a [`ColumnSpec`]; [`TaskConfig::load`] gives the settings (the paper's by default, any
 //!   subset overridden by a file); [`meta_train_tasks`] → [`MetaTrainedModel`] whose
@@ -78,6 +80,7 @@ mod scalar;
 mod tasks;
 mod train;
 pub mod variants;
+mod work;
 
 pub use adapt::adapt_online;
 pub use batched::ModelWorkspace;
@@ -92,8 +95,8 @@ pub use dataset::{
 };
 pub use error::{LearnError, Result};
 pub use experiment::{
-    CellResult, CellSummary, Experiment, SegmentPrediction, Spread, SpreadCell, ValidationDetail,
-    architecture, evaluation_condition_of, explain_flight,
+    CellResult, CellSummary, Experiment, SegmentPrediction, ValidationDetail, architecture,
+    evaluation_condition_of, explain_flight,
 };
 pub use explain::{
     EquationRule, Explanation, InputImportance, ModelNames, OutputExplanation, Term, explain,
@@ -112,3 +115,4 @@ pub use tasks::{
     meta_train_tasks, read_column_tasks, read_recording, segment_data,
 };
 pub use train::{MetaTrainingOutcome, TaskData, meta_train, meta_train_from, meta_train_observed};
+pub use work::{Cells, Spread, SpreadCell, WorkItem, spread_cells};

@@ -2,17 +2,18 @@
 //! model on an unseen draw, and its checkpoint round-trips; the paper's checkpoints keep their
 //! layout.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use data::TaskSource;
 use learn::{ColumnSpec, MetaTrainedModel, TaskConfig, TaskSet, TrainedOn};
 use sindy::Derivative;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("learn-own-data-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A temporary folder, removed when dropped.
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("learn-own-data-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// x' = v, v' = −k·x − c·v + u with u = cos(1.3 t), sampled every 0.05 s (RK4, 4 substeps).
@@ -93,7 +94,8 @@ fn meta_trained(dir: &Path) -> MetaTrainedModel {
 
 #[test]
 fn a_meta_trained_model_adapts_to_an_unseen_draw_better_than_without_adaptation() {
-    let dir = scratch("adapt");
+    let scratch_dir = scratch("adapt");
+    let dir = scratch_dir.path().to_path_buf();
     let model = meta_trained(&dir);
     let TrainedOn::Columns(columns) = &model.trained_on else {
         panic!("a model of CSV tasks");
@@ -144,7 +146,8 @@ fn a_meta_trained_model_adapts_to_an_unseen_draw_better_than_without_adaptation(
 
 #[test]
 fn a_checkpoint_is_either_a_flight_model_or_a_model_of_csv_tasks() {
-    let dir = scratch("layout");
+    let scratch_dir = scratch("layout");
+    let dir = scratch_dir.path().to_path_buf();
     let model = meta_trained(&dir);
     let path = dir.join("model.json");
     model.save(&path).unwrap();

@@ -26,10 +26,18 @@ pub(crate) fn try_hold() -> Result<MutexGuard<'static, Vec<PathBuf>>, ()> {
     }
 }
 
-/// Records a staging path, installing the handler on first use.
-pub(crate) fn register(path: PathBuf) {
+/// Creates a staging file or folder with `create` and records its path (`path_of`), the handler
+/// installed first and the registry held throughout: an interrupt at any moment either comes
+/// before it exists (the default action is no longer in force) or removes it, never leaves it.
+pub(crate) fn create_registered<T, E>(
+    create: impl FnOnce() -> Result<T, E>,
+    path_of: impl FnOnce(&T) -> PathBuf,
+) -> Result<T, E> {
     install();
-    hold().push(path);
+    let mut registry = hold();
+    let created = create()?;
+    registry.push(path_of(&created));
+    Ok(created)
 }
 
 /// Forgets a staging path (committed or removed by its owner).

@@ -119,11 +119,15 @@ fn prepare_folder(plan: &FolderPlan, created: &mut Vec<PathBuf>) -> Result<Stage
     }
     finish_journal(dir)?;
     remove_dead_staging(dir);
-    let staging = tempfile::Builder::new()
-        .prefix(&staging_prefix())
-        .tempdir_in(dir)
-        .map_err(not_writable(dir, &plan.option))?;
-    signals::register(staging.path().to_path_buf());
+    let staging = signals::create_registered(
+        || {
+            tempfile::Builder::new()
+                .prefix(&staging_prefix())
+                .tempdir_in(dir)
+                .map_err(not_writable(dir, &plan.option))
+        },
+        |staging| staging.path().to_path_buf(),
+    )?;
     let parents = plan.files.iter().filter_map(|r| r.parent());
     for parent in parents.chain(plan.subfolders.iter().map(PathBuf::as_path)) {
         if parent.as_os_str().is_empty() {
@@ -164,13 +168,17 @@ fn prepare_file(plan: &FilePlan, created: &mut Vec<PathBuf>) -> Result<StagedFil
         .file_name()
         .map(|n| format!("-{}", n.to_string_lossy()))
         .unwrap_or_default();
-    let staging = tempfile::Builder::new()
-        .prefix(&staging_prefix())
-        .suffix(&name)
-        .tempfile_in(&parent)
-        .map_err(not_writable(&plan.path, &plan.option))?
-        .into_temp_path();
-    signals::register(staging.to_path_buf());
+    let staging = signals::create_registered(
+        || {
+            tempfile::Builder::new()
+                .prefix(&staging_prefix())
+                .suffix(&name)
+                .tempfile_in(&parent)
+                .map(tempfile::NamedTempFile::into_temp_path)
+                .map_err(not_writable(&plan.path, &plan.option))
+        },
+        |staging| staging.to_path_buf(),
+    )?;
     Ok(StagedFile {
         plan: plan.clone(),
         staging,

@@ -13,6 +13,16 @@
 //! What it is not for: any model or metric (those live in `sindy` and `learn`), rendering (the
 //! `report` crate), argument parsing (the `learn` binary).
 //!
+//! **Work items and shards.** Each run enumerates its work once, in a fixed order, as
+//! [`learn::WorkItem`]s (one meta-training: formulation, cells, seed) — [`run`] and
+//! [`run_variants`] (the ablations) and [`spread_sweep`] (the seed spread) alike — and renders the
+//! items' results with one function per run. [`run_shard`], [`run_variants_shard`] and
+//! [`run_spread`] with a [`ShardSpec`] run only the items at positions ≡ K (mod N) and return a
+//! [`ShardFile`] (written as `shard.json`: configuration hash, data hashes, items, results);
+//! [`merge`] checks shards and hands their results to the same rendering ([`merged_run`],
+//! [`merged_ablations`], [`spread_document`]), so merged shards give the unsharded run's bytes.
+//! `docs/cluster.md` describes running them under SLURM, Kubernetes or `xargs -P`.
+//!
 //! Adding a wind condition needs no code: a flight in the data directory and one entry in the
 //! conditions file make a new row in every table and a new figure per table.
 //!
@@ -21,18 +31,31 @@
 //! fitted (SINDy) or adapted online (LeARN) on the support segment, scored on that segment.
 //! **Generalisation MSE**: the same model, unchanged, scored on the query segment.
 
+mod ablations;
+mod ablations_markdown;
 mod causal_library;
+mod cells;
 mod config;
 mod error;
 mod output;
 pub mod own_data;
 mod run;
+mod shard;
 mod sindy_column;
 mod sindy_variant;
+mod spread;
 mod summary;
+mod tables;
 mod variants;
 
+pub use ablations::{
+    AblationCell, AblationCellDetail, AblationProvenance, AblationRow, AblationSeedOutcome,
+    Ablations, AblationsContext, AblationsOutcome, AblationsShard, SeedCell, VariantCell,
+    merged_ablations, run_variants, run_variants_shard, write_ablations,
+};
+pub use ablations_markdown::ablations_markdown;
 pub use causal_library::{CausalLibrary, MAX_CONTROL_LAGS, first_order_lag};
+pub use cells::figure_file_name;
 pub use config::{CheckedRunConfig, LearnRun, MAX_SEEDS, RunConfig, merge_patch};
 pub use error::{PipelineError, Result};
 pub use output::{
@@ -40,19 +63,27 @@ pub use output::{
     result_files, update_readme, updated_readme, write_outputs,
 };
 pub use run::{
-    GENERATED_PATHS, RunOptions, RunOutcome, figure_file_name, git_commit, run, uncommitted_inputs,
+    GENERATED_PATHS, ReproduceShard, RunOptions, RunOutcome, git_commit, merged_run, run,
+    run_shard, shard_timings, uncommitted_inputs,
+};
+pub use shard::{
+    ItemResult, MergedSweep, SHARD_FILE, SHARD_FORMAT, ShardDocument, ShardFile, ShardProvenance,
+    ShardSpec, Sweep, SweepKind, merge, read_shard, write_shard,
 };
 pub use sindy_column::{SegmentEvaluation, SindyConfig, evaluate_flight, fit_and_evaluate};
 pub use sindy_variant::{
     LibraryRegression, SegmentPredictions, VariantEvaluation, evaluate_features,
 };
+pub use spread::{SpreadContext, SpreadShard, run_spread, spread_document, spread_sweep};
 pub use summary::{
     CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,
     StageTiming, Summary, Timings,
 };
+pub use tables::{
+    CellDetail, ConditionName, LearnCellOutcome, ReproduceContext, RunInputs, SindyOutcome,
+};
 pub use variants::{
-    AblationProvenance, AblationRow, Ablations, AblationsOutcome, CheckedVariants,
-    ENSEMBLE_SEED_STRIDE, LearnedBasisSpec, MAX_ENSEMBLE_MEMBERS, MAX_VARIANTS, Outcome, SeedCell,
-    VariantCell, VariantKind, VariantSpec, VariantsConfig, ablations_markdown,
-    ensemble_member_seeds, evaluate_variants, reproduce_columns, run_variants, write_ablations,
+    CheckedVariants, ENSEMBLE_SEED_STRIDE, LearnedBasisSpec, MAX_ENSEMBLE_MEMBERS, MAX_VARIANTS,
+    Outcome, VariantKind, VariantSpec, VariantsConfig, ensemble_member_seeds, evaluate_variants,
+    reproduce_columns,
 };

@@ -2,12 +2,14 @@
 
 use std::path::{Path, PathBuf};
 
+use data::Formulation;
 use rayon::prelude::*;
 use report::{Comparison, PublishedTables, Tolerances, latex, load_tables, markdown};
 
+use crate::cells::figure_file_name;
 use crate::config::CheckedRunConfig;
 use crate::error::{PipelineError, Result, write_text};
-use crate::run::{RunOutcome, figure_file_name};
+use crate::run::RunOutcome;
 use crate::summary::{StageTiming, Timings};
 
 /// The marker lines between which the README shows the generated tables.
@@ -41,13 +43,19 @@ impl OutputPaths {
 /// The files a run of `config` writes below its results folder (relative): each table as JSON and
 /// Markdown, each figure, `summary.json` and `timings.json`.
 pub fn result_files(config: &CheckedRunConfig) -> Vec<PathBuf> {
+    let labels: Vec<&str> = config.conditions.evaluation().map(|c| c.label()).collect();
+    result_files_of(&config.raw.formulations, &labels)
+}
+
+/// [`result_files`] of a run with these tables and condition labels.
+pub(crate) fn result_files_of(formulations: &[Formulation], labels: &[&str]) -> Vec<PathBuf> {
     let mut files = Vec::new();
-    for formulation in &config.raw.formulations {
+    for formulation in formulations {
         let table = formulation.name();
         files.push(Path::new("tables").join(format!("{table}.json")));
         files.push(Path::new("tables").join(format!("{table}.md")));
-        for condition in config.conditions.evaluation() {
-            files.push(Path::new("figures").join(figure_file_name(table, condition.label())));
+        for label in labels {
+            files.push(Path::new("figures").join(figure_file_name(table, label)));
         }
     }
     files.extend([PathBuf::from("summary.json"), PathBuf::from("timings.json")]);
@@ -56,9 +64,12 @@ pub fn result_files(config: &CheckedRunConfig) -> Vec<PathBuf> {
 
 /// The files a run of `config` writes in its LaTeX folder: `<table>.tex`.
 pub fn latex_files(config: &CheckedRunConfig) -> Vec<PathBuf> {
-    config
-        .raw
-        .formulations
+    latex_files_of(&config.raw.formulations)
+}
+
+/// [`latex_files`] of a run with these tables.
+pub(crate) fn latex_files_of(formulations: &[Formulation]) -> Vec<PathBuf> {
+    formulations
         .iter()
         .map(|f| PathBuf::from(format!("{}.tex", f.name())))
         .collect()

@@ -1,22 +1,32 @@
 //! Running the experiment: SINDy and LeARN on every formulation × evaluation condition.
+//!
+//! Every process of a run (the unsharded one, or each shard) loads the flights, cuts the segments
+//! and fits SINDy (milliseconds); the LeARN work is the sweep of [`learn::WorkItem`]s, each
+//! item's cells carrying what the tables need ([`LearnCellOutcome`]), rendered by
+//! [`crate::tables::render`].
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::sindy_column::SegmentEvaluation;
-use data::{Condition, FlightLog, Formulation, Mat, Segment, SplitSpec, file_sha256};
+use data::{Condition, FlightLog, Formulation, Mat, Segment, file_sha256};
 use indicatif::{ProgressBar, ProgressStyle};
-use learn::{CellResult, DataFile, EquationRule, Experiment, RangeCoverage, explain, row_major};
+use learn::{CellResult, Cells, DataFile, EquationRule, Experiment, WorkItem, explain, row_major};
 use rayon::prelude::*;
-use report::{MethodTrace, Mse, OutputAxis, PublishedTables, QualitativeFigure, ResultsTable, Row};
-use sindy::Derivative;
+use report::{MethodTrace, PublishedTables, QualitativeFigure, ResultsTable};
 
+use crate::cells::{cell_figure, flight_segments, stacked_columns};
 use crate::config::CheckedRunConfig;
 use crate::error::{PipelineError, Result, in_flight};
-use crate::summary::{
-    CellRecord, FileRef, InputContribution, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT,
-    SindyCell, StageTiming, Summary,
+use crate::shard::{
+    ItemResult, MergedSweep, ShardFile, ShardProvenance, ShardSpec, Sweep, SweepKind,
 };
+use crate::summary::{FileRef, StageTiming, Summary};
+use crate::tables::{
+    CellDetail, ConditionName, LearnCellOutcome, ReproduceContext, RunInputs, SindyOutcome, render,
+};
+use crate::variants::VariantsConfig;
 
 /// How a run reports progress.
 pub struct RunOptions<'a> {
@@ -37,11 +47,16 @@ pub struct RunOutcome {
     pub uncommitted_inputs: Option<bool>,
 }
 
-/// One formulation on one evaluation flight.
-struct Cell<'a> {
+/// A shard of a reproduce run: each work item's cells.
+pub type ReproduceShard = ShardFile<ReproduceContext, Vec<LearnCellOutcome>>;
+
+/// One formulation on one evaluation flight, with SINDy fitted.
+struct Cell {
     formulation: Formulation,
-    condition: &'a Condition,
-    flight: &'a EvaluationFlight,
+    condition: Condition,
+    flight: DataFile,
+    /// The flight's file as read (errors name it).
+    flight_path: PathBuf,
     support: Segment,
     query: Segment,
     sindy: SegmentEvaluation,
@@ -85,6 +100,9 @@ fn progress_bar(show: bool, length: usize, message: &str) -> ProgressBar {
     bar
 }
 
+/// The stage in which the work items run.
+const ITEMS_STAGE: &str = "LeARN meta-training and adaptation, variant columns";
+
 /// Runs SINDy and LeARN for every formulation and evaluation condition of `config`, on the
 /// flights under `data_dir`. `root` is the project root (for the git commit and relative paths).
 pub fn run(
@@ -97,124 +115,288 @@ pub fn run(
         options,
         timings: Vec::new(),
     };
-    let conditions: Vec<&Condition> = config.conditions.evaluation().collect();
-    let (experiment, flights) = stopwatch.time("load flights", || {
-        let experiment = Experiment::load(
-            config.learn.clone(),
-            config.conditions.clone(),
-            data_dir,
-            config.protocol,
-        )?;
-        let flights = conditions
-            .par_iter()
-            .map(|condition| load_evaluation_flight(config, data_dir, condition))
-            .collect::<Result<Vec<_>>>()?;
-        Ok((experiment, flights))
+    let work = ReproduceWork::plan(config, data_dir, root, &mut stopwatch)?;
+    let results = stopwatch.time(ITEMS_STAGE, || {
+        work.run_items(ShardSpec::WHOLE, options.show_progress)
     })?;
-
-    let jobs: Vec<(Formulation, usize)> = config
-        .raw
-        .formulations
-        .iter()
-        .flat_map(|&f| (0..conditions.len()).map(move |c| (f, c)))
-        .collect();
-    let cells = stopwatch.time("SINDy", || {
-        let bar = progress_bar(options.show_progress, jobs.len(), "SINDy");
-        let cells = jobs
-            .par_iter()
-            .map(|&(formulation, index)| {
-                let cell = sindy_cell(config, formulation, conditions[index], &flights[index]);
-                bar.inc(1);
-                cell
-            })
-            .collect::<Result<Vec<_>>>();
-        bar.finish_and_clear();
-        cells
-    })?;
-
-    // The extra columns' folds and bagging blocks against the segments, before LeARN runs.
-    if let Some(path) = &config.raw.variants {
-        let path = root.join(path);
-        let variants = crate::variants::VariantsConfig::read(&path)?;
-        for cell in &cells {
-            let segment = format!(
-                "the {} support segment of {}",
-                cell.formulation.name(),
-                cell.flight.log.path.display()
-            );
-            variants.check_rows(&path, cell.support.len(), &segment, true)?;
-        }
-    }
-
-    let seeds = &config.raw.learn.seeds;
-    let learn_results = stopwatch.time("LeARN meta-training and adaptation", || {
-        let bar = progress_bar(options.show_progress, jobs.len() * seeds.len(), "LeARN");
-        let mut per_seed = Vec::with_capacity(seeds.len());
-        for &seed in seeds {
-            per_seed.push(learn_cells(&experiment, &cells, seed, &bar)?);
-        }
-        bar.finish_and_clear();
-        Ok(per_seed)
-    })?;
-
-    let variant_columns = match &config.raw.variants {
-        Some(path) => stopwatch.time("variants", || {
-            // The run's own LeARN models (first seed) serve the variants that need them.
-            let cells: Vec<_> = cells
-                .iter()
-                .zip(&learn_results[0])
-                .map(|(c, learn)| (&c.support, &c.query, &learn.model))
-                .collect();
-            crate::variants::reproduce_columns(&root.join(path), &cells)
-        })?,
-        None => Vec::new(),
-    };
-
+    let outcomes: Vec<LearnCellOutcome> = results.into_iter().flat_map(|r| r.result).collect();
     let (tables, figures, summary) = stopwatch.time("tables, figures and summary", || {
-        let published = PublishedTables::load(&config.published_path)?;
-        let protocol = experiment.protocol().name().to_string();
-        let mut tables = build_tables(config, &cells, &learn_results, &published, &protocol);
-        for (cell, columns) in cells.iter().zip(&variant_columns) {
-            let table = tables
-                .iter_mut()
-                .find(|t| t.table == cell.formulation.name());
-            let row = table.and_then(|t| {
-                t.rows
-                    .iter_mut()
-                    .find(|r| r.condition == cell.condition.label())
-            });
-            if let Some(row) = row {
-                row.variants.extend(columns.clone());
-            }
-        }
-        let figures = cells
-            .iter()
-            .enumerate()
-            .map(|(index, cell)| figure(cell, &learn_results[0][index]))
-            .collect::<Result<Vec<_>>>()?;
-        let records = cells
-            .iter()
-            .enumerate()
-            .map(|(index, cell)| record(cell, &learn_results, index))
-            .collect::<Result<Vec<_>>>()?;
-        let provenance = provenance(config, root, &flights, &learn_results, protocol)?;
-        let summary = Summary {
-            format: SUMMARY_FORMAT.to_string(),
-            run: config.raw.name.clone(),
-            description: config.raw.description.clone(),
-            provenance,
-            tables: tables.clone(),
-            cells: records,
-        };
-        Ok((tables, figures, summary))
+        render(&work.sweep.context, &outcomes, git_commit(root))
     })?;
-
     Ok(RunOutcome {
         tables,
         figures,
         summary,
         timings: stopwatch.timings,
         uncommitted_inputs: uncommitted_inputs(root),
+    })
+}
+
+/// Runs shard `shard` of the run of `config` (see [`run`]): the items at its positions.
+pub fn run_shard(
+    config: &CheckedRunConfig,
+    data_dir: &Path,
+    root: &Path,
+    options: &RunOptions,
+    shard: ShardSpec,
+) -> Result<ReproduceShard> {
+    let mut stopwatch = Stopwatch {
+        options,
+        timings: Vec::new(),
+    };
+    let work = ReproduceWork::plan(config, data_dir, root, &mut stopwatch)?;
+    let results = stopwatch.time(ITEMS_STAGE, || work.run_items(shard, options.show_progress))?;
+    let provenance = ShardProvenance::here(root, stopwatch.timings);
+    Ok(work.sweep.shard_file(shard, results, provenance))
+}
+
+/// The outcome of merged reproduce shards: rendered as [`run`] renders; the timings are each
+/// shard's stages and the merge's.
+pub fn merged_run(
+    merged: MergedSweep<ReproduceContext, Vec<LearnCellOutcome>>,
+) -> Result<RunOutcome> {
+    let start = Instant::now();
+    let outcomes: Vec<LearnCellOutcome> = merged.results.into_iter().flatten().collect();
+    let (tables, figures, summary) = render(&merged.context, &outcomes, merged.git_commit)?;
+    let mut timings = shard_timings(&merged.shards);
+    timings.push(StageTiming {
+        stage: "merge: tables, figures and summary".to_string(),
+        seconds: start.elapsed().as_secs_f64(),
+    });
+    let uncommitted = merged.shards.iter().map(|(_, _, p)| p.uncommitted_inputs);
+    Ok(RunOutcome {
+        tables,
+        figures,
+        summary,
+        timings,
+        uncommitted_inputs: uncommitted
+            .reduce(|a, b| a.zip(b).map(|(a, b)| a || b))
+            .flatten(),
+    })
+}
+
+/// Each shard's stages, named by the shard and its host.
+pub fn shard_timings(shards: &[(PathBuf, ShardSpec, ShardProvenance)]) -> Vec<StageTiming> {
+    shards
+        .iter()
+        .flat_map(|(_, shard, provenance)| {
+            let host = provenance.host.as_deref().unwrap_or("unknown host");
+            provenance.stages.iter().map(move |stage| StageTiming {
+                stage: format!("shard {shard} on {host}: {}", stage.stage),
+                seconds: stage.seconds,
+            })
+        })
+        .collect()
+}
+
+/// A reproduce run's work, planned: the flights loaded, the cells cut and fitted by SINDy, and
+/// the sweep of LeARN work items.
+struct ReproduceWork<'c> {
+    config: &'c CheckedRunConfig,
+    experiment: Experiment,
+    cells: Vec<Cell>,
+    /// The variants file whose `reproduce` columns are added, if any.
+    variants: Option<VariantsConfig>,
+    sweep: Sweep<ReproduceContext>,
+}
+
+impl<'c> ReproduceWork<'c> {
+    /// Loads the flights and fits SINDy on every cell (the stages "load flights" and "SINDy"),
+    /// checks the variant columns' folds against the segments, and enumerates the work items.
+    fn plan(
+        config: &'c CheckedRunConfig,
+        data_dir: &Path,
+        root: &Path,
+        stopwatch: &mut Stopwatch,
+    ) -> Result<Self> {
+        let conditions: Vec<&Condition> = config.conditions.evaluation().collect();
+        let (experiment, flights) = stopwatch.time("load flights", || {
+            let experiment = Experiment::load(
+                config.learn.clone(),
+                config.conditions.clone(),
+                data_dir,
+                config.protocol,
+            )?;
+            let flights = conditions
+                .par_iter()
+                .map(|condition| load_evaluation_flight(config, data_dir, condition))
+                .collect::<Result<Vec<_>>>()?;
+            Ok((experiment, flights))
+        })?;
+        let cells = stopwatch.time("SINDy", || sindy_cells(config, &conditions, &flights))?;
+        // The extra columns' folds and bagging blocks against the segments, before LeARN runs.
+        let variants = match &config.variants_path {
+            Some(path) => {
+                let variants = VariantsConfig::read(path)?;
+                for cell in &cells {
+                    let segment = format!(
+                        "the {} support segment of {}",
+                        cell.formulation.name(),
+                        cell.flight_path.display()
+                    );
+                    variants.check_rows(path, cell.support.len(), &segment, true)?;
+                }
+                Some(variants)
+            }
+            None => None,
+        };
+        let items = experiment.work_items(&config.raw.formulations, &config.raw.learn.seeds);
+        let sweep = Sweep {
+            kind: SweepKind::Reproduce,
+            context: context(config, root, &experiment, &flights)?,
+            items,
+            data_files: experiment.data_files(),
+        };
+        Ok(Self {
+            config,
+            experiment,
+            cells,
+            variants,
+            sweep,
+        })
+    }
+
+    /// Runs the items of `shard`, with a bar over their cells when `show_progress`.
+    fn run_items(
+        &self,
+        shard: ShardSpec,
+        show_progress: bool,
+    ) -> Result<Vec<ItemResult<Vec<LearnCellOutcome>>>> {
+        let conditions = self.sweep.context.conditions.len();
+        let cells: usize = shard
+            .positions(self.sweep.items.len())
+            .iter()
+            .map(|&p| match self.sweep.items[p].cells {
+                Cells::Condition(_) => 1,
+                Cells::Every => conditions,
+            })
+            .sum();
+        let bar = progress_bar(show_progress, cells, "LeARN");
+        let results = self.sweep.run(shard, |item| self.run_item(item, &bar));
+        bar.finish_and_clear();
+        results
+    }
+
+    /// One work item: LeARN on its cells; with the first seed, each cell's detail too.
+    fn run_item(&self, item: &WorkItem, bar: &ProgressBar) -> Result<Vec<LearnCellOutcome>> {
+        let results = self.experiment.run_item_observed(item, &|_| bar.inc(1))?;
+        let first_seed = item.seed == self.config.raw.learn.seeds[0];
+        results
+            .iter()
+            .map(|result| {
+                let cell = self.cell(item.formulation, &result.summary.condition)?;
+                check_same_targets(cell, result)?;
+                let detail = if first_seed {
+                    Some(self.cell_detail(cell, result)?)
+                } else {
+                    None
+                };
+                Ok(LearnCellOutcome {
+                    summary: result.summary.clone(),
+                    final_meta_loss: result.model.meta_loss_history.last().copied(),
+                    meta_training_files: result.model.data_files.clone(),
+                    first_seed: detail,
+                })
+            })
+            .collect()
+    }
+
+    fn cell(&self, formulation: Formulation, condition: &str) -> Result<&Cell> {
+        self.cells
+            .iter()
+            .find(|c| c.formulation == formulation && c.condition.name == condition)
+            .ok_or_else(|| PipelineError::Mismatch {
+                what: format!("{} {condition}", formulation.name()),
+                message: "LeARN evaluated a cell the run does not have".to_string(),
+            })
+    }
+
+    /// What the tables take from the first seed's cell: SINDy and the flight, the figure, the
+    /// explanation of the adapted model, the variant columns with its model.
+    fn cell_detail(&self, cell: &Cell, result: &CellResult) -> Result<CellDetail> {
+        let model = &result.model;
+        let support_inputs = model.standardiser.apply(&row_major(&cell.support.inputs()));
+        let explanation = explain(
+            cell.formulation,
+            &model.architecture,
+            &result.adapted_parameters,
+            &support_inputs,
+            EquationRule::default(),
+        );
+        let variant_columns = match &self.variants {
+            Some(variants) => crate::variants::reproduce_columns(
+                variants,
+                &[(&cell.support, &cell.query, model)],
+            )?
+            .pop()
+            .unwrap_or_default(),
+            None => BTreeMap::new(),
+        };
+        Ok(CellDetail {
+            flight: cell.flight.clone(),
+            support_rows: [cell.support.rows.start, cell.support.rows.end],
+            query_rows: [cell.query.rows.start, cell.query.rows.end],
+            sindy: SindyOutcome {
+                adapt: cell.sindy.support_mse,
+                r#gen: cell.sindy.query_mse,
+                equations: cell.sindy.model.equations(3),
+                query_coverage: sindy_query_coverage(cell, result),
+            },
+            explanation,
+            figure: figure(cell, result)?,
+            variant_columns,
+        })
+    }
+}
+
+/// The context of a reproduce run of `config`: everything rendering takes from the configuration.
+fn context(
+    config: &CheckedRunConfig,
+    root: &Path,
+    experiment: &Experiment,
+    flights: &[EvaluationFlight],
+) -> Result<ReproduceContext> {
+    let run_config_path = config
+        .path
+        .strip_prefix(root)
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| config.path.clone());
+    let input_sha256 = config
+        .input_files("--config")
+        .iter()
+        .map(|(_, path)| file_sha256(path).map_err(PipelineError::from))
+        .collect::<Result<_>>()?;
+    Ok(ReproduceContext {
+        run: config.raw.name.clone(),
+        description: config.raw.description.clone(),
+        formulations: config.raw.formulations.clone(),
+        conditions: config
+            .conditions
+            .evaluation()
+            .map(|c| ConditionName {
+                name: c.name.clone(),
+                label: c.label().to_string(),
+            })
+            .collect(),
+        published: PublishedTables::load(&config.published_path)?,
+        protocol: experiment.protocol().name().to_string(),
+        inputs: RunInputs {
+            run_config: FileRef {
+                path: run_config_path,
+                sha256: config.sha256.clone(),
+            },
+            conditions: file_ref(&config.raw.conditions, &config.conditions_path)?,
+            published: file_ref(&config.raw.published, &config.published_path)?,
+            learn_config: file_ref(&config.raw.learn.config, &config.learn_config_path)?,
+            learn_overrides: config.raw.learn.overrides.clone(),
+            split: config.raw.split,
+            derivative: config.raw.derivative,
+            seeds: config.raw.learn.seeds.clone(),
+            sindy: config.raw.sindy.clone(),
+            learn: config.learn.get().clone(),
+        },
+        input_sha256,
+        evaluation_files: flights.iter().map(|f| f.file.clone()).collect(),
     })
 }
 
@@ -236,12 +418,31 @@ fn load_evaluation_flight(
     Ok(EvaluationFlight { log, file })
 }
 
-fn sindy_cell<'a>(
+/// SINDy on every formulation × evaluation flight, in table order.
+fn sindy_cells(
+    config: &CheckedRunConfig,
+    conditions: &[&Condition],
+    flights: &[EvaluationFlight],
+) -> Result<Vec<Cell>> {
+    let jobs: Vec<(Formulation, usize)> = config
+        .raw
+        .formulations
+        .iter()
+        .flat_map(|&f| (0..conditions.len()).map(move |c| (f, c)))
+        .collect();
+    jobs.par_iter()
+        .map(|&(formulation, index)| {
+            sindy_cell(config, formulation, conditions[index], &flights[index])
+        })
+        .collect()
+}
+
+fn sindy_cell(
     config: &CheckedRunConfig,
     formulation: Formulation,
-    condition: &'a Condition,
-    flight: &'a EvaluationFlight,
-) -> Result<Cell<'a>> {
+    condition: &Condition,
+    flight: &EvaluationFlight,
+) -> Result<Cell> {
     let (support, query) = flight_segments(
         &flight.log,
         formulation,
@@ -252,62 +453,13 @@ fn sindy_cell<'a>(
         .map_err(|error| in_flight(&flight.log.path, error))?;
     Ok(Cell {
         formulation,
-        condition,
-        flight,
+        condition: condition.clone(),
+        flight: flight.file.clone(),
+        flight_path: flight.log.path.clone(),
         support,
         query,
         sindy,
     })
-}
-
-/// The support and query segments of `log` (cut by `split`, targets by `derivative` on each
-/// segment); errors name the flight's file.
-pub(crate) fn flight_segments(
-    log: &FlightLog,
-    formulation: Formulation,
-    split: SplitSpec,
-    derivative: Derivative,
-) -> Result<(Segment, Segment)> {
-    let segments = || -> std::result::Result<(Segment, Segment), data::DataError> {
-        let rows = split.split(log.len())?;
-        let support = formulation.segment(log, rows.support, derivative)?;
-        let query = formulation.segment(log, rows.query, derivative)?;
-        Ok((support, query))
-    };
-    segments().map_err(|error| in_flight(&log.path, error))
-}
-
-/// LeARN for every cell with one seed, in the cells' order. Under the `paper` protocol one
-/// meta-trained model per formulation serves every condition.
-fn learn_cells(
-    experiment: &Experiment,
-    cells: &[Cell],
-    seed: u64,
-    bar: &ProgressBar,
-) -> Result<Vec<CellResult>> {
-    let shared_models = if experiment.protocol() == learn::Protocol::Paper {
-        let mut formulations: Vec<Formulation> = cells.iter().map(|c| c.formulation).collect();
-        formulations.dedup();
-        let first_condition = &cells[0].condition.name;
-        formulations
-            .par_iter()
-            .map(|&f| Ok((f, experiment.meta_train(f, first_condition, seed)?)))
-            .collect::<Result<Vec<_>>>()?
-    } else {
-        Vec::new()
-    };
-    cells
-        .par_iter()
-        .map(|cell| {
-            let result = match shared_models.iter().find(|(f, _)| *f == cell.formulation) {
-                Some((_, model)) => experiment.evaluate(model, &cell.condition.name)?,
-                None => experiment.run_cell(cell.formulation, &cell.condition.name, seed)?,
-            };
-            check_same_targets(cell, &result)?;
-            bar.inc(1);
-            Ok(result)
-        })
-        .collect()
 }
 
 /// Both methods must be scored against the same targets on the same rows.
@@ -347,91 +499,11 @@ fn max_abs_difference(a: &Mat<f64>, b: &Mat<f64>) -> f64 {
     largest
 }
 
-fn mean(values: impl Iterator<Item = f64>) -> f64 {
-    let (sum, count) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    sum / count as f64
-}
-
-/// The LeARN errors of cell `index`, averaged over seeds.
-fn learn_mse(learn_results: &[Vec<CellResult>], index: usize) -> Mse {
-    Mse {
-        adaptation: mean(learn_results.iter().map(|r| r[index].summary.adapt_mse)),
-        generalisation: mean(learn_results.iter().map(|r| r[index].summary.gen_mse)),
-    }
-}
-
-fn build_tables(
-    config: &CheckedRunConfig,
-    cells: &[Cell],
-    learn_results: &[Vec<CellResult>],
-    published: &PublishedTables,
-    protocol: &str,
-) -> Vec<ResultsTable> {
-    config
-        .raw
-        .formulations
-        .iter()
-        .map(|formulation| {
-            let indices: Vec<usize> = (0..cells.len())
-                .filter(|&index| cells[index].formulation == *formulation)
-                .collect();
-            let rows = indices
-                .iter()
-                .map(|&index| {
-                    let cell = &cells[index];
-                    Row::new(
-                        cell.condition.label(),
-                        Mse {
-                            adaptation: cell.sindy.support_mse,
-                            generalisation: cell.sindy.query_mse,
-                        },
-                        learn_mse(learn_results, index),
-                    )
-                })
-                .collect();
-            let learn_coverages: Vec<Option<RangeCoverage>> = indices
-                .iter()
-                .map(|&index| seed_mean_coverage(learn_results, index, |s| &s.query_coverage))
-                .collect();
-            let coverages = indices.iter().zip(&learn_coverages).map(|(&index, learn)| {
-                (
-                    cells[index].condition.label(),
-                    learn.as_ref(),
-                    sindy_query_coverage(&cells[index], &learn_results[0][index]),
-                )
-            });
-            let mut table = ResultsTable {
-                table: formulation.name().to_string(),
-                protocol: protocol.to_string(),
-                rows,
-                notes: coverage_note(coverages).into_iter().collect(),
-            };
-            table.attach_published(published);
-            table
-        })
-        .collect()
-}
-
-/// A cell's coverage (`field` of each seed's summary) with LeARN's errors averaged over the seeds,
-/// as its MSE is; the first seed's if the seeds' counts disagree.
-fn seed_mean_coverage(
-    learn_results: &[Vec<CellResult>],
-    index: usize,
-    field: fn(&learn::CellSummary) -> &Option<RangeCoverage>,
-) -> Option<RangeCoverage> {
-    let per_seed: Option<Vec<&RangeCoverage>> = learn_results
-        .iter()
-        .map(|results| field(&results[index].summary).as_ref())
-        .collect();
-    let per_seed = per_seed?;
-    RangeCoverage::mean(&per_seed).or_else(|| per_seed.first().map(|c| (*c).clone()))
-}
-
 /// SINDy's query predictions scored on the same split as LeARN's query coverage: the samples
 /// inside and outside the range of the LeARN meta-training inputs (SINDy itself never saw those
 /// flights; the split only asks whether the samples where LeARN extrapolates are hard for SINDy
 /// too). `None` without a range.
-fn sindy_query_coverage(cell: &Cell, learn_result: &CellResult) -> Option<RangeCoverage> {
+fn sindy_query_coverage(cell: &Cell, learn_result: &CellResult) -> Option<learn::RangeCoverage> {
     let names = cell.formulation.input_names();
     learn_result.model.standardiser.coverage_with_errors(
         &row_major(&cell.query.inputs()),
@@ -439,138 +511,6 @@ fn sindy_query_coverage(cell: &Cell, learn_result: &CellResult) -> Option<RangeC
         &row_major(&cell.sindy.query_prediction),
         &row_major(&cell.query.targets),
     )
-}
-
-/// The note under a table on how much of each query segment lies outside the range of the
-/// meta-training inputs (where the networks extrapolate), naming the input that goes farthest,
-/// with LeARN's and SINDy's generalisation MSE over the samples inside and outside that range;
-/// `None` if no cell has a range.
-fn coverage_note<'a>(
-    coverages: impl Iterator<Item = (&'a str, Option<&'a RangeCoverage>, Option<RangeCoverage>)>,
-) -> Option<String> {
-    let split = |coverage: Option<&RangeCoverage>| match coverage {
-        Some(RangeCoverage {
-            mse_inside: Some(inside),
-            mse_outside: Some(outside),
-            ..
-        }) => Some(format!("{inside:.3} / {outside:.3}")),
-        _ => None,
-    };
-    let parts: Vec<String> = coverages
-        .filter_map(|(label, coverage, sindy)| {
-            let coverage = coverage?;
-            let farthest = coverage
-                .inputs
-                .iter()
-                .filter(|input| input.samples_outside > 0)
-                .max_by(|a, b| a.largest_excess_in_std.total_cmp(&b.largest_excess_in_std));
-            let errors = match (split(Some(coverage)), split(sindy.as_ref())) {
-                (Some(learn), Some(sindy)) => {
-                    format!("; MSE inside / outside: LeARN {learn}, SINDy {sindy}")
-                }
-                (Some(learn), None) => format!("; MSE inside / outside: LeARN {learn}"),
-                _ => String::new(),
-            };
-            let detail = farthest.map_or(String::new(), |input| {
-                format!(
-                    " (farthest: {} by {:.1} std on {} samples{}{errors})",
-                    input.input,
-                    input.largest_excess_in_std,
-                    input.samples_outside,
-                    contributions(input, sindy.as_ref())
-                )
-            });
-            Some(format!(
-                "{label} {} of {}{detail}",
-                coverage.samples_outside, coverage.samples
-            ))
-        })
-        .collect();
-    (!parts.is_empty()).then(|| {
-        format!(
-            "LeARN query samples with an input outside the range of the meta-training inputs \
-             (the networks extrapolate there), with the generalisation MSE of each method over the \
-             query samples inside and outside that range: {}.",
-            parts.join("; ")
-        )
-    })
-}
-
-/// What the samples outside on `input` add to each method's generalisation MSE (SINDy's from its
-/// own coverage of the same samples), e.g. ", which add 0.126 to LeARN's MSE and 0.020 to
-/// SINDy's"; empty without the errors.
-fn contributions(input: &learn::InputCoverage, sindy: Option<&RangeCoverage>) -> String {
-    let Some(learn) = input.contribution_to_mse else {
-        return String::new();
-    };
-    let sindy = sindy
-        .and_then(|coverage| coverage.inputs.iter().find(|i| i.input == input.input))
-        .and_then(|i| i.contribution_to_mse);
-    match sindy {
-        Some(sindy) => {
-            format!(", which add {learn:.3} to LeARN's MSE and {sindy:.3} to SINDy's")
-        }
-        None => format!(", which add {learn:.3} to LeARN's MSE"),
-    }
-}
-
-/// Column `j` of two stacked matrices.
-fn stacked_column(top: &Mat<f64>, bottom: &Mat<f64>, j: usize) -> Vec<f64> {
-    (0..top.nrows())
-        .map(|i| top[(i, j)])
-        .chain((0..bottom.nrows()).map(|i| bottom[(i, j)]))
-        .collect()
-}
-
-/// Every column of two stacked matrices (support rows, then query rows).
-pub(crate) fn stacked_columns(top: &Mat<f64>, bottom: &Mat<f64>) -> Vec<Vec<f64>> {
-    (0..top.ncols())
-        .map(|j| stacked_column(top, bottom, j))
-        .collect()
-}
-
-/// The qualitative figure of one cell (time and ground truth over both segments, one trace per
-/// method) and its file name.
-pub(crate) fn cell_figure(
-    formulation: Formulation,
-    condition: &Condition,
-    support: &Segment,
-    query: &Segment,
-    methods: Vec<MethodTrace>,
-) -> Result<(String, QualitativeFigure)> {
-    let figure = QualitativeFigure {
-        table: formulation.name().to_string(),
-        condition: condition.label().to_string(),
-        time: support.time.iter().chain(&query.time).copied().collect(),
-        split: support.len(),
-        outputs: formulation
-            .target_names()
-            .iter()
-            .map(|o| OutputAxis::for_target(o))
-            .collect(),
-        truth: stacked_columns(&support.targets, &query.targets),
-        methods,
-    };
-    figure.validate()?;
-    Ok((
-        figure_file_name(formulation.name(), condition.label()),
-        figure,
-    ))
-}
-
-/// The figure's file name: table and condition label, with anything unusual replaced by `-`.
-pub fn figure_file_name(table: &str, label: &str) -> String {
-    let clean: String = label
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
-                c
-            } else {
-                '-'
-            }
-        })
-        .collect();
-    format!("{table}_{clean}.svg")
 }
 
 fn figure(cell: &Cell, learn_result: &CellResult) -> Result<(String, QualitativeFigure)> {
@@ -594,72 +534,11 @@ fn figure(cell: &Cell, learn_result: &CellResult) -> Result<(String, Qualitative
     ];
     cell_figure(
         cell.formulation,
-        cell.condition,
+        &cell.condition,
         &cell.support,
         &cell.query,
         methods,
     )
-}
-
-fn record(cell: &Cell, learn_results: &[Vec<CellResult>], index: usize) -> Result<CellRecord> {
-    let first = &learn_results[0][index];
-    let model = &first.model;
-    let support_inputs = model.standardiser.apply(&row_major(&cell.support.inputs()));
-    let explanation = explain(
-        cell.formulation,
-        &model.architecture,
-        &first.adapted_parameters,
-        &support_inputs,
-        EquationRule::default(),
-    );
-    let mse = learn_mse(learn_results, index);
-    let sindy_split = sindy_query_coverage(cell, first);
-    Ok(CellRecord {
-        table: cell.formulation.name().to_string(),
-        condition: cell.condition.name.clone(),
-        label: cell.condition.label().to_string(),
-        flight: cell.flight.file.clone(),
-        support_rows: [cell.support.rows.start, cell.support.rows.end],
-        query_rows: [cell.query.rows.start, cell.query.rows.end],
-        sindy: SindyCell {
-            adapt: cell.sindy.support_mse,
-            r#gen: cell.sindy.query_mse,
-            equations: cell.sindy.model.equations(3),
-            gen_inside_range: sindy_split.as_ref().and_then(|c| c.mse_inside),
-            gen_outside_range: sindy_split.as_ref().and_then(|c| c.mse_outside),
-            gen_added_outside_range: sindy_split
-                .iter()
-                .flat_map(|c| &c.inputs)
-                .filter_map(|input| {
-                    Some(InputContribution {
-                        input: input.input.clone(),
-                        contribution_to_mse: input.contribution_to_mse?,
-                    })
-                })
-                .collect(),
-        },
-        learn: LearnCell {
-            adapt: mse.adaptation,
-            r#gen: mse.generalisation,
-            seeds: learn_results
-                .iter()
-                .map(|results| {
-                    let result = &results[index];
-                    LearnSeedCell {
-                        seed: result.summary.seed,
-                        adapt: result.summary.adapt_mse,
-                        r#gen: result.summary.gen_mse,
-                        unadapted_adapt: result.summary.unadapted_adapt_mse,
-                        unadapted_gen: result.summary.unadapted_gen_mse,
-                        final_meta_loss: result.model.meta_loss_history.last().copied(),
-                    }
-                })
-                .collect(),
-            explanation,
-            support_coverage: seed_mean_coverage(learn_results, index, |s| &s.support_coverage),
-            query_coverage: seed_mean_coverage(learn_results, index, |s| &s.query_coverage),
-        },
-    })
 }
 
 fn file_ref(written: &Path, resolved: &Path) -> Result<FileRef> {
@@ -702,160 +581,4 @@ pub fn git_commit(root: &Path) -> String {
 pub fn uncommitted_inputs(root: &Path) -> Option<bool> {
     git(root, &["status", "--porcelain", "--untracked-files=no"])
         .map(|text| !text.trim().is_empty())
-}
-
-fn provenance(
-    config: &CheckedRunConfig,
-    root: &Path,
-    flights: &[EvaluationFlight],
-    learn_results: &[Vec<CellResult>],
-    protocol: String,
-) -> Result<Provenance> {
-    let mut data_files: Vec<DataFile> = flights.iter().map(|f| f.file.clone()).collect();
-    for result in learn_results.iter().flatten() {
-        data_files.extend(result.model.data_files.iter().cloned());
-        data_files.push(result.summary.evaluation_file.clone());
-    }
-    data_files.sort_by(|a, b| a.path.cmp(&b.path));
-    data_files.dedup_by(|a, b| a.path == b.path);
-    let run_config_path = config
-        .path
-        .strip_prefix(root)
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| config.path.clone());
-    Ok(Provenance {
-        git_commit: git_commit(root),
-        run_config: FileRef {
-            path: run_config_path,
-            sha256: config.sha256.clone(),
-        },
-        conditions: file_ref(&config.raw.conditions, &config.conditions_path)?,
-        published: file_ref(&config.raw.published, &config.published_path)?,
-        learn_config: file_ref(&config.raw.learn.config, &config.learn_config_path)?,
-        learn_overrides: config.raw.learn.overrides.clone(),
-        data_files,
-        protocol,
-        split: config.raw.split,
-        derivative: config.raw.derivative,
-        seeds: config.raw.learn.seeds.clone(),
-        sindy: config.raw.sindy.clone(),
-        learn: config.learn.get().clone(),
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A still flight of `n` samples at 50 Hz read from `path`.
-    fn still_flight(path: &str, n: usize) -> FlightLog {
-        FlightLog {
-            path: PathBuf::from(path),
-            meta: None,
-            time: (0..n).map(|k| k as f64 * 0.02).collect(),
-            position: vec![[0.0; 3]; n],
-            velocity: vec![[0.0; 3]; n],
-            quaternion: vec![[0.0, 0.0, 0.0, 1.0]; n],
-            rotation: vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]; n],
-            body_rate: vec![[0.0; 3]; n],
-            thrust_setpoint: vec![0.5; n],
-            hover_throttle: vec![0.5; n],
-            motor_command: vec![[1500.0; 4]; n],
-            position_desired: None,
-            velocity_desired: None,
-            attitude_setpoint: None,
-            residual_force: None,
-        }
-    }
-
-    #[test]
-    fn a_flight_too_short_to_split_is_named() {
-        let short = still_flight("/data/experiment/short.csv", 3);
-        let message = flight_segments(
-            &short,
-            Formulation::Full,
-            SplitSpec::Halves,
-            Derivative::Forward,
-        )
-        .unwrap_err()
-        .to_string();
-        assert_eq!(
-            message,
-            "/data/experiment/short.csv: split: 3 rows are too few to split (1 / 2)"
-        );
-        let (support, query) = flight_segments(
-            &still_flight("long.csv", 10),
-            Formulation::Full,
-            SplitSpec::Halves,
-            Derivative::Forward,
-        )
-        .unwrap();
-        assert_eq!((support.rows, query.rows), (0..5, 5..10));
-    }
-
-    #[test]
-    fn figure_names_are_safe() {
-        assert_eq!(figure_file_name("full", "70psin20"), "full_70psin20.svg");
-        assert_eq!(
-            figure_file_name("attitude", "8 m/s gust"),
-            "attitude_8-m-s-gust.svg"
-        );
-    }
-
-    #[test]
-    fn stacked_columns_follow_time_order() {
-        let top = Mat::from_fn(2, 2, |i, j| (i * 10 + j) as f64);
-        let bottom = Mat::from_fn(1, 2, |_, j| 100.0 + j as f64);
-        assert_eq!(stacked_column(&top, &bottom, 1), vec![1.0, 11.0, 101.0]);
-        assert_eq!(mean([1.0, 2.0, 6.0].into_iter()), 3.0);
-    }
-
-    #[test]
-    fn the_coverage_note_names_the_input_that_goes_farthest() {
-        let input = |input: &str, samples_outside, largest_excess_in_std| learn::InputCoverage {
-            input: input.to_string(),
-            samples_outside,
-            largest_excess_in_std,
-            contribution_to_mse: (samples_outside > 0).then_some(0.125),
-        };
-        let inside = RangeCoverage {
-            samples: 10,
-            samples_outside: 0,
-            inputs: vec![input("w_x", 0, 0.0), input("w_z", 0, 0.0)],
-            mse_inside: Some(0.5),
-            mse_outside: None,
-        };
-        let outside = RangeCoverage {
-            samples: 10,
-            samples_outside: 3,
-            inputs: vec![input("w_x", 2, 6.5), input("w_z", 3, 9.61)],
-            mse_inside: Some(0.25),
-            mse_outside: Some(2.5),
-        };
-        let mut sindy = RangeCoverage {
-            mse_inside: Some(0.5),
-            mse_outside: Some(1.25),
-            ..outside.clone()
-        };
-        sindy.inputs[1].contribution_to_mse = Some(0.0703125);
-        let note = coverage_note(
-            [
-                ("35wind", Some(&inside), None),
-                ("100wind", Some(&outside), Some(sindy)),
-                ("70wind", Some(&outside), None),
-                ("new", None, None),
-            ]
-            .into_iter(),
-        )
-        .unwrap();
-        assert!(
-            note.ends_with(
-                ": 35wind 0 of 10; \
-                 100wind 3 of 10 (farthest: w_z by 9.6 std on 3 samples, which add 0.125 to LeARN's MSE and 0.070 to SINDy's; MSE inside / outside: LeARN 0.250 / 2.500, SINDy 0.500 / 1.250); \
-                 70wind 3 of 10 (farthest: w_z by 9.6 std on 3 samples, which add 0.125 to LeARN's MSE; MSE inside / outside: LeARN 0.250 / 2.500)."
-            ),
-            "{note}"
-        );
-        assert_eq!(coverage_note([("35wind", None, None)].into_iter()), None);
-    }
 }

@@ -7,14 +7,15 @@ use crate::sindy_column::SindyConfig;
 use data::SplitSpec;
 use learn::{DataFile, Explanation, LearnConfig, RangeCoverage};
 use report::ResultsTable;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use sindy::Derivative;
 
 /// The format tag of `summary.json`.
 pub const SUMMARY_FORMAT: &str = "learn-results/1";
 
 /// A configuration file a run read.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FileRef {
     /// As written in the run configuration (relative to the project root).
     pub path: PathBuf,
@@ -128,7 +129,8 @@ pub struct Summary {
 }
 
 /// Wall time of one stage.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StageTiming {
     pub stage: String,
     pub seconds: f64,

@@ -8,7 +8,7 @@
 //! cross-validation inside the support segment; the query segment is only ever scored.
 //!
 //! Variant kinds:
-//! - `library`: a [`crate::CausalLibrary`] and a [`sindy::RegressionSpec`];
+//! - `library`: a [`crate::causal_library::CausalLibrary`] and a [`sindy::RegressionSpec`];
 //! - `select`: per cell, the candidate variant (by name) with the lowest support cross-validation
 //!   error (mean over outputs of each output's best penalty score);
 //! - `learned_basis`: the meta-trained LeARN library Θ(X; ψ) as features, optionally beside a fixed
@@ -22,23 +22,20 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use data::{
-    Condition, FlightLog, Formulation, NoiseFloor, Segment, forward_difference_noise_floor,
-};
+use crate::causal_library::CausalLibrary;
+use crate::sindy_variant::LibraryRegression;
+use crate::sindy_variant::SegmentPredictions;
+use crate::sindy_variant::VariantEvaluation;
+use crate::sindy_variant::evaluate_features;
+use data::{Formulation, Segment};
 use learn::variants::{LearnedFeatures, learned_features};
 use learn::{Experiment, MetaTrainedModel};
 use rayon::prelude::*;
-use report::{MethodTrace, PublishedTables, QualitativeFigure};
 use serde::{Deserialize, Serialize};
-use sindy::{EnsemblePrediction, Mat, RegressionFit, RegressionSpec};
+use sindy::{Mat, RegressionFit, RegressionSpec};
 
-use crate::causal_library::CausalLibrary;
 use crate::config::{CheckedRunConfig, RunConfig, check_seeds, merge_patch};
-use crate::error::{PipelineError, Result, write_text};
-use crate::run::flight_segments;
-use crate::sindy_variant::{
-    LibraryRegression, SegmentPredictions, VariantEvaluation, evaluate_features,
-};
+use crate::error::{PipelineError, Result};
 
 /// The most variants a variants file may declare (every variant runs on every cell and seed; the
 /// committed file declares 14).
@@ -111,7 +108,7 @@ pub fn ensemble_member_seeds(seed: u64, members: usize) -> Option<Vec<u64>> {
 impl VariantKind {
     /// Whether the variant needs the meta-trained LeARN networks (the paper's LeARN and the
     /// closed-form adaptations over its basis).
-    fn needs_meta_training(&self) -> bool {
+    pub(crate) fn needs_meta_training(&self) -> bool {
         matches!(
             self,
             Self::LearnedBasis(_) | Self::Learn | Self::LearnEnsemble { .. }
@@ -522,14 +519,13 @@ impl VariantsConfig {
     }
 }
 
-/// The extra columns `make reproduce` shows: the `reproduce` variants of the variants file at
-/// `path`, for each (support, query, the run's meta-trained LeARN model) of a cell, with the first
-/// seed of that file.
+/// The extra columns `make reproduce` shows: the `reproduce` variants of the variants file
+/// `config`, for each (support, query, the run's meta-trained LeARN model) of a cell, with the
+/// first seed of that file.
 pub fn reproduce_columns(
-    path: &Path,
+    config: &VariantsConfig,
     cells: &[(&Segment, &Segment, &MetaTrainedModel)],
 ) -> Result<Vec<BTreeMap<String, report::Mse>>> {
-    let config = VariantsConfig::read(path)?;
     let variants = config.reproduce_variants();
     let seed = config.seeds[0];
     cells
@@ -554,88 +550,6 @@ pub fn reproduce_columns(
                 .collect())
         })
         .collect()
-}
-
-/// Mean and spread of one variant on one cell over the seeds.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct VariantCell {
-    pub adapt: f64,
-    pub r#gen: f64,
-    /// Sample standard deviation over seeds (0 for one seed).
-    pub adapt_std: f64,
-    pub gen_std: f64,
-    pub seeds: Vec<SeedCell>,
-}
-
-/// One seed of one variant on one cell.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SeedCell {
-    pub seed: u64,
-    pub adapt: f64,
-    pub r#gen: f64,
-    /// Mean over outputs of the best support cross-validation MSE (variants that fit a
-    /// regression).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub support_cv: Option<f64>,
-    /// What was chosen inside the support segment: per output the penalty, and for `select` the
-    /// candidate.
-    pub chosen: BTreeMap<String, serde_json::Value>,
-    /// For bagged variants: the fraction of query targets inside the predictive band.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub query_band_coverage: Option<f64>,
-}
-
-/// One row of the ablation table: one formulation on one condition.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct AblationRow {
-    pub table: String,
-    pub condition: String,
-    /// The paper's numbers, when it has them, and the target min(SINDy gen, LeARN gen).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub published: Option<report::MethodPair>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub target: Option<f64>,
-    /// Our SINDy with the paper's settings (the run configuration's).
-    pub sindy: report::Mse,
-    /// Noise floor of the forward-difference targets on each segment.
-    pub noise_floor_support: NoiseFloor,
-    pub noise_floor_query: NoiseFloor,
-    pub variants: BTreeMap<String, VariantCell>,
-    /// The headline model fitted with the first seed, one equation per output, terms ordered by
-    /// their share of the prediction's variance on the support segment (largest first).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub headline_equations: Vec<String>,
-}
-
-/// The whole ablation result (`results/ablations/ablations.json`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Ablations {
-    pub name: String,
-    pub description: String,
-    pub protocol: String,
-    pub provenance: AblationProvenance,
-    pub config: VariantsConfig,
-    pub rows: Vec<AblationRow>,
-}
-
-/// Where the ablation numbers come from.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct AblationProvenance {
-    /// The last commit that changed an input of the run (see [`crate::git_commit`]).
-    pub git_commit: String,
-    /// The evaluation flights (relative to the data directory) and their SHA-256.
-    pub data_files: Vec<learn::DataFile>,
-    /// The LeARN configuration the learned-basis variants were meta-trained with (after
-    /// `learn_overrides`), when any learned-basis variant ran.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub learn_config: Option<learn::LearnConfig>,
-}
-
-struct CellData<'a> {
-    formulation: Formulation,
-    condition: &'a Condition,
-    support: Segment,
-    query: Segment,
 }
 
 /// One variant's outcome on one cell and seed, with its traces.
@@ -675,155 +589,6 @@ impl Outcome {
     }
 }
 
-/// Everything `make ablations` writes.
-pub struct AblationsOutcome {
-    pub ablations: Ablations,
-    pub figures: Vec<(String, QualitativeFigure)>,
-}
-
-/// Runs every variant on every cell and seed.
-pub fn run_variants(
-    config: &CheckedVariants,
-    data_dir: &Path,
-    on_progress: &(dyn Fn(&str) + Sync),
-) -> Result<AblationsOutcome> {
-    let run = &config.run;
-    let conditions: Vec<&Condition> = run.conditions.evaluation().collect();
-    let logs = conditions
-        .par_iter()
-        .map(|condition| {
-            let path = run.conditions.flight_path(
-                data_dir,
-                condition,
-                &run.conditions.evaluation_controller,
-            );
-            let file = learn::DataFile {
-                path: path.strip_prefix(data_dir).unwrap_or(&path).to_path_buf(),
-                sha256: data::file_sha256(&path)?,
-            };
-            Ok((FlightLog::read(&path)?, file))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let (logs, data_files): (Vec<FlightLog>, Vec<learn::DataFile>) = logs.into_iter().unzip();
-    let mut cells = Vec::new();
-    for &formulation in &run.raw.formulations {
-        for (condition, log) in conditions.iter().zip(&logs) {
-            let (support, query) =
-                flight_segments(log, formulation, run.raw.split, run.raw.derivative)?;
-            // What depends on the segment's length (folds, bagging blocks), before any fit.
-            let segment = format!(
-                "the {} support segment of {}",
-                formulation.name(),
-                log.path.display()
-            );
-            config
-                .raw
-                .check_rows(&config.path, support.len(), &segment, false)?;
-            cells.push(CellData {
-                formulation,
-                condition,
-                support,
-                query,
-            });
-        }
-    }
-    let experiment = if config
-        .raw
-        .variants
-        .iter()
-        .any(|v| v.kind.needs_meta_training())
-    {
-        Some(learned_basis_experiment(config, data_dir)?)
-    } else {
-        None
-    };
-    let published = PublishedTables::load(&run.published_path)?;
-    let dt = logs.first().map_or(0.02, |l| l.sample_interval());
-    let mut rows = Vec::with_capacity(cells.len());
-    let mut figures = Vec::new();
-    for cell in &cells {
-        on_progress(&format!(
-            "{} {}",
-            cell.formulation.name(),
-            cell.condition.label()
-        ));
-        let per_seed = config
-            .raw
-            .seeds
-            .par_iter()
-            .map(|&seed| evaluate_all(config, experiment.as_ref(), cell, seed))
-            .collect::<Result<Vec<_>>>()?;
-        let sindy =
-            crate::sindy_column::fit_and_evaluate(&run.raw.sindy, &cell.support, &cell.query)?;
-        let pair = published
-            .get(cell.formulation.name(), cell.condition.label())
-            .copied();
-        let mut variants = BTreeMap::new();
-        for (index, spec) in config.raw.variants.iter().enumerate() {
-            let seeds: Vec<SeedCell> = config
-                .raw
-                .seeds
-                .iter()
-                .zip(&per_seed)
-                .map(|(&seed, outcomes)| SeedCell {
-                    seed,
-                    adapt: outcomes[index].predictions.support_mse,
-                    r#gen: outcomes[index].predictions.query_mse,
-                    support_cv: outcomes[index].support_cv,
-                    chosen: outcomes[index].chosen.clone(),
-                    query_band_coverage: outcomes[index]
-                        .predictions
-                        .query_band
-                        .as_ref()
-                        .map(|band| coverage(band, &cell.query.targets)),
-                })
-                .collect();
-            variants.insert(spec.name.clone(), summarise(seeds));
-        }
-        let equations_index = config
-            .raw
-            .equations_variant(&config.raw.headline)
-            .and_then(|name| config.raw.variants.iter().position(|v| v.name == name));
-        if let Some(name) = &config.raw.figure_variant {
-            let index = config.raw.variants.iter().position(|v| &v.name == name);
-            if let Some(index) = index {
-                figures.push(figure(cell, name, &per_seed[0][index].predictions)?);
-            }
-        }
-        rows.push(AblationRow {
-            table: cell.formulation.name().to_string(),
-            condition: cell.condition.label().to_string(),
-            target: pair.map(|p| p.sindy.generalisation.min(p.learn.generalisation)),
-            published: pair,
-            sindy: report::Mse {
-                adaptation: sindy.support_mse,
-                generalisation: sindy.query_mse,
-            },
-            noise_floor_support: forward_difference_noise_floor(&cell.support, dt)?,
-            noise_floor_query: forward_difference_noise_floor(&cell.query, dt)?,
-            variants,
-            headline_equations: equations_index
-                .map(|index| equations(&per_seed[0][index].regression, cell.formulation))
-                .unwrap_or_default(),
-        });
-    }
-    Ok(AblationsOutcome {
-        ablations: Ablations {
-            name: config.raw.name.clone(),
-            description: config.raw.description.clone(),
-            provenance: AblationProvenance {
-                git_commit: crate::git_commit(&config.root),
-                data_files,
-                learn_config: experiment.as_ref().map(|e| e.config().get().clone()),
-            },
-            protocol: "support = first half, query = second half, forward-difference targets on each segment; every choice by blocked cross-validation inside the support segment".to_string(),
-            config: config.raw.clone(),
-            rows,
-        },
-        figures,
-    })
-}
-
 /// The run's LeARN configuration with the variants file's `learn_overrides`, checked; errors name
 /// the variants file and `learn_overrides`.
 fn learned_basis_config(config: &CheckedVariants) -> Result<learn::CheckedConfig> {
@@ -851,7 +616,10 @@ fn learned_basis_config(config: &CheckedVariants) -> Result<learn::CheckedConfig
     })
 }
 
-fn learned_basis_experiment(config: &CheckedVariants, data_dir: &Path) -> Result<Experiment> {
+pub(crate) fn learned_basis_experiment(
+    config: &CheckedVariants,
+    data_dir: &Path,
+) -> Result<Experiment> {
     let run = &config.run;
     Ok(Experiment::load(
         learned_basis_config(config)?,
@@ -859,26 +627,6 @@ fn learned_basis_experiment(config: &CheckedVariants, data_dir: &Path) -> Result
         data_dir,
         run.protocol,
     )?)
-}
-
-/// Every variant of the configuration on one cell with one seed, in declaration order.
-fn evaluate_all(
-    config: &CheckedVariants,
-    experiment: Option<&Experiment>,
-    cell: &CellData,
-    seed: u64,
-) -> Result<Vec<Outcome>> {
-    let meta_train = |seed: u64| -> Result<MetaTrainedModel> {
-        let experiment = experiment.expect("loaded when a variant needs the LeARN networks");
-        Ok(experiment.meta_train(cell.formulation, &cell.condition.name, seed)?)
-    };
-    evaluate_variants(
-        &config.raw.variants,
-        meta_train,
-        &cell.support,
-        &cell.query,
-        seed,
-    )
 }
 
 /// Every variant of `variants` on one support/query pair with one seed, in declaration order.
@@ -1063,352 +811,6 @@ fn outcome_of(
         chosen,
         support_cv: Some(support_cv),
     }
-}
-
-/// `ẋ_i = b + Σ c·feature` per output: the terms with a non-zero coefficient, ordered by the size
-/// of their standardised coefficient (their share of the prediction's spread on the support
-/// segment), coefficients in the units of the raw features.
-fn equations(
-    regression: &Option<(Vec<String>, RegressionFit)>,
-    formulation: Formulation,
-) -> Vec<String> {
-    let Some((feature_names, fit)) = regression else {
-        return Vec::new();
-    };
-    let fit = &fit.full;
-    let (raw, intercepts) = fit.raw_coefficients();
-    formulation
-        .target_names()
-        .iter()
-        .enumerate()
-        .map(|(j, output)| {
-            let mut terms: Vec<usize> = (0..raw.nrows())
-                .filter(|&i| fit.coefficients[(i, j)] != 0.0)
-                .collect();
-            terms.sort_by(|&a, &b| {
-                fit.coefficients[(b, j)]
-                    .abs()
-                    .total_cmp(&fit.coefficients[(a, j)].abs())
-            });
-            let mut text = format!("{output} = {:.4}", intercepts[j]);
-            for i in terms {
-                let c = raw[(i, j)];
-                let sign = if c < 0.0 { '-' } else { '+' };
-                text.push_str(&format!(" {sign} {:.4} {}", c.abs(), feature_names[i]));
-            }
-            text
-        })
-        .collect()
-}
-
-/// The intercept and the first `terms` terms of an equation written by [`equations`].
-fn shorten(equation: &str, terms: usize) -> String {
-    let words: Vec<&str> = equation.split(' ').collect();
-    // "out = b" then groups of three words: sign, coefficient, feature.
-    let keep = (3 + 3 * terms).min(words.len());
-    let mut text = words[..keep].join(" ");
-    if keep < words.len() {
-        text.push_str(" …");
-    }
-    text
-}
-
-/// The fraction of `targets` inside the band.
-fn coverage(band: &EnsemblePrediction, targets: &Mat<f64>) -> f64 {
-    let (n, m) = targets.shape();
-    let inside = (0..m)
-        .flat_map(|j| (0..n).map(move |i| (i, j)))
-        .filter(|&(i, j)| {
-            band.lower[(i, j)] <= targets[(i, j)] && targets[(i, j)] <= band.upper[(i, j)]
-        })
-        .count();
-    inside as f64 / (n * m) as f64
-}
-
-fn summarise(seeds: Vec<SeedCell>) -> VariantCell {
-    let stats = |values: Vec<f64>| -> (f64, f64) {
-        let n = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / n;
-        let variance = if values.len() > 1 {
-            values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)
-        } else {
-            0.0
-        };
-        (mean, variance.sqrt())
-    };
-    let (adapt, adapt_std) = stats(seeds.iter().map(|s| s.adapt).collect());
-    let (r#gen, gen_std) = stats(seeds.iter().map(|s| s.r#gen).collect());
-    VariantCell {
-        adapt,
-        r#gen,
-        adapt_std,
-        gen_std,
-        seeds,
-    }
-}
-
-fn band_series(support: &EnsemblePrediction, query: &EnsemblePrediction) -> report::Band {
-    report::Band {
-        lower: crate::run::stacked_columns(&support.lower, &query.lower),
-        upper: crate::run::stacked_columns(&support.upper, &query.upper),
-    }
-}
-
-fn figure(
-    cell: &CellData,
-    name: &str,
-    predictions: &SegmentPredictions,
-) -> Result<(String, QualitativeFigure)> {
-    let band = match (&predictions.support_band, &predictions.query_band) {
-        (Some(s), Some(q)) => Some(band_series(s, q)),
-        _ => None,
-    };
-    let method = MethodTrace {
-        method: name.to_string(),
-        prediction: crate::run::stacked_columns(
-            &predictions.support_prediction,
-            &predictions.query_prediction,
-        ),
-        band,
-    };
-    crate::run::cell_figure(
-        cell.formulation,
-        cell.condition,
-        &cell.support,
-        &cell.query,
-        vec![method],
-    )
-}
-
-/// Writes `ablations.json`, `ablations.md` and the figures under `dir`; returns the paths.
-pub fn write_ablations(outcome: &AblationsOutcome, dir: &Path) -> Result<Vec<PathBuf>> {
-    let mut written = Vec::new();
-    let json = dir.join("ablations.json");
-    let text = serde_json::to_string_pretty(&outcome.ablations).expect("plain data serialises");
-    write_text(&json, &format!("{text}\n"))?;
-    written.push(json);
-    let md = dir.join("ablations.md");
-    write_text(&md, &ablations_markdown(&outcome.ablations))?;
-    written.push(md);
-    for (file, figure) in &outcome.figures {
-        let path = dir.join("figures").join(file);
-        figure.save_svg(&path)?;
-        written.push(path);
-    }
-    Ok(written)
-}
-
-/// The ablation tables as Markdown: the headline comparison, then every variant's generalisation
-/// and adaptation MSE (mean ± standard deviation over seeds) per formulation.
-pub fn ablations_markdown(ablations: &Ablations) -> String {
-    let config = &ablations.config;
-    let seeds = config
-        .seeds
-        .iter()
-        .map(u64::to_string)
-        .collect::<Vec<_>>()
-        .join(", ");
-    let mut out = format!(
-        "# Ablations: {}\n\n{}\n\nProtocol: {}. Seeds: {seeds}. MSE = mean over samples and state \
-         dimensions; `±` is the standard deviation over seeds (0 for deterministic variants).\n\n\
-         Noise floor of the forward-difference target on the query segment (`data::forward_difference_noise_floor`): \
-         `lower–upper`, where upper = mean square of forward difference minus a Savitzky–Golay(21, 3) \
-         derivative (counts motion faster than 0.4 s as noise) and lower = twice the negative lag-one \
-         autocovariance of that residual.\n\n",
-        ablations.name, ablations.description, ablations.protocol
-    );
-    out.push_str(&format!(
-        "## Headline: `{}` against min(published SINDy gen, published LeARN gen)\n\n",
-        config.headline
-    ));
-    out.push_str("| table | condition | published SINDy gen | published LeARN gen | target | ours SINDy gen | headline gen | vs target | below target | noise floor (query) | headline / floor upper |\n");
-    out.push_str("|---|---|---|---|---|---|---|---|---|---|---|\n");
-    let mut wins = 0;
-    for row in &ablations.rows {
-        let headline = &row.variants[&config.headline];
-        let (pub_sindy, pub_learn) = row
-            .published
-            .map(|p| {
-                (
-                    format!("{:.3}", p.sindy.generalisation),
-                    format!("{:.3}", p.learn.generalisation),
-                )
-            })
-            .unwrap_or(("–".to_string(), "–".to_string()));
-        let (target, versus, below) = match row.target {
-            Some(target) => {
-                let below = headline.r#gen < target;
-                wins += usize::from(below);
-                (
-                    format!("{target:.3}"),
-                    format!("{:+.1} %", 100.0 * (headline.r#gen / target - 1.0)),
-                    if below { "yes" } else { "**no**" }.to_string(),
-                )
-            }
-            None => ("–".to_string(), "–".to_string(), "–".to_string()),
-        };
-        out.push_str(&format!(
-            "| {} | {} | {pub_sindy} | {pub_learn} | {target} | {:.3} | {:.3} ± {:.3} | {versus} | {below} | {:.3}–{:.3} | {:.2} |\n",
-            row.table,
-            row.condition,
-            row.sindy.generalisation,
-            headline.r#gen,
-            headline.gen_std,
-            row.noise_floor_query.lower,
-            row.noise_floor_query.upper,
-            headline.r#gen / row.noise_floor_query.upper,
-        ));
-    }
-    out.push_str(&format!(
-        "\n`{}` is below the target in {wins} of {} cells.\n\n",
-        config.headline,
-        ablations.rows.iter().filter(|r| r.target.is_some()).count()
-    ));
-    out.push_str(
-        "## Distance above the noise floor: generalisation MSE ÷ the query floor's upper estimate\n\n\
-         1.00 would mean nothing but (upper-estimate) noise is left; the lower estimate shows how \
-         much of that upper estimate may itself be fast, predictable motion.\n\n\
-         | table | condition | floor (lower–upper) | published SINDy | published LeARN | ours SINDy | headline | best variant |\n\
-         |---|---|---|---|---|---|---|---|\n",
-    );
-    for row in &ablations.rows {
-        let floor = row.noise_floor_query.upper;
-        let ratio = |value: f64| format!("{:.2}", value / floor);
-        let (pub_sindy, pub_learn) = row
-            .published
-            .map(|p| (ratio(p.sindy.generalisation), ratio(p.learn.generalisation)))
-            .unwrap_or(("–".to_string(), "–".to_string()));
-        let best = row
-            .variants
-            .values()
-            .map(|v| v.r#gen)
-            .fold(f64::INFINITY, f64::min);
-        out.push_str(&format!(
-            "| {} | {} | {:.3}–{floor:.3} | {pub_sindy} | {pub_learn} | {} | {} | {} |\n",
-            row.table,
-            row.condition,
-            row.noise_floor_query.lower,
-            ratio(row.sindy.generalisation),
-            ratio(row.variants[&config.headline].r#gen),
-            ratio(best),
-        ));
-    }
-    out.push('\n');
-    if let Some(name) = &config.figure_variant {
-        out.push_str(&format!(
-            "## Predictive band of `{name}` (drawn in `figures/`): share of query targets inside it\n\n\
-             Band = ensemble mean ± 2·√(members' variance + the output's support CV MSE); about 0.95 \
-             is expected if the errors were Gaussian and the query behaved like the support.\n\n\
-             | table | condition | coverage (mean over seeds) |\n|---|---|---|\n"
-        ));
-        for row in &ablations.rows {
-            let values: Vec<f64> = row.variants[name]
-                .seeds
-                .iter()
-                .filter_map(|s| s.query_band_coverage)
-                .collect();
-            if !values.is_empty() {
-                let mean = values.iter().sum::<f64>() / values.len() as f64;
-                out.push_str(&format!(
-                    "| {} | {} | {mean:.3} |\n",
-                    row.table, row.condition
-                ));
-            }
-        }
-        out.push('\n');
-    }
-    out.push_str("## Best variant per cell (generalisation MSE, mean over seeds)\n\n");
-    out.push_str("| table | condition | best variant | gen | target | vs target |\n|---|---|---|---|---|---|\n");
-    for row in &ablations.rows {
-        let (name, cell) = row
-            .variants
-            .iter()
-            .min_by(|a, b| a.1.r#gen.total_cmp(&b.1.r#gen))
-            .expect("at least one variant");
-        let versus = row
-            .target
-            .map(|t| format!("{:+.1} %", 100.0 * (cell.r#gen / t - 1.0)))
-            .unwrap_or_else(|| "–".to_string());
-        let target = row
-            .target
-            .map(|t| format!("{t:.3}"))
-            .unwrap_or_else(|| "–".to_string());
-        out.push_str(&format!(
-            "| {} | {} | `{name}` | {:.3} | {target} | {versus} |\n",
-            row.table, row.condition, cell.r#gen
-        ));
-    }
-    out.push_str("\n(Picking the best variant per cell by its query error is itself a choice made on the query segment: this table is descriptive. The headline column above is declared in `experiments/variants.json`; its description says when it was chosen.)\n\n");
-    for metric in ["gen", "adapt"] {
-        out.push_str(&format!(
-            "## Every variant, {metric} MSE (mean ± std over seeds)\n\n"
-        ));
-        let names: Vec<&str> = config.variants.iter().map(|v| v.name.as_str()).collect();
-        out.push_str("| table | condition | ours SINDy |");
-        for name in &names {
-            out.push_str(&format!(" `{name}` |"));
-        }
-        out.push_str("\n|---|---|---|");
-        out.push_str(&"---|".repeat(names.len()));
-        out.push('\n');
-        for row in &ablations.rows {
-            let sindy = if metric == "gen" {
-                row.sindy.generalisation
-            } else {
-                row.sindy.adaptation
-            };
-            out.push_str(&format!(
-                "| {} | {} | {sindy:.3} |",
-                row.table, row.condition
-            ));
-            for name in &names {
-                let cell = &row.variants[*name];
-                let (mean, std) = if metric == "gen" {
-                    (cell.r#gen, cell.gen_std)
-                } else {
-                    (cell.adapt, cell.adapt_std)
-                };
-                out.push_str(&format!(" {mean:.3} ± {std:.3} |"));
-            }
-            out.push('\n');
-        }
-        out.push('\n');
-    }
-    if ablations
-        .rows
-        .iter()
-        .any(|r| !r.headline_equations.is_empty())
-    {
-        let name = config
-            .equations_variant(&config.headline)
-            .unwrap_or(&config.headline);
-        let role = if name == config.headline {
-            String::new()
-        } else {
-            format!(
-                " (the regression member of the headline `{}`)",
-                config.headline
-            )
-        };
-        out.push_str(&format!(
-            "## `{name}` equations{role} (seed {}), the five largest terms\n\n\
-             Terms ordered by standardised coefficient; every term is in `ablations.json`.\n\n",
-            config.seeds.first().copied().unwrap_or_default()
-        ));
-        for row in &ablations.rows {
-            out.push_str(&format!("- {} {}:\n", row.table, row.condition));
-            for equation in &row.headline_equations {
-                let shown = shorten(equation, 5);
-                out.push_str(&format!("  - `{shown}`\n"));
-            }
-        }
-        out.push('\n');
-    }
-    out.push_str("## Variants\n\n");
-    for variant in &config.variants {
-        out.push_str(&format!("- `{}`: {}\n", variant.name, variant.description));
-    }
-    out
 }
 
 #[cfg(test)]

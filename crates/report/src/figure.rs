@@ -8,6 +8,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+use serde::{Deserialize, Serialize};
 
 use crate::error::{ReportError, Result, write_text};
 
@@ -26,7 +27,7 @@ const METHOD_GAP: u32 = 18;
 const FONT: &str = "sans-serif";
 
 /// What one panel shows on its vertical axis.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct OutputAxis {
     /// The derivative's symbol, e.g. `v̇x`.
     pub symbol: String,
@@ -59,7 +60,7 @@ impl OutputAxis {
 }
 
 /// One method's prediction over the whole flight, one vector per output.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MethodTrace {
     /// The name shown above its panels, e.g. `SINDy`.
     pub method: String,
@@ -71,14 +72,14 @@ pub struct MethodTrace {
 }
 
 /// A band around a prediction, `lower[output][sample]` ≤ `upper[output][sample]`.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Band {
     pub lower: Vec<Vec<f64>>,
     pub upper: Vec<Vec<f64>>,
 }
 
 /// Everything one figure shows.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct QualitativeFigure {
     /// The formulation, e.g. `full`.
     pub table: String,

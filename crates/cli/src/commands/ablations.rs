@@ -1,11 +1,14 @@
-//! `learn ablations`: every variant of `experiments/variants.json` on every cell, over its seeds.
+//! `learn ablations`: every variant of `experiments/variants.json` on every cell, over its seeds;
+//! with `--shard K/N`, one shard of that work (merged by `learn merge`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
-use outputs::{Existing, OutputSet};
-use pipeline::VariantsConfig;
+use outputs::{Existing, FolderId, OutputSet, Staged};
+use pipeline::{AblationsOutcome, ShardSpec, VariantsConfig};
 
 use super::Global;
+use super::shard::{SHARD_HELP, ShardOutputs, parse_shard};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -30,47 +33,97 @@ pub struct Args {
     /// and --root do not apply).
     #[arg(long)]
     pub render_only: bool,
+    #[arg(long, value_name = "K/N", value_parser = parse_shard, allow_hyphen_values = true, help = SHARD_HELP,
+          requires = "out", conflicts_with = "render_only")]
+    pub shard: Option<ShardSpec>,
 }
 
 /// What the output manifest records as the writer of these files.
-const PRODUCER: &str = "ablations";
+pub const PRODUCER: &str = "ablations";
+/// The writer of a shard's result (never removes, nor is removed by, the run's own files).
+const SHARD_PRODUCER: &str = "ablations-shard";
 
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     if args.render_only {
         return render_only(&args);
     }
-    let start = std::time::Instant::now();
+    let start = Instant::now();
     let config = VariantsConfig::load(&args.config, &args.root)?;
+    let inputs = config.input_files("--config");
+    if let Some(shard) = args.shard {
+        return run_shard(global, &args, &config, &inputs, shard);
+    }
+    let (set, folder) = plan_outputs(&inputs, &args.out, args.force)?;
+    let data_dir = global.data_dir()?;
+    let staged = set.prepare()?;
+    let outcome = pipeline::run_variants(&config, &data_dir, &progress(global, start))?;
+    write_outcome(&outcome, staged, folder, &args.out, start)
+}
+
+/// `--shard K/N`: the shard's items only, into `--out/shard.json`.
+fn run_shard(
+    global: &Global,
+    args: &Args,
+    config: &pipeline::CheckedVariants,
+    inputs: &[(String, PathBuf)],
+    shard: ShardSpec,
+) -> anyhow::Result<()> {
+    let outputs = ShardOutputs::plan(SHARD_PRODUCER, &args.out, args.force, inputs)?;
+    let data_dir = global.data_dir()?;
+    let staged = outputs.prepare()?;
+    let start = Instant::now();
+    let file = pipeline::run_variants_shard(config, &data_dir, &progress(global, start), shard)?;
+    staged.commit(&file)
+}
+
+/// A line per finished item, only on a terminal and without --quiet (a log gets the summary).
+fn progress(global: &Global, start: Instant) -> impl Fn(&str) + Sync {
+    let show_progress = global.show_progress();
+    move |item: &str| {
+        if show_progress {
+            note!("{:>7.1} s  {item}", start.elapsed().as_secs_f64());
+        }
+    }
+}
+
+/// The ablations' output set, checked: `ablations.{json,md}` and `figures/` in `out`; `inputs`
+/// (what, path) may be none of them.
+pub fn plan_outputs(
+    inputs: &[(String, PathBuf)],
+    out: &Path,
+    force: bool,
+) -> anyhow::Result<(OutputSet, FolderId)> {
     let mut set = OutputSet::new(PRODUCER);
-    for (what, path) in config.input_files("--config") {
+    for (what, path) in inputs {
         set.input(format!("the {what} input"), path);
     }
-    let folder = set.folder(&args.out, "--out", Existing::from_force(args.force));
+    let folder = set.folder(out, "--out", Existing::from_force(force));
     for file in pipeline::ablation_files() {
         set.file_in(folder, file);
     }
     // The figures' names depend on the cells: checked when the set is committed.
     set.subfolder_in(folder, "figures");
     set.check()?;
-    let data_dir = global.data_dir()?;
-    let staged = set.prepare()?;
-    // Per-cell lines only on a terminal and without --quiet (a log gets the final summary).
-    let show_progress = global.show_progress();
-    let progress = |cell: &str| {
-        if show_progress {
-            note!("{:>7.1} s  {cell}", start.elapsed().as_secs_f64());
-        }
-    };
-    let outcome = pipeline::run_variants(&config, &data_dir, &progress)?;
+    Ok((set, folder))
+}
+
+/// Writes `outcome` into the staged folder, commits it and prints the tables.
+pub fn write_outcome(
+    outcome: &AblationsOutcome,
+    staged: Staged,
+    folder: FolderId,
+    out: &Path,
+    start: Instant,
+) -> anyhow::Result<()> {
     super::staged_write(&staged, || {
-        pipeline::write_ablations(&outcome, staged.dir(folder))
+        pipeline::write_ablations(outcome, staged.dir(folder))
     })?;
     let written = staged.commit()?;
     note!(
         "{:>7.1} s  total; wrote {} files under {}",
         start.elapsed().as_secs_f64(),
         written.len(),
-        args.out.display()
+        out.display()
     );
     say!("{}", pipeline::ablations_markdown(&outcome.ablations));
     Ok(())

@@ -1,5 +1,6 @@
 //! `learn meta-train`: meta-train LeARN, adapt online on each evaluation flight, print and save the
-//! LeARN columns (and, with `--seed-spread`, the seed-to-seed spread of every cell).
+//! LeARN columns (and, with `--seed-spread`, the seed-to-seed spread of every cell: see
+//! `seed_spread.rs`).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -8,15 +9,17 @@ use anyhow::Context;
 use data::{ExperimentConditions, Formulation};
 use indicatif::{ProgressBar, ProgressStyle};
 use learn::{CellSummary, Experiment, LearnConfig, Protocol, evaluation_condition_of};
+use pipeline::ShardSpec;
 use report::{Method, PublishedTables};
 use serde_json::{Value, json};
 
 use outputs::{Existing, FileId, FolderId, OutputSet};
 
 use super::Global;
+use super::shard::{SHARD_HELP, parse_shard};
 
-/// What the output manifests record as the writer of the checkpoints.
-const PRODUCER: &str = "meta-train";
+/// What the output manifests record as the writer of the checkpoints and the spread.
+pub const PRODUCER: &str = "meta-train";
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -44,7 +47,7 @@ pub struct Args {
     pub seed: Option<u64>,
     /// Summary JSON of the run [default: results/.scratch/learn/learn.json, the tool's scratch,
     /// replaced on every run]; with --tasks, the model (required). A file given here is not
-    /// replaced without --force.
+    /// replaced without --force. With --seed-spread --shard K/N: the folder of the shard's result.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Directory of the JSON checkpoints, one per formulation and fold [default:
@@ -61,7 +64,7 @@ pub struct Args {
     /// `--spread-out` only: no summary (`--out`), no checkpoints (`--checkpoints`), no
     /// comparison with the published numbers (`--published`), and the seeds are the
     /// configuration's `spread_seeds` (not `--seed`).
-    #[arg(long, conflicts_with_all = ["condition", "out", "checkpoints", "published", "seed"])]
+    #[arg(long, conflicts_with_all = ["condition", "checkpoints", "published", "seed"])]
     pub seed_spread: bool,
     /// Where `--seed-spread` writes its result (only with `--seed-spread`).
     #[arg(
@@ -75,6 +78,30 @@ pub struct Args {
     /// with --force.
     #[arg(long)]
     pub force: bool,
+    /// With --seed-spread: run only shard K of N of its work items (K from 0), written to --out
+    /// DIR as shard.json; `learn merge` puts the shards together. See docs/cluster.md.
+    #[arg(long, value_name = "K/N", value_parser = parse_shard, allow_hyphen_values = true, long_help = SHARD_HELP,
+          requires = "seed_spread", requires = "out", conflicts_with = "spread_out")]
+    pub shard: Option<ShardSpec>,
+}
+
+impl Args {
+    /// `--config`, or [`DEFAULT_CONFIG`] for the flights when not given.
+    pub fn config_path(&self) -> PathBuf {
+        self.config
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(DEFAULT_CONFIG))
+    }
+
+    /// `--out` with `--seed-spread` names the shard's folder, so it needs `--shard`; the message
+    /// when it is given without (clap cannot say "conflicts unless").
+    pub fn out_without_shard(&self) -> Option<String> {
+        (self.seed_spread && self.out.is_some() && self.shard.is_none()).then(|| {
+            "the argument '--seed-spread' cannot be used with '--out <OUT>' (the spread goes to \
+             --spread-out; --out names a shard's folder, with --shard K/N)"
+                .to_string()
+        })
+    }
 }
 
 /// A seed: a whole number from 0 to `u64::MAX`, said so when it is not.
@@ -107,7 +134,7 @@ fn published_tables(path: Option<&Path>) -> anyhow::Result<Option<PublishedTable
     Ok(Some(PublishedTables::load(path)?))
 }
 
-fn formulations(names: &[String]) -> anyhow::Result<Vec<Formulation>> {
+pub fn formulations(names: &[String]) -> anyhow::Result<Vec<Formulation>> {
     if names.is_empty() {
         return Ok(Formulation::ALL.to_vec());
     }
@@ -123,7 +150,7 @@ fn formulations(names: &[String]) -> anyhow::Result<Vec<Formulation>> {
 }
 
 /// Writes `value` as JSON to `staging`, the staging path of `path` (named in errors).
-fn write_json(staging: &Path, path: &Path, value: &Value) -> anyhow::Result<()> {
+pub fn write_json(staging: &Path, path: &Path, value: &Value) -> anyhow::Result<()> {
     std::fs::write(staging, serde_json::to_string_pretty(value)? + "\n")
         .with_context(|| path.display().to_string())
 }
@@ -143,7 +170,7 @@ fn published(
 
 /// A bar over `cells` cells on standard error, drawn only when `show` (a terminal, not --quiet), in
 /// the style of `learn reproduce`.
-pub(crate) fn progress_bar(show: bool, cells: usize, message: &str) -> ProgressBar {
+pub fn progress_bar(show: bool, cells: usize, message: &str) -> ProgressBar {
     if !show {
         return ProgressBar::hidden();
     }
@@ -225,18 +252,14 @@ fn checkpoint_dir(args: &Args) -> PathBuf {
         .unwrap_or_else(|| PathBuf::from(DEFAULT_CHECKPOINTS))
 }
 
-/// The run's output set: the summary (`--out`) and the checkpoints' folder, or with
-/// `--seed-spread` the spread file; the inputs, which no output may be.
-fn output_set(args: &Args, inputs: &[(&str, &Path)]) -> anyhow::Result<(OutputSet, Outputs)> {
+/// The run's output set: the summary (`--out`) and the checkpoints' folder; the inputs, which no
+/// output may be.
+fn output_set(args: &Args, inputs: &[(String, PathBuf)]) -> anyhow::Result<(OutputSet, Outputs)> {
     let mut set = OutputSet::new(PRODUCER);
-    for (option, path) in inputs {
-        set.input(format!("the {option} input"), path);
+    for (what, path) in inputs {
+        set.input(format!("the {what} input"), path);
     }
     let force = Existing::from_force(args.force);
-    if args.seed_spread {
-        let spread = set.file(&args.spread_out, "--spread-out", force);
-        return Ok((set, Outputs::Spread(spread)));
-    }
     // The defaults are the tool's scratch, replaced on every run.
     let out = match &args.out {
         Some(out) => set.file(out, "--out", force),
@@ -256,14 +279,14 @@ fn output_set(args: &Args, inputs: &[(&str, &Path)]) -> anyhow::Result<(OutputSe
             out_path.display()
         );
     }
-    Ok((set, Outputs::Run { out, checkpoints }))
+    Ok((set, Outputs { out, checkpoints }))
 }
 
 /// Where the run writes, in its output set.
 #[derive(Clone, Copy)]
-enum Outputs {
-    Spread(FileId),
-    Run { out: FileId, checkpoints: FolderId },
+struct Outputs {
+    out: FileId,
+    checkpoints: FolderId,
 }
 
 /// `--config` for the flights when not given.
@@ -274,19 +297,21 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         return super::meta_train_tasks::run(global, &args);
     }
     args.tasks.refuse_without_tasks()?;
-    let config_path = args
-        .config
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(DEFAULT_CONFIG));
+    let config_path = args.config_path();
     let published_path = args
         .published
         .clone()
         .unwrap_or_else(|| PathBuf::from(DEFAULT_PUBLISHED));
-    let inputs: [(&str, &Path); 3] = [
+    let inputs: Vec<(String, PathBuf)> = [
         ("--config", &config_path),
         ("--conditions", &args.conditions),
         ("--published", &published_path),
-    ];
+    ]
+    .map(|(what, path)| (what.to_string(), path.clone()))
+    .into();
+    if args.seed_spread {
+        return super::seed_spread::run(global, &args, &inputs);
+    }
     let out = args
         .out
         .clone()
@@ -298,12 +323,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     if let Some(seed) = args.seed {
         config = config.with_seed(seed);
     }
-    // The spread is not compared with the paper: no published file is read for it.
-    let table = if args.seed_spread {
-        None
-    } else {
-        published_tables(args.published.as_deref())?
-    };
+    let table = published_tables(args.published.as_deref())?;
     let conditions = ExperimentConditions::load(&args.conditions)?;
     let data_dir = global.data_dir()?;
     let protocol = Protocol::parse(&args.protocol)?;
@@ -319,19 +339,17 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     };
     let protocol = Protocol::resolve(protocol, &conditions, &data_dir);
 
-    if let Outputs::Run { checkpoints, .. } = outputs {
-        let seed = config.get().seed;
-        for &formulation in &formulations {
-            for condition in &evaluated {
-                let name = checkpoint_path(Path::new(""), protocol, formulation, condition, seed);
-                let path = set.file_in(checkpoints, name);
-                if super::same_file(&path, &out) {
-                    anyhow::bail!(
-                        "{}: is both --out and a checkpoint of this run ({}), refusing to write the summary over it",
-                        out.display(),
-                        path.display()
-                    );
-                }
+    let seed = config.get().seed;
+    for &formulation in &formulations {
+        for condition in &evaluated {
+            let name = checkpoint_path(Path::new(""), protocol, formulation, condition, seed);
+            let path = set.file_in(outputs.checkpoints, name);
+            if super::same_file(&path, &out) {
+                anyhow::bail!(
+                    "{}: is both --out and a checkpoint of this run ({}), refusing to write the summary over it",
+                    out.display(),
+                    path.display()
+                );
             }
         }
     }
@@ -340,64 +358,6 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let experiment = Experiment::load(config.clone(), conditions, &data_dir, Some(protocol))?;
     say!("protocol: {}", protocol.name());
 
-    if args.seed_spread {
-        let seeds = config.get().spread_seeds.clone();
-        let started = Instant::now();
-        let cells = formulations.len() * experiment.evaluation_conditions().len() * seeds.len();
-        let bar = progress_bar(global.show_progress(), cells, "seed spread");
-        let spread = experiment.seed_spread_observed(&formulations, &seeds, &|_| bar.inc(1));
-        bar.finish_and_clear();
-        let spread = spread?;
-        say!(
-            "seed spread over seeds {seeds:?} ({:.1} s)",
-            started.elapsed().as_secs_f64()
-        );
-        say!(
-            "{:<14} {:<10} {:>9} {:>9} {:>9} {:>9} {:>9}",
-            "formulation",
-            "condition",
-            "gen mean",
-            "gen std",
-            "gen min",
-            "gen max",
-            "adapt std"
-        );
-        for cell in &spread {
-            say!(
-                "{:<14} {:<10} {:>9.4} {:>9.4} {:>9.4} {:>9.4} {:>9.4}",
-                cell.formulation.name(),
-                cell.label,
-                cell.gen_mse.mean,
-                cell.gen_mse.std,
-                cell.gen_mse.min,
-                cell.gen_mse.max,
-                cell.adapt_mse.std
-            );
-        }
-        let Outputs::Spread(spread_file) = outputs else {
-            anyhow::bail!("--seed-spread without its output (a bug)");
-        };
-        write_json(
-            staged.path(spread_file),
-            &args.spread_out,
-            &json!({
-                "what": "seed-to-seed spread of the LeARN adaptation and generalisation MSE per table cell",
-                "how": format!(
-                    "learn meta-train --seed-spread --config {} (every cell meta-trained and adapted once per seed; std is the sample standard deviation over seeds)",
-                    config_path.display()
-                ),
-                "protocol": protocol.name(),
-                "config": config.get(),
-                "seeds": seeds,
-                "cells": spread,
-            }),
-        )?;
-        staged.commit()?;
-        say!("wrote {}", args.spread_out.display());
-        return Ok(());
-    }
-
-    let seed = config.get().seed;
     let started = Instant::now();
     let bar = progress_bar(
         global.show_progress(),
@@ -422,13 +382,10 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         "meta-training and adaptation of {} cells: {elapsed:.1} s",
         cells.len()
     );
-    let Outputs::Run {
+    let Outputs {
         out: out_file,
         checkpoints: checkpoint_folder,
-    } = outputs
-    else {
-        anyhow::bail!("a run without its outputs (a bug)");
-    };
+    } = outputs;
     let mut checkpoints = Vec::new();
     for cell in &cells {
         let at = |dir: &Path| {

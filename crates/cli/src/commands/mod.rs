@@ -6,11 +6,14 @@ mod conditions;
 mod evaluate;
 mod explain;
 mod inspect;
+mod merge;
 mod meta_train;
 mod meta_train_tasks;
 mod mismatch;
 mod own_data_example;
 mod reproduce;
+mod seed_spread;
+mod shard;
 mod simulate;
 mod sindy;
 
@@ -67,6 +70,8 @@ pub enum Command {
     /// The worked example of LeARN on your own data: a simulated family of oscillators, its
     /// learning curve against SINDy and ridge.
     OwnDataExample(own_data_example::Args),
+    /// Put the shards of a sharded run (`--shard K/N`) together: the unsharded run's files.
+    Merge(merge::Args),
 }
 
 #[derive(Subcommand, Debug)]
@@ -96,6 +101,21 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Mismatch(args) => mismatch::run(&global, args),
         Command::Ablations(args) => ablations::run(&global, args),
         Command::OwnDataExample(args) => own_data_example::run(&global, args),
+        Command::Merge(args) => merge::run(&global, args),
+    }
+}
+
+impl Cli {
+    /// Combinations of options that clap cannot express, refused as usage errors (exit code 2)
+    /// as clap's own are.
+    pub fn validated(self) -> Result<Self, clap::Error> {
+        if let Command::MetaTrain(args) = &self.command
+            && let Some(message) = args.out_without_shard()
+        {
+            let mut command = <Self as clap::CommandFactory>::command();
+            return Err(command.error(clap::error::ErrorKind::ArgumentConflict, message));
+        }
+        Ok(self)
     }
 }
 

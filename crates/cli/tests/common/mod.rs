@@ -3,8 +3,15 @@
 
 #![allow(dead_code)]
 
-use std::path::Path;
+pub mod sweep;
+
+use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// The workspace root.
+pub fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
 
 /// What one run of `learn` gave.
 pub struct Run {

@@ -1,0 +1,350 @@
+//! `make ablations`: every variant of `experiments/variants.json` on every formulation ×
+//! evaluation condition, over the configuration's seeds (see [`crate::VariantsConfig`] for the
+//! variants and the protocol).
+//!
+//! The work is a sweep of (formulation, condition, seed) items ([`learn::WorkItem`]), each
+//! evaluating every variant on its cell with its seed ([`AblationSeedOutcome`]); the first seed's
+//! item also carries the cell's SINDy, noise floors, headline equations and figure. The
+//! unsharded run, each shard and `learn merge` render the same results through the same code.
+
+mod work;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use data::{Formulation, NoiseFloor};
+use learn::{Cells, WorkItem};
+use report::QualitativeFigure;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{PipelineError, Result, write_text};
+use crate::shard::{MergedSweep, ShardFile, ShardProvenance, ShardSpec};
+use crate::summary::StageTiming;
+use crate::tables::ConditionName;
+use crate::variants::{CheckedVariants, VariantsConfig};
+
+use work::AblationsWork;
+
+/// Mean and spread of one variant on one cell over the seeds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VariantCell {
+    pub adapt: f64,
+    pub r#gen: f64,
+    /// Sample standard deviation over seeds (0 for one seed).
+    pub adapt_std: f64,
+    pub gen_std: f64,
+    pub seeds: Vec<SeedCell>,
+}
+
+/// One seed of one variant on one cell.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SeedCell {
+    pub seed: u64,
+    pub adapt: f64,
+    pub r#gen: f64,
+    /// Mean over outputs of the best support cross-validation MSE (variants that fit a
+    /// regression).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub support_cv: Option<f64>,
+    /// What was chosen inside the support segment: per output the penalty, and for `select` the
+    /// candidate.
+    pub chosen: BTreeMap<String, serde_json::Value>,
+    /// For bagged variants: the fraction of query targets inside the predictive band.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub query_band_coverage: Option<f64>,
+}
+
+/// One row of the ablation table: one formulation on one condition.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AblationRow {
+    pub table: String,
+    pub condition: String,
+    /// The paper's numbers, when it has them, and the target min(SINDy gen, LeARN gen).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub published: Option<report::MethodPair>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub target: Option<f64>,
+    /// Our SINDy with the paper's settings (the run configuration's).
+    pub sindy: report::Mse,
+    /// Noise floor of the forward-difference targets on each segment.
+    pub noise_floor_support: NoiseFloor,
+    pub noise_floor_query: NoiseFloor,
+    pub variants: BTreeMap<String, VariantCell>,
+    /// The headline model fitted with the first seed, one equation per output, terms ordered by
+    /// their share of the prediction's variance on the support segment (largest first).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub headline_equations: Vec<String>,
+}
+
+/// The whole ablation result (`results/ablations/ablations.json`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Ablations {
+    pub name: String,
+    pub description: String,
+    pub protocol: String,
+    pub provenance: AblationProvenance,
+    pub config: VariantsConfig,
+    pub rows: Vec<AblationRow>,
+}
+
+/// Where the ablation numbers come from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AblationProvenance {
+    /// The last commit that changed an input of the run (see [`crate::git_commit`]).
+    pub git_commit: String,
+    /// The evaluation flights (relative to the data directory) and their SHA-256.
+    pub data_files: Vec<learn::DataFile>,
+    /// The LeARN configuration the learned-basis variants were meta-trained with (after
+    /// `learn_overrides`), when any learned-basis variant ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub learn_config: Option<learn::LearnConfig>,
+}
+
+/// Everything `make ablations` writes.
+pub struct AblationsOutcome {
+    pub ablations: Ablations,
+    pub figures: Vec<(String, QualitativeFigure)>,
+}
+
+/// What rendering the ablations takes from the configuration: the same for every shard.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AblationsContext {
+    pub config: VariantsConfig,
+    /// The cells (formulation × evaluation condition), in row order.
+    pub cells: Vec<AblationCell>,
+    /// The evaluation flights (relative to the data directory), in row order of the conditions.
+    pub evaluation_files: Vec<learn::DataFile>,
+    /// See [`AblationProvenance::learn_config`].
+    pub learn_config: Option<learn::LearnConfig>,
+    /// The SHA-256 of every file the ablations read besides the flights.
+    pub input_sha256: Vec<String>,
+}
+
+/// One row of the ablation tables, as configured.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AblationCell {
+    pub formulation: Formulation,
+    pub condition: ConditionName,
+    /// The paper's numbers for the cell, when it has them.
+    pub published: Option<report::MethodPair>,
+}
+
+/// Every variant on one cell with one seed: a work item's result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AblationSeedOutcome {
+    /// One per variant, in declaration order.
+    pub variants: Vec<SeedCell>,
+    /// With the first seed only: the cell's parts that do not vary with the seed, and those the
+    /// tables take from the first seed.
+    pub first_seed: Option<AblationCellDetail>,
+}
+
+/// See [`AblationSeedOutcome::first_seed`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AblationCellDetail {
+    /// Our SINDy with the run configuration's settings.
+    pub sindy: report::Mse,
+    pub noise_floor_support: NoiseFloor,
+    pub noise_floor_query: NoiseFloor,
+    /// See [`AblationRow::headline_equations`].
+    pub headline_equations: Vec<String>,
+    /// The figure of the configuration's `figure_variant`, if any: file name and contents.
+    pub figure: Option<(String, QualitativeFigure)>,
+}
+
+/// A shard of the ablations: each (cell, seed) item's variants.
+pub type AblationsShard = ShardFile<AblationsContext, AblationSeedOutcome>;
+
+/// Runs every variant on every cell and seed; `on_progress` is told each item as it ends.
+pub fn run_variants(
+    config: &CheckedVariants,
+    data_dir: &Path,
+    on_progress: &(dyn Fn(&str) + Sync),
+) -> Result<AblationsOutcome> {
+    let work = AblationsWork::plan(config, data_dir)?;
+    let results = work.run_items(ShardSpec::WHOLE, on_progress)?;
+    let results: Vec<AblationSeedOutcome> = results.into_iter().map(|r| r.result).collect();
+    render_ablations(
+        &work.sweep.context,
+        &work.sweep.items,
+        &results,
+        crate::git_commit(&config.root),
+    )
+}
+
+/// Runs shard `shard` of the ablations (see [`run_variants`]).
+pub fn run_variants_shard(
+    config: &CheckedVariants,
+    data_dir: &Path,
+    on_progress: &(dyn Fn(&str) + Sync),
+    shard: ShardSpec,
+) -> Result<AblationsShard> {
+    let start = std::time::Instant::now();
+    let work = AblationsWork::plan(config, data_dir)?;
+    let planned = start.elapsed().as_secs_f64();
+    let results = work.run_items(shard, on_progress)?;
+    let stages = vec![
+        StageTiming {
+            stage: "load flights, cut the cells".to_string(),
+            seconds: planned,
+        },
+        StageTiming {
+            stage: "variants".to_string(),
+            seconds: start.elapsed().as_secs_f64() - planned,
+        },
+    ];
+    let provenance = ShardProvenance::here(&config.root, stages);
+    Ok(work.sweep.shard_file(shard, results, provenance))
+}
+
+/// The ablations of merged shards, rendered as [`run_variants`] renders them.
+pub fn merged_ablations(
+    merged: MergedSweep<AblationsContext, AblationSeedOutcome>,
+) -> Result<AblationsOutcome> {
+    render_ablations(
+        &merged.context,
+        &merged.items,
+        &merged.results,
+        merged.git_commit,
+    )
+}
+
+/// The ablations of `context` from every item's outcome (`results[i]` of `items[i]`), at the
+/// commit the work was done at.
+fn render_ablations(
+    context: &AblationsContext,
+    items: &[WorkItem],
+    results: &[AblationSeedOutcome],
+    git_commit: String,
+) -> Result<AblationsOutcome> {
+    let config = &context.config;
+    let by_item: BTreeMap<(Formulation, &Cells, u64), &AblationSeedOutcome> = items
+        .iter()
+        .zip(results)
+        .map(|(item, result)| ((item.formulation, &item.cells, item.seed), result))
+        .collect();
+    let mut rows = Vec::with_capacity(context.cells.len());
+    let mut figures = Vec::new();
+    for cell in &context.cells {
+        let cells = Cells::Condition(cell.condition.name.clone());
+        let per_seed = config
+            .seeds
+            .iter()
+            .map(|&seed| {
+                by_item
+                    .get(&(cell.formulation, &cells, seed))
+                    .copied()
+                    .ok_or_else(|| PipelineError::Mismatch {
+                        what: format!(
+                            "{} {} seed {seed}",
+                            cell.formulation.name(),
+                            cell.condition.label
+                        ),
+                        message: "no ablation result".to_string(),
+                    })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let detail = per_seed[0]
+            .first_seed
+            .as_ref()
+            .ok_or_else(|| PipelineError::Mismatch {
+                what: format!("{} {}", cell.formulation.name(), cell.condition.label),
+                message: "the first seed's result has no cell detail".to_string(),
+            })?;
+        figures.extend(detail.figure.clone());
+        rows.push(ablation_row(context, cell, &per_seed, detail));
+    }
+    Ok(AblationsOutcome {
+        ablations: Ablations {
+            name: config.name.clone(),
+            description: config.description.clone(),
+            provenance: AblationProvenance {
+                git_commit,
+                data_files: context.evaluation_files.clone(),
+                learn_config: context.learn_config.clone(),
+            },
+            protocol: PROTOCOL.to_string(),
+            config: config.clone(),
+            rows,
+        },
+        figures,
+    })
+}
+
+/// The protocol line of `ablations.json`.
+const PROTOCOL: &str = "support = first half, query = second half, forward-difference targets on each segment; every choice by blocked cross-validation inside the support segment";
+
+/// One row: every variant summarised over the seeds (`per_seed`, in the configuration's order).
+fn ablation_row(
+    context: &AblationsContext,
+    cell: &AblationCell,
+    per_seed: &[&AblationSeedOutcome],
+    detail: &AblationCellDetail,
+) -> AblationRow {
+    let variants = context
+        .config
+        .variants
+        .iter()
+        .enumerate()
+        .map(|(index, spec)| {
+            let seeds = per_seed.iter().map(|s| s.variants[index].clone()).collect();
+            (spec.name.clone(), summarise(seeds))
+        })
+        .collect();
+    let pair = cell.published;
+    AblationRow {
+        table: cell.formulation.name().to_string(),
+        condition: cell.condition.label.clone(),
+        target: pair.map(|p| p.sindy.generalisation.min(p.learn.generalisation)),
+        published: pair,
+        sindy: detail.sindy,
+        noise_floor_support: detail.noise_floor_support,
+        noise_floor_query: detail.noise_floor_query,
+        variants,
+        headline_equations: detail.headline_equations.clone(),
+    }
+}
+
+fn summarise(seeds: Vec<SeedCell>) -> VariantCell {
+    let stats = |values: Vec<f64>| -> (f64, f64) {
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let variance = if values.len() > 1 {
+            values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)
+        } else {
+            0.0
+        };
+        (mean, variance.sqrt())
+    };
+    let (adapt, adapt_std) = stats(seeds.iter().map(|s| s.adapt).collect());
+    let (r#gen, gen_std) = stats(seeds.iter().map(|s| s.r#gen).collect());
+    VariantCell {
+        adapt,
+        r#gen,
+        adapt_std,
+        gen_std,
+        seeds,
+    }
+}
+
+/// Writes `ablations.json`, `ablations.md` and the figures under `dir`; returns the paths.
+pub fn write_ablations(outcome: &AblationsOutcome, dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    let json = dir.join("ablations.json");
+    let text = serde_json::to_string_pretty(&outcome.ablations).expect("plain data serialises");
+    write_text(&json, &format!("{text}\n"))?;
+    written.push(json);
+    let md = dir.join("ablations.md");
+    write_text(&md, &crate::ablations_markdown(&outcome.ablations))?;
+    written.push(md);
+    for (file, figure) in &outcome.figures {
+        let path = dir.join("figures").join(file);
+        figure.save_svg(&path)?;
+        written.push(path);
+    }
+    Ok(written)
+}

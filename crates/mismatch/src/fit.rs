@@ -3,7 +3,7 @@
 //! fit rows), with the timing term resolved into a delay, a motor lag or both, and an air velocity
 //! when a drag was kept.
 
-use physics::Effects;
+use physics::{EffectId, Effects};
 use serde::Serialize;
 
 use crate::library::{Candidate, TIMING};
@@ -28,8 +28,8 @@ impl FittedSet {
     }
 
     /// The effect ids present, in order of first appearance.
-    pub fn ids(&self) -> Vec<&'static str> {
-        let mut ids: Vec<&'static str> = Vec::new();
+    pub fn ids(&self) -> Vec<EffectId> {
+        let mut ids: Vec<EffectId> = Vec::new();
         for p in &self.parameters {
             if !ids.contains(&p.effect_id()) {
                 ids.push(p.effect_id());
@@ -39,7 +39,7 @@ impl FittedSet {
     }
 
     /// The set without the parameters of effect `id` (and without the wind when no drag is left).
-    pub fn without(&self, id: &str) -> Self {
+    pub fn without(&self, id: EffectId) -> Self {
         let drag_left = self.parameters.iter().any(|p| {
             matches!(p, Parameter::LinearDrag(_) | Parameter::QuadraticDrag) && p.effect_id() != id
         });
@@ -313,7 +313,7 @@ fn fit_timing(
         set.parameters.push(kind);
         set.values.push(start);
         let sse = set.refit(problem, iterations);
-        scores.insert(kind.effect_id().to_string(), serde_json::json!(sse));
+        scores.insert(kind.effect_id().name().to_string(), serde_json::json!(sse));
         singles.push((set, sse));
     }
     let delay = singles[0].0.values.last().copied().unwrap_or(0.0);

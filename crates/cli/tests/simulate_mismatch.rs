@@ -235,6 +235,45 @@ fn demo_checks_every_scenario_before_running_a_case() {
     assert!(!dir.join("work").exists());
 }
 
+/// Effect ids are checked where a file is read: an unknown one (a typo) in a scenario's or a demo
+/// case's effects is a one-line field error that lists the known ids, before any work. A demo's
+/// `pairs` name cases, not effects: a name that is no case is refused too.
+#[test]
+fn an_unknown_effect_id_is_a_field_error_listing_the_known_ids() {
+    let known = physics::EffectId::ALL.map(physics::EffectId::name);
+    let dir = setup("effect-id-scenario");
+    write_scenario(&dir, "s.json", |s| {
+        s["effects"] = json!({"drag": {"c": 0.05}});
+    });
+    let run = learn_in(
+        &dir,
+        &["simulate", "--scenario", "s.json", "--out", "f.csv"],
+    );
+    let message =
+        run.one_line_error(&[&["s.json: field 'effects.drag ", "`drag`"], &known[..]].concat());
+    assert!(!message.contains("not valid JSON"), "{message}");
+    assert!(!dir.join("f.csv").exists());
+
+    let dir = setup("effect-id-demo");
+    write_manifest(&dir, &["control"]);
+    let mut manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("demo.json")).unwrap()).unwrap();
+    manifest["cases"][0]["effects"] = json!({"lineardrag": {"d": [0.1, 0.1, 0.1]}});
+    std::fs::write(dir.join("demo.json"), manifest.to_string()).unwrap();
+    demo(&dir).one_line_error(
+        &[
+            &["demo.json", "cases[0].effects.lineardrag", "`lineardrag`"],
+            &known[..],
+        ]
+        .concat(),
+    );
+    manifest["cases"][0]["effects"] = json!({});
+    manifest["pairs"] = json!(["control", "wind"]);
+    std::fs::write(dir.join("demo.json"), manifest.to_string()).unwrap();
+    demo(&dir).one_line_error(&["demo.json", "pairs[1]", "\"wind\" is not a case"]);
+    assert!(!dir.join("work").exists() && !dir.join("out").exists());
+}
+
 #[test]
 fn demo_refuses_a_file_as_work_directory_before_running() {
     let dir = setup("demo-work-file");

@@ -2,7 +2,7 @@
 //! on held-out data.
 
 use data::{FlightLog, RateFrame};
-use physics::{Effects, Logger, NominalModel};
+use physics::{EffectId, Effects, Logger, NominalModel};
 use serde::Serialize;
 
 use crate::describe::describe;
@@ -85,7 +85,7 @@ pub struct Window {
 /// One effect found.
 #[derive(Clone, Debug, Serialize)]
 pub struct EffectReport {
-    pub id: String,
+    pub id: EffectId,
     pub parameters: serde_json::Value,
     pub description: String,
     /// This effect's share of the nominal model's noise-normalised residual sum of squares (fit
@@ -425,9 +425,9 @@ fn build_report(
         .iter()
         .zip(shares)
         .map(|(evidence, share)| EffectReport {
-            id: evidence.id.clone(),
-            parameters: parameters[evidence.id.as_str()].clone(),
-            description: describe(&evidence.id, &effects),
+            id: evidence.id,
+            parameters: parameters[evidence.id.name()].clone(),
+            description: describe(evidence.id, &effects),
             explained_fraction: share,
             evidence: evidence.clone(),
         })

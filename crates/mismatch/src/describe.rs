@@ -1,28 +1,11 @@
 //! Plain words for effects, and the effects without one of them.
 
-use physics::Effects;
+use physics::{EffectId, Effects};
 
 /// The effects without one of them (and without the wind when no drag is left for it to act on).
-pub fn remove_effect(effects: &Effects, id: &str) -> Effects {
+pub fn remove_effect(effects: &Effects, id: EffectId) -> Effects {
     let mut e = *effects;
-    match id {
-        "linear_drag" => e.linear_drag = None,
-        "quadratic_drag" => e.quadratic_drag = None,
-        "wind" => e.wind = None,
-        "thrust_scale" => e.thrust_scale = None,
-        "motor_lag" => e.motor_lag = None,
-        "ground_effect" => e.ground_effect = None,
-        "torque_bias" => e.torque_bias = None,
-        "inertia_scale" => e.inertia_scale = None,
-        "delay" => e.delay = None,
-        "thrust_map" => e.thrust_map = None,
-        "thrust_tilt" => e.thrust_tilt = None,
-        "rotor_drag" => e.rotor_drag = None,
-        "translational_lift" => e.translational_lift = None,
-        "drag_lag" => e.drag_lag = None,
-        "wind_gradient" => e.wind_gradient = None,
-        _ => {}
-    }
+    e.remove(id);
     if e.quadratic_drag.is_none() && e.linear_drag.is_none() && e.rotor_drag.is_none() {
         e.wind = None;
     }
@@ -36,10 +19,10 @@ fn vector(v: [f64; 3], digits: usize) -> String {
     format!("[{:.digits$}, {:.digits$}, {:.digits$}]", v[0], v[1], v[2])
 }
 
-/// One sentence per effect, in plain words.
-pub fn describe(id: &str, e: &Effects) -> String {
+/// One sentence for effect `id` of `e`, in plain words.
+pub fn describe(id: EffectId, e: &Effects) -> String {
     match id {
-        "linear_drag" => {
+        EffectId::LinearDrag => {
             let d = e.linear_drag.map(|x| x.d).unwrap_or_default();
             format!(
                 "Rotor drag: a force against the velocity along each body axis, d = {} 1/s (at 2 m/s forward flight about {:.2} m/s² of deceleration).",
@@ -47,14 +30,14 @@ pub fn describe(id: &str, e: &Effects) -> String {
                 2.0 * d[0].max(d[1])
             )
         }
-        "quadratic_drag" => {
+        EffectId::QuadraticDrag => {
             let c = e.quadratic_drag.map(|x| x.c).unwrap_or_default();
             format!(
                 "Aerodynamic drag growing with the square of the airspeed, c = {c:.4} 1/m (at 5 m/s airspeed about {:.2} m/s²).",
                 25.0 * c
             )
         }
-        "wind" => {
+        EffectId::Wind => {
             let w = e.air_velocity();
             format!(
                 "The drag acts on the velocity relative to air moving at {} m/s (speed {:.2} m/s): there is wind.",
@@ -62,18 +45,18 @@ pub fn describe(id: &str, e: &Effects) -> String {
                 physics::vector::norm(w)
             )
         }
-        "thrust_scale" => {
+        EffectId::ThrustScale => {
             let k = e.thrust_scale.map(|x| x.k).unwrap_or(1.0);
             format!(
                 "The rotors produce {k:.3} times the thrust the model assumes ({:+.1}%).",
                 100.0 * (k - 1.0)
             )
         }
-        "motor_lag" => format!(
+        EffectId::MotorLag => format!(
             "Each motor reaches its commanded speed with a first-order lag of time constant {:.1} ms.",
             1000.0 * e.lag_s()
         ),
-        "ground_effect" => {
+        EffectId::GroundEffect => {
             let r = e.ground_effect.map(|x| x.r_m).unwrap_or_default();
             format!(
                 "Extra thrust near the ground (ground effect), radius r = {r:.3} m: +{:.1}% thrust at 0.3 m height, +{:.2}% at 1.5 m.",
@@ -81,19 +64,19 @@ pub fn describe(id: &str, e: &Effects) -> String {
                 100.0 * (1.0 / (1.0 - physics::ground_ratio(r, 1.5)) - 1.0)
             )
         }
-        "torque_bias" => format!(
+        EffectId::TorqueBias => format!(
             "A constant extra angular acceleration {} rad/s² (a torque offset, e.g. an off-centre mass or a tilted motor).",
             vector(e.torque_bias.map(|x| x.b).unwrap_or_default(), 3)
         ),
-        "inertia_scale" => format!(
+        EffectId::InertiaScale => format!(
             "The moments of inertia are {} times the model's.",
             vector(e.inertia_scale.map(|x| x.k).unwrap_or([1.0; 3]), 3)
         ),
-        "delay" => format!(
+        EffectId::Delay => format!(
             "The vehicle responds to its commands {:.1} ms late.",
             1000.0 * e.delay_s()
         ),
-        "thrust_map" => {
+        EffectId::ThrustMap => {
             let k = e.thrust_map.map(|m| m.k).unwrap_or([1.0, 1.0, 0.0]);
             format!(
                 "The thrust does not follow the command in proportion: T / (m g) = {:.3} + {:.3} (x − 1) {:+.3} (x − 1)² for a command asking x m g (at hover {:+.1}%, its slope {:+.0}% from the model's).",
@@ -104,7 +87,7 @@ pub fn describe(id: &str, e: &Effects) -> String {
                 100.0 * (k[1] - 1.0)
             )
         }
-        "thrust_tilt" => {
+        EffectId::ThrustTilt => {
             let [x, y] = e.thrust_tilt.map(|t| t.angles_rad).unwrap_or([0.0; 2]);
             format!(
                 "The thrust axis is tilted from the body z axis by {:.2}° about x and {:.2}° about y ({:.2}° in all; uncalibrated, that reads as a steady sideways force of {:.2} m/s²).",
@@ -114,7 +97,7 @@ pub fn describe(id: &str, e: &Effects) -> String {
                 9.81 * (x.cos() * y.cos()).acos().sin()
             )
         }
-        "rotor_drag" => {
+        EffectId::RotorDrag => {
             let d = e.rotor_drag.map(|r| r.d).unwrap_or([0.0; 2]);
             format!(
                 "Rotor drag proportional to the thrust and linear in the airspeed: {:.3} 1/s edgewise and {:.3} 1/s along the rotor axis (at hover thrust and 5 m/s edgewise airspeed about {:.2} m/s²).",
@@ -123,7 +106,7 @@ pub fn describe(id: &str, e: &Effects) -> String {
                 5.0 * d[0]
             )
         }
-        "translational_lift" => {
+        EffectId::TranslationalLift => {
             let c = e.translational_lift.map(|l| l.c).unwrap_or(0.0);
             format!(
                 "Translational lift: the rotors give more thrust in edgewise airflow, by {:+.1}% at 5 m/s and {:+.1}% at 10 m/s (c = {c:.5} s²/m²).",
@@ -131,11 +114,11 @@ pub fn describe(id: &str, e: &Effects) -> String {
                 100.0 * 100.0 * c
             )
         }
-        "drag_lag" => format!(
+        EffectId::DragLag => format!(
             "The air forces follow the velocity with a first-order lag of {:.2} s (the wake and inflow take time to build up).",
             e.drag_lag_s()
         ),
-        "wind_gradient" => {
+        EffectId::WindGradient => {
             let g = e.wind_gradient.map(|g| g.per_m).unwrap_or_default();
             let largest = g.iter().flatten().fold(0.0f64, |a, b| a.max(b.abs()));
             format!(
@@ -143,6 +126,5 @@ pub fn describe(id: &str, e: &Effects) -> String {
                 serde_json::to_string(&g).unwrap_or_default()
             )
         }
-        other => other.to_string(),
     }
 }

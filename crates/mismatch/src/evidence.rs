@@ -20,6 +20,7 @@
 //! While an effect fails, the weakest failing one (smallest fit gain) is dropped and the rest
 //! refitted; the rule is then applied again to every effect left.
 
+use physics::EffectId;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -50,7 +51,7 @@ impl Default for EvidenceSettings {
 /// The evidence for one effect of the final set.
 #[derive(Clone, Debug, Serialize)]
 pub struct Evidence {
-    pub id: String,
+    pub id: EffectId,
     /// Parameters of the effect (the degrees of freedom of the test).
     pub parameters: usize,
     /// `Λ = ΔSSE / (κ s²)` and the χ² quantile it is compared with.
@@ -191,7 +192,7 @@ struct Judge<'a> {
 
 /// The evidence for effect `id` of the judged set; returns it with the refitted set without the
 /// effect.
-fn evidence_for(judge: &Judge, id: &str) -> (Evidence, FittedSet) {
+fn evidence_for(judge: &Judge, id: EffectId) -> (Evidence, FittedSet) {
     let Judge {
         problem,
         set,
@@ -227,7 +228,7 @@ fn evidence_for(judge: &Judge, id: &str) -> (Evidence, FittedSet) {
         && reduction >= settings.min_heldout_reduction;
     (
         Evidence {
-            id: id.to_string(),
+            id,
             parameters,
             likelihood_ratio,
             likelihood_ratio_threshold: threshold,
@@ -302,7 +303,7 @@ pub fn apply(
             block_rows,
         };
         let outcomes: Vec<(Evidence, FittedSet)> =
-            ids.par_iter().map(|id| evidence_for(&judge, id)).collect();
+            ids.par_iter().map(|id| evidence_for(&judge, *id)).collect();
         let weakest = outcomes
             .iter()
             .filter(|(e, _)| !e.passes)
@@ -352,7 +353,7 @@ mod tests {
 
     fn evidence(removed: f64) -> Evidence {
         Evidence {
-            id: "x".into(),
+            id: EffectId::ThrustScale,
             parameters: 1,
             likelihood_ratio: 100.0,
             likelihood_ratio_threshold: 10.0,

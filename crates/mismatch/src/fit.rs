@@ -3,10 +3,10 @@
 //! fit rows), with the timing term resolved into a delay, a motor lag or both, and an air velocity
 //! when a drag was kept.
 
-use physics::Effects;
+use physics::{EffectId, Effects};
 use serde::Serialize;
 
-use crate::library::{Candidate, TIMING};
+use crate::library::{Candidate, CandidateId};
 use crate::problem::{Channels, Problem};
 use crate::refine::{
     Parameter, effect_column, effects_from, levenberg_marquardt, profile_search, profile_wind,
@@ -28,8 +28,8 @@ impl FittedSet {
     }
 
     /// The effect ids present, in order of first appearance.
-    pub fn ids(&self) -> Vec<&'static str> {
-        let mut ids: Vec<&'static str> = Vec::new();
+    pub fn ids(&self) -> Vec<EffectId> {
+        let mut ids: Vec<EffectId> = Vec::new();
         for p in &self.parameters {
             if !ids.contains(&p.effect_id()) {
                 ids.push(p.effect_id());
@@ -39,7 +39,7 @@ impl FittedSet {
     }
 
     /// The set without the parameters of effect `id` (and without the wind when no drag is left).
-    pub fn without(&self, id: &str) -> Self {
+    pub fn without(&self, id: EffectId) -> Self {
         let drag_left = self.parameters.iter().any(|p| {
             matches!(p, Parameter::LinearDrag(_) | Parameter::QuadraticDrag) && p.effect_id() != id
         });
@@ -107,23 +107,14 @@ pub fn profile_nonlinear(
             .filter(|c| !candidate.columns.contains(c))
             .collect()
     };
-    let find = |id: &str| candidates.iter().find(|c| c.id == id);
-    if let Some(candidate) = find("ground_effect") {
+    let find = |id: CandidateId| candidates.iter().find(|c| c.id == id);
+    if let Some(candidate) = find(CandidateId::GroundEffect) {
         let others = others_of(candidate);
-        let effect = |r: f64| effects_from(&[Parameter::GroundRadius], &[r]);
-        let (radius, _) = profile_search(
-            problem,
-            columns,
-            &others,
-            range.clone(),
-            block_rows,
-            &radius_grid(),
-            effect,
-        );
-        columns[candidate.columns[0]] =
-            effect_column(problem, &base, &effect(radius), radius * radius);
+        let radius = profiled_ground_radius(problem, columns, &others, block_rows);
+        let effect = effects_from(&[Parameter::GroundRadius], &[radius]);
+        columns[candidate.columns[0]] = effect_column(problem, &base, &effect, radius * radius);
     }
-    if let Some(candidate) = find(TIMING) {
+    if let Some(candidate) = find(CandidateId::DelayOrMotorLag) {
         let others = others_of(candidate);
         let grid: Vec<f64> = timing_grid().into_iter().skip(1).collect();
         let best = [Parameter::Delay, Parameter::MotorLag]
@@ -146,7 +137,7 @@ pub fn profile_nonlinear(
             effect_column(problem, &base, &effects_from(&[best.0], &[best.1]), best.1);
     }
     let mut wind = [0.0; 3];
-    if let Some(candidate) = find("quadratic_drag") {
+    if let Some(candidate) = find(CandidateId::QuadraticDrag) {
         let others = others_of(candidate);
         let (w, _) = profile_wind(problem, before, columns, &others, range, block_rows);
         wind = w;
@@ -179,37 +170,31 @@ fn screen_estimates(
     };
     for candidate in candidates {
         let cols = &candidate.columns;
-        match candidate.id.as_str() {
-            "thrust_scale" => push(Parameter::ThrustScale, 1.0 + coefficient(cols[0])),
-            "linear_drag" => {
+        match candidate.id {
+            CandidateId::ThrustScale => push(Parameter::ThrustScale, 1.0 + coefficient(cols[0])),
+            CandidateId::LinearDrag => {
                 for (i, &c) in cols.iter().enumerate() {
                     push(Parameter::LinearDrag(i), coefficient(c).max(0.0));
                 }
             }
-            "quadratic_drag" => push(Parameter::QuadraticDrag, coefficient(cols[0]).max(0.0)),
-            "ground_effect" => {
+            CandidateId::QuadraticDrag => {
+                push(Parameter::QuadraticDrag, coefficient(cols[0]).max(0.0))
+            }
+            CandidateId::GroundEffect => {
                 let others: Vec<usize> = kept_columns
                     .iter()
                     .copied()
                     .filter(|c| !cols.contains(c))
                     .collect();
-                let (radius, _) = profile_search(
-                    problem,
-                    columns,
-                    &others,
-                    0..problem.split,
-                    block_rows,
-                    &radius_grid(),
-                    |r| effects_from(&[Parameter::GroundRadius], &[r]),
-                );
+                let radius = profiled_ground_radius(problem, columns, &others, block_rows);
                 push(Parameter::GroundRadius, radius);
             }
-            "torque_bias" => {
+            CandidateId::TorqueBias => {
                 for (i, &c) in cols.iter().enumerate() {
                     push(Parameter::TorqueBias(i), coefficient(c));
                 }
             }
-            "inertia_scale" => {
+            CandidateId::InertiaScale => {
                 for (i, &c) in cols.iter().enumerate() {
                     push(
                         Parameter::InertiaScale(i),
@@ -217,10 +202,31 @@ fn screen_estimates(
                     );
                 }
             }
-            _ => {}
+            // Resolved into a delay, a motor lag or both by `fit_timing`.
+            CandidateId::DelayOrMotorLag => {}
         }
     }
     set
+}
+
+/// The ground-effect radius of the grid that best explains the fit rows next to the columns
+/// `others`.
+fn profiled_ground_radius(
+    problem: &Problem,
+    columns: &[Vec<Channels>],
+    others: &[usize],
+    block_rows: usize,
+) -> f64 {
+    let (radius, _) = profile_search(
+        problem,
+        columns,
+        others,
+        0..problem.split,
+        block_rows,
+        &radius_grid(),
+        |r| effects_from(&[Parameter::GroundRadius], &[r]),
+    );
+    radius
 }
 
 /// What the screen produced: the candidates, their columns, the design and the selection.
@@ -252,11 +258,11 @@ pub fn fit_parameters(
         return (FittedSet::default(), alternatives);
     }
     let linear = screen_estimates(problem, &kept, columns, design, block_rows);
-    let timing = kept.iter().any(|c| c.id == TIMING);
+    let timing = kept.iter().any(|c| c.id == CandidateId::DelayOrMotorLag);
     let mut set = if timing {
         let others: Vec<usize> = kept
             .iter()
-            .filter(|c| c.id != TIMING)
+            .filter(|c| c.id != CandidateId::DelayOrMotorLag)
             .flat_map(|c| c.columns.clone())
             .collect();
         let (set, scores) = fit_timing(problem, columns, &others, &linear, iterations, block_rows);
@@ -313,7 +319,7 @@ fn fit_timing(
         set.parameters.push(kind);
         set.values.push(start);
         let sse = set.refit(problem, iterations);
-        scores.insert(kind.effect_id().to_string(), serde_json::json!(sse));
+        scores.insert(kind.effect_id().name().to_string(), serde_json::json!(sse));
         singles.push((set, sse));
     }
     let delay = singles[0].0.values.last().copied().unwrap_or(0.0);

@@ -17,6 +17,10 @@
 //! are fitted jointly with the exact model on the first part of the recording; each effect is then
 //! named only when the evidence rule holds for it ([`evidence`]). Several flights of one vehicle are
 //! analysed together by [`fleet`].
+//!
+//! Names: every effect is named by a [`physics::EffectId`] (its spelling, `linear_drag` …, is what
+//! the outputs print); the candidates of the library by a [`CandidateId`] (an effect, or the timing
+//! term `delay_or_motor_lag`). Every choice that depends on an effect matches over those enums.
 
 // Index loops over channels and 3-vectors read like the formulas they implement.
 #![allow(clippy::needless_range_loop)]
@@ -44,7 +48,7 @@ pub use describe::{describe, remove_effect};
 pub use error::{MismatchError, Result};
 pub use evidence::{Evidence, EvidenceSettings};
 pub use fit::FittedSet;
-pub use library::{Candidate, TIMING, Term, build_library};
+pub use library::{Candidate, CandidateId, Term, build_library};
 pub use output::{
     check_directory, check_outputs, check_run_outputs, markdown_text, output_paths, write_figure,
     write_outputs,

@@ -1,13 +1,14 @@
-//! The library of candidate physics terms. Each candidate is one effect of the vocabulary (or, for
-//! the timing term, the first-order signature shared by a delay and a motor lag) with named terms,
-//! their formulas and units. A term's column is the change of the model's matched prediction when
+//! The library of candidate physics terms. Each candidate ([`CandidateId`]) is one effect of the
+//! vocabulary (or, for the timing term, the first-order signature shared by a delay and a motor lag)
+//! with named terms, their formulas and units. A term's column is the change of the model's matched prediction when
 //! its coefficient moves away from zero, computed with the same forward model that later fits the
 //! effect exactly, so the linear screen and the nonlinear fit describe the same physics.
 
 use physics::{
-    Delay, Effects, GroundEffect, InertiaScale, LinearDrag, QuadraticDrag, ThrustScale, TorqueBias,
+    Delay, EffectId, Effects, GroundEffect, InertiaScale, LinearDrag, QuadraticDrag, ThrustScale,
+    TorqueBias,
 };
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 
 use crate::problem::{Channels, Problem};
 
@@ -22,19 +23,64 @@ pub struct Term {
     pub coefficient: String,
 }
 
+/// What a candidate of the library stands for: one effect of the vocabulary, or the first-order
+/// timing signature a delay and a motor lag share (resolved into either or both by the fit).
+/// Serialises and displays as the effect's id, or `delay_or_motor_lag`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CandidateId {
+    ThrustScale,
+    LinearDrag,
+    QuadraticDrag,
+    GroundEffect,
+    DelayOrMotorLag,
+    TorqueBias,
+    InertiaScale,
+}
+
+impl CandidateId {
+    /// The effect the candidate stands for (none for the timing term).
+    pub const fn effect(self) -> Option<EffectId> {
+        match self {
+            Self::ThrustScale => Some(EffectId::ThrustScale),
+            Self::LinearDrag => Some(EffectId::LinearDrag),
+            Self::QuadraticDrag => Some(EffectId::QuadraticDrag),
+            Self::GroundEffect => Some(EffectId::GroundEffect),
+            Self::DelayOrMotorLag => None,
+            Self::TorqueBias => Some(EffectId::TorqueBias),
+            Self::InertiaScale => Some(EffectId::InertiaScale),
+        }
+    }
+
+    /// The effect's id, or `delay_or_motor_lag` for the timing term.
+    pub const fn name(self) -> &'static str {
+        match self.effect() {
+            Some(id) => id.name(),
+            None => "delay_or_motor_lag",
+        }
+    }
+}
+
+impl std::fmt::Display for CandidateId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.name())
+    }
+}
+
+impl Serialize for CandidateId {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
+}
+
 /// A group of terms that stands for one effect.
 #[derive(Clone, Debug, Serialize)]
 pub struct Candidate {
-    /// A vocabulary id, or `delay_or_motor_lag` for the timing term.
-    pub id: String,
+    pub id: CandidateId,
     pub terms: Vec<Term>,
     /// Indices of the candidate's columns in the design.
     #[serde(skip)]
     pub columns: Vec<usize>,
 }
-
-/// The id of the first-order timing candidate (resolved into `delay` or `motor_lag` by the fit).
-pub const TIMING: &str = "delay_or_motor_lag";
 
 fn term(name: &str, formula: &str, units: &str, coefficient: &str) -> Term {
     Term {
@@ -50,7 +96,7 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
     let base = problem.predict(&Effects::default());
     let mut columns: Vec<Vec<Channels>> = Vec::new();
     let mut candidates = Vec::new();
-    let mut add = |id: &str, terms: Vec<Term>, perturbed: Vec<(Effects, f64)>| {
+    let mut add = |id: CandidateId, terms: Vec<Term>, perturbed: Vec<(Effects, f64)>| {
         let start = columns.len();
         for (effects, step) in perturbed {
             let predicted = problem.predict(&effects);
@@ -69,7 +115,7 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
             );
         }
         candidates.push(Candidate {
-            id: id.to_string(),
+            id,
             terms,
             columns: (start..columns.len()).collect(),
         });
@@ -81,7 +127,7 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
     };
     let step = 1e-3;
     add(
-        "thrust_scale",
+        CandidateId::ThrustScale,
         vec![term("thrust", "R e3 T / m", "m/s²", "k − 1 (1)")],
         vec![(
             with(&|e| e.thrust_scale = Some(ThrustScale { k: 1.0 + step })),
@@ -90,7 +136,7 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
     );
     let axes = ["x", "y", "z"];
     add(
-        "linear_drag",
+        CandidateId::LinearDrag,
         axes.iter()
             .map(|a| {
                 term(
@@ -110,7 +156,7 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
             .collect(),
     );
     add(
-        "quadratic_drag",
+        CandidateId::QuadraticDrag,
         vec![term("air_drag", "−|v| v", "m²/s²", "c (1/m)")],
         vec![(
             with(&|e| e.quadratic_drag = Some(QuadraticDrag { c: 1.0 })),
@@ -119,7 +165,7 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
     );
     let small_radius: f64 = 0.02;
     add(
-        "ground_effect",
+        CandidateId::GroundEffect,
         vec![term(
             "ground_thrust",
             "R e3 T / (16 m z²)",
@@ -133,7 +179,7 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
     );
     let timing_step = problem.recording.dt / 4.0;
     add(
-        TIMING,
+        CandidateId::DelayOrMotorLag,
         vec![term(
             "command_rate",
             "−d/dt (R e3 T / m, J⁻¹ τ)",
@@ -151,7 +197,7 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
     );
     if problem.channels == 6 {
         add(
-            "torque_bias",
+            CandidateId::TorqueBias,
             axes.iter()
                 .map(|a| {
                     term(
@@ -171,7 +217,7 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
                 .collect(),
         );
         add(
-            "inertia_scale",
+            CandidateId::InertiaScale,
             axes.iter()
                 .map(|a| {
                     term(

@@ -6,8 +6,8 @@
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use physics::{
-    Delay, Effects, GroundEffect, InertiaScale, LinearDrag, MotorLag, QuadraticDrag, ThrustScale,
-    TorqueBias, Wind,
+    Delay, EffectId, Effects, GroundEffect, InertiaScale, LinearDrag, MotorLag, QuadraticDrag,
+    ThrustScale, TorqueBias, Wind,
 };
 
 use crate::problem::{Channels, Problem};
@@ -61,18 +61,18 @@ impl Parameter {
         }
     }
 
-    /// The vocabulary id the parameter belongs to.
-    pub fn effect_id(self) -> &'static str {
+    /// The effect the parameter belongs to.
+    pub fn effect_id(self) -> EffectId {
         match self {
-            Self::ThrustScale => "thrust_scale",
-            Self::LinearDrag(_) => "linear_drag",
-            Self::QuadraticDrag => "quadratic_drag",
-            Self::Wind(_) => "wind",
-            Self::GroundRadius => "ground_effect",
-            Self::TorqueBias(_) => "torque_bias",
-            Self::InertiaScale(_) => "inertia_scale",
-            Self::Delay => "delay",
-            Self::MotorLag => "motor_lag",
+            Self::ThrustScale => EffectId::ThrustScale,
+            Self::LinearDrag(_) => EffectId::LinearDrag,
+            Self::QuadraticDrag => EffectId::QuadraticDrag,
+            Self::Wind(_) => EffectId::Wind,
+            Self::GroundRadius => EffectId::GroundEffect,
+            Self::TorqueBias(_) => EffectId::TorqueBias,
+            Self::InertiaScale(_) => EffectId::InertiaScale,
+            Self::Delay => EffectId::Delay,
+            Self::MotorLag => EffectId::MotorLag,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! when one is concealed, outputs that refuse to overwrite, errors that name the problem.
 
 use mismatch::{AnalysisSettings, MismatchError, analyze, check_outputs, write_outputs};
-use physics::{Effects, NominalModel, Scenario, ThrustScale, TorqueBias, simulate};
+use physics::{EffectId, Effects, NominalModel, Scenario, ThrustScale, TorqueBias, simulate};
 
 mod common;
 
@@ -53,7 +53,7 @@ fn names_and_fits_a_concealed_thrust_loss() {
         ..Effects::default()
     };
     let analysis = analyze(&flight(effects, 3), &model(), "demo", &settings()).unwrap();
-    assert_eq!(analysis.fitted.ids(), vec!["thrust_scale"]);
+    assert_eq!(analysis.fitted.ids(), [EffectId::ThrustScale]);
     let k = analysis.fitted.thrust_scale.unwrap().k;
     assert!((k - 0.9).abs() < 0.01, "{k}");
     let fit = &analysis.report.fit;
@@ -74,7 +74,7 @@ fn names_a_torque_bias_and_writes_outputs_once() {
         ..Effects::default()
     };
     let analysis = analyze(&flight(effects, 4), &model(), "demo", &settings()).unwrap();
-    assert_eq!(analysis.fitted.ids(), vec!["torque_bias"]);
+    assert_eq!(analysis.fitted.ids(), [EffectId::TorqueBias]);
     let b = analysis.fitted.torque_bias.unwrap().b;
     for (found, truth) in b.iter().zip([0.6, -0.4, 0.25]) {
         assert!((found - truth).abs() < 0.05, "{b:?}");
@@ -201,7 +201,7 @@ fn a_delay_behind_sampled_commands_is_measured() {
     };
     let log = simulate(&vehicle, &scenario, "delay").unwrap();
     let analysis = analyze(&log, &model, "a", &AnalysisSettings::default()).unwrap();
-    assert_eq!(analysis.fitted.ids(), vec!["delay"]);
+    assert_eq!(analysis.fitted.ids(), [EffectId::Delay]);
     let delay = analysis.fitted.delay_s();
     assert!((delay / 0.025 - 1.0).abs() < 0.1, "{delay}");
     let shares: Vec<f64> = analysis

@@ -4,7 +4,9 @@
 
 use mismatch::fleet::FleetPlan;
 use mismatch::fleet::FleetReport;
-use physics::{DragLag, Effects, NominalModel, RotorDrag, Scenario, ThrustTilt, Wind, simulate};
+use physics::{
+    DragLag, EffectId, Effects, NominalModel, RotorDrag, Scenario, ThrustTilt, Wind, simulate,
+};
 
 mod common;
 
@@ -83,13 +85,8 @@ fn analyse(name: &str, conditions: &[Condition], lag_s: Option<f64>) -> FleetRep
     report
 }
 
-fn effect_ids(report: &FleetReport) -> Vec<&str> {
-    report
-        .vehicle
-        .effects
-        .iter()
-        .map(|e| e.id.as_str())
-        .collect()
+fn effect_ids(report: &FleetReport) -> Vec<EffectId> {
+    report.vehicle.effects.iter().map(|e| e.id).collect()
 }
 
 /// Every flight's estimated air (both roles) within `tolerance` m/s of the truth, horizontally.
@@ -123,7 +120,7 @@ fn the_winds_of_several_flights_come_out_of_one_vehicle() {
     let report = analyse("plain", &conditions, None);
     let ids = effect_ids(&report);
     assert!(
-        ids.contains(&"thrust_tilt") && ids.contains(&"rotor_drag"),
+        ids.contains(&EffectId::ThrustTilt) && ids.contains(&EffectId::RotorDrag),
         "{ids:?}"
     );
     assert_winds(&report, &conditions, 0.5);
@@ -142,7 +139,7 @@ fn a_lag_of_the_air_forces_is_found_in_still_air_and_bounds_the_winds_scale() {
     ];
     let report = analyse("lag", &conditions, Some(0.3));
     let ids = effect_ids(&report);
-    assert!(ids.contains(&"drag_lag"), "{ids:?}");
+    assert!(ids.contains(&EffectId::DragLag), "{ids:?}");
     let scale = report
         .scale
         .as_ref()

@@ -3,6 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+use physics::EffectId;
+
 /// The real data directory (see `data::real_data_dir_for_tests`: skips locally, fails under CI).
 fn real_data_dir() -> Option<PathBuf> {
     data::real_data_dir_for_tests(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
@@ -28,8 +30,8 @@ fn names_drag_on_the_relative_wind_in_the_strongest_wind() {
     .unwrap();
     assert_eq!(analysis.report.rate_frame.used, data::RateFrame::World);
     let ids = analysis.fitted.ids();
-    let drag = ids.contains(&"quadratic_drag") || ids.contains(&"linear_drag");
-    assert!(drag && ids.contains(&"wind"), "{ids:?}");
+    let drag = ids.contains(&EffectId::QuadraticDrag) || ids.contains(&EffectId::LinearDrag);
+    assert!(drag && ids.contains(&EffectId::Wind), "{ids:?}");
     // The wind tunnel blows along −x at about 12 m/s.
     let wind = analysis.fitted.air_velocity();
     assert!(wind[0] < -8.0, "{wind:?}");

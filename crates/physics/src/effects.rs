@@ -1,5 +1,7 @@
 //! The vocabulary of unmodelled effects, switchable one by one in the simulated plant and used by
-//! the mismatch tool to model what it finds. Ids and parameter names are an output contract.
+//! the mismatch tool to model what it finds. Ids and parameter names are an output contract: each
+//! effect is named by an [`EffectId`] (in the order of this table), which is also its key in
+//! [`Effects`]' JSON.
 //!
 //! | id | parameters | physics (accelerations per unit mass, SI) |
 //! |---|---|---|
@@ -21,27 +23,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::effect_id::EffectId;
 use crate::model::{NominalModel, angular_acceleration_with_inertia};
 use crate::vector::{E3, Mat3, Vec3, add, hadamard, mat_t_vec, mat_vec, norm, scale, sub};
-
-/// Every effect id of the vocabulary, in a fixed order.
-pub const EFFECT_IDS: [&str; 15] = [
-    "linear_drag",
-    "quadratic_drag",
-    "wind",
-    "thrust_scale",
-    "motor_lag",
-    "ground_effect",
-    "torque_bias",
-    "inertia_scale",
-    "delay",
-    "thrust_map",
-    "thrust_tilt",
-    "rotor_drag",
-    "translational_lift",
-    "drag_lag",
-    "wind_gradient",
-];
 
 /// The largest `(r / 4z)²` the ground-effect formula is evaluated at (the formula diverges at 1):
 /// below `z = r / (4 √0.5)` the thrust gain is held at 2.
@@ -289,30 +273,53 @@ impl Effects {
     }
 
     /// The ids of the effects present, in vocabulary order.
-    pub fn ids(&self) -> Vec<&'static str> {
-        let present = [
-            self.linear_drag.is_some(),
-            self.quadratic_drag.is_some(),
-            self.wind.is_some(),
-            self.thrust_scale.is_some(),
-            self.motor_lag.is_some(),
-            self.ground_effect.is_some(),
-            self.torque_bias.is_some(),
-            self.inertia_scale.is_some(),
-            self.delay.is_some(),
-            self.thrust_map.is_some(),
-            self.thrust_tilt.is_some(),
-            self.rotor_drag.is_some(),
-            self.translational_lift.is_some(),
-            self.drag_lag.is_some(),
-            self.wind_gradient.is_some(),
-        ];
-        EFFECT_IDS
-            .iter()
-            .zip(present)
-            .filter(|(_, p)| *p)
-            .map(|(id, _)| *id)
+    pub fn ids(&self) -> Vec<EffectId> {
+        EffectId::ALL
+            .into_iter()
+            .filter(|id| self.contains(*id))
             .collect()
+    }
+
+    /// Whether effect `id` is present.
+    pub fn contains(&self, id: EffectId) -> bool {
+        match id {
+            EffectId::LinearDrag => self.linear_drag.is_some(),
+            EffectId::QuadraticDrag => self.quadratic_drag.is_some(),
+            EffectId::Wind => self.wind.is_some(),
+            EffectId::ThrustScale => self.thrust_scale.is_some(),
+            EffectId::MotorLag => self.motor_lag.is_some(),
+            EffectId::GroundEffect => self.ground_effect.is_some(),
+            EffectId::TorqueBias => self.torque_bias.is_some(),
+            EffectId::InertiaScale => self.inertia_scale.is_some(),
+            EffectId::Delay => self.delay.is_some(),
+            EffectId::ThrustMap => self.thrust_map.is_some(),
+            EffectId::ThrustTilt => self.thrust_tilt.is_some(),
+            EffectId::RotorDrag => self.rotor_drag.is_some(),
+            EffectId::TranslationalLift => self.translational_lift.is_some(),
+            EffectId::DragLag => self.drag_lag.is_some(),
+            EffectId::WindGradient => self.wind_gradient.is_some(),
+        }
+    }
+
+    /// Removes effect `id` (nothing else: an effect that needs it, as the wind needs a drag, stays).
+    pub fn remove(&mut self, id: EffectId) {
+        match id {
+            EffectId::LinearDrag => self.linear_drag = None,
+            EffectId::QuadraticDrag => self.quadratic_drag = None,
+            EffectId::Wind => self.wind = None,
+            EffectId::ThrustScale => self.thrust_scale = None,
+            EffectId::MotorLag => self.motor_lag = None,
+            EffectId::GroundEffect => self.ground_effect = None,
+            EffectId::TorqueBias => self.torque_bias = None,
+            EffectId::InertiaScale => self.inertia_scale = None,
+            EffectId::Delay => self.delay = None,
+            EffectId::ThrustMap => self.thrust_map = None,
+            EffectId::ThrustTilt => self.thrust_tilt = None,
+            EffectId::RotorDrag => self.rotor_drag = None,
+            EffectId::TranslationalLift => self.translational_lift = None,
+            EffectId::DragLag => self.drag_lag = None,
+            EffectId::WindGradient => self.wind_gradient = None,
+        }
     }
 
     /// Air velocity seen by the drag terms at the reference (zero without a wind effect).
@@ -462,12 +469,68 @@ mod tests {
             r#"{"quadratic_drag": {"c": 0.05}, "wind": {"w_air": [2, 0, 0]}, "delay": {"delay_s": 0.03}}"#,
         )
         .unwrap();
-        assert_eq!(effects.ids(), vec!["quadratic_drag", "wind", "delay"]);
+        assert_eq!(
+            effects.ids(),
+            [EffectId::QuadraticDrag, EffectId::Wind, EffectId::Delay]
+        );
         assert!(effects.validate().is_ok());
         assert!(serde_json::from_str::<Effects>(r#"{"drag": {"c": 1}}"#).is_err());
         let lonely_wind: Effects =
             serde_json::from_str(r#"{"wind": {"w_air": [1, 0, 0]}}"#).unwrap();
         assert_eq!(lonely_wind.validate().unwrap_err().0, "wind");
+    }
+
+    /// Every effect present at once (the parameters are only placeholders).
+    fn every_effect() -> Effects {
+        Effects {
+            linear_drag: Some(LinearDrag { d: [0.1; 3] }),
+            quadratic_drag: Some(QuadraticDrag { c: 0.1 }),
+            wind: Some(Wind { w_air: [1.0; 3] }),
+            thrust_scale: Some(ThrustScale { k: 0.9 }),
+            motor_lag: Some(MotorLag { tau_s: 0.02 }),
+            ground_effect: Some(GroundEffect { r_m: 0.3 }),
+            torque_bias: Some(TorqueBias { b: [0.1; 3] }),
+            inertia_scale: Some(InertiaScale { k: [1.1; 3] }),
+            delay: Some(Delay { delay_s: 0.02 }),
+            thrust_map: Some(ThrustMap { k: [1.0, 1.0, 0.0] }),
+            thrust_tilt: Some(ThrustTilt {
+                angles_rad: [0.01; 2],
+            }),
+            rotor_drag: Some(RotorDrag { d: [0.3, 0.1] }),
+            translational_lift: Some(TranslationalLift { c: 0.001 }),
+            drag_lag: Some(DragLag { tau_s: 0.2 }),
+            wind_gradient: Some(WindGradient {
+                per_m: [[0.0; 3]; 3],
+                reference_m: [0.0; 3],
+            }),
+        }
+    }
+
+    /// Each id is the key of its effect in the JSON, and `contains`, `remove` and `ids` act on
+    /// exactly that effect.
+    #[test]
+    fn the_ids_are_the_keys_of_the_effects() {
+        let every = every_effect();
+        assert_eq!(every.ids(), EffectId::ALL);
+        let json = serde_json::to_value(every).unwrap();
+        let mut keys: Vec<&str> = json
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(|k| k.as_str())
+            .collect();
+        let mut names = EffectId::ALL.map(EffectId::name);
+        keys.sort_unstable();
+        names.sort_unstable();
+        assert_eq!(keys, names);
+        for id in EffectId::ALL {
+            let mut without = every;
+            without.remove(id);
+            assert!(every.contains(id) && !without.contains(id));
+            let json = serde_json::to_value(without).unwrap();
+            assert!(json.get(id.name()).is_none(), "{id}");
+            assert_eq!(json.as_object().unwrap().len(), EffectId::ALL.len() - 1);
+        }
     }
 
     #[test]

@@ -2,13 +2,12 @@
 //!
 //! What it is for: the nominal model read from JSON ([`NominalModel`]: mass, gravity, inertia, and
 //! how thrust and torques follow from a recorded command); the vocabulary of unmodelled effects
-//! ([`Effects`], ids and parameter names are an output contract); a closed-loop simulator
-//! ([`simulate`]: RK4 rigid body, geometric tracking controller that knows only the nominal model,
-//! figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`]; a [`Scenario`] is read
-//! from JSON or, for examples and tests, built by [`Scenario::figure_eight`]) that writes
-//! Neural-Fly logs the data tools read back ([`write_readable`]); and the residual force of a
-//! recorded flight ([`residual_force`], the `fa`
-//! column).
+//! ([`Effects`], each named by an [`EffectId`]; ids and parameter names are an output contract); a
+//! closed-loop simulator ([`simulate`]: RK4 rigid body, geometric tracking controller that knows
+//! only the nominal model, figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`]; a
+//! [`Scenario`] is read from JSON or, for examples and tests, built by [`Scenario::figure_eight`])
+//! that writes Neural-Fly logs the data tools read back ([`write_readable`]); and the residual
+//! force of a recorded flight ([`residual_force`], the `fa` column).
 //!
 //! What it is not for: analysing mismatches (the `mismatch` crate), reading CSVs (the `data` crate).
 //!
@@ -19,6 +18,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod controller;
+mod effect_id;
 mod effects;
 mod error;
 mod jitter;
@@ -31,10 +31,11 @@ pub mod vector;
 mod writer;
 
 pub use controller::{ControlOutput, Gains, GeometricController, MeasuredState};
+pub use effect_id::{EffectId, UnknownEffectId};
 pub use effects::{
-    Delay, DragLag, EFFECT_IDS, Effects, GROUND_EFFECT_MAX_RATIO, GroundEffect, InertiaScale,
-    LinearDrag, MAX_TILT_RAD, MotorLag, QuadraticDrag, RotorDrag, ThrustMap, ThrustScale,
-    ThrustTilt, TorqueBias, TranslationalLift, Wind, WindGradient, ground_ratio,
+    Delay, DragLag, Effects, GROUND_EFFECT_MAX_RATIO, GroundEffect, InertiaScale, LinearDrag,
+    MAX_TILT_RAD, MotorLag, QuadraticDrag, RotorDrag, ThrustMap, ThrustScale, ThrustTilt,
+    TorqueBias, TranslationalLift, Wind, WindGradient, ground_ratio,
 };
 pub use error::{PhysicsError, Result};
 pub use jitter::{Jitter, JitterSignal, MAX_JITTER};

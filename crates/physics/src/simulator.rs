@@ -183,15 +183,19 @@ impl Scenario {
 
     /// Reads a scenario and its model (resolved relative to the scenario file), and checks both
     /// (together: the simulator needs a mixer, and the reference must stay above the ground).
+    /// What the file holds is checked as it is read, each error naming the field: an unknown key,
+    /// an effect id that is not one of [`crate::EffectId::ALL`] among them.
     pub fn load(path: &Path) -> Result<(Self, NominalModel)> {
         let text = std::fs::read_to_string(path).map_err(|source| PhysicsError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        let scenario: Self = inputs::json::from_str(&text).map_err(|error| PhysicsError::Json {
-            path: path.to_path_buf(),
-            message: error.to_string(),
-        })?;
+        let scenario: Self =
+            inputs::json::from_str(&text).map_err(|error| PhysicsError::Field {
+                path: path.to_path_buf(),
+                field: error.field,
+                message: error.message,
+            })?;
         scenario.validate(path)?;
         let model = NominalModel::load(&scenario.model_path(path))?;
         scenario.validate_with_model(&model, path)?;

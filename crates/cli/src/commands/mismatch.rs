@@ -171,7 +171,7 @@ fn run_recording(recording: &Path, model_path: &Path, args: &Args) -> anyhow::Re
     })?;
     staged.commit()?;
     let report = &analysis.report;
-    let names: Vec<&str> = report.effects.iter().map(|e| e.id.as_str()).collect();
+    let names: Vec<&str> = report.effects.iter().map(|e| e.id.name()).collect();
     say!(
         "effects: {}; held-out MSE {:.5} -> {:.5}; wrote {}",
         if names.is_empty() {

@@ -51,7 +51,12 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         physics::write_readable(&log, staged.path(file), &args.scenario)
     })?;
     staged.commit()?;
-    let effects = scenario.effects.ids();
+    let effects: Vec<&str> = scenario
+        .effects
+        .ids()
+        .into_iter()
+        .map(physics::EffectId::name)
+        .collect();
     say!(
         "wrote {} ({} rows, {:.1} s, seed {}, effects: {})",
         args.out.display(),

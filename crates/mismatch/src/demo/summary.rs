@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use physics::{Effects, NominalModel, Scenario, Trajectory};
+use physics::{EffectId, Effects, NominalModel, Scenario, Trajectory};
 use serde::Serialize;
 
 use crate::analysis::Analysis;
@@ -33,7 +33,7 @@ pub const TARGETS: Targets = Targets {
 /// One parameter, true against found.
 #[derive(Clone, Debug, Serialize)]
 pub struct ParameterCheck {
-    pub effect: String,
+    pub effect: EffectId,
     pub parameter: String,
     pub truth: serde_json::Value,
     pub found: serde_json::Value,
@@ -48,8 +48,8 @@ pub struct CellOutcome {
     pub configuration: String,
     pub case: String,
     pub seed: u64,
-    pub true_effects: Vec<String>,
-    pub found_effects: Vec<String>,
+    pub true_effects: Vec<EffectId>,
+    pub found_effects: Vec<EffectId>,
     pub named_exactly: bool,
     pub parameters: Vec<ParameterCheck>,
     pub heldout_mse_before: f64,
@@ -74,22 +74,17 @@ impl CellOutcome {
         analysis: &Analysis,
     ) -> Self {
         let report = &analysis.report;
-        let true_effects: Vec<String> = truth.ids().iter().map(|s| s.to_string()).collect();
-        let found_effects: Vec<String> = analysis
-            .fitted
-            .ids()
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let true_effects = truth.ids();
+        let found_effects = analysis.fitted.ids();
         let parameters = compare_parameters(truth, &analysis.fitted);
         let (before, after) = (report.fit.heldout.before.mse, report.fit.heldout.after.mse);
         let ratio = after / before.max(1e-300);
         let mut failures = Vec::new();
-        let missing: Vec<&String> = true_effects
+        let missing: Vec<&EffectId> = true_effects
             .iter()
             .filter(|id| !found_effects.contains(id))
             .collect();
-        let extra: Vec<&String> = found_effects
+        let extra: Vec<&EffectId> = found_effects
             .iter()
             .filter(|id| !true_effects.contains(id))
             .collect();
@@ -154,24 +149,57 @@ fn numbers(value: &serde_json::Value) -> Vec<f64> {
     }
 }
 
-/// Relative errors of every parameter of every true effect that was found.
+/// Relative errors of every parameter of every true effect that was found; the effects in the
+/// alphabetical order of their ids, as in their JSON.
 pub fn compare_parameters(truth: &Effects, found: &Effects) -> Vec<ParameterCheck> {
     let truth_json = serde_json::to_value(truth).expect("serialises");
     let found_json = serde_json::to_value(found).expect("serialises");
-    let mut checks = Vec::new();
-    let Some(true_map) = truth_json.as_object() else {
-        return checks;
-    };
-    for (effect, parameters) in true_map {
-        let Some(found_parameters) = found_json.get(effect) else {
-            continue;
-        };
-        let factor = matches!(effect.as_str(), "thrust_scale" | "inertia_scale");
-        for (name, value) in parameters.as_object().into_iter().flatten() {
-            let found_value = found_parameters
-                .get(name)
-                .cloned()
-                .unwrap_or(serde_json::Value::Null);
+    let mut found_true: Vec<EffectId> = truth
+        .ids()
+        .into_iter()
+        .filter(|id| found.contains(*id))
+        .collect();
+    found_true.sort_by_key(|id| id.name());
+    found_true
+        .into_iter()
+        .flat_map(|id| parameter_checks(id, &truth_json[id.name()], &found_json[id.name()]))
+        .collect()
+}
+
+/// Whether the effect's parameters are factors (1: no effect), whose errors are relative to
+/// |true − 1|.
+fn is_factor(id: EffectId) -> bool {
+    match id {
+        EffectId::ThrustScale | EffectId::InertiaScale => true,
+        EffectId::LinearDrag
+        | EffectId::QuadraticDrag
+        | EffectId::Wind
+        | EffectId::MotorLag
+        | EffectId::GroundEffect
+        | EffectId::TorqueBias
+        | EffectId::Delay
+        | EffectId::ThrustMap
+        | EffectId::ThrustTilt
+        | EffectId::RotorDrag
+        | EffectId::TranslationalLift
+        | EffectId::DragLag
+        | EffectId::WindGradient => false,
+    }
+}
+
+/// One check per parameter of `effect`, from its true and found parameters (JSON objects).
+fn parameter_checks(
+    effect: EffectId,
+    truth: &serde_json::Value,
+    found: &serde_json::Value,
+) -> Vec<ParameterCheck> {
+    let reference = if is_factor(effect) { 1.0 } else { 0.0 };
+    truth
+        .as_object()
+        .into_iter()
+        .flatten()
+        .map(|(name, value)| {
+            let found_value = found.get(name).cloned().unwrap_or(serde_json::Value::Null);
             let (t, f) = (numbers(value), numbers(&found_value));
             let difference: f64 = t
                 .iter()
@@ -179,14 +207,13 @@ pub fn compare_parameters(truth: &Effects, found: &Effects) -> Vec<ParameterChec
                 .map(|(a, b)| (a - b).powi(2))
                 .sum::<f64>()
                 .sqrt();
-            let reference = if factor { 1.0 } else { 0.0 };
             let magnitude: f64 = t
                 .iter()
                 .map(|a| (a - reference).powi(2))
                 .sum::<f64>()
                 .sqrt();
-            checks.push(ParameterCheck {
-                effect: effect.clone(),
+            ParameterCheck {
+                effect,
                 parameter: name.clone(),
                 truth: value.clone(),
                 found: round_json(&found_value),
@@ -195,10 +222,9 @@ pub fn compare_parameters(truth: &Effects, found: &Effects) -> Vec<ParameterChec
                 } else {
                     f64::INFINITY
                 },
-            });
-        }
-    }
-    checks
+            }
+        })
+        .collect()
 }
 
 fn round_json(value: &serde_json::Value) -> serde_json::Value {
@@ -210,6 +236,14 @@ fn round_json(value: &serde_json::Value) -> serde_json::Value {
         serde_json::Value::Array(a) => serde_json::Value::Array(a.iter().map(round_json).collect()),
         other => other.clone(),
     }
+}
+
+/// The ids separated by commas.
+fn joined(ids: &[EffectId]) -> String {
+    ids.iter()
+        .map(|id| id.name())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn compact(value: &serde_json::Value) -> String {
@@ -319,7 +353,7 @@ impl DemoSummary {
                 c.configuration,
                 c.case,
                 if c.passed { "OK  " } else { "MISS" },
-                c.found_effects.join(", "),
+                joined(&c.found_effects),
                 c.heldout_ratio,
                 if c.failures.is_empty() {
                     String::new()
@@ -469,11 +503,11 @@ impl DemoSummary {
                     )
                 })
                 .collect();
-            let list = |v: &[String]| {
+            let list = |v: &[EffectId]| {
                 if v.is_empty() {
                     "none".to_string()
                 } else {
-                    v.join(", ")
+                    joined(v)
                 }
             };
             let _ = writeln!(

@@ -7,8 +7,8 @@
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use physics::{
-    Delay, DragLag, Effects, QuadraticDrag, RotorDrag, ThrustMap, ThrustTilt, TranslationalLift,
-    Wind, WindGradient,
+    Delay, DragLag, EffectId, Effects, QuadraticDrag, RotorDrag, ThrustMap, ThrustTilt,
+    TranslationalLift, Wind, WindGradient,
 };
 use rayon::prelude::*;
 use serde::Serialize;
@@ -28,16 +28,16 @@ pub enum VehicleParameter {
 }
 
 impl VehicleParameter {
-    /// The effect id it belongs to.
-    pub fn effect_id(self) -> &'static str {
+    /// The effect it belongs to.
+    pub fn effect_id(self) -> EffectId {
         match self {
-            Self::ThrustMap(_) => "thrust_map",
-            Self::Tilt(_) => "thrust_tilt",
-            Self::RotorDrag(_) => "rotor_drag",
-            Self::Lift => "translational_lift",
-            Self::QuadraticDrag => "quadratic_drag",
-            Self::Delay => "delay",
-            Self::DragLag => "drag_lag",
+            Self::ThrustMap(_) => EffectId::ThrustMap,
+            Self::Tilt(_) => EffectId::ThrustTilt,
+            Self::RotorDrag(_) => EffectId::RotorDrag,
+            Self::Lift => EffectId::TranslationalLift,
+            Self::QuadraticDrag => EffectId::QuadraticDrag,
+            Self::Delay => EffectId::Delay,
+            Self::DragLag => EffectId::DragLag,
         }
     }
 
@@ -74,18 +74,27 @@ impl VehicleParameter {
     }
 }
 
-/// The parameters of the vehicle effect `id`.
-pub fn parameters_of(id: &str) -> Vec<VehicleParameter> {
+/// The vehicle parameters of effect `id`: none for the effects the joint analysis does not fit
+/// as a property of the vehicle (the air's velocity and gradient are fitted per flight, see
+/// [`Air`]; the others are not among its candidates).
+pub fn parameters_of(id: EffectId) -> Vec<VehicleParameter> {
     use VehicleParameter as P;
     match id {
-        "thrust_map" => vec![P::ThrustMap(0), P::ThrustMap(1), P::ThrustMap(2)],
-        "thrust_tilt" => vec![P::Tilt(0), P::Tilt(1)],
-        "rotor_drag" => vec![P::RotorDrag(0), P::RotorDrag(1)],
-        "translational_lift" => vec![P::Lift],
-        "quadratic_drag" => vec![P::QuadraticDrag],
-        "delay" => vec![P::Delay],
-        "drag_lag" => vec![P::DragLag],
-        _ => Vec::new(),
+        EffectId::ThrustMap => vec![P::ThrustMap(0), P::ThrustMap(1), P::ThrustMap(2)],
+        EffectId::ThrustTilt => vec![P::Tilt(0), P::Tilt(1)],
+        EffectId::RotorDrag => vec![P::RotorDrag(0), P::RotorDrag(1)],
+        EffectId::TranslationalLift => vec![P::Lift],
+        EffectId::QuadraticDrag => vec![P::QuadraticDrag],
+        EffectId::Delay => vec![P::Delay],
+        EffectId::DragLag => vec![P::DragLag],
+        EffectId::Wind
+        | EffectId::WindGradient
+        | EffectId::LinearDrag
+        | EffectId::ThrustScale
+        | EffectId::MotorLag
+        | EffectId::GroundEffect
+        | EffectId::TorqueBias
+        | EffectId::InertiaScale => Vec::new(),
     }
 }
 
@@ -100,26 +109,27 @@ pub struct Vehicle {
 
 impl Vehicle {
     /// The effect ids present, in order of first appearance (`wind_gradient` last).
-    pub fn ids(&self) -> Vec<&'static str> {
-        let mut ids: Vec<&'static str> = Vec::new();
+    pub fn ids(&self) -> Vec<EffectId> {
+        let mut ids: Vec<EffectId> = Vec::new();
         for p in &self.parameters {
             if !ids.contains(&p.effect_id()) {
                 ids.push(p.effect_id());
             }
         }
         if self.gradient {
-            ids.push("wind_gradient");
+            ids.push(EffectId::WindGradient);
         }
         ids
     }
 
-    /// Adds effect `id` at its neutral values, or `start` (nothing if present).
-    pub fn with(&self, id: &str, start: Option<&[f64]>) -> Self {
+    /// Adds effect `id` at its neutral values, or `start` (nothing if present, or if `id` has no
+    /// vehicle parameters: see [`parameters_of`]).
+    pub fn with(&self, id: EffectId, start: Option<&[f64]>) -> Self {
         let mut out = self.clone();
         if self.ids().contains(&id) {
             return out;
         }
-        if id == "wind_gradient" {
+        if id == EffectId::WindGradient {
             out.gradient = true;
             return out;
         }

@@ -36,7 +36,7 @@ mod sensitivity;
 use std::path::{Path, PathBuf};
 
 use data::ExperimentConditions;
-use physics::NominalModel;
+use physics::{EffectId, NominalModel};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -75,19 +75,19 @@ impl Default for FleetSettings {
 }
 
 /// Effects the calm flights are tried with, in this order.
-const CALM_CANDIDATES: [&str; 6] = [
-    "thrust_map",
-    "thrust_tilt",
-    "rotor_drag",
-    "quadratic_drag",
-    "delay",
-    "drag_lag",
+const CALM_CANDIDATES: [EffectId; 6] = [
+    EffectId::ThrustMap,
+    EffectId::ThrustTilt,
+    EffectId::RotorDrag,
+    EffectId::QuadraticDrag,
+    EffectId::Delay,
+    EffectId::DragLag,
 ];
 /// Effects only moving air shows, tried on all flights. Drag laws are not among them: they are
 /// identified where the airspeed is known (in still air), since with unknown winds a drag law's
 /// shape trades against the winds' scale (a term growing with the square of the airspeed can
 /// shrink every wind in proportion).
-const WIND_CANDIDATES: [&str; 2] = ["wind_gradient", "translational_lift"];
+const WIND_CANDIDATES: [EffectId; 2] = [EffectId::WindGradient, EffectId::TranslationalLift];
 
 /// The spread of positions (standard deviation) along an axis from which a flight's air gradient
 /// is fitted along it, m.
@@ -321,7 +321,7 @@ pub struct SelectionStep {
     /// `calm` (held-out error of the calm flights) or `transfer` (held-out error of each windy
     /// condition with the vehicle fitted without it).
     pub stage: String,
-    pub candidate: String,
+    pub candidate: EffectId,
     pub error_before: f64,
     pub error_with: f64,
     pub accepted: bool,
@@ -424,14 +424,25 @@ fn still_airs(flights: &[FleetFlight], vehicle: &Vehicle) -> Vec<Air> {
         .collect()
 }
 
-/// Starting values tried for the nonlinear effects.
-fn starts(id: &str) -> Vec<Option<Vec<f64>>> {
+/// Starting values tried for effect `id`: several for the nonlinear effects, one at its neutral
+/// values (`None`) for the others.
+fn starts(id: EffectId) -> Vec<Option<Vec<f64>>> {
     match id {
-        "delay" => vec![Some(vec![0.04]), Some(vec![0.1]), Some(vec![0.16])],
-        "drag_lag" => vec![Some(vec![0.1]), Some(vec![0.3]), Some(vec![0.6])],
-        "rotor_drag" => vec![Some(vec![0.3, 0.1])],
-        "quadratic_drag" => vec![Some(vec![0.02])],
-        _ => vec![None],
+        EffectId::Delay => vec![Some(vec![0.04]), Some(vec![0.1]), Some(vec![0.16])],
+        EffectId::DragLag => vec![Some(vec![0.1]), Some(vec![0.3]), Some(vec![0.6])],
+        EffectId::RotorDrag => vec![Some(vec![0.3, 0.1])],
+        EffectId::QuadraticDrag => vec![Some(vec![0.02])],
+        EffectId::LinearDrag
+        | EffectId::Wind
+        | EffectId::ThrustScale
+        | EffectId::MotorLag
+        | EffectId::GroundEffect
+        | EffectId::TorqueBias
+        | EffectId::InertiaScale
+        | EffectId::ThrustMap
+        | EffectId::ThrustTilt
+        | EffectId::TranslationalLift
+        | EffectId::WindGradient => vec![None],
     }
 }
 
@@ -457,19 +468,19 @@ fn calibrate_calm(
         settings.min_step,
         selection,
         |vehicle| {
-            let trials: Vec<(&str, Option<Vec<f64>>)> = CALM_CANDIDATES
+            let trials: Vec<(EffectId, Option<Vec<f64>>)> = CALM_CANDIDATES
                 .into_iter()
                 .filter(|id| !vehicle.ids().contains(id))
-                .filter(|id| *id != "drag_lag" || vehicle.feels_wind())
+                .filter(|id| *id != EffectId::DragLag || vehicle.feels_wind())
                 .flat_map(|id| starts(id).into_iter().map(move |start| (id, start)))
                 .collect();
-            let scored: Vec<(String, Vehicle, f64)> = trials
+            let scored: Vec<(EffectId, Vehicle, f64)> = trials
                 .par_iter()
                 .map(|(id, start)| {
-                    let trial = vehicle.with(id, start.as_deref());
+                    let trial = vehicle.with(*id, start.as_deref());
                     let fitted = fit_two_step(&fit_rows, &trial, &[], true, settings.iterations);
                     let trial_error = score(&fitted.vehicle);
-                    (id.to_string(), fitted.vehicle, trial_error)
+                    (*id, fitted.vehicle, trial_error)
                 })
                 .collect();
             first_lowest(scored)
@@ -478,7 +489,7 @@ fn calibrate_calm(
 }
 
 /// The trial with the lowest error, the first in order among equals.
-fn first_lowest(trials: Vec<(String, Vehicle, f64)>) -> Option<(String, Vehicle, f64)> {
+fn first_lowest(trials: Vec<(EffectId, Vehicle, f64)>) -> Option<(EffectId, Vehicle, f64)> {
     trials.into_iter().fold(None, |best, trial| match best {
         Some(b) if b.2 <= trial.2 => Some(b),
         _ => Some(trial),
@@ -493,7 +504,7 @@ fn forward_select(
     mut error: f64,
     min_step: f64,
     selection: &mut Vec<SelectionStep>,
-    best_candidate: impl Fn(&Vehicle) -> Option<(String, Vehicle, f64)>,
+    best_candidate: impl Fn(&Vehicle) -> Option<(EffectId, Vehicle, f64)>,
 ) -> Vehicle {
     while let Some((id, candidate, candidate_error)) = best_candidate(&vehicle) {
         let accepted = candidate_error <= (1.0 - min_step) * error;
@@ -606,17 +617,17 @@ fn add_wind_effects(
         selection,
         |vehicle| {
             // Every wind candidate needs a drag for the air to act through.
-            let trials: Vec<(&str, Option<Vec<f64>>)> = WIND_CANDIDATES
+            let trials: Vec<(EffectId, Option<Vec<f64>>)> = WIND_CANDIDATES
                 .into_iter()
                 .filter(|id| !vehicle.ids().contains(id) && vehicle.feels_wind())
                 .flat_map(|id| starts(id).into_iter().map(move |start| (id, start)))
                 .collect();
-            let scored: Vec<(String, Vehicle, f64)> = trials
+            let scored: Vec<(EffectId, Vehicle, f64)> = trials
                 .par_iter()
                 .map(|(id, start)| {
-                    let trial = vehicle.with(id, start.as_deref());
+                    let trial = vehicle.with(*id, start.as_deref());
                     let trial_error = transfer_error(flights, &trial, settings);
-                    (id.to_string(), trial, trial_error)
+                    (*id, trial, trial_error)
                 })
                 .collect();
             first_lowest(scored)

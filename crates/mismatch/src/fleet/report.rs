@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use physics::NominalModel;
+use physics::{EffectId, NominalModel};
 use plotters::prelude::*;
 use serde::Serialize;
 
@@ -76,7 +76,7 @@ pub struct FlightHeldout {
 /// One vehicle effect: id, parameters, plain words.
 #[derive(Clone, Debug, Serialize)]
 pub struct VehicleEffect {
-    pub id: String,
+    pub id: EffectId,
     pub parameters: serde_json::Value,
     pub description: String,
 }
@@ -122,7 +122,7 @@ fn gradient_effect(airs: &[Air]) -> VehicleEffect {
         .flat_map(|a| a.values.iter().skip(3))
         .fold(0.0f64, |m, v| m.max(v.abs()));
     VehicleEffect {
-        id: "wind_gradient".into(),
+        id: EffectId::WindGradient,
         parameters: serde_json::json!({"per_flight": "flights[].gradient_per_m"}),
         description: format!(
             "The air is not uniform where the vehicle flies: each windy flight's air velocity varies along the axes the flight spans, by up to {largest:.2} m/s per metre (the per-flight gradients are with the flights)."
@@ -212,12 +212,12 @@ impl FleetReport {
                 .ids()
                 .into_iter()
                 .map(|id| {
-                    if id == "wind_gradient" {
+                    if id == EffectId::WindGradient {
                         return gradient_effect(&found.airs);
                     }
                     VehicleEffect {
-                        id: id.to_string(),
-                        parameters: effects_json(&found.vehicle)[id].clone(),
+                        id,
+                        parameters: effects_json(&found.vehicle)[id.name()].clone(),
                         description: describe(id, &effects),
                     }
                 })

@@ -6,8 +6,9 @@
 //! the experiment behind the paper's LeARN columns ([`Experiment`]), and the same model on any
 //! multi-task CSV set ([`meta_train_tasks`], [`evaluate_recording`], [`explain_recording`]).
 //!
-//! What it is not for: reading flight files or estimating derivatives (the `data` crate), SINDy
-//! (`sindy`), tables and figures (`report`), the command line (`cli`).
+//! What it is not for: reading flight files (the `data` crate), estimating derivatives
+//! (`sindy::differentiation`), SINDy (`sindy`), tables and figures (`report`), the command line
+//! (`cli`).
 //!
 //! # Public API
 //!

@@ -25,6 +25,7 @@ mod jitter;
 mod logger;
 mod model;
 mod residual;
+mod scenario;
 mod simulator;
 mod trajectory;
 pub mod vector;
@@ -44,11 +45,12 @@ pub use logger::{
 };
 pub use model::{Mixer, NominalModel, ThrustSource, Wrench, angular_acceleration_with_inertia};
 pub use residual::{five_point_derivative, residual_force};
-pub use simulator::{
+pub use scenario::{
     MAX_DELAY_S, MAX_DURATION_S, MAX_LOG_ROWS, MAX_NOISE, MAX_PHYSICS_RATE_HZ,
     MAX_REFERENCE_ACCELERATION_M_S2, MAX_WARMUP_S, MIN_HOVER_THROTTLE, MIN_LOG_ROWS,
-    MIN_PHYSICS_RATE_HZ, Noise, Scenario, simulate,
+    MIN_PHYSICS_RATE_HZ, Noise, Scenario,
 };
+pub use simulator::simulate;
 pub use trajectory::{
     LowPass, MAX_POSITION_M, MAX_WAYPOINTS, MAX_YAW_RATE_RAD_S, Reference, ReferenceGenerator,
     Trajectory,

@@ -153,14 +153,7 @@ impl Formulation {
                 controls[(i, j)] = buffer[dim_x + j];
             }
         }
-        let dt = log.sample_interval();
-        let mut targets = Mat::<f64>::zeros(n, dim_x);
-        for j in 0..dim_x {
-            let column: Vec<f64> = (0..n).map(|i| states[(i, j)]).collect();
-            for (i, value) in derivative.apply(&column, dt)?.into_iter().enumerate() {
-                targets[(i, j)] = value;
-            }
-        }
+        let targets = derivative.apply_columns(states.as_ref(), log.sample_interval())?;
         Ok(Segment {
             formulation: *self,
             time: log.time[rows.clone()].to_vec(),

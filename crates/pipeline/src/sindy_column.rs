@@ -122,14 +122,7 @@ fn estimate(segment: &Segment, derivative: Derivative) -> sindy::Result<Mat<f64>
         return Err(shape("support segment", "needs at least two samples"));
     }
     let dt = (segment.time[n - 1] - segment.time[0]) / (n - 1) as f64;
-    let mut targets = Mat::zeros(n, segment.states.ncols());
-    for j in 0..segment.states.ncols() {
-        let column: Vec<f64> = segment.states.col(j).iter().copied().collect();
-        for (i, value) in derivative.apply(&column, dt)?.into_iter().enumerate() {
-            targets[(i, j)] = value;
-        }
-    }
-    Ok(targets)
+    Ok(derivative.apply_columns(segment.states.as_ref(), dt)?)
 }
 
 /// Cuts `log` with `split`, builds both segments of `formulation` (each with its own derivative

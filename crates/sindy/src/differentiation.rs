@@ -130,6 +130,18 @@ impl Derivative {
             Self::SavitzkyGolay { window, order } => savitzky_golay(x, dt, window, order),
         })
     }
+
+    /// [`Derivative::apply`] to each column of `x` (one row per sample, sampled every `dt`).
+    pub fn apply_columns(&self, x: faer::MatRef<'_, f64>, dt: f64) -> Result<faer::Mat<f64>> {
+        let mut derivatives = faer::Mat::zeros(x.nrows(), x.ncols());
+        for j in 0..x.ncols() {
+            let column: Vec<f64> = x.col(j).iter().copied().collect();
+            for (i, value) in self.apply(&column, dt)?.into_iter().enumerate() {
+                derivatives[(i, j)] = value;
+            }
+        }
+        Ok(derivatives)
+    }
 }
 
 impl std::fmt::Display for Derivative {

@@ -97,14 +97,7 @@ impl Trajectory {
             return Err(shape("trajectory", "needs at least two samples"));
         }
         let dt = (self.time[n - 1] - self.time[0]) / (n - 1) as f64;
-        let mut targets = Mat::zeros(n, self.states.ncols());
-        for j in 0..self.states.ncols() {
-            let column: Vec<f64> = (0..n).map(|i| self.states[(i, j)]).collect();
-            for (i, value) in derivative.apply(&column, dt)?.into_iter().enumerate() {
-                targets[(i, j)] = value;
-            }
-        }
-        Ok(targets)
+        Ok(derivative.apply_columns(self.states.as_ref(), dt)?)
     }
 }
 

@@ -17,6 +17,12 @@ pub(crate) fn hold() -> MutexGuard<'static, Vec<PathBuf>> {
         .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
+/// The registry, held, with the handler installed: an interrupt waits until it is released.
+pub(crate) fn hold_installed() -> MutexGuard<'static, Vec<PathBuf>> {
+    install();
+    hold()
+}
+
 /// The registry unless this thread holds it already (a drop inside a commit).
 pub(crate) fn try_hold() -> Result<MutexGuard<'static, Vec<PathBuf>>, ()> {
     match STAGING.try_lock() {

@@ -117,7 +117,11 @@ fn prepare_folder(plan: &FolderPlan, created: &mut Vec<PathBuf>) -> Result<Stage
             option: plan.option.clone(),
         });
     }
-    finish_journal(dir)?;
+    {
+        // A killed commit is finished whole: an interrupt waits for it, as for any commit.
+        let _registry = signals::hold_installed();
+        finish_journal(dir)?;
+    }
     remove_dead_staging(dir);
     let staging = signals::create_registered(
         || {
@@ -148,11 +152,26 @@ fn prepare_folder(plan: &FolderPlan, created: &mut Vec<PathBuf>) -> Result<Stage
 
 /// Creates and removes a file in `dir`: a rename into it will work.
 fn probe(dir: &Path, option: &str) -> Result<()> {
-    tempfile::Builder::new()
-        .prefix(&staging_prefix())
-        .tempfile_in(dir)
-        .map(drop)
-        .map_err(not_writable(dir, option))
+    probe_observed(dir, option, |_| {})
+}
+
+/// [`probe`], calling `while_present` while the probe file exists. The file is registered like
+/// any staging, so an interrupt at any moment removes it.
+fn probe_observed(dir: &Path, option: &str, while_present: impl FnOnce(&Path)) -> Result<()> {
+    let file = signals::create_registered(
+        || {
+            tempfile::Builder::new()
+                .prefix(&staging_prefix())
+                .tempfile_in(dir)
+                .map(tempfile::NamedTempFile::into_temp_path)
+                .map_err(not_writable(dir, option))
+        },
+        |file| file.to_path_buf(),
+    )?;
+    while_present(&file);
+    let mut registry = signals::hold();
+    signals::unregister(&mut registry, &file);
+    file.close().map_err(io(dir))
 }
 
 /// Stages a named file beside its target (which proves the folder writable).
@@ -406,5 +425,27 @@ impl Drop for Staged {
                 let _ = std::fs::remove_dir(dir);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The writability probe is staging like any other: registered while it exists (an interrupt
+    /// then removes it; unregistered, a SIGINT at that moment left it behind), gone afterwards.
+    #[test]
+    fn the_probe_is_registered_while_it_exists() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut seen = None;
+        probe_observed(dir.path(), "--out", |file| {
+            assert!(file.exists());
+            assert!(signals::hold().iter().any(|p| p == file), "registered");
+            seen = Some(file.to_path_buf());
+        })
+        .unwrap();
+        let file = seen.expect("the probe ran");
+        assert!(!file.exists(), "removed");
+        assert!(!signals::hold().contains(&file), "unregistered");
     }
 }

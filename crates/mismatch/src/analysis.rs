@@ -2,7 +2,7 @@
 //! on held-out data.
 
 use data::{FlightLog, RateFrame};
-use physics::{EffectId, Effects, Logger, NominalModel};
+use physics::{EffectId, EffectParameters, Effects, Logger, NominalModel};
 use serde::Serialize;
 
 use crate::describe::describe;
@@ -86,7 +86,7 @@ pub struct Window {
 #[derive(Clone, Debug, Serialize)]
 pub struct EffectReport {
     pub id: EffectId,
-    pub parameters: serde_json::Value,
+    pub parameters: EffectParameters,
     pub description: String,
     /// This effect's share of the nominal model's noise-normalised residual sum of squares (fit
     /// part) that the fitted effects remove, in [0, 1]; the shares sum to the total removed.
@@ -419,14 +419,15 @@ fn build_report(
     let nominal_sse = problem.whitened_sse(residuals.before, fit_rows.clone());
     let fitted_sse = problem.whitened_sse(residuals.after, fit_rows.clone());
     let shares = explained_fractions(&judgement.evidence, nominal_sse, fitted_sse);
-    let parameters = serde_json::to_value(effects).expect("effects serialise");
     let effect_reports = judgement
         .evidence
         .iter()
         .zip(shares)
         .map(|(evidence, share)| EffectReport {
             id: evidence.id,
-            parameters: parameters[evidence.id.name()].clone(),
+            parameters: effects
+                .parameters(evidence.id)
+                .expect("a named effect is in the fitted set"),
             description: describe(evidence.id, &effects),
             explained_fraction: share,
             evidence: evidence.clone(),

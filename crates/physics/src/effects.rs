@@ -114,6 +114,50 @@ pub struct WindGradient {
 /// The largest thrust-axis tilt angle accepted, rad.
 pub const MAX_TILT_RAD: f64 = 0.5;
 
+/// One effect's parameters: serialises as that effect's entry in [`Effects`]' JSON.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum EffectParameters {
+    LinearDrag(LinearDrag),
+    QuadraticDrag(QuadraticDrag),
+    Wind(Wind),
+    ThrustScale(ThrustScale),
+    MotorLag(MotorLag),
+    GroundEffect(GroundEffect),
+    TorqueBias(TorqueBias),
+    InertiaScale(InertiaScale),
+    Delay(Delay),
+    ThrustMap(ThrustMap),
+    ThrustTilt(ThrustTilt),
+    RotorDrag(RotorDrag),
+    TranslationalLift(TranslationalLift),
+    DragLag(DragLag),
+    WindGradient(WindGradient),
+}
+
+impl EffectParameters {
+    /// The effect these parameters belong to.
+    pub fn id(&self) -> EffectId {
+        match self {
+            Self::LinearDrag(_) => EffectId::LinearDrag,
+            Self::QuadraticDrag(_) => EffectId::QuadraticDrag,
+            Self::Wind(_) => EffectId::Wind,
+            Self::ThrustScale(_) => EffectId::ThrustScale,
+            Self::MotorLag(_) => EffectId::MotorLag,
+            Self::GroundEffect(_) => EffectId::GroundEffect,
+            Self::TorqueBias(_) => EffectId::TorqueBias,
+            Self::InertiaScale(_) => EffectId::InertiaScale,
+            Self::Delay(_) => EffectId::Delay,
+            Self::ThrustMap(_) => EffectId::ThrustMap,
+            Self::ThrustTilt(_) => EffectId::ThrustTilt,
+            Self::RotorDrag(_) => EffectId::RotorDrag,
+            Self::TranslationalLift(_) => EffectId::TranslationalLift,
+            Self::DragLag(_) => EffectId::DragLag,
+            Self::WindGradient(_) => EffectId::WindGradient,
+        }
+    }
+}
+
 /// A set of effects; `None` means absent. Serialises as `{"<id>": {<parameters>}, ...}`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -298,6 +342,29 @@ impl Effects {
             EffectId::TranslationalLift => self.translational_lift.is_some(),
             EffectId::DragLag => self.drag_lag.is_some(),
             EffectId::WindGradient => self.wind_gradient.is_some(),
+        }
+    }
+
+    /// The parameters of effect `id`, when present.
+    pub fn parameters(&self, id: EffectId) -> Option<EffectParameters> {
+        match id {
+            EffectId::LinearDrag => self.linear_drag.map(EffectParameters::LinearDrag),
+            EffectId::QuadraticDrag => self.quadratic_drag.map(EffectParameters::QuadraticDrag),
+            EffectId::Wind => self.wind.map(EffectParameters::Wind),
+            EffectId::ThrustScale => self.thrust_scale.map(EffectParameters::ThrustScale),
+            EffectId::MotorLag => self.motor_lag.map(EffectParameters::MotorLag),
+            EffectId::GroundEffect => self.ground_effect.map(EffectParameters::GroundEffect),
+            EffectId::TorqueBias => self.torque_bias.map(EffectParameters::TorqueBias),
+            EffectId::InertiaScale => self.inertia_scale.map(EffectParameters::InertiaScale),
+            EffectId::Delay => self.delay.map(EffectParameters::Delay),
+            EffectId::ThrustMap => self.thrust_map.map(EffectParameters::ThrustMap),
+            EffectId::ThrustTilt => self.thrust_tilt.map(EffectParameters::ThrustTilt),
+            EffectId::RotorDrag => self.rotor_drag.map(EffectParameters::RotorDrag),
+            EffectId::TranslationalLift => self
+                .translational_lift
+                .map(EffectParameters::TranslationalLift),
+            EffectId::DragLag => self.drag_lag.map(EffectParameters::DragLag),
+            EffectId::WindGradient => self.wind_gradient.map(EffectParameters::WindGradient),
         }
     }
 
@@ -530,6 +597,20 @@ mod tests {
             let json = serde_json::to_value(without).unwrap();
             assert!(json.get(id.name()).is_none(), "{id}");
             assert_eq!(json.as_object().unwrap().len(), EffectId::ALL.len() - 1);
+        }
+    }
+
+    /// An effect's typed parameters serialise exactly as its entry in the set's JSON, and know
+    /// their id; absent effects have none.
+    #[test]
+    fn typed_parameters_are_the_entries_of_the_set() {
+        let every = every_effect();
+        let json = serde_json::to_value(every).unwrap();
+        for id in EffectId::ALL {
+            let parameters = every.parameters(id).unwrap();
+            assert_eq!(parameters.id(), id);
+            assert_eq!(serde_json::to_value(parameters).unwrap(), json[id.name()]);
+            assert!(Effects::default().parameters(id).is_none(), "{id}");
         }
     }
 

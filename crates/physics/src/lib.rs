@@ -34,9 +34,9 @@ mod writer;
 pub use controller::{ControlOutput, Gains, GeometricController, MeasuredState};
 pub use effect_id::{EffectId, UnknownEffectId};
 pub use effects::{
-    Delay, DragLag, Effects, GROUND_EFFECT_MAX_RATIO, GroundEffect, InertiaScale, LinearDrag,
-    MAX_TILT_RAD, MotorLag, QuadraticDrag, RotorDrag, ThrustMap, ThrustScale, ThrustTilt,
-    TorqueBias, TranslationalLift, Wind, WindGradient, ground_ratio,
+    Delay, DragLag, EffectParameters, Effects, GROUND_EFFECT_MAX_RATIO, GroundEffect, InertiaScale,
+    LinearDrag, MAX_TILT_RAD, MotorLag, QuadraticDrag, RotorDrag, ThrustMap, ThrustScale,
+    ThrustTilt, TorqueBias, TranslationalLift, Wind, WindGradient, ground_ratio,
 };
 pub use error::{PhysicsError, Result};
 pub use jitter::{Jitter, JitterSignal, MAX_JITTER};

@@ -4,13 +4,12 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use physics::{EffectId, NominalModel};
+use physics::{EffectId, EffectParameters, Effects, NominalModel};
 use plotters::prelude::*;
 use serde::Serialize;
 
 use super::{
     Air, AttitudeCheck, FleetFlight, FleetSettings, Identification, ScaleReport, SelectionStep,
-    Vehicle,
 };
 use crate::describe::describe;
 use crate::error::{MismatchError, Result, io_error};
@@ -77,8 +76,19 @@ pub struct FlightHeldout {
 #[derive(Clone, Debug, Serialize)]
 pub struct VehicleEffect {
     pub id: EffectId,
-    pub parameters: serde_json::Value,
+    pub parameters: VehicleParameters,
     pub description: String,
+}
+
+/// A vehicle effect's parameters: fitted for the vehicle, or kept with each flight.
+#[derive(Clone, Copy, Debug, Serialize)]
+#[serde(untagged)]
+pub enum VehicleParameters {
+    Fitted(EffectParameters),
+    /// Where in the report the per-flight values are (`flights[].gradient_per_m`).
+    PerFlight {
+        per_flight: &'static str,
+    },
 }
 
 /// Everything written to `<model stem>.json`.
@@ -97,7 +107,7 @@ pub struct FleetReport {
     /// How the winds move with the drag lag across what the calm flights leave open.
     pub scale: Option<ScaleReport>,
     /// Per validation group: the vehicle fitted without it.
-    pub validation_vehicles: Vec<(String, serde_json::Value)>,
+    pub validation_vehicles: Vec<(String, Effects)>,
     pub settings: FleetSettings,
     /// What the reader should know about how the numbers were made.
     pub notes: Vec<String>,
@@ -111,10 +121,6 @@ pub struct VehicleReport {
     pub effects: Vec<VehicleEffect>,
 }
 
-fn effects_json(vehicle: &Vehicle) -> serde_json::Value {
-    serde_json::to_value(vehicle.effects(None)).expect("effects serialise")
-}
-
 /// The air's spatial variation: a property of each windy flight's air, summarised.
 fn gradient_effect(airs: &[Air]) -> VehicleEffect {
     let largest = airs
@@ -123,7 +129,9 @@ fn gradient_effect(airs: &[Air]) -> VehicleEffect {
         .fold(0.0f64, |m, v| m.max(v.abs()));
     VehicleEffect {
         id: EffectId::WindGradient,
-        parameters: serde_json::json!({"per_flight": "flights[].gradient_per_m"}),
+        parameters: VehicleParameters::PerFlight {
+            per_flight: "flights[].gradient_per_m",
+        },
         description: format!(
             "The air is not uniform where the vehicle flies: each windy flight's air velocity varies along the axes the flight spans, by up to {largest:.2} m/s per metre (the per-flight gradients are with the flights)."
         ),
@@ -217,7 +225,9 @@ impl FleetReport {
                     }
                     VehicleEffect {
                         id,
-                        parameters: effects_json(&found.vehicle)[id.name()].clone(),
+                        parameters: VehicleParameters::Fitted(
+                            effects.parameters(id).expect("an effect of the vehicle"),
+                        ),
                         description: describe(id, &effects),
                     }
                 })
@@ -269,7 +279,7 @@ impl FleetReport {
             validation_vehicles: found
                 .validation_vehicles
                 .iter()
-                .map(|(name, v)| (name.clone(), effects_json(v)))
+                .map(|(name, v)| (name.clone(), v.effects(None)))
                 .collect(),
             settings,
             notes,
@@ -337,7 +347,9 @@ impl FleetReport {
                 md,
                 "- **{}** `{}` — {}",
                 e.id,
-                e.parameters.to_string().replace(',', ", "),
+                serde_json::to_string(&e.parameters)
+                    .expect("parameters serialise")
+                    .replace(',', ", "),
                 e.description
             );
         }

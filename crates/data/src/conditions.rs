@@ -112,6 +112,13 @@ impl ExperimentConditions {
             field: field.to_string(),
             message,
         };
+        self.validate_controllers(&config_error)?;
+        self.validate_conditions(&config_error)?;
+        self.validate_paper_training(&config_error)
+    }
+
+    /// Controller names: non-empty, one path component each, listed once.
+    fn validate_controllers(&self, config_error: &dyn Fn(&str, String) -> DataError) -> Result<()> {
         for (index, controller) in self.controllers.iter().enumerate() {
             if controller.trim().is_empty() {
                 return Err(config_error(
@@ -136,6 +143,12 @@ impl ExperimentConditions {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// The conditions: wind speeds, the evaluation controller, the file pattern, each
+    /// condition's files, at least one evaluation condition.
+    fn validate_conditions(&self, config_error: &dyn Fn(&str, String) -> DataError) -> Result<()> {
         for (index, condition) in self.conditions.iter().enumerate() {
             if let Some(speed) = condition.mean_wind_m_s
                 && !(speed.is_finite() && (0.0..=1e3).contains(&speed))
@@ -170,7 +183,7 @@ impl ExperimentConditions {
                     .to_string(),
             ));
         }
-        check_conditions(&self.conditions, "conditions", &config_error)?;
+        check_conditions(&self.conditions, "conditions", config_error)?;
         for (index, condition) in self.conditions.iter().enumerate() {
             if let Some(controller) = condition
                 .files
@@ -205,6 +218,14 @@ impl ExperimentConditions {
                 "no condition has role \"evaluation\" (the tables would have no row)".to_string(),
             ));
         }
+        Ok(())
+    }
+
+    /// The paper's meta-training flights: a pattern by condition, meta-training roles only.
+    fn validate_paper_training(
+        &self,
+        config_error: &dyn Fn(&str, String) -> DataError,
+    ) -> Result<()> {
         let paper = &self.paper_training;
         check_pattern(&paper.file_pattern, &["condition"], &["condition"])
             .map_err(|message| config_error("paper_training.file_pattern", message))?;
@@ -215,11 +236,7 @@ impl ExperimentConditions {
                     .to_string(),
             ));
         }
-        check_conditions(
-            &paper.conditions,
-            "paper_training.conditions",
-            &config_error,
-        )?;
+        check_conditions(&paper.conditions, "paper_training.conditions", config_error)?;
         for (index, condition) in paper.conditions.iter().enumerate() {
             let field = format!("paper_training.conditions[{index}]");
             if condition.role != Role::MetaTraining {

@@ -96,7 +96,16 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
     let base = problem.predict(&Effects::default());
     let mut columns: Vec<Vec<Channels>> = Vec::new();
     let mut candidates = Vec::new();
-    let mut add = |id: CandidateId, terms: Vec<Term>, perturbed: Vec<(Effects, f64)>| {
+    let mut specs = translational_candidates(problem.recording.dt);
+    if problem.channels == 6 {
+        specs.extend(attitude_candidates());
+    }
+    for CandidateSpec {
+        id,
+        terms,
+        perturbed,
+    } in specs
+    {
         let start = columns.len();
         for (effects, step) in perturbed {
             let predicted = problem.predict(&effects);
@@ -119,86 +128,114 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
             terms,
             columns: (start..columns.len()).collect(),
         });
-    };
-    let with = |f: &dyn Fn(&mut Effects)| {
-        let mut e = Effects::default();
-        f(&mut e);
-        e
-    };
-    let step = 1e-3;
-    add(
-        CandidateId::ThrustScale,
-        vec![term("thrust", "R e3 T / m", "m/s²", "k − 1 (1)")],
-        vec![(
-            with(&|e| e.thrust_scale = Some(ThrustScale { k: 1.0 + step })),
-            step,
-        )],
-    );
-    let axes = ["x", "y", "z"];
-    add(
-        CandidateId::LinearDrag,
-        axes.iter()
-            .map(|a| {
-                term(
-                    &format!("rotor_drag_{a}"),
-                    &format!("−R e_{a} e_{a}ᵀ Rᵀ v"),
-                    "m/s",
-                    &format!("d{a} (1/s)"),
-                )
-            })
-            .collect(),
-        (0..3)
-            .map(|i| {
-                let mut d = [0.0; 3];
-                d[i] = 1.0;
-                (with(&|e| e.linear_drag = Some(LinearDrag { d })), 1.0)
-            })
-            .collect(),
-    );
-    add(
-        CandidateId::QuadraticDrag,
-        vec![term("air_drag", "−|v| v", "m²/s²", "c (1/m)")],
-        vec![(
-            with(&|e| e.quadratic_drag = Some(QuadraticDrag { c: 1.0 })),
-            1.0,
-        )],
-    );
+    }
+    (candidates, columns)
+}
+
+/// A candidate before its columns are computed: each column is the model's response to one
+/// perturbed effect set, divided by the perturbation's step.
+struct CandidateSpec {
+    id: CandidateId,
+    terms: Vec<Term>,
+    perturbed: Vec<(Effects, f64)>,
+}
+
+/// The effect set with `f` applied to the empty one.
+fn with(f: &dyn Fn(&mut Effects)) -> Effects {
+    let mut e = Effects::default();
+    f(&mut e);
+    e
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// Relative step of the factor parameters' derivatives.
+const STEP: f64 = 1e-3;
+
+/// The candidates of the translational channels (`dt`: the recording's sample interval).
+fn translational_candidates(dt: f64) -> Vec<CandidateSpec> {
+    let step = STEP;
     let small_radius: f64 = 0.02;
-    add(
-        CandidateId::GroundEffect,
-        vec![term(
-            "ground_thrust",
-            "R e3 T / (16 m z²)",
-            "1/s²",
-            "r² (m²)",
-        )],
-        vec![(
-            with(&|e| e.ground_effect = Some(GroundEffect { r_m: small_radius })),
-            small_radius * small_radius,
-        )],
-    );
-    let timing_step = problem.recording.dt / 4.0;
-    add(
-        CandidateId::DelayOrMotorLag,
-        vec![term(
-            "command_rate",
-            "−d/dt (R e3 T / m, J⁻¹ τ)",
-            "m/s³, rad/s³",
-            "delay or lag time constant (s)",
-        )],
-        vec![(
-            with(&|e| {
-                e.delay = Some(Delay {
-                    delay_s: timing_step,
+    let timing_step = dt / 4.0;
+    vec![
+        CandidateSpec {
+            id: CandidateId::ThrustScale,
+            terms: vec![term("thrust", "R e3 T / m", "m/s²", "k − 1 (1)")],
+            perturbed: vec![(
+                with(&|e| e.thrust_scale = Some(ThrustScale { k: 1.0 + step })),
+                step,
+            )],
+        },
+        CandidateSpec {
+            id: CandidateId::LinearDrag,
+            terms: AXES
+                .iter()
+                .map(|a| {
+                    term(
+                        &format!("rotor_drag_{a}"),
+                        &format!("−R e_{a} e_{a}ᵀ Rᵀ v"),
+                        "m/s",
+                        &format!("d{a} (1/s)"),
+                    )
                 })
-            }),
-            timing_step,
-        )],
-    );
-    if problem.channels == 6 {
-        add(
-            CandidateId::TorqueBias,
-            axes.iter()
+                .collect(),
+            perturbed: (0..3)
+                .map(|i| {
+                    let mut d = [0.0; 3];
+                    d[i] = 1.0;
+                    (with(&|e| e.linear_drag = Some(LinearDrag { d })), 1.0)
+                })
+                .collect(),
+        },
+        CandidateSpec {
+            id: CandidateId::QuadraticDrag,
+            terms: vec![term("air_drag", "−|v| v", "m²/s²", "c (1/m)")],
+            perturbed: vec![(
+                with(&|e| e.quadratic_drag = Some(QuadraticDrag { c: 1.0 })),
+                1.0,
+            )],
+        },
+        CandidateSpec {
+            id: CandidateId::GroundEffect,
+            terms: vec![term(
+                "ground_thrust",
+                "R e3 T / (16 m z²)",
+                "1/s²",
+                "r² (m²)",
+            )],
+            perturbed: vec![(
+                with(&|e| e.ground_effect = Some(GroundEffect { r_m: small_radius })),
+                small_radius * small_radius,
+            )],
+        },
+        CandidateSpec {
+            id: CandidateId::DelayOrMotorLag,
+            terms: vec![term(
+                "command_rate",
+                "−d/dt (R e3 T / m, J⁻¹ τ)",
+                "m/s³, rad/s³",
+                "delay or lag time constant (s)",
+            )],
+            perturbed: vec![(
+                with(&|e| {
+                    e.delay = Some(Delay {
+                        delay_s: timing_step,
+                    })
+                }),
+                timing_step,
+            )],
+        },
+    ]
+}
+
+/// The candidates that act on the angular channels only.
+fn attitude_candidates() -> Vec<CandidateSpec> {
+    let step = STEP;
+    vec![
+        CandidateSpec {
+            id: CandidateId::TorqueBias,
+            terms: AXES
+                .iter()
                 .map(|a| {
                     term(
                         &format!("torque_bias_{a}"),
@@ -208,17 +245,18 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
                     )
                 })
                 .collect(),
-            (0..3)
+            perturbed: (0..3)
                 .map(|i| {
                     let mut b = [0.0; 3];
                     b[i] = 1.0;
                     (with(&|e| e.torque_bias = Some(TorqueBias { b })), 1.0)
                 })
                 .collect(),
-        );
-        add(
-            CandidateId::InertiaScale,
-            axes.iter()
+        },
+        CandidateSpec {
+            id: CandidateId::InertiaScale,
+            terms: AXES
+                .iter()
                 .map(|a| {
                     term(
                         &format!("torque_response_{a}"),
@@ -228,14 +266,13 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
                     )
                 })
                 .collect(),
-            (0..3)
+            perturbed: (0..3)
                 .map(|i| {
                     let mut k = [1.0; 3];
                     k[i] = 1.0 / (1.0 + step);
                     (with(&|e| e.inertia_scale = Some(InertiaScale { k })), step)
                 })
                 .collect(),
-        );
-    }
-    (candidates, columns)
+        },
+    ]
 }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
-use crate::analysis::{Analysis, check_finite};
+use crate::analysis::{Analysis, Report, check_finite};
 use crate::error::{MismatchError, Result, io_error};
 use crate::problem::CHANNEL_NAMES;
 
@@ -86,13 +86,8 @@ fn drawable(lo: f64, hi: f64) -> bool {
     lo.is_finite() && hi.is_finite() && span.is_normal() && span > 0.0
 }
 
-/// The figure: one panel per channel. Fails, without drawing, unless the data are finite and every
-/// axis spans a drawable range (finite ends, a normal positive span).
-pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
-    let plot_error = |e: &dyn std::fmt::Display| MismatchError::Plot {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
+/// Each channel's plotted range; the error says what cannot be drawn.
+fn drawable_ranges(analysis: &Analysis) -> std::result::Result<Vec<(f64, f64)>, String> {
     let problem = &analysis.problem;
     let channels = problem.channels;
     let time = &problem.time;
@@ -101,19 +96,19 @@ pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
         || analysis.after.len() != time.len()
         || channels > CHANNEL_NAMES.len()
     {
-        return Err(plot_error(&format!(
+        return Err(format!(
             "{} times, {} and {} residual rows for {channels} channels",
             time.len(),
             analysis.before.len(),
             analysis.after.len()
-        )));
+        ));
     }
     if !drawable(time[0], time[time.len() - 1]) || time.iter().any(|t| !t.is_finite()) {
-        return Err(plot_error(&format!(
+        return Err(format!(
             "the time axis from {} to {} s cannot be drawn",
             time[0],
             time[time.len() - 1]
-        )));
+        ));
     }
     let mut ranges = Vec::with_capacity(channels);
     for c in 0..channels {
@@ -129,10 +124,10 @@ pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
             .chain(&analysis.after)
             .all(|r| r[c].is_finite());
         if !finite || !drawable(lo, hi) {
-            return Err(plot_error(&format!(
+            return Err(format!(
                 "the residual of {} is not finite or spans no drawable range ({lo} to {hi})",
                 CHANNEL_NAMES[c]
-            )));
+            ));
         }
         ranges.push((lo, hi));
     }
@@ -142,8 +137,22 @@ pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
         .iter()
         .all(|w| w.t_start.is_finite() && w.t_end.is_finite());
     if !windows_drawable {
-        return Err(plot_error(&"a located window has a non-finite time"));
+        return Err("a located window has a non-finite time".to_string());
     }
+    Ok(ranges)
+}
+
+/// The figure: one panel per channel. Fails, without drawing, unless the data are finite and every
+/// axis spans a drawable range (finite ends, a normal positive span).
+pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
+    let plot_error = |e: &dyn std::fmt::Display| MismatchError::Plot {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let ranges = drawable_ranges(analysis).map_err(|message| plot_error(&message))?;
+    let problem = &analysis.problem;
+    let channels = problem.channels;
+    let time = &problem.time;
     let root = SVGBackend::new(path, (1100, 60 + 190 * channels as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_error(&e))?;
     let (title, body) = root.split_vertically(50);
@@ -225,8 +234,17 @@ pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
 
 /// The report in plain words.
 pub fn markdown_text(analysis: &Analysis) -> String {
-    let report = &analysis.report;
     let mut md = String::new();
+    header_markdown(&analysis.report, &mut md);
+    disagreement_markdown(analysis, &mut md);
+    effects_markdown(&analysis.report, &mut md);
+    candidates_markdown(&analysis.report, &mut md);
+    fit_markdown(&analysis.report, &mut md);
+    md
+}
+
+/// The title, the comparison and the frame of the body rates.
+fn header_markdown(report: &Report, md: &mut String) {
     let _ = writeln!(md, "# Sim-to-real mismatch: {}\n", report.recording);
     let _ = writeln!(
         md,
@@ -242,6 +260,11 @@ pub fn markdown_text(analysis: &Analysis) -> String {
         "The `w` column was read in {frame}: it matches the rate implied by the recorded attitude with an RMS error of {:.4} rad/s in the body frame and {:.4} rad/s in the world frame.\n",
         report.rate_frame.body_rms, report.rate_frame.world_rms
     );
+}
+
+/// The channels against their noise floors and the stretches that disagree.
+fn disagreement_markdown(analysis: &Analysis, md: &mut String) {
+    let report = &analysis.report;
     let _ = writeln!(md, "## Where the model and the recording disagree\n");
     let _ = writeln!(
         md,
@@ -283,6 +306,10 @@ pub fn markdown_text(analysis: &Analysis) -> String {
             );
         }
     }
+}
+
+/// The evidence rule, the effects named and those not named, what remains unexplained.
+fn effects_markdown(report: &Report, md: &mut String) {
     let _ = writeln!(md, "\n## What is missing from the model\n");
     let rule = report.settings.evidence;
     let _ = writeln!(
@@ -346,6 +373,10 @@ pub fn markdown_text(analysis: &Analysis) -> String {
             );
         }
     }
+}
+
+/// Every candidate with its selection frequency, and the command-rate alternatives.
+fn candidates_markdown(report: &Report, md: &mut String) {
     let _ = writeln!(
         md,
         "\nCandidates and how often each was chosen in {} bootstrap resamples:\n",
@@ -374,6 +405,10 @@ pub fn markdown_text(analysis: &Analysis) -> String {
             serde_json::Value::Object(timing.clone())
         );
     }
+}
+
+/// The fit and held-out errors before and after.
+fn fit_markdown(report: &Report, md: &mut String) {
     let fit = &report.fit;
     let reduction = |before: f64, after: f64| 100.0 * (1.0 - after / before.max(1e-300));
     let _ = writeln!(md, "\n## Does the fit improve?\n");
@@ -401,5 +436,4 @@ pub fn markdown_text(analysis: &Analysis) -> String {
         reduction(fit.heldout.before.mse, fit.heldout.after.mse)
     );
     let _ = writeln!(md, "\nFigure: `mismatch.svg`.");
-    md
 }

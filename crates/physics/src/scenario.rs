@@ -193,11 +193,25 @@ impl Scenario {
     /// at [`MAX_REFERENCE_ACCELERATION_M_S2`]. Together these keep every value of the simulated log
     /// inside the ranges the data tools accept (`PLAUSIBLE_RANGES` of the data crate).
     pub fn validate(&self, origin: &Path) -> Result<()> {
-        let field = |field: String, message: String| PhysicsError::Field {
-            path: origin.to_path_buf(),
-            field,
-            message,
-        };
+        self.validate_rates(origin)?;
+        self.validate_timing(origin)?;
+        let rows = self.rows();
+        if !(MIN_LOG_ROWS..=MAX_LOG_ROWS).contains(&rows) {
+            return Err(field_error(
+                origin,
+                "duration_s".into(),
+                format!(
+                    "duration_s · log_rate_hz gives {rows} rows, a log needs between {MIN_LOG_ROWS} and {MAX_LOG_ROWS}"
+                ),
+            ));
+        }
+        self.validate_vehicle(origin)?;
+        self.validate_reference(origin)
+    }
+
+    /// Duration, warm-up, log and physics rates, hover throttle.
+    fn validate_rates(&self, origin: &Path) -> Result<()> {
+        let field = |field: String, message: String| field_error(origin, field, message);
         let positive = |name: &str, value: f64| {
             if value.is_finite() && value > 0.0 {
                 Ok(())
@@ -254,16 +268,12 @@ impl Scenario {
                 "must be a whole multiple of log_rate_hz".into(),
             ));
         }
-        self.validate_timing(origin)?;
-        let rows = self.rows();
-        if !(MIN_LOG_ROWS..=MAX_LOG_ROWS).contains(&rows) {
-            return Err(field(
-                "duration_s".into(),
-                format!(
-                    "duration_s · log_rate_hz gives {rows} rows, a log needs between {MIN_LOG_ROWS} and {MAX_LOG_ROWS}"
-                ),
-            ));
-        }
+        Ok(())
+    }
+
+    /// Gains, effects (with the delay's bound) and noise levels.
+    fn validate_vehicle(&self, origin: &Path) -> Result<()> {
+        let field = |field: String, message: String| field_error(origin, field, message);
         self.gains
             .validate()
             .map_err(|(f, m)| field(format!("gains.{f}"), m))?;
@@ -296,6 +306,13 @@ impl Scenario {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// The trajectory's own checks, and a reference that stays near the origin and accelerates
+    /// within bounds at every control time.
+    fn validate_reference(&self, origin: &Path) -> Result<()> {
+        let field = |field: String, message: String| field_error(origin, field, message);
         self.trajectory.validate().map_err(|(f, m)| field(f, m))?;
         let generator = self.trajectory.generator();
         for t in self.control_times() {
@@ -475,5 +492,13 @@ impl Scenario {
         let row_dt = 1.0 / self.log_rate_hz;
         let warmup_rows = self.warmup_rows();
         (0..warmup_rows + self.rows()).map(move |step| (step as f64 - warmup_rows as f64) * row_dt)
+    }
+}
+/// A scenario field's error, naming the file.
+fn field_error(origin: &Path, field: String, message: String) -> PhysicsError {
+    PhysicsError::Field {
+        path: origin.to_path_buf(),
+        field,
+        message,
     }
 }

@@ -10,8 +10,11 @@
 //! new recording ([`own_data::compare_on_recording`], `learn evaluate`) and the worked example's
 //! learning curve ([`own_data::example`], `make own-data-example`).
 //!
-//! What it is not for: any model or metric (those live in `sindy` and `learn`), rendering (the
-//! `report` crate), argument parsing (the `learn` binary).
+//! What it is not for: any model or metric (those live in `sindy` and `learn`); rendering: every
+//! table, note and figure is drawn by the `report` crate from its typed inputs, which this crate
+//! fills ([`report::ResultsTable`], [`report::AblationTables`] via [`Ablations::tables`],
+//! [`report::QueryCoverage`], [`report::QualitativeFigure`]) and writes to files; argument parsing
+//! (the `learn` binary).
 //!
 //! **Work items and shards.** Each run enumerates its work once, in a fixed order, as
 //! [`learn::WorkItem`]s (one meta-training: formulation, cells, seed) — [`run`] and
@@ -32,7 +35,6 @@
 //! **Generalisation MSE**: the same model, unchanged, scored on the query segment.
 
 mod ablations;
-mod ablations_markdown;
 mod causal_library;
 mod cells;
 mod config;
@@ -49,11 +51,10 @@ mod tables;
 mod variants;
 
 pub use ablations::{
-    AblationCell, AblationCellDetail, AblationProvenance, AblationRow, AblationSeedOutcome,
-    Ablations, AblationsContext, AblationsOutcome, AblationsShard, SeedCell, VariantCell,
-    merged_ablations, run_variants, run_variants_shard, write_ablations,
+    AblationCell, AblationCellDetail, AblationProvenance, AblationSeedOutcome, Ablations,
+    AblationsContext, AblationsOutcome, AblationsShard, merged_ablations, run_variants,
+    run_variants_shard, write_ablations,
 };
-pub use ablations_markdown::ablations_markdown;
 pub use causal_library::{CausalLibrary, MAX_CONTROL_LAGS, first_order_lag};
 pub use cells::figure_file_name;
 pub use config::{CheckedRunConfig, LearnRun, MAX_SEEDS, RunConfig, merge_patch};

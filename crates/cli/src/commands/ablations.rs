@@ -125,7 +125,10 @@ pub fn write_outcome(
         written.len(),
         out.display()
     );
-    say!("{}", pipeline::ablations_markdown(&outcome.ablations));
+    say!(
+        "{}",
+        report::ablations_markdown(&outcome.ablations.tables())
+    );
     Ok(())
 }
 
@@ -136,7 +139,7 @@ fn render_only(args: &Args) -> anyhow::Result<()> {
         inputs::read_json_text(&json).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
     let ablations: pipeline::Ablations =
         inputs::json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
-    let markdown = pipeline::ablations_markdown(&ablations);
+    let markdown = report::ablations_markdown(&ablations.tables());
     // Only ablations.md is rewritten: the run's other files stay its own.
     let mut set = OutputSet::new(PRODUCER).updating_only_its_files();
     set.input("the ablations.json input", &json);

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use data::{Formulation, NoiseFloor};
 use learn::{Cells, WorkItem};
-use report::QualitativeFigure;
+use report::{AblationRow, AblationTables, QualitativeFigure, SeedCell, VariantCell, VariantNote};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result, write_text};
@@ -25,58 +25,8 @@ use crate::variants::{CheckedVariants, VariantsConfig};
 
 use work::AblationsWork;
 
-/// Mean and spread of one variant on one cell over the seeds.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct VariantCell {
-    pub adapt: f64,
-    pub r#gen: f64,
-    /// Sample standard deviation over seeds (0 for one seed).
-    pub adapt_std: f64,
-    pub gen_std: f64,
-    pub seeds: Vec<SeedCell>,
-}
-
-/// One seed of one variant on one cell.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SeedCell {
-    pub seed: u64,
-    pub adapt: f64,
-    pub r#gen: f64,
-    /// Mean over outputs of the best support cross-validation MSE (variants that fit a
-    /// regression).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub support_cv: Option<f64>,
-    /// What was chosen inside the support segment: per output the penalty, and for `select` the
-    /// candidate.
-    pub chosen: BTreeMap<String, serde_json::Value>,
-    /// For bagged variants: the fraction of query targets inside the predictive band.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub query_band_coverage: Option<f64>,
-}
-
-/// One row of the ablation table: one formulation on one condition.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct AblationRow {
-    pub table: String,
-    pub condition: String,
-    /// The paper's numbers, when it has them, and the target min(SINDy gen, LeARN gen).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub published: Option<report::MethodPair>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub target: Option<f64>,
-    /// Our SINDy with the paper's settings (the run configuration's).
-    pub sindy: report::Mse,
-    /// Noise floor of the forward-difference targets on each segment.
-    pub noise_floor_support: NoiseFloor,
-    pub noise_floor_query: NoiseFloor,
-    pub variants: BTreeMap<String, VariantCell>,
-    /// The headline model fitted with the first seed, one equation per output, terms ordered by
-    /// their share of the prediction's variance on the support segment (largest first).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub headline_equations: Vec<String>,
-}
-
-/// The whole ablation result (`results/ablations/ablations.json`).
+/// The whole ablation result (`results/ablations/ablations.json`). Its rows are `report`'s
+/// [`AblationRow`]s; [`Ablations::tables`] is what `ablations.md` shows of it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Ablations {
     pub name: String,
@@ -85,6 +35,33 @@ pub struct Ablations {
     pub provenance: AblationProvenance,
     pub config: VariantsConfig,
     pub rows: Vec<AblationRow>,
+}
+
+impl Ablations {
+    /// The ablation tables as `report` renders them ([`report::ablations_markdown`]).
+    pub fn tables(&self) -> AblationTables<'_> {
+        let config = &self.config;
+        AblationTables {
+            name: &self.name,
+            description: &self.description,
+            protocol: &self.protocol,
+            seeds: &config.seeds,
+            headline: &config.headline,
+            headline_equations_of: config
+                .equations_variant(&config.headline)
+                .unwrap_or(&config.headline),
+            figure_variant: config.figure_variant.as_deref(),
+            variants: config
+                .variants
+                .iter()
+                .map(|v| VariantNote {
+                    name: &v.name,
+                    description: &v.description,
+                })
+                .collect(),
+            rows: &self.rows,
+        }
+    }
 }
 
 /// Where the ablation numbers come from.
@@ -339,7 +316,10 @@ pub fn write_ablations(outcome: &AblationsOutcome, dir: &Path) -> Result<Vec<Pat
     write_text(&json, &format!("{text}\n"))?;
     written.push(json);
     let md = dir.join("ablations.md");
-    write_text(&md, &crate::ablations_markdown(&outcome.ablations))?;
+    write_text(
+        &md,
+        &report::ablations_markdown(&outcome.ablations.tables()),
+    )?;
     written.push(md);
     for (file, figure) in &outcome.figures {
         let path = dir.join("figures").join(file);

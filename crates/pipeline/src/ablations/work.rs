@@ -7,10 +7,10 @@ use crate::sindy_variant::SegmentPredictions;
 use data::{Condition, FlightLog, Formulation, Segment, forward_difference_noise_floor};
 use learn::{Cells, Experiment, MetaTrainedModel, WorkItem};
 use rayon::prelude::*;
-use report::{MethodTrace, PublishedTables, QualitativeFigure};
+use report::{MethodTrace, PublishedTables, QualitativeFigure, SeedCell};
 use sindy::{EnsemblePrediction, Mat, RegressionFit};
 
-use super::{AblationCell, AblationCellDetail, AblationSeedOutcome, AblationsContext, SeedCell};
+use super::{AblationCell, AblationCellDetail, AblationSeedOutcome, AblationsContext};
 use crate::cells::{cell_figure, flight_segments};
 use crate::error::{PipelineError, Result};
 use crate::shard::{ItemResult, ShardSpec, Sweep, SweepKind};

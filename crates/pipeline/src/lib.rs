@@ -13,8 +13,10 @@
 //! What it is not for: any model or metric (those live in `sindy` and `learn`); rendering: every
 //! table, note and figure is drawn by the `report` crate from its typed inputs, which this crate
 //! fills ([`report::ResultsTable`], [`report::AblationTables`] via [`Ablations::tables`],
-//! [`report::QueryCoverage`], [`report::QualitativeFigure`]) and writes to files; argument parsing
-//! (the `learn` binary).
+//! [`report::QueryCoverage`], [`report::QualitativeFigure`]) and writes to files; drawing
+//! progress: a run reports its stages and units of work to the caller's observer ([`Progress`],
+//! [`NoProgress`] for none), and the `learn` binary draws the bars and prints the stage times;
+//! argument parsing (the `learn` binary).
 //!
 //! **Work items and shards.** Each run enumerates its work once, in a fixed order, as
 //! [`learn::WorkItem`]s (one meta-training: formulation, cells, seed) — [`run`] and
@@ -41,6 +43,7 @@ mod config;
 mod error;
 mod output;
 pub mod own_data;
+mod progress;
 mod run;
 mod shard;
 mod sindy_column;
@@ -63,9 +66,10 @@ pub use output::{
     OutputPaths, README_BEGIN, README_END, ablation_files, check_paper, check_readme, latex_files,
     result_files, update_readme, updated_readme, write_outputs,
 };
+pub use progress::{NoProgress, Progress, Stage, Units};
 pub use run::{
-    GENERATED_PATHS, ReproduceShard, RunOptions, RunOutcome, git_commit, merged_run, run,
-    run_shard, shard_timings, uncommitted_inputs,
+    GENERATED_PATHS, ReproduceShard, RunOutcome, git_commit, merged_run, run, run_shard,
+    shard_timings, uncommitted_inputs,
 };
 pub use shard::{
     ItemResult, MergedSweep, SHARD_FILE, SHARD_FORMAT, ShardDocument, ShardFile, ShardProvenance,

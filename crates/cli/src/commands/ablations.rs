@@ -8,6 +8,7 @@ use outputs::{Existing, FolderId, OutputSet, Staged};
 use pipeline::{AblationsOutcome, ShardSpec, VariantsConfig};
 
 use super::Global;
+use super::progress::ItemLines;
 use super::shard::{SHARD_HELP, ShardOutputs, parse_shard};
 
 #[derive(clap::Args, Debug)]
@@ -77,12 +78,10 @@ fn run_shard(
 }
 
 /// A line per finished item, only on a terminal and without --quiet (a log gets the summary).
-fn progress(global: &Global, start: Instant) -> impl Fn(&str) + Sync {
-    let show_progress = global.show_progress();
-    move |item: &str| {
-        if show_progress {
-            note!("{:>7.1} s  {item}", start.elapsed().as_secs_f64());
-        }
+fn progress(global: &Global, start: Instant) -> ItemLines {
+    ItemLines {
+        show: global.show_progress(),
+        start,
     }
 }
 

@@ -18,7 +18,8 @@ use report::{AblationRow, AblationTables, QualitativeFigure, SeedCell, VariantCe
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result, write_text};
-use crate::shard::{MergedSweep, ShardFile, ShardProvenance, ShardSpec};
+use crate::progress::{Progress, Stage, Stopwatch};
+use crate::shard::{ItemResult, MergedSweep, ShardFile, ShardProvenance, ShardSpec};
 use crate::summary::StageTiming;
 use crate::tables::ConditionName;
 use crate::variants::{CheckedVariants, VariantsConfig};
@@ -136,14 +137,14 @@ pub struct AblationCellDetail {
 /// A shard of the ablations: each (cell, seed) item's variants.
 pub type AblationsShard = ShardFile<AblationsContext, AblationSeedOutcome>;
 
-/// Runs every variant on every cell and seed; `on_progress` is told each item as it ends.
+/// Runs every variant on every cell and seed; `progress` is told of the stages (see
+/// [`run_variants_shard`]) and of each item as it ends.
 pub fn run_variants(
     config: &CheckedVariants,
     data_dir: &Path,
-    on_progress: &(dyn Fn(&str) + Sync),
+    progress: &dyn Progress,
 ) -> Result<AblationsOutcome> {
-    let work = AblationsWork::plan(config, data_dir)?;
-    let results = work.run_items(ShardSpec::WHOLE, on_progress)?;
+    let (work, results, _) = plan_and_run(config, data_dir, progress, ShardSpec::WHOLE)?;
     let results: Vec<AblationSeedOutcome> = results.into_iter().map(|r| r.result).collect();
     render_ablations(
         &work.sweep.context,
@@ -153,29 +154,42 @@ pub fn run_variants(
     )
 }
 
-/// Runs shard `shard` of the ablations (see [`run_variants`]).
+/// Runs shard `shard` of the ablations (see [`run_variants`]); the shard records the times of
+/// the stages.
 pub fn run_variants_shard(
     config: &CheckedVariants,
     data_dir: &Path,
-    on_progress: &(dyn Fn(&str) + Sync),
+    progress: &dyn Progress,
     shard: ShardSpec,
 ) -> Result<AblationsShard> {
-    let start = std::time::Instant::now();
-    let work = AblationsWork::plan(config, data_dir)?;
-    let planned = start.elapsed().as_secs_f64();
-    let results = work.run_items(shard, on_progress)?;
-    let stages = vec![
-        StageTiming {
-            stage: "load flights, cut the cells".to_string(),
-            seconds: planned,
-        },
-        StageTiming {
-            stage: "variants".to_string(),
-            seconds: start.elapsed().as_secs_f64() - planned,
-        },
-    ];
+    let (work, results, stages) = plan_and_run(config, data_dir, progress, shard)?;
     let provenance = ShardProvenance::here(&config.root, stages);
     Ok(work.sweep.shard_file(shard, results, provenance))
+}
+
+/// The results of the items of `shard`, and the stages' times: "load flights, cut the cells", then
+/// "variants" (one unit of progress per item).
+type ShardRun<'c> = (
+    AblationsWork<'c>,
+    Vec<ItemResult<AblationSeedOutcome>>,
+    Vec<StageTiming>,
+);
+
+/// Plans the ablations and runs the items of `shard`.
+fn plan_and_run<'c>(
+    config: &'c CheckedVariants,
+    data_dir: &Path,
+    progress: &dyn Progress,
+    shard: ShardSpec,
+) -> Result<ShardRun<'c>> {
+    let mut stopwatch = Stopwatch::new(progress);
+    let work = stopwatch.time("load flights, cut the cells", || {
+        AblationsWork::plan(config, data_dir)
+    })?;
+    let items = shard.positions(work.sweep.items.len()).len();
+    let stage = Stage::counting("variants", "variants", items);
+    let results = stopwatch.time(stage, || work.run_items(shard, progress))?;
+    Ok((work, results, stopwatch.timings()))
 }
 
 /// The ablations of merged shards, rendered as [`run_variants`] renders them.

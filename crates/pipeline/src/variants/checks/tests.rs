@@ -262,7 +262,11 @@ fn every_variant_spec_is_checked_when_the_file_is_read() {
         let message = read_error(name, &variants, "");
         assert!(message.contains(expected), "{name}: {message}");
     }
-    let a = library(linear, ridge);
+}
+
+#[test]
+fn counts_and_repeated_names_are_checked_when_the_file_is_read() {
+    let a = format!(r#"{{"name": "a", "description": "", {RIDGE}}}"#);
     let seeds = config(&a, "").replace(
         r#""seeds": [1]"#,
         &format!(

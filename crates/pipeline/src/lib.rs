@@ -10,8 +10,13 @@
 //! new recording ([`own_data::compare_on_recording`], `learn evaluate`) and the worked example's
 //! learning curve ([`own_data::example`], `make own-data-example`).
 //!
-//! What it is not for: any model or metric (those live in `sindy` and `learn`), rendering (the
-//! `report` crate), argument parsing (the `learn` binary).
+//! What it is not for: any model or metric (those live in `sindy` and `learn`); rendering: every
+//! table, note and figure is drawn by the `report` crate from its typed inputs, which this crate
+//! fills ([`report::ResultsTable`], [`report::AblationTables`] via [`Ablations::tables`],
+//! [`report::QueryCoverage`], [`report::QualitativeFigure`]) and writes to files; drawing
+//! progress: a run reports its stages and units of work to the caller's observer ([`Progress`],
+//! [`NoProgress`] for none), and the `learn` binary draws the bars and prints the stage times;
+//! argument parsing (the `learn` binary).
 //!
 //! **Work items and shards.** Each run enumerates its work once, in a fixed order, as
 //! [`learn::WorkItem`]s (one meta-training: formulation, cells, seed) — [`run`] and
@@ -32,13 +37,13 @@
 //! **Generalisation MSE**: the same model, unchanged, scored on the query segment.
 
 mod ablations;
-mod ablations_markdown;
 mod causal_library;
 mod cells;
 mod config;
 mod error;
 mod output;
 pub mod own_data;
+mod progress;
 mod run;
 mod shard;
 mod sindy_column;
@@ -49,11 +54,10 @@ mod tables;
 mod variants;
 
 pub use ablations::{
-    AblationCell, AblationCellDetail, AblationProvenance, AblationRow, AblationSeedOutcome,
-    Ablations, AblationsContext, AblationsOutcome, AblationsShard, SeedCell, VariantCell,
-    merged_ablations, run_variants, run_variants_shard, write_ablations,
+    AblationCell, AblationCellDetail, AblationProvenance, AblationSeedOutcome, Ablations,
+    AblationsContext, AblationsOutcome, AblationsShard, merged_ablations, run_variants,
+    run_variants_shard, write_ablations,
 };
-pub use ablations_markdown::ablations_markdown;
 pub use causal_library::{CausalLibrary, MAX_CONTROL_LAGS, first_order_lag};
 pub use cells::figure_file_name;
 pub use config::{CheckedRunConfig, LearnRun, MAX_SEEDS, RunConfig, merge_patch};
@@ -62,9 +66,10 @@ pub use output::{
     OutputPaths, README_BEGIN, README_END, ablation_files, check_paper, check_readme, latex_files,
     result_files, update_readme, updated_readme, write_outputs,
 };
+pub use progress::{NoProgress, Progress, Stage, Units};
 pub use run::{
-    GENERATED_PATHS, ReproduceShard, RunOptions, RunOutcome, git_commit, merged_run, run,
-    run_shard, shard_timings, uncommitted_inputs,
+    GENERATED_PATHS, ReproduceShard, RunOutcome, git_commit, merged_run, run, run_shard,
+    shard_timings, uncommitted_inputs,
 };
 pub use shard::{
     ItemResult, MergedSweep, SHARD_FILE, SHARD_FORMAT, ShardDocument, ShardFile, ShardProvenance,

@@ -165,28 +165,21 @@ fn to_json<T: serde::Serialize>(value: &T) -> Result<String> {
     Ok(text)
 }
 
-/// The README's generated block: every table, then a pointer to the figures.
+/// The README's generated block ([`report::readme_block`]): every table, then the figures'
+/// folder relative to the README, with the first full-dynamics figure shown.
 fn readme_block(outcome: &RunOutcome, figures: &Path, readme: &Path) -> String {
-    let mut block = String::new();
-    for table in &outcome.tables {
-        block.push_str(&markdown(table));
-        block.push('\n');
-    }
     let base = readme.parent().unwrap_or(Path::new(""));
-    let relative = figures.strip_prefix(base).unwrap_or(figures);
-    if let Some((name, _)) = outcome
+    let relative = figures
+        .strip_prefix(base)
+        .unwrap_or(figures)
+        .display()
+        .to_string();
+    let example = outcome
         .figures
         .iter()
         .find(|(name, _)| name.starts_with("full_"))
-    {
-        block.push_str(&format!(
-            "The paper's qualitative figure, one per table and condition, is in `{}/`; for \
-             example the full dynamics in the first condition:\n\n![{name}]({}/{name})\n",
-            relative.display(),
-            relative.display()
-        ));
-    }
-    block
+        .map(|(name, _)| (relative.as_str(), name.as_str()));
+    report::readme_block(&outcome.tables, example)
 }
 
 fn read_readme(readme: &Path) -> Result<String> {

@@ -2,8 +2,9 @@
 //!
 //! Every process of a run (the unsharded one, or each shard) loads the flights, cuts the segments
 //! and fits SINDy (milliseconds); the LeARN work is the sweep of [`learn::WorkItem`]s, each
-//! item's cells carrying what the tables need ([`LearnCellOutcome`]), rendered by
-//! [`crate::tables::render`].
+//! item's cells carrying what the tables need ([`LearnCellOutcome`]), assembled by
+//! [`crate::tables::render`]. Progress goes to the caller's observer ([`Progress`]): each stage,
+//! and each LeARN cell as it ends.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -11,7 +12,6 @@ use std::time::Instant;
 
 use crate::sindy_column::SegmentEvaluation;
 use data::{Condition, FlightLog, Formulation, Mat, Segment, file_sha256};
-use indicatif::{ProgressBar, ProgressStyle};
 use learn::{CellResult, Cells, DataFile, EquationRule, Experiment, WorkItem, explain, row_major};
 use rayon::prelude::*;
 use report::{MethodTrace, PublishedTables, QualitativeFigure, ResultsTable};
@@ -19,6 +19,7 @@ use report::{MethodTrace, PublishedTables, QualitativeFigure, ResultsTable};
 use crate::cells::{cell_figure, flight_segments, stacked_columns};
 use crate::config::CheckedRunConfig;
 use crate::error::{PipelineError, Result, in_flight};
+use crate::progress::{Progress, Stage, Stopwatch};
 use crate::shard::{
     ItemResult, MergedSweep, ShardFile, ShardProvenance, ShardSpec, Sweep, SweepKind,
 };
@@ -27,14 +28,6 @@ use crate::tables::{
     CellDetail, ConditionName, LearnCellOutcome, ReproduceContext, RunInputs, SindyOutcome, render,
 };
 use crate::variants::VariantsConfig;
-
-/// How a run reports progress.
-pub struct RunOptions<'a> {
-    /// Draw progress bars (the caller decides: not quiet and a terminal).
-    pub show_progress: bool,
-    /// Called when a stage finishes, with its wall time.
-    pub on_stage: &'a (dyn Fn(&StageTiming) + Sync),
-}
 
 /// Everything a run produced, ready to be written.
 pub struct RunOutcome {
@@ -67,57 +60,22 @@ struct EvaluationFlight {
     file: DataFile,
 }
 
-/// Times stages and reports each one as it ends.
-struct Stopwatch<'a> {
-    options: &'a RunOptions<'a>,
-    timings: Vec<StageTiming>,
-}
-
-impl Stopwatch<'_> {
-    fn time<T>(&mut self, stage: &str, work: impl FnOnce() -> Result<T>) -> Result<T> {
-        let start = Instant::now();
-        let value = work()?;
-        let timing = StageTiming {
-            stage: stage.to_string(),
-            seconds: start.elapsed().as_secs_f64(),
-        };
-        (self.options.on_stage)(&timing);
-        self.timings.push(timing);
-        Ok(value)
-    }
-}
-
-fn progress_bar(show: bool, length: usize, message: &str) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(length as u64).with_message(message.to_string());
-    bar.set_style(
-        ProgressStyle::with_template("{msg:>12} [{bar:32}] {pos}/{len} cells, {elapsed}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
-    bar
-}
-
 /// The stage in which the work items run.
 const ITEMS_STAGE: &str = "LeARN meta-training and adaptation, variant columns";
 
 /// Runs SINDy and LeARN for every formulation and evaluation condition of `config`, on the
-/// flights under `data_dir`. `root` is the project root (for the git commit and relative paths).
+/// flights under `data_dir`. `root` is the project root (for the git commit and relative paths);
+/// `progress` is told of each stage and LeARN cell.
 pub fn run(
     config: &CheckedRunConfig,
     data_dir: &Path,
     root: &Path,
-    options: &RunOptions,
+    progress: &dyn Progress,
 ) -> Result<RunOutcome> {
-    let mut stopwatch = Stopwatch {
-        options,
-        timings: Vec::new(),
-    };
+    let mut stopwatch = Stopwatch::new(progress);
     let work = ReproduceWork::plan(config, data_dir, root, &mut stopwatch)?;
-    let results = stopwatch.time(ITEMS_STAGE, || {
-        work.run_items(ShardSpec::WHOLE, options.show_progress)
+    let results = stopwatch.time(work.items_stage(ShardSpec::WHOLE), || {
+        work.run_items(ShardSpec::WHOLE, progress)
     })?;
     let outcomes: Vec<LearnCellOutcome> = results.into_iter().flat_map(|r| r.result).collect();
     let (tables, figures, summary) = stopwatch.time("tables, figures and summary", || {
@@ -127,7 +85,7 @@ pub fn run(
         tables,
         figures,
         summary,
-        timings: stopwatch.timings,
+        timings: stopwatch.timings(),
         uncommitted_inputs: uncommitted_inputs(root),
     })
 }
@@ -137,16 +95,13 @@ pub fn run_shard(
     config: &CheckedRunConfig,
     data_dir: &Path,
     root: &Path,
-    options: &RunOptions,
+    progress: &dyn Progress,
     shard: ShardSpec,
 ) -> Result<ReproduceShard> {
-    let mut stopwatch = Stopwatch {
-        options,
-        timings: Vec::new(),
-    };
+    let mut stopwatch = Stopwatch::new(progress);
     let work = ReproduceWork::plan(config, data_dir, root, &mut stopwatch)?;
-    let results = stopwatch.time(ITEMS_STAGE, || work.run_items(shard, options.show_progress))?;
-    let provenance = ShardProvenance::here(root, stopwatch.timings);
+    let results = stopwatch.time(work.items_stage(shard), || work.run_items(shard, progress))?;
+    let provenance = ShardProvenance::here(root, stopwatch.timings());
     Ok(work.sweep.shard_file(shard, results, provenance))
 }
 
@@ -256,12 +211,8 @@ impl<'c> ReproduceWork<'c> {
         })
     }
 
-    /// Runs the items of `shard`, with a bar over their cells when `show_progress`.
-    fn run_items(
-        &self,
-        shard: ShardSpec,
-        show_progress: bool,
-    ) -> Result<Vec<ItemResult<Vec<LearnCellOutcome>>>> {
+    /// The stage of the items of `shard`, counting their LeARN cells.
+    fn items_stage(&self, shard: ShardSpec) -> Stage<'static> {
         let conditions = self.sweep.context.conditions.len();
         let cells: usize = shard
             .positions(self.sweep.items.len())
@@ -271,15 +222,29 @@ impl<'c> ReproduceWork<'c> {
                 Cells::Every => conditions,
             })
             .sum();
-        let bar = progress_bar(show_progress, cells, "LeARN");
-        let results = self.sweep.run(shard, |item| self.run_item(item, &bar));
-        bar.finish_and_clear();
-        results
+        Stage::counting(ITEMS_STAGE, "LeARN", cells)
+    }
+
+    /// Runs the items of `shard`, telling `progress` of each cell as it ends.
+    fn run_items(
+        &self,
+        shard: ShardSpec,
+        progress: &dyn Progress,
+    ) -> Result<Vec<ItemResult<Vec<LearnCellOutcome>>>> {
+        self.sweep.run(shard, |item| self.run_item(item, progress))
     }
 
     /// One work item: LeARN on its cells; with the first seed, each cell's detail too.
-    fn run_item(&self, item: &WorkItem, bar: &ProgressBar) -> Result<Vec<LearnCellOutcome>> {
-        let results = self.experiment.run_item_observed(item, &|_| bar.inc(1))?;
+    fn run_item(&self, item: &WorkItem, progress: &dyn Progress) -> Result<Vec<LearnCellOutcome>> {
+        let cell_done = |cell: &learn::CellSummary| {
+            progress.advance(format_args!(
+                "{} {} seed {}",
+                cell.formulation.name(),
+                cell.label,
+                cell.seed
+            ));
+        };
+        let results = self.experiment.run_item_observed(item, &cell_done)?;
         let first_seed = item.seed == self.config.raw.learn.seeds[0];
         results
             .iter()

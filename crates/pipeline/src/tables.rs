@@ -1,7 +1,8 @@
-//! Rendering a reproduce run: from its context (what the configuration says) and its work items'
-//! results ([`LearnCellOutcome`] per cell and seed) to the tables, figures and `summary.json`.
-//! The unsharded run and `learn merge` both render through [`render`], so their outputs are the
-//! same bytes.
+//! Assembling a reproduce run's results: from its context (what the configuration says) and its
+//! work items' results ([`LearnCellOutcome`] per cell and seed) to the typed tables, figures and
+//! `summary.json` (every number averaged over seeds, every cell in table order); the text under a
+//! table is `report`'s ([`report::coverage_note`]). The unsharded run and `learn merge` both
+//! assemble through [`render`], so their outputs are the same bytes.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -9,7 +10,9 @@ use std::path::PathBuf;
 use crate::sindy_column::SindyConfig;
 use data::{Formulation, SplitSpec};
 use learn::{CellSummary, DataFile, Explanation, LearnConfig, RangeCoverage};
-use report::{Mse, PublishedTables, QualitativeFigure, ResultsTable, Row};
+use report::{
+    FarthestInput, Mse, PublishedTables, QualitativeFigure, QueryCoverage, ResultsTable, Row,
+};
 use serde::{Deserialize, Serialize};
 use sindy::Derivative;
 
@@ -286,75 +289,45 @@ fn table(
 }
 
 /// The note under a table on how much of each query segment lies outside the range of the
-/// meta-training inputs (where the networks extrapolate), naming the input that goes farthest,
-/// with LeARN's and SINDy's generalisation MSE over the samples inside and outside that range;
-/// `None` if no cell has a range.
+/// meta-training inputs ([`report::coverage_note`]), from each cell's label, LeARN's coverage (over
+/// the seeds) and SINDy's of the same samples; `None` if no cell has a range.
 fn coverage_note<'a>(
     coverages: impl Iterator<Item = (&'a str, Option<&'a RangeCoverage>, Option<RangeCoverage>)>,
 ) -> Option<String> {
-    let split = |coverage: Option<&RangeCoverage>| match coverage {
-        Some(RangeCoverage {
-            mse_inside: Some(inside),
-            mse_outside: Some(outside),
-            ..
-        }) => Some(format!("{inside:.3} / {outside:.3}")),
-        _ => None,
-    };
-    let parts: Vec<String> = coverages
-        .filter_map(|(label, coverage, sindy)| {
-            let coverage = coverage?;
-            let farthest = coverage
-                .inputs
-                .iter()
-                .filter(|input| input.samples_outside > 0)
-                .max_by(|a, b| a.largest_excess_in_std.total_cmp(&b.largest_excess_in_std));
-            let errors = match (split(Some(coverage)), split(sindy.as_ref())) {
-                (Some(learn), Some(sindy)) => {
-                    format!("; MSE inside / outside: LeARN {learn}, SINDy {sindy}")
-                }
-                (Some(learn), None) => format!("; MSE inside / outside: LeARN {learn}"),
-                _ => String::new(),
-            };
-            let detail = farthest.map_or(String::new(), |input| {
-                format!(
-                    " (farthest: {} by {:.1} std on {} samples{}{errors})",
-                    input.input,
-                    input.largest_excess_in_std,
-                    input.samples_outside,
-                    contributions(input, sindy.as_ref())
-                )
-            });
-            Some(format!(
-                "{label} {} of {}{detail}",
-                coverage.samples_outside, coverage.samples
-            ))
-        })
+    let cells: Vec<Option<QueryCoverage>> = coverages
+        .map(|(label, learn, sindy)| Some(query_coverage(label, learn?, sindy.as_ref())))
         .collect();
-    (!parts.is_empty()).then(|| {
-        format!(
-            "LeARN query samples with an input outside the range of the meta-training inputs \
-             (the networks extrapolate there), with the generalisation MSE of each method over the \
-             query samples inside and outside that range: {}.",
-            parts.join("; ")
-        )
-    })
+    report::coverage_note(&cells)
 }
 
-/// What the samples outside on `input` add to each method's generalisation MSE (SINDy's from its
-/// own coverage of the same samples), e.g. ", which add 0.126 to LeARN's MSE and 0.020 to
-/// SINDy's"; empty without the errors.
-fn contributions(input: &learn::InputCoverage, sindy: Option<&RangeCoverage>) -> String {
-    let Some(learn) = input.contribution_to_mse else {
-        return String::new();
-    };
-    let sindy = sindy
-        .and_then(|coverage| coverage.inputs.iter().find(|i| i.input == input.input))
-        .and_then(|i| i.contribution_to_mse);
-    match sindy {
-        Some(sindy) => {
-            format!(", which add {learn:.3} to LeARN's MSE and {sindy:.3} to SINDy's")
-        }
-        None => format!(", which add {learn:.3} to LeARN's MSE"),
+/// A cell's query coverage as the note reports it: the input that goes farthest (with what the
+/// samples outside on it add to each method's MSE), each method's MSE inside and outside.
+fn query_coverage(
+    label: &str,
+    learn: &RangeCoverage,
+    sindy: Option<&RangeCoverage>,
+) -> QueryCoverage {
+    let inside_outside = |coverage: &RangeCoverage| coverage.mse_inside.zip(coverage.mse_outside);
+    let farthest = learn
+        .inputs
+        .iter()
+        .filter(|input| input.samples_outside > 0)
+        .max_by(|a, b| a.largest_excess_in_std.total_cmp(&b.largest_excess_in_std));
+    QueryCoverage {
+        label: label.to_string(),
+        samples: learn.samples,
+        samples_outside: learn.samples_outside,
+        farthest: farthest.map(|input| FarthestInput {
+            input: input.input.clone(),
+            largest_excess_in_std: input.largest_excess_in_std,
+            samples_outside: input.samples_outside,
+            learn_added: input.contribution_to_mse,
+            sindy_added: sindy
+                .and_then(|coverage| coverage.inputs.iter().find(|i| i.input == input.input))
+                .and_then(|i| i.contribution_to_mse),
+        }),
+        learn_inside_outside: inside_outside(learn),
+        sindy_inside_outside: sindy.and_then(inside_outside),
     }
 }
 

@@ -4,7 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use pipeline::{OutputPaths, RunConfig, RunOptions, run, write_outputs};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use pipeline::{OutputPaths, Progress, RunConfig, Stage, StageTiming, run, write_outputs};
 use serde_json::{Value, json};
 
 fn workspace() -> PathBuf {
@@ -69,7 +72,36 @@ fn conditions(with_new: bool) -> Value {
     })
 }
 
-/// Runs the pipeline on `conditions` with a tiny LeARN budget and writes under `out`.
+/// An observer that counts the units of work and records the stages.
+#[derive(Default)]
+struct Counting {
+    /// (name, units announced) of each stage, as it starts.
+    started: Mutex<Vec<(String, Option<usize>)>>,
+    advances: AtomicUsize,
+    finished: Mutex<Vec<String>>,
+}
+
+impl Progress for Counting {
+    fn stage(&self, stage: &Stage<'_>) {
+        let units = stage.units.map(|units| units.total);
+        self.started
+            .lock()
+            .unwrap()
+            .push((stage.name.to_string(), units));
+    }
+
+    fn advance(&self, unit: std::fmt::Arguments<'_>) {
+        assert!(unit.to_string().contains(" seed 7"), "{unit}");
+        self.advances.fetch_add(1, Ordering::Relaxed);
+    }
+
+    fn finish(&self, timing: &StageTiming) {
+        self.finished.lock().unwrap().push(timing.stage.clone());
+    }
+}
+
+/// Runs the pipeline on `conditions` with a tiny LeARN budget and writes under `out`; its observer
+/// sees every stage, and every LeARN cell (three tables × the evaluation conditions) once.
 fn run_with(dir: &Path, data: &Path, conditions: &Value, out: &Path) {
     let conditions_path = dir.join(format!(
         "conditions-{}.json",
@@ -100,11 +132,28 @@ fn run_with(dir: &Path, data: &Path, conditions: &Value, out: &Path) {
     let config_path = dir.join("run.json");
     std::fs::write(&config_path, config.to_string()).unwrap();
     let checked = RunConfig::load(&config_path, &root).unwrap();
-    let options = RunOptions {
-        show_progress: false,
-        on_stage: &|_| {},
-    };
-    let outcome = run(&checked, data, &root, &options).unwrap();
+    let observer = Counting::default();
+    let outcome = run(&checked, data, &root, &observer).unwrap();
+    let cells = 3 * conditions["conditions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["role"] == "evaluation")
+        .count();
+    assert_eq!(observer.advances.load(Ordering::Relaxed), cells);
+    let started = observer.started.into_inner().unwrap();
+    let finished = observer.finished.into_inner().unwrap();
+    let timed: Vec<&str> = outcome.timings.iter().map(|t| t.stage.as_str()).collect();
+    assert_eq!(finished, timed);
+    assert_eq!(
+        started
+            .iter()
+            .map(|(name, _)| name.as_str())
+            .collect::<Vec<_>>(),
+        timed
+    );
+    let counted: Vec<usize> = started.iter().filter_map(|(_, units)| *units).collect();
+    assert_eq!(counted, [cells], "{started:?}");
     let paths = OutputPaths {
         results_dir: out.to_path_buf(),
         latex_dir: out.join("latex"),

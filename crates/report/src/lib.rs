@@ -1,17 +1,24 @@
-//! Reports of the experiments: the paper's three tables and its qualitative figure.
+//! Reports of the experiments: the paper's three tables and its qualitative figure, and every
+//! text the runs write about their results.
 //!
 //! What it is for: the results types every tool reads and writes ([`ResultsTable`], whose JSON is
 //! `{"table", "protocol", "rows": [{"condition", "sindy", "learn", "published", ...}]}`); rendering
-//! them as Markdown ([`markdown`]), LaTeX in the paper's booktabs layout ([`latex`]) and JSON;
-//! the paper's published numbers ([`PublishedTables`]); the regression check against them with
-//! declared per-cell tolerances ([`Tolerances`], [`Comparison`]); and the paper's qualitative
-//! figure as SVG ([`QualitativeFigure`]); learning curves as SVG and Markdown ([`CurveFigure`],
-//! [`curve_markdown`]).
+//! them as Markdown ([`markdown`]), LaTeX in the paper's booktabs layout ([`latex`]) and JSON, and
+//! the README's results block ([`readme_block`]); the note under a table on the query samples
+//! outside the meta-training range ([`coverage_note`]); the ablation tables of `make ablations`
+//! ([`ablations_markdown`] over [`AblationTables`], whose rows [`AblationRow`] are those of
+//! `ablations.json`); the paper's published numbers ([`PublishedTables`]); the regression check
+//! against them with declared per-cell tolerances ([`Tolerances`], [`Comparison`]); the paper's
+//! qualitative figure as SVG ([`QualitativeFigure`]); learning curves as SVG and Markdown
+//! ([`CurveFigure`], [`curve_markdown`]).
 //!
-//! What it is not for: computing any number. It knows nothing of flights, SINDy or LeARN: the
-//! `pipeline` crate runs the experiments and hands the numbers and traces to this crate.
+//! What it is not for: computing any number. It knows nothing of flights, SINDy or LeARN and does
+//! not depend on the crates that do: the `pipeline` crate runs the experiments and hands the
+//! numbers and traces to this crate in its own plain types.
 
+mod ablations;
 mod compare;
+mod coverage;
 mod curve;
 mod error;
 mod figure;
@@ -19,12 +26,16 @@ mod published;
 mod render;
 mod table;
 
+pub use ablations::{
+    AblationRow, AblationTables, SeedCell, VariantCell, VariantNote, ablations_markdown,
+};
 pub use compare::{CellComparison, CellStatus, Comparison, Direction, ToleranceRule, Tolerances};
+pub use coverage::{FarthestInput, QueryCoverage, coverage_note};
 pub use curve::{CurveFigure, CurveSeries, curve_markdown};
 pub use error::{ReportError, Result};
 pub use figure::{
     ADAPTATION, Band, GENERALISATION, GROUND_TRUTH, MethodTrace, OutputAxis, QualitativeFigure,
 };
 pub use published::PublishedTables;
-pub use render::{caption, latex, latex_label, markdown};
+pub use render::{caption, latex, latex_label, markdown, readme_block};
 pub use table::{Method, MethodPair, Metric, Mse, PAPER_TABLES, ResultsTable, Row, load_tables};

@@ -66,6 +66,23 @@ fn markdown_cell(row: &Row, method: Method, metric: Metric) -> String {
     cell
 }
 
+/// The README's generated results block: every table in Markdown, then a pointer to the figures
+/// with `example` (the folder as linked from the README, and a figure's file name) shown inline.
+pub fn readme_block(tables: &[ResultsTable], example: Option<(&str, &str)>) -> String {
+    let mut block = String::new();
+    for table in tables {
+        block.push_str(&markdown(table));
+        block.push('\n');
+    }
+    if let Some((folder, name)) = example {
+        block.push_str(&format!(
+            "The paper's qualitative figure, one per table and condition, is in `{folder}/`; for \
+             example the full dynamics in the first condition:\n\n![{name}]({folder}/{name})\n"
+        ));
+    }
+    block
+}
+
 /// The table in Markdown: a caption line, a legend line and one row per condition. Each cell holds
 /// our value (bold when it is the better of SINDy and LeARN for that metric) followed by the published value and
 /// the difference; variants, if any, follow as plain columns; the table's notes, if any, follow it

@@ -8,6 +8,7 @@ use outputs::{Existing, FolderId, OutputSet, Staged};
 use pipeline::{AblationsOutcome, ShardSpec, VariantsConfig};
 
 use super::Global;
+use super::progress::ItemLines;
 use super::shard::{SHARD_HELP, ShardOutputs, parse_shard};
 
 #[derive(clap::Args, Debug)]
@@ -77,12 +78,10 @@ fn run_shard(
 }
 
 /// A line per finished item, only on a terminal and without --quiet (a log gets the summary).
-fn progress(global: &Global, start: Instant) -> impl Fn(&str) + Sync {
-    let show_progress = global.show_progress();
-    move |item: &str| {
-        if show_progress {
-            note!("{:>7.1} s  {item}", start.elapsed().as_secs_f64());
-        }
+fn progress(global: &Global, start: Instant) -> ItemLines {
+    ItemLines {
+        show: global.show_progress(),
+        start,
     }
 }
 
@@ -125,7 +124,10 @@ pub fn write_outcome(
         written.len(),
         out.display()
     );
-    say!("{}", pipeline::ablations_markdown(&outcome.ablations));
+    say!(
+        "{}",
+        report::ablations_markdown(&outcome.ablations.tables())
+    );
     Ok(())
 }
 
@@ -136,7 +138,7 @@ fn render_only(args: &Args) -> anyhow::Result<()> {
         inputs::read_json_text(&json).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
     let ablations: pipeline::Ablations =
         inputs::json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
-    let markdown = pipeline::ablations_markdown(&ablations);
+    let markdown = report::ablations_markdown(&ablations.tables());
     // Only ablations.md is rewritten: the run's other files stay its own.
     let mut set = OutputSet::new(PRODUCER).updating_only_its_files();
     set.input("the ablations.json input", &json);

@@ -7,7 +7,6 @@ use std::time::Instant;
 
 use anyhow::Context;
 use data::{ExperimentConditions, Formulation};
-use indicatif::{ProgressBar, ProgressStyle};
 use learn::{CellSummary, Experiment, LearnConfig, Protocol, evaluation_condition_of};
 use pipeline::ShardSpec;
 use report::{Method, PublishedTables};
@@ -16,6 +15,7 @@ use serde_json::{Value, json};
 use outputs::{Existing, FileId, FolderId, OutputSet};
 
 use super::Global;
+use super::progress::progress_bar;
 use super::shard::{SHARD_HELP, parse_shard};
 
 /// What the output manifests record as the writer of the checkpoints and the spread.
@@ -166,23 +166,6 @@ fn published(
         .get(cell.formulation.name(), &cell.label)?
         .get(method);
     Some((mse.adaptation, mse.generalisation))
-}
-
-/// A bar over `cells` cells on standard error, drawn only when `show` (a terminal, not --quiet), in
-/// the style of `learn reproduce`.
-pub fn progress_bar(show: bool, cells: usize, message: &str) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(cells as u64).with_message(message.to_string());
-    bar.set_style(
-        ProgressStyle::with_template("{msg:>12} [{bar:32}] {pos}/{len} cells, {elapsed}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
-    // Drawn (and its clock kept running) from the start: the first cells take seconds.
-    bar.enable_steady_tick(std::time::Duration::from_millis(250));
-    bar
 }
 
 /// The column of SINDy's generalisation MSE as published (this command does not run SINDy).

@@ -11,6 +11,7 @@ mod meta_train;
 mod meta_train_tasks;
 mod mismatch;
 mod own_data_example;
+mod progress;
 mod reproduce;
 mod seed_spread;
 mod shard;

@@ -6,9 +6,10 @@ use std::time::Instant;
 
 use anyhow::bail;
 use outputs::{Existing, FileId, FolderId, OutputSet, Staged};
-use pipeline::{OutputPaths, RunConfig, RunOptions, RunOutcome, ShardSpec, StageTiming};
+use pipeline::{OutputPaths, RunConfig, RunOutcome, ShardSpec};
 
 use super::Global;
+use super::progress::StageBars;
 use super::shard::{SHARD_HELP, ShardOutputs, parse_shard};
 
 #[derive(clap::Args, Debug)]
@@ -78,7 +79,8 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         data_dir.display(),
         available_threads()
     );
-    let outcome = pipeline::run(&config, &data_dir, &args.root, &run_options(global))?;
+    let progress = StageBars::new(global.show_progress());
+    let outcome = pipeline::run(&config, &data_dir, &args.root, &progress)?;
     write_outcome(&outcome, staged, plan.ids, &to, start)
 }
 
@@ -99,19 +101,9 @@ fn run_shard(
         data_dir.display(),
         available_threads()
     );
-    let file = pipeline::run_shard(config, &data_dir, &args.root, &run_options(global), shard)?;
+    let progress = StageBars::new(global.show_progress());
+    let file = pipeline::run_shard(config, &data_dir, &args.root, &progress, shard)?;
     staged.commit(&file)
-}
-
-/// Progress as `learn reproduce` reports it: bars on a terminal, each stage's time.
-fn run_options(global: &Global) -> RunOptions<'static> {
-    fn print_stage(timing: &StageTiming) {
-        note!("{:>7.2} s  {}", timing.seconds, timing.stage);
-    }
-    RunOptions {
-        show_progress: global.show_progress(),
-        on_stage: &print_stage,
-    }
 }
 
 /// Writes `outcome` into the staged set (tables, figures, summary, timings, LaTeX, README block),

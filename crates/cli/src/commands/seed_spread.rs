@@ -11,7 +11,8 @@ use outputs::{Existing, OutputSet, Staged};
 use pipeline::{ShardProvenance, ShardSpec, StageTiming};
 
 use super::Global;
-use super::meta_train::{Args, PRODUCER, formulations, progress_bar, write_json};
+use super::meta_train::{Args, PRODUCER, formulations, write_json};
+use super::progress::progress_bar;
 use super::shard::ShardOutputs;
 
 /// The writer of a shard's result (never removes, nor is removed by, the run's own files).

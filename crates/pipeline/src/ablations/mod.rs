@@ -14,69 +14,20 @@ use std::path::{Path, PathBuf};
 
 use data::{Formulation, NoiseFloor};
 use learn::{Cells, WorkItem};
-use report::QualitativeFigure;
+use report::{AblationRow, AblationTables, QualitativeFigure, SeedCell, VariantCell, VariantNote};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result, write_text};
-use crate::shard::{MergedSweep, ShardFile, ShardProvenance, ShardSpec};
+use crate::progress::{Progress, Stage, Stopwatch};
+use crate::shard::{ItemResult, MergedSweep, ShardFile, ShardProvenance, ShardSpec};
 use crate::summary::StageTiming;
 use crate::tables::ConditionName;
 use crate::variants::{CheckedVariants, VariantsConfig};
 
 use work::AblationsWork;
 
-/// Mean and spread of one variant on one cell over the seeds.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct VariantCell {
-    pub adapt: f64,
-    pub r#gen: f64,
-    /// Sample standard deviation over seeds (0 for one seed).
-    pub adapt_std: f64,
-    pub gen_std: f64,
-    pub seeds: Vec<SeedCell>,
-}
-
-/// One seed of one variant on one cell.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SeedCell {
-    pub seed: u64,
-    pub adapt: f64,
-    pub r#gen: f64,
-    /// Mean over outputs of the best support cross-validation MSE (variants that fit a
-    /// regression).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub support_cv: Option<f64>,
-    /// What was chosen inside the support segment: per output the penalty, and for `select` the
-    /// candidate.
-    pub chosen: BTreeMap<String, serde_json::Value>,
-    /// For bagged variants: the fraction of query targets inside the predictive band.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub query_band_coverage: Option<f64>,
-}
-
-/// One row of the ablation table: one formulation on one condition.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct AblationRow {
-    pub table: String,
-    pub condition: String,
-    /// The paper's numbers, when it has them, and the target min(SINDy gen, LeARN gen).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub published: Option<report::MethodPair>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub target: Option<f64>,
-    /// Our SINDy with the paper's settings (the run configuration's).
-    pub sindy: report::Mse,
-    /// Noise floor of the forward-difference targets on each segment.
-    pub noise_floor_support: NoiseFloor,
-    pub noise_floor_query: NoiseFloor,
-    pub variants: BTreeMap<String, VariantCell>,
-    /// The headline model fitted with the first seed, one equation per output, terms ordered by
-    /// their share of the prediction's variance on the support segment (largest first).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub headline_equations: Vec<String>,
-}
-
-/// The whole ablation result (`results/ablations/ablations.json`).
+/// The whole ablation result (`results/ablations/ablations.json`). Its rows are `report`'s
+/// [`AblationRow`]s; [`Ablations::tables`] is what `ablations.md` shows of it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Ablations {
     pub name: String,
@@ -85,6 +36,33 @@ pub struct Ablations {
     pub provenance: AblationProvenance,
     pub config: VariantsConfig,
     pub rows: Vec<AblationRow>,
+}
+
+impl Ablations {
+    /// The ablation tables as `report` renders them ([`report::ablations_markdown`]).
+    pub fn tables(&self) -> AblationTables<'_> {
+        let config = &self.config;
+        AblationTables {
+            name: &self.name,
+            description: &self.description,
+            protocol: &self.protocol,
+            seeds: &config.seeds,
+            headline: &config.headline,
+            headline_equations_of: config
+                .equations_variant(&config.headline)
+                .unwrap_or(&config.headline),
+            figure_variant: config.figure_variant.as_deref(),
+            variants: config
+                .variants
+                .iter()
+                .map(|v| VariantNote {
+                    name: &v.name,
+                    description: &v.description,
+                })
+                .collect(),
+            rows: &self.rows,
+        }
+    }
 }
 
 /// Where the ablation numbers come from.
@@ -159,14 +137,14 @@ pub struct AblationCellDetail {
 /// A shard of the ablations: each (cell, seed) item's variants.
 pub type AblationsShard = ShardFile<AblationsContext, AblationSeedOutcome>;
 
-/// Runs every variant on every cell and seed; `on_progress` is told each item as it ends.
+/// Runs every variant on every cell and seed; `progress` is told of the stages (see
+/// [`run_variants_shard`]) and of each item as it ends.
 pub fn run_variants(
     config: &CheckedVariants,
     data_dir: &Path,
-    on_progress: &(dyn Fn(&str) + Sync),
+    progress: &dyn Progress,
 ) -> Result<AblationsOutcome> {
-    let work = AblationsWork::plan(config, data_dir)?;
-    let results = work.run_items(ShardSpec::WHOLE, on_progress)?;
+    let (work, results, _) = plan_and_run(config, data_dir, progress, ShardSpec::WHOLE)?;
     let results: Vec<AblationSeedOutcome> = results.into_iter().map(|r| r.result).collect();
     render_ablations(
         &work.sweep.context,
@@ -176,29 +154,42 @@ pub fn run_variants(
     )
 }
 
-/// Runs shard `shard` of the ablations (see [`run_variants`]).
+/// Runs shard `shard` of the ablations (see [`run_variants`]); the shard records the times of
+/// the stages.
 pub fn run_variants_shard(
     config: &CheckedVariants,
     data_dir: &Path,
-    on_progress: &(dyn Fn(&str) + Sync),
+    progress: &dyn Progress,
     shard: ShardSpec,
 ) -> Result<AblationsShard> {
-    let start = std::time::Instant::now();
-    let work = AblationsWork::plan(config, data_dir)?;
-    let planned = start.elapsed().as_secs_f64();
-    let results = work.run_items(shard, on_progress)?;
-    let stages = vec![
-        StageTiming {
-            stage: "load flights, cut the cells".to_string(),
-            seconds: planned,
-        },
-        StageTiming {
-            stage: "variants".to_string(),
-            seconds: start.elapsed().as_secs_f64() - planned,
-        },
-    ];
+    let (work, results, stages) = plan_and_run(config, data_dir, progress, shard)?;
     let provenance = ShardProvenance::here(&config.root, stages);
     Ok(work.sweep.shard_file(shard, results, provenance))
+}
+
+/// The results of the items of `shard`, and the stages' times: "load flights, cut the cells", then
+/// "variants" (one unit of progress per item).
+type ShardRun<'c> = (
+    AblationsWork<'c>,
+    Vec<ItemResult<AblationSeedOutcome>>,
+    Vec<StageTiming>,
+);
+
+/// Plans the ablations and runs the items of `shard`.
+fn plan_and_run<'c>(
+    config: &'c CheckedVariants,
+    data_dir: &Path,
+    progress: &dyn Progress,
+    shard: ShardSpec,
+) -> Result<ShardRun<'c>> {
+    let mut stopwatch = Stopwatch::new(progress);
+    let work = stopwatch.time("load flights, cut the cells", || {
+        AblationsWork::plan(config, data_dir)
+    })?;
+    let items = shard.positions(work.sweep.items.len()).len();
+    let stage = Stage::counting("variants", "variants", items);
+    let results = stopwatch.time(stage, || work.run_items(shard, progress))?;
+    Ok((work, results, stopwatch.timings()))
 }
 
 /// The ablations of merged shards, rendered as [`run_variants`] renders them.
@@ -339,7 +330,10 @@ pub fn write_ablations(outcome: &AblationsOutcome, dir: &Path) -> Result<Vec<Pat
     write_text(&json, &format!("{text}\n"))?;
     written.push(json);
     let md = dir.join("ablations.md");
-    write_text(&md, &crate::ablations_markdown(&outcome.ablations))?;
+    write_text(
+        &md,
+        &report::ablations_markdown(&outcome.ablations.tables()),
+    )?;
     written.push(md);
     for (file, figure) in &outcome.figures {
         let path = dir.join("figures").join(file);

@@ -7,12 +7,13 @@ use crate::sindy_variant::SegmentPredictions;
 use data::{Condition, FlightLog, Formulation, Segment, forward_difference_noise_floor};
 use learn::{Cells, Experiment, MetaTrainedModel, WorkItem};
 use rayon::prelude::*;
-use report::{MethodTrace, PublishedTables, QualitativeFigure};
+use report::{MethodTrace, PublishedTables, QualitativeFigure, SeedCell};
 use sindy::{EnsemblePrediction, Mat, RegressionFit};
 
-use super::{AblationCell, AblationCellDetail, AblationSeedOutcome, AblationsContext, SeedCell};
+use super::{AblationCell, AblationCellDetail, AblationSeedOutcome, AblationsContext};
 use crate::cells::{cell_figure, flight_segments};
 use crate::error::{PipelineError, Result};
+use crate::progress::Progress;
 use crate::shard::{ItemResult, ShardSpec, Sweep, SweepKind};
 use crate::tables::ConditionName;
 use crate::variants::{CheckedVariants, Outcome, evaluate_variants, learned_basis_experiment};
@@ -100,15 +101,15 @@ impl<'c> AblationsWork<'c> {
         })
     }
 
-    /// Runs the items of `shard`, telling `on_progress` each one as it ends.
+    /// Runs the items of `shard`, telling `progress` of each one as it ends.
     pub(super) fn run_items(
         &self,
         shard: ShardSpec,
-        on_progress: &(dyn Fn(&str) + Sync),
+        progress: &dyn Progress,
     ) -> Result<Vec<ItemResult<AblationSeedOutcome>>> {
         self.sweep.run(shard, |item| {
             let outcome = self.run_item(item)?;
-            on_progress(&item.to_string());
+            progress.advance(format_args!("{item}"));
             Ok(outcome)
         })
     }

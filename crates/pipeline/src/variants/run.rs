@@ -1,0 +1,466 @@
+//! Running the variants on one cell: every variant of a file on one support/query pair with one
+//! seed ([`evaluate_variants`]), in declaration order (a `select` or `average` takes the outcomes
+//! of variants before it), and `make reproduce`'s extra columns ([`reproduce_columns`]).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::sindy_variant::{SegmentPredictions, VariantEvaluation, evaluate_features};
+use data::{Formulation, Segment};
+use learn::variants::learned_features;
+use learn::{Experiment, MetaTrainedModel};
+use rayon::prelude::*;
+use sindy::{Mat, RegressionFit};
+
+use super::checks::learned_basis_config;
+use super::combinators::{average, ensemble_mean, select};
+use super::schema::{
+    CheckedVariants, LearnedBasisSpec, VariantKind, VariantSpec, VariantsConfig,
+    ensemble_member_seeds,
+};
+use crate::error::{PipelineError, Result};
+
+/// One variant's outcome on one cell and seed, with its traces.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// Predictions and MSE on both segments (and the band of a bagged variant).
+    pub predictions: SegmentPredictions,
+    /// The feature names and the fitted regression, for variants that fit one.
+    pub regression: Option<(Vec<String>, RegressionFit)>,
+    /// Everything chosen inside the support segment (per output penalty; `variant` for select).
+    pub chosen: BTreeMap<String, serde_json::Value>,
+    /// Mean over outputs of the best support cross-validation MSE (variants that fit a
+    /// regression).
+    pub support_cv: Option<f64>,
+}
+
+impl Outcome {
+    /// A variant without a regression (nothing chosen, no band): its predictions, scored on both
+    /// segments.
+    pub(super) fn unfitted(
+        support_prediction: Mat<f64>,
+        query_prediction: Mat<f64>,
+        support: &Segment,
+        query: &Segment,
+    ) -> Self {
+        Self {
+            predictions: SegmentPredictions::scored(
+                support_prediction,
+                query_prediction,
+                support.targets.as_ref(),
+                query.targets.as_ref(),
+            ),
+            regression: None,
+            chosen: BTreeMap::new(),
+            support_cv: None,
+        }
+    }
+}
+
+impl LearnedBasisSpec {
+    /// Features of both segments from the frozen networks (and the fixed library), regression
+    /// fitted and its penalty chosen on the support segment.
+    pub fn evaluate(
+        &self,
+        model: &MetaTrainedModel,
+        support: &Segment,
+        query: &Segment,
+        seed: u64,
+    ) -> Result<VariantEvaluation> {
+        let features = |segment: &Segment| -> Result<(Mat<f64>, Vec<String>)> {
+            let (learned, learned_names) = learned_features(model, segment, self.features);
+            let Some(library) = &self.library else {
+                return Ok((learned, learned_names));
+            };
+            let (fixed, mut names) = library.features(segment)?;
+            names.extend(learned_names);
+            let theta = Mat::from_fn(segment.len(), fixed.ncols() + learned.ncols(), |i, j| {
+                if j < fixed.ncols() {
+                    fixed[(i, j)]
+                } else {
+                    learned[(i, j - fixed.ncols())]
+                }
+            });
+            Ok((theta, names))
+        };
+        let (support_theta, names) = features(support)?;
+        let (query_theta, _) = features(query)?;
+        Ok(evaluate_features(
+            &self.regression,
+            names,
+            support_theta.as_ref(),
+            support.targets.as_ref(),
+            query_theta.as_ref(),
+            query.targets.as_ref(),
+            seed,
+        )?)
+    }
+}
+
+/// The extra columns `make reproduce` shows: the `reproduce` variants of the variants file
+/// `config`, for each (support, query, the run's meta-trained LeARN model) of a cell, with the
+/// first seed of that file.
+pub fn reproduce_columns(
+    config: &VariantsConfig,
+    cells: &[(&Segment, &Segment, &MetaTrainedModel)],
+) -> Result<Vec<BTreeMap<String, report::Mse>>> {
+    let variants = config.reproduce_variants();
+    let seed = config.seeds[0];
+    cells
+        .par_iter()
+        .map(|(support, query, model)| {
+            // The run's model serves every variant; `read` refused ensembles in these columns.
+            let run_model = |_seed: u64| -> Result<MetaTrainedModel> { Ok((*model).clone()) };
+            let outcomes = evaluate_variants(&variants, run_model, support, query, seed)?;
+            Ok(variants
+                .iter()
+                .zip(outcomes)
+                .filter(|(spec, _)| config.reproduce.contains(&spec.name))
+                .map(|(spec, outcome)| {
+                    (
+                        spec.name.clone(),
+                        report::Mse {
+                            adaptation: outcome.predictions.support_mse,
+                            generalisation: outcome.predictions.query_mse,
+                        },
+                    )
+                })
+                .collect())
+        })
+        .collect()
+}
+
+/// The LeARN experiment of the learned-basis variants: the run's, with the variants file's
+/// `learn_overrides`.
+pub(crate) fn learned_basis_experiment(
+    config: &CheckedVariants,
+    data_dir: &Path,
+) -> Result<Experiment> {
+    let run = &config.run;
+    Ok(Experiment::load(
+        learned_basis_config(config)?,
+        run.conditions.clone(),
+        data_dir,
+        run.protocol,
+    )?)
+}
+
+/// Every variant of `variants` on one support/query pair with one seed, in declaration order.
+/// `meta_train(s)` meta-trains the LeARN networks with seed `s`: with `seed` when a learned-basis
+/// variant needs them, with each member seed of a `learn_ensemble`, at most once per seed. It must
+/// not read the query segment (the pipeline's leaves the evaluation flight out entirely).
+pub fn evaluate_variants(
+    variants: &[VariantSpec],
+    meta_train: impl Fn(u64) -> Result<MetaTrainedModel>,
+    support: &Segment,
+    query: &Segment,
+    seed: u64,
+) -> Result<Vec<Outcome>> {
+    let mut outcomes: Vec<Outcome> = Vec::with_capacity(variants.len());
+    let mut cell = Cell {
+        variants,
+        models: MetaTrainedModels {
+            train: &meta_train,
+            models: BTreeMap::new(),
+        },
+        support,
+        query,
+        seed,
+    };
+    for spec in variants {
+        let outcome = cell
+            .evaluate(spec, &outcomes)
+            .map_err(|error| match error {
+                error @ PipelineError::Mismatch { .. } => error,
+                error => PipelineError::Mismatch {
+                    what: format!("variant '{}'", spec.name),
+                    message: error.to_string(),
+                },
+            })?;
+        outcomes.push(outcome);
+    }
+    Ok(outcomes)
+}
+
+/// The variants of one cell and seed as they run: the models meta-trained so far.
+struct Cell<'a, F> {
+    variants: &'a [VariantSpec],
+    models: MetaTrainedModels<'a, F>,
+    support: &'a Segment,
+    query: &'a Segment,
+    seed: u64,
+}
+
+impl<F: Fn(u64) -> Result<MetaTrainedModel>> Cell<'_, F> {
+    /// The variant `spec`, after those before it (`done`, their outcomes in declaration order).
+    fn evaluate(&mut self, spec: &VariantSpec, done: &[Outcome]) -> Result<Outcome> {
+        let (support, query, seed) = (self.support, self.query, self.seed);
+        Ok(match &spec.kind {
+            VariantKind::Library(variant) => {
+                let evaluation = variant.evaluate(support, query, seed)?;
+                outcome_of(evaluation, BTreeMap::new(), &support.formulation)
+            }
+            VariantKind::Select { candidates } => {
+                let candidates = self.earlier(spec, done, candidates, "candidate")?;
+                select(self.variants, done, &candidates)
+            }
+            VariantKind::LearnedBasis(variant) => {
+                let model = self.models.get(seed)?;
+                let evaluation = variant.evaluate(model, support, query, seed)?;
+                outcome_of(evaluation, BTreeMap::new(), &support.formulation)
+            }
+            VariantKind::Learn => {
+                let model = self.models.get(seed)?;
+                let [on_support, on_query] = adapted_predictions(model, support, query);
+                Outcome::unfitted(on_support, on_query, support, query)
+            }
+            VariantKind::LearnEnsemble { members } => {
+                let seeds = ensemble_member_seeds(seed, *members).ok_or_else(|| {
+                    PipelineError::Mismatch {
+                        what: format!("seed {seed}"),
+                        message: "its ensemble member seeds overflow".to_string(),
+                    }
+                })?;
+                let predictions = seeds
+                    .into_iter()
+                    .map(|member| {
+                        Ok(adapted_predictions(
+                            self.models.get(member)?,
+                            support,
+                            query,
+                        ))
+                    })
+                    .collect::<Result<Vec<_>>>()?;
+                ensemble_mean(predictions, support, query)
+            }
+            VariantKind::Average { members } => {
+                let members: Vec<&SegmentPredictions> = self
+                    .earlier(spec, done, members, "member")?
+                    .into_iter()
+                    .map(|index| &done[index].predictions)
+                    .collect();
+                average(&members, support, query)
+            }
+        })
+    }
+
+    /// The indices of the variants `names` (each declared before `spec`, so in `done`).
+    fn earlier(
+        &self,
+        spec: &VariantSpec,
+        done: &[Outcome],
+        names: &[String],
+        what: &str,
+    ) -> Result<Vec<usize>> {
+        let found: Vec<usize> = names
+            .iter()
+            .filter_map(|name| self.variants.iter().position(|v| &v.name == name))
+            .filter(|&index| index < done.len())
+            .collect();
+        if found.len() != names.len() || found.is_empty() {
+            return Err(PipelineError::Mismatch {
+                what: format!("variant '{}'", spec.name),
+                message: format!("every {what} must be declared before it"),
+            });
+        }
+        Ok(found)
+    }
+}
+
+/// The meta-trained models of one cell, each trained by `train` on first use of its seed.
+struct MetaTrainedModels<'t, F> {
+    train: &'t F,
+    models: BTreeMap<u64, MetaTrainedModel>,
+}
+
+impl<F: Fn(u64) -> Result<MetaTrainedModel>> MetaTrainedModels<'_, F> {
+    fn get(&mut self, seed: u64) -> Result<&MetaTrainedModel> {
+        if !self.models.contains_key(&seed) {
+            let model = (self.train)(seed)?;
+            self.models.insert(seed, model);
+        }
+        Ok(&self.models[&seed])
+    }
+}
+
+/// `model` adapted online on `support` (its own adaptation settings), predicting both segments.
+fn adapted_predictions(
+    model: &MetaTrainedModel,
+    support: &Segment,
+    query: &Segment,
+) -> [Mat<f64>; 2] {
+    let adapted = model.adapt(support, &model.config.adaptation);
+    [support, query].map(|segment| {
+        learn::from_row_major(
+            &model.predict_segment(&adapted, segment),
+            model.architecture.state_dim,
+        )
+    })
+}
+
+fn outcome_of(
+    evaluation: VariantEvaluation,
+    mut chosen: BTreeMap<String, serde_json::Value>,
+    formulation: &Formulation,
+) -> Outcome {
+    let selections = &evaluation.fit.selections;
+    for (selection, output) in selections.iter().zip(formulation.target_names()) {
+        chosen.insert(output, serde_json::json!(selection.chosen));
+    }
+    let support_cv = selections
+        .iter()
+        .map(|s| s.scores.iter().copied().fold(f64::INFINITY, f64::min))
+        .sum::<f64>()
+        / selections.len().max(1) as f64;
+    Outcome {
+        predictions: evaluation.predictions,
+        regression: Some((evaluation.feature_names, evaluation.fit)),
+        chosen,
+        support_cv: Some(support_cv),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::variants::testing::{RIDGE, config, segment, write};
+    use learn::{CHECKPOINT_FORMAT, Protocol, Standardiser};
+
+    fn untrained_model() -> MetaTrainedModel {
+        let mut config: learn::LearnConfig =
+            serde_json::from_str(include_str!("../../../../experiments/learn.json")).unwrap();
+        config.hidden_layers = vec![5, 4];
+        config.adaptation.passes = 2;
+        let architecture = learn::architecture(Formulation::Attitude, &config);
+        MetaTrainedModel {
+            format: CHECKPOINT_FORMAT.to_string(),
+            trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
+                formulation: Formulation::Attitude,
+                protocol: Protocol::LeaveConditionOut,
+                held_out_condition: None,
+            }),
+            seed: 2,
+            parameters: architecture.initial_parameters(2),
+            standardiser: Standardiser::identity(architecture.input_dim),
+            architecture,
+            config,
+            data_files: Vec::new(),
+            meta_loss_history: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn learn_is_the_adapted_network_and_average_the_mean_of_its_members() {
+        let text = config(
+            &format!(
+                r#"{{"name": "a", "description": "", {RIDGE}}},
+                   {{"name": "l", "description": "", "kind": "learn"}},
+                   {{"name": "m", "description": "", "kind": "average", "members": ["l", "a"]}}"#
+            ),
+            "",
+        );
+        let read = VariantsConfig::read(&write("evaluate", &text)).unwrap();
+        let (support, query) = (segment(60, 0.0), segment(40, 1.3));
+        let model = untrained_model();
+        let outcomes =
+            evaluate_variants(&read.variants, |_| Ok(model.clone()), &support, &query, 1).unwrap();
+        let adapted = model.adapt(&support, &model.config.adaptation);
+        assert_ne!(adapted, model.parameters, "adaptation moved nothing");
+        let expected = model.predict_segment(&adapted, &query);
+        let learn = &outcomes[1].predictions;
+        for i in 0..query.len() {
+            for j in 0..3 {
+                assert_eq!(learn.query_prediction[(i, j)], expected[i * 3 + j]);
+                let mean = 0.5
+                    * (learn.query_prediction[(i, j)]
+                        + outcomes[0].predictions.query_prediction[(i, j)]);
+                assert_eq!(outcomes[2].predictions.query_prediction[(i, j)], mean);
+            }
+        }
+        let error = |prediction: &Mat<f64>, segment: &Segment| {
+            sindy::mean_squared_error(prediction.as_ref(), segment.targets.as_ref())
+        };
+        assert_eq!(learn.query_mse, error(&learn.query_prediction, &query));
+        let average = &outcomes[2].predictions;
+        assert_eq!(
+            average.support_mse,
+            error(&average.support_prediction, &support)
+        );
+        assert!(outcomes[1].support_cv.is_none() && outcomes[2].chosen.is_empty());
+        assert!(outcomes[0].support_cv.is_some() && outcomes[2].regression.is_none());
+    }
+
+    #[test]
+    fn learn_ensemble_is_the_mean_of_its_members_each_meta_trained_once_from_its_own_seed() {
+        let text = config(
+            r#"{"name": "l", "description": "", "kind": "learn"},
+               {"name": "a", "description": "", "kind": "learn_ensemble", "members": 3}"#,
+            "",
+        );
+        let read = VariantsConfig::read(&write("ensemble", &text)).unwrap();
+        let (support, query) = (segment(60, 0.0), segment(40, 1.3));
+        // A different (untrained) model per seed; the seeds asked for are recorded.
+        let asked = std::sync::Mutex::new(Vec::new());
+        let model_for = |seed: u64| {
+            let mut model = untrained_model();
+            model.seed = seed;
+            model.parameters = model.architecture.initial_parameters(seed);
+            model
+        };
+        let train = |seed: u64| {
+            asked.lock().unwrap().push(seed);
+            Ok(model_for(seed))
+        };
+        let outcomes = evaluate_variants(&read.variants, train, &support, &query, 7).unwrap();
+        // The `learn` model (seed 7) is the ensemble's first member, trained once.
+        assert_eq!(*asked.lock().unwrap(), vec![7, 1_000_007, 2_000_007]);
+        assert_eq!(
+            ensemble_member_seeds(7, 3),
+            Some(vec![7, 1_000_007, 2_000_007])
+        );
+        let members: Vec<[Mat<f64>; 2]> = [7, 1_000_007, 2_000_007]
+            .into_iter()
+            .map(|seed| adapted_predictions(&model_for(seed), &support, &query))
+            .collect();
+        let ensemble = &outcomes[1].predictions;
+        for i in 0..query.len() {
+            for j in 0..3 {
+                let mean = members.iter().map(|m| m[1][(i, j)]).sum::<f64>() / 3.0;
+                assert!(
+                    (ensemble.query_prediction[(i, j)] - mean).abs() <= 1e-12 * mean.abs().max(1.0)
+                );
+            }
+        }
+        assert_eq!(outcomes[0].predictions.query_prediction, members[0][1]);
+        assert_ne!(
+            members[0][1], members[1][1],
+            "the members are different models"
+        );
+        assert!(outcomes[1].chosen.is_empty() && outcomes[1].support_cv.is_none());
+    }
+
+    #[test]
+    fn an_error_while_evaluating_names_the_variant() {
+        // Bagging blocks longer than the support segment: found against the segment.
+        let text = config(
+            r#"{"name": "a", "description": "", "kind": "library", "library": {"linear": true},
+               "regression": {"penalty": {"kind": "ridge", "lambdas": [0.0]}, "bagging": {"members": 3, "block": 500}}}"#,
+            "",
+        );
+        let read = VariantsConfig::read(&write("evaluate-error", &text)).unwrap();
+        let (support, query) = (segment(60, 0.0), segment(40, 1.3));
+        let message = evaluate_variants(
+            &read.variants,
+            |_| Ok(untrained_model()),
+            &support,
+            &query,
+            1,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            message.starts_with("variant 'a': ") && message.contains("bagging.block"),
+            "{message}"
+        );
+    }
+}

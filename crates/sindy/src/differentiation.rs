@@ -191,10 +191,7 @@ fn savitzky_golay_weights(window: usize, order: usize, at: f64) -> Vec<f64> {
         }
     });
     // weights = V (VᵀV)⁻¹ d
-    use faer::linalg::solvers::Solve;
-    let gram = vandermonde.transpose() * &vandermonde;
-    let solved = gram.full_piv_lu().solve(&derivative_row);
-    let weights = &vandermonde * &solved;
+    let weights = crate::linalg::projection_weights(vandermonde.as_ref(), derivative_row.as_ref());
     (0..window).map(|j| weights[(j, 0)]).collect()
 }
 

@@ -5,6 +5,7 @@ use faer::{Mat, MatRef};
 
 use crate::error::{Result, SindyError, invalid, shape};
 use crate::library::{FeatureLibrary, LibrarySpec};
+use crate::linalg::product;
 use crate::optimizer::OptimizerSpec;
 use crate::reduced::{BLOCK_ROWS, ReducedProblem};
 
@@ -279,8 +280,7 @@ impl SindyParams {
         targets: MatRef<'_, f64>,
     ) -> Result<(SindyModel, Mat<f64>)> {
         let (model, theta) = self.fit_with_library_matrix(inputs, targets)?;
-        let prediction = theta * model.coefficients().transpose();
-        crate::linalg::clear_upper_vector_state();
+        let prediction = product(theta.as_ref(), model.coefficients().transpose());
         Ok((model, prediction))
     }
 
@@ -473,9 +473,7 @@ impl SindyModel {
         let features = self.coefficients.ncols();
         if inputs.nrows().saturating_mul(features) <= LARGE_LIBRARY_ENTRIES {
             let theta = self.library.transform(inputs);
-            let prediction = theta * self.coefficients.transpose();
-            crate::linalg::clear_upper_vector_state();
-            return Ok(prediction);
+            return Ok(product(theta.as_ref(), self.coefficients.transpose()));
         }
         // A large library is evaluated by blocks of rows, never whole.
         let mut prediction = Mat::zeros(inputs.nrows(), self.coefficients.nrows());
@@ -485,8 +483,7 @@ impl SindyModel {
             prediction
                 .as_mut()
                 .subrows_mut(start, rows)
-                .copy_from(&theta * self.coefficients.transpose());
-            crate::linalg::clear_upper_vector_state();
+                .copy_from(product(theta.as_ref(), self.coefficients.transpose()));
         }
         Ok(prediction)
     }

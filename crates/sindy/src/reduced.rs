@@ -25,7 +25,7 @@ use std::ops::Range;
 use faer::{Mat, MatRef};
 use rayon::prelude::*;
 
-use crate::linalg::clear_upper_vector_state;
+use crate::linalg::{product, qr_triangle};
 
 /// Rows of one block of the library (the memory of the reduction is about this many rows of Θ
 /// per thread).
@@ -127,22 +127,17 @@ impl ReducedProblem {
 
     /// ΘᵀΘ = RᵀR.
     pub fn gram(&self) -> Mat<f64> {
-        let gram = self.triangular.transpose() * &self.triangular;
-        clear_upper_vector_state();
-        gram
+        product(self.triangular.transpose(), self.triangular.as_ref())
     }
 
     /// ΘᵀY = RᵀZ.
     pub fn moments(&self) -> Mat<f64> {
-        let moments = self.triangular.transpose() * &self.projected;
-        clear_upper_vector_state();
-        moments
+        product(self.triangular.transpose(), self.projected.as_ref())
     }
 
     /// `‖Θ ξ_j − y_j‖²` for each target j, ξ one row per target (as [`crate::StlsqFit`]).
     pub fn residual_sum_of_squares(&self, coefficients: MatRef<'_, f64>) -> Vec<f64> {
-        let fitted = &self.triangular * coefficients.transpose();
-        clear_upper_vector_state();
+        let fitted = product(self.triangular.as_ref(), coefficients.transpose());
         (0..self.projected.ncols())
             .map(|j| {
                 let inside: f64 = (0..self.projected.nrows())
@@ -218,10 +213,7 @@ fn stacked_triangle(
     if stacked.nrows() == 0 {
         return stacked;
     }
-    let qr = stacked.qr();
-    let r = qr.thin_R().to_owned();
-    clear_upper_vector_state();
-    r
+    qr_triangle(stacked.as_ref())
 }
 
 #[cfg(test)]

@@ -23,7 +23,7 @@ use faer::{Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, field, shape};
-use crate::linalg::ridge_from_gram;
+use crate::linalg::{product, ridge_from_gram};
 use crate::optimizer::{Lasso, Stlsq};
 use crate::selection::{BlockedFolds, Fold, Selection, cross_validate};
 
@@ -153,7 +153,7 @@ impl LinearFit {
     /// Predictions, one row per row of `theta`, one column per target.
     pub fn predict(&self, theta: MatRef<'_, f64>) -> Mat<f64> {
         let z = standardised(theta, &self.feature_centre, &self.feature_scale);
-        let mut prediction = &z * &self.coefficients;
+        let mut prediction = product(z.as_ref(), self.coefficients.as_ref());
         for j in 0..prediction.ncols() {
             for i in 0..prediction.nrows() {
                 prediction[(i, j)] += self.target_centre[j];
@@ -379,19 +379,19 @@ impl RegressionSpec {
                 }
             })
             .collect();
-        let gram = z.transpose() * &z;
+        let gram = product(z.transpose(), z.as_ref());
         let mut coefficients = Mat::<f64>::zeros(p, y.ncols());
         for j in 0..y.ncols() {
             let centred = Mat::from_fn(n, 1, |i, _| y[(i, j)] - target_centre[j]);
             let value = values[j.min(values.len() - 1)];
             let column: Vec<f64> = match &self.penalty {
                 Penalty::Ridge { .. } => {
-                    let rhs = z.transpose() * &centred;
+                    let rhs = product(z.transpose(), centred.as_ref());
                     let b = ridge_from_gram(gram.as_ref(), rhs.as_ref(), value * n as f64);
                     (0..p).map(|i| b[(i, 0)]).collect()
                 }
                 Penalty::Lasso { .. } => {
-                    let moments = z.transpose() * &centred;
+                    let moments = product(z.transpose(), centred.as_ref());
                     let largest = (0..p).map(|i| moments[(i, 0)].abs()).fold(0.0, f64::max);
                     let lasso = Lasso::new(value * largest)?;
                     let b = lasso.fit(z.as_ref(), centred.as_ref(), &[format!("column {j}")])?;

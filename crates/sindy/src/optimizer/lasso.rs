@@ -19,7 +19,7 @@ use faer::{Mat, MatRef};
 use rayon::prelude::*;
 
 use crate::error::{Result, SindyError, invalid};
-use crate::linalg::ridge_from_gram;
+use crate::linalg::{product, ridge_from_gram};
 
 /// Checked LASSO settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,8 +43,8 @@ impl Lasso {
         targets: MatRef<'_, f64>,
         target_names: &[String],
     ) -> Result<Mat<f64>> {
-        let gram = theta.transpose() * theta;
-        let moments = theta.transpose() * targets;
+        let gram = product(theta.transpose(), theta);
+        let moments = product(theta.transpose(), targets);
         self.fit_gram(gram.as_ref(), moments.as_ref(), target_names)
     }
 
@@ -172,9 +172,9 @@ pub fn kkt_violation(
     coefficients: &[f64],
     lambda: f64,
 ) -> f64 {
-    let gram = theta.transpose() * theta;
+    let gram = product(theta.transpose(), theta);
     let y = Mat::from_fn(target.len(), 1, |i, _| target[i]);
-    let moments = theta.transpose() * &y;
+    let moments = product(theta.transpose(), y.as_ref());
     gram_kkt_violation(gram.as_ref(), moments.as_ref(), coefficients, lambda)
 }
 

@@ -14,15 +14,11 @@ use faer::{Mat, MatRef};
 use rayon::prelude::*;
 
 use crate::error::{Result, invalid};
-use faer::linalg::solvers::SolveLstsq;
-
 use crate::linalg::{
-    CholeskyQr, clear_upper_vector_state, full_rank_qr, full_rank_triangular_rows, least_squares,
-    ridge_from_gram,
+    CholeskyQr, full_rank_triangular_rows, householder_least_squares, least_squares, product,
+    ridge_from_gram, solve_upper,
 };
 use crate::reduced::ReducedProblem;
-use faer::Par;
-use faer::linalg::triangular_solve::solve_upper_triangular_in_place;
 
 /// Work per target above which targets are fitted in parallel: features³ for the ridge steps on
 /// the Gram matrix and the refit on R (p × p), samples × features² when the refit needs Θ itself
@@ -71,14 +67,13 @@ impl Stlsq {
 
     /// Fits every column of `targets` (n × targets) on the library `theta` (n × features).
     pub fn fit(&self, theta: MatRef<'_, f64>, targets: MatRef<'_, f64>) -> StlsqFit {
-        let gram = theta.transpose() * theta;
-        let moments = theta.transpose() * targets;
+        let gram = product(theta.transpose(), theta);
+        let moments = product(theta.transpose(), targets);
         let reduced = LibraryQr::new(theta, targets, gram.as_ref());
         let reference = match &reduced {
             Some(reduced) => reduced.solution.clone(),
             None => least_squares(theta, targets),
         };
-        clear_upper_vector_state();
         let fit_target = |i: usize| -> (Vec<f64>, usize) {
             let reference_pattern: Vec<bool> = (0..theta.ncols())
                 .map(|j| reference[(j, i)] != 0.0)
@@ -124,14 +119,9 @@ impl Stlsq {
         let gram = reduced.gram();
         let moments = reduced.moments();
         let reference = match full_rank_triangular_rows(r, reduced.rows()) {
-            true => {
-                let mut solution = projected.to_owned();
-                solve_upper_triangular_in_place(r, solution.as_mut(), Par::Seq);
-                solution
-            }
+            true => solve_upper(r, projected),
             false => least_squares(r, projected),
         };
-        clear_upper_vector_state();
         let fit_target = |i: usize| -> (Vec<f64>, usize) {
             let reference_pattern: Vec<bool> =
                 (0..features).map(|j| reference[(j, i)] != 0.0).collect();
@@ -229,19 +219,16 @@ impl LibraryQr {
     ) -> Option<Self> {
         if let Some(qr) = CholeskyQr::new(theta, gram) {
             let projected = qr.project(targets);
-            let mut solution = projected.clone();
-            solve_upper_triangular_in_place(qr.r(), solution.as_mut(), Par::Seq);
-            clear_upper_vector_state();
+            let solution = solve_upper(qr.r(), projected.as_ref());
             return Some(Self {
                 triangular: qr.r().to_owned(),
                 projected,
                 solution,
             });
         }
-        let (qr, triangular) = full_rank_qr(theta)?;
-        let solution = qr.solve_lstsq(targets);
+        let (triangular, solution) = householder_least_squares(theta, targets)?;
         // Qᵀy = R·ξ_ls.
-        let projected = &triangular * &solution;
+        let projected = product(triangular.as_ref(), solution.as_ref());
         Some(Self {
             triangular,
             projected,

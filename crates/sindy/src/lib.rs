@@ -51,11 +51,9 @@ mod error;
 mod library;
 mod linalg;
 mod model;
-mod optimizer;
+mod optimizers;
 mod persist;
-mod reduced;
 mod regression;
-mod selection;
 mod stream;
 
 pub use differentiation::{Derivative, DifferentiationError};
@@ -65,17 +63,16 @@ pub use linalg::least_squares;
 pub use model::{
     LARGE_LIBRARY_ENTRIES, Score, SindyModel, SindyParams, Trajectory, mean_squared_error, r2_score,
 };
-pub use optimizer::{
-    DEFAULT_ALPHA, DEFAULT_MAX_ITER, Lasso, Optimizer, OptimizerSpec, Stlsq, StlsqFit,
-    kkt_violation,
+pub use optimizers::{
+    DEFAULT_ALPHA, DEFAULT_MAX_ITER, Lasso, Optimizer, OptimizerSpec, Problem, Ridge, Stlsq,
+    StlsqFit, kkt_violation,
 };
 pub use persist::MODEL_FORMAT;
-pub use reduced::{BLOCK_ROWS, ReducedProblem, Reduction, SEGMENT_ROWS, segment_triangle};
 pub use regression::{
-    Bagging, EnsemblePrediction, LinearFit, MAX_BAGGING_BLOCK, MAX_BAGGING_MEMBERS, MAX_PENALTY,
-    MAX_PENALTY_CANDIDATES, Penalty, RegressionFit, RegressionSpec, select_rows,
+    Bagging, BlockedFolds, EnsemblePrediction, LinearFit, MAX_BAGGING_BLOCK, MAX_BAGGING_MEMBERS,
+    MAX_FOLDS, MAX_PENALTY, MAX_PENALTY_CANDIDATES, Penalty, RegressionFit, RegressionSpec,
+    Selection,
 };
-pub use selection::{BlockedFolds, Fold, MAX_FOLDS, Selection, cross_validate};
 pub use stream::{RowBlock, StreamedFit};
 
 /// Re-exported so that users name the same matrix types.

@@ -6,8 +6,8 @@ use faer::{Mat, MatRef};
 use crate::error::{Result, SindyError, invalid, shape};
 use crate::library::{FeatureLibrary, LibrarySpec};
 use crate::linalg::product;
-use crate::optimizer::OptimizerSpec;
-use crate::reduced::{BLOCK_ROWS, ReducedProblem};
+use crate::optimizers::tsqr::{BLOCK_ROWS, reduce_row_blocks};
+use crate::optimizers::{Optimizer, OptimizerSpec, Problem};
 
 /// One recorded trajectory: states x(t), optional controls u(t), optional derivatives ẋ(t).
 /// Samples must be uniformly spaced in time when derivatives are estimated from the states.
@@ -125,7 +125,8 @@ impl Score {
 }
 
 /// Entries (rows × features) above which a library is evaluated by blocks of rows and the fit
-/// reduced as it is built ([`ReducedProblem`]) instead of forming Θ whole: 2²² entries, 32 MB.
+/// reduced as it is built (see [`Problem::reduced`]) instead of forming Θ whole: 2²² entries,
+/// 32 MB.
 pub const LARGE_LIBRARY_ENTRIES: usize = 1 << 22;
 
 /// Settings of a SINDy fit, checked when [`SindyParams::fit`] runs.
@@ -207,8 +208,8 @@ impl SindyParams {
     /// Fits on inputs X = [x, u] and targets ẋ given as matrices (one row per sample).
     ///
     /// A library of more than [`LARGE_LIBRARY_ENTRIES`] entries is never formed whole: it is
-    /// evaluated and reduced by blocks of rows ([`ReducedProblem`]), in memory independent of
-    /// the number of rows, with the same coefficients up to rounding.
+    /// evaluated and reduced by blocks of rows (see [`Problem::reduced`]), in memory independent
+    /// of the number of rows, with the same coefficients up to rounding.
     pub fn fit_matrices(
         &self,
         inputs: MatRef<'_, f64>,
@@ -223,15 +224,14 @@ impl SindyParams {
         let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
         let feature_names = self.library.feature_names(&input_names);
         let sizes = FeatureSizes::new(features);
-        let reduced =
-            ReducedProblem::from_row_blocks(inputs.nrows(), features, targets.ncols(), |rows| {
-                let inputs = inputs.subrows(rows.start, rows.len());
-                let theta = self.library_block(inputs, rows.start, &feature_names, &sizes)?;
-                Ok::<_, SindyError>((theta, targets.subrows(rows.start, rows.len()).to_owned()))
-            })?;
+        let reduced = reduce_row_blocks(inputs.nrows(), features, targets.ncols(), |rows| {
+            let inputs = inputs.subrows(rows.start, rows.len());
+            let theta = self.library_block(inputs, rows.start, &feature_names, &sizes)?;
+            Ok::<_, SindyError>((theta, targets.subrows(rows.start, rows.len()).to_owned()))
+        })?;
         let sizes = sizes.into_vec();
         check_scale(&sizes, &feature_names)?;
-        let coefficients = optimizer.fit_reduced(&reduced, &self.state_names)?;
+        let coefficients = optimizer.solve(&reduced.with_target_names(&self.state_names))?;
         Ok(self.model(feature_names, coefficients))
     }
 
@@ -268,7 +268,8 @@ impl SindyParams {
             format!("feature '{}'", feature_names[j])
         })?;
         check_scale(&column_sizes(theta.as_ref()), &feature_names)?;
-        let coefficients = optimizer.fit(theta.as_ref(), targets, &self.state_names)?;
+        let problem = Problem::new(theta.as_ref(), targets).with_target_names(&self.state_names);
+        let coefficients = optimizer.solve(&problem)?;
         Ok((self.model(feature_names, coefficients), theta))
     }
 
@@ -302,7 +303,7 @@ impl SindyParams {
         &self,
         inputs: MatRef<'_, f64>,
         targets: MatRef<'_, f64>,
-    ) -> Result<crate::Optimizer> {
+    ) -> Result<Box<dyn Optimizer>> {
         self.check_names()?;
         let optimizer = self.optimizer.checked()?;
         let (dim_x, dim_u) = (self.state_names.len(), self.control_names.len());
@@ -352,7 +353,7 @@ impl SindyParams {
     }
 
     /// The names are checked and the optimizer with them.
-    pub(crate) fn checked_optimizer(&self) -> Result<crate::Optimizer> {
+    pub(crate) fn checked_optimizer(&self) -> Result<Box<dyn Optimizer>> {
         self.check_names()?;
         self.optimizer.checked()
     }
@@ -760,7 +761,7 @@ pub(crate) fn check_finite(
 
 /// The most the largest magnitudes of two features of one fit may differ by: beyond it a
 /// least-squares fit in double precision (16 digits) cannot resolve the smaller one.
-pub const MAX_FEATURE_SCALE_RATIO: f64 = 1e12;
+pub(crate) const MAX_FEATURE_SCALE_RATIO: f64 = 1e12;
 
 /// Refuses a library whose features differ in size by more than [`MAX_FEATURE_SCALE_RATIO`]
 /// (largest magnitude of each non-zero column): the fit would be noise or not finite.

@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Result, SindyError};
 use crate::library::{FeatureLibrary, LibrarySpec};
 use crate::model::SindyModel;
-use crate::optimizer::OptimizerSpec;
+use crate::optimizers::OptimizerSpec;
 
 /// The format tag written in every model file.
 pub const MODEL_FORMAT: &str = "sindy-model/1";

@@ -1,5 +1,5 @@
 //! Regularised linear regression of targets on any feature matrix Θ, with the regularisation chosen
-//! by blocked cross-validation inside the rows it is given ([`crate::selection`]), and bagged
+//! by blocked cross-validation inside the rows it is given ([`selection`]), and bagged
 //! ensembles that give a spread.
 //!
 //! Columns of Θ are standardised with the training rows' statistics (centred when there is an
@@ -22,10 +22,14 @@
 use faer::{Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
+mod selection;
+
 use crate::error::{Result, field, shape};
-use crate::linalg::{product, ridge_from_gram};
-use crate::optimizer::{Lasso, Stlsq};
-use crate::selection::{BlockedFolds, Fold, Selection, cross_validate};
+use crate::linalg::product;
+use crate::optimizers::{DEFAULT_MAX_ITER, Lasso, Optimizer, Problem, Ridge, Stlsq};
+use selection::{Fold, cross_validate};
+
+pub use selection::{BlockedFolds, MAX_FOLDS, Selection};
 
 /// The most candidate values of a penalty (each is cross-validated on every fold; the committed
 /// variants use up to 8).
@@ -379,34 +383,30 @@ impl RegressionSpec {
                 }
             })
             .collect();
+        // One Gram matrix for every target's problem.
         let gram = product(z.transpose(), z.as_ref());
         let mut coefficients = Mat::<f64>::zeros(p, y.ncols());
         for j in 0..y.ncols() {
             let centred = Mat::from_fn(n, 1, |i, _| y[(i, j)] - target_centre[j]);
             let value = values[j.min(values.len() - 1)];
-            let column: Vec<f64> = match &self.penalty {
-                Penalty::Ridge { .. } => {
-                    let rhs = product(z.transpose(), centred.as_ref());
-                    let b = ridge_from_gram(gram.as_ref(), rhs.as_ref(), value * n as f64);
-                    (0..p).map(|i| b[(i, 0)]).collect()
-                }
+            let problem = Problem::with_gram(z.as_ref(), centred.as_ref(), gram.clone())
+                .with_target_names(&[format!("column {j}")]);
+            let optimizer: Box<dyn Optimizer> = match &self.penalty {
+                Penalty::Ridge { .. } => Box::new(Ridge::new(value * n as f64)?),
                 Penalty::Lasso { .. } => {
-                    let moments = product(z.transpose(), centred.as_ref());
+                    let moments = problem.moments();
                     let largest = (0..p).map(|i| moments[(i, 0)].abs()).fold(0.0, f64::max);
-                    let lasso = Lasso::new(value * largest)?;
-                    let b = lasso.fit(z.as_ref(), centred.as_ref(), &[format!("column {j}")])?;
-                    (0..p).map(|i| b[(0, i)]).collect()
+                    Box::new(Lasso::new(value * largest)?)
                 }
                 Penalty::Stlsq { alpha, .. } => {
                     let deviation =
                         (centred.col(0).iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
-                    let stlsq = Stlsq::new(value * deviation, *alpha, 20)?;
-                    let b = stlsq.fit(z.as_ref(), centred.as_ref()).coefficients;
-                    (0..p).map(|i| b[(0, i)]).collect()
+                    Box::new(Stlsq::new(value * deviation, *alpha, DEFAULT_MAX_ITER)?)
                 }
             };
-            for (i, c) in column.into_iter().enumerate() {
-                coefficients[(i, j)] = c;
+            let b = optimizer.solve(&problem)?;
+            for i in 0..p {
+                coefficients[(i, j)] = b[(0, i)];
             }
         }
         Ok(LinearFit {
@@ -435,7 +435,7 @@ fn check_finite(matrix: MatRef<'_, f64>, what: &str) -> Result<()> {
 }
 
 /// The rows `rows` of `matrix`, in that order.
-pub fn select_rows(matrix: MatRef<'_, f64>, rows: &[usize]) -> Mat<f64> {
+fn select_rows(matrix: MatRef<'_, f64>, rows: &[usize]) -> Mat<f64> {
     Mat::from_fn(rows.len(), matrix.ncols(), |i, j| matrix[(rows[i], j)])
 }
 

@@ -210,6 +210,18 @@ impl SindyParams {
     /// A library of more than [`LARGE_LIBRARY_ENTRIES`] entries is never formed whole: it is
     /// evaluated and reduced by blocks of rows (see [`Problem::reduced`]), in memory independent
     /// of the number of rows, with the same coefficients up to rounding.
+    ///
+    /// ```
+    /// use sindy::{Mat, SindyParams};
+    /// // ẋ = u − x at scattered points (x, u), the derivatives known
+    /// let inputs = Mat::from_fn(100, 2, |i, j| ((i * (j + 3)) as f64 * 0.77).sin());
+    /// let targets = Mat::from_fn(100, 1, |i, _| inputs[(i, 1)] - inputs[(i, 0)]);
+    /// let model = SindyParams::new(&["x"], &["u"]).fit_matrices(inputs.as_ref(), targets.as_ref())?;
+    /// assert_eq!(model.equations(2), vec!["x' = -1.00 x + 1.00 u"]);
+    /// let predicted = model.predict_inputs(inputs.as_ref())?;
+    /// assert!((predicted[(7, 0)] - targets[(7, 0)]).abs() < 1e-12);
+    /// # Ok::<(), sindy::SindyError>(())
+    /// ```
     pub fn fit_matrices(
         &self,
         inputs: MatRef<'_, f64>,
@@ -588,6 +600,18 @@ impl SindyModel {
     /// per interval. The controls (one row per time, or zero columns without control) are
     /// interpolated linearly between samples, so the mid-step control is the mean of the two
     /// neighbouring samples. Returns the states at every time (first row = `x0`).
+    ///
+    /// ```
+    /// use sindy::{Mat, SindyParams};
+    /// // ẋ = −x, fitted from exact derivatives, then integrated from x = 1 for one second
+    /// let inputs = Mat::from_fn(50, 1, |i, _| i as f64 * 0.1 - 2.5);
+    /// let targets = Mat::from_fn(50, 1, |i, _| -inputs[(i, 0)]);
+    /// let model = SindyParams::new(&["x"], &[]).fit_matrices(inputs.as_ref(), targets.as_ref())?;
+    /// let time: Vec<f64> = (0..=100).map(|k| k as f64 * 0.01).collect();
+    /// let states = model.simulate(&[1.0], &time, Mat::<f64>::zeros(101, 0).as_ref())?;
+    /// assert!((states[(100, 0)] - (-1.0f64).exp()).abs() < 1e-9);
+    /// # Ok::<(), sindy::SindyError>(())
+    /// ```
     pub fn simulate(
         &self,
         x0: &[f64],
@@ -691,7 +715,7 @@ pub(crate) fn constant_columns(actual: MatRef<'_, f64>) -> Vec<usize> {
 pub(crate) const CONSTANT_RELATIVE_SPREAD: f64 = 1e-9;
 
 /// Coefficient of determination, averaged uniformly over columns (scikit-learn's `r2_score`).
-pub fn r2_score(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -> f64 {
+pub(crate) fn r2_score(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -> f64 {
     let (n, m) = actual.shape();
     let mut total = 0.0;
     for j in 0..m {

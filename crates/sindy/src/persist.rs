@@ -25,7 +25,7 @@ use crate::model::SindyModel;
 use crate::optimizers::OptimizerSpec;
 
 /// The format tag written in every model file.
-pub const MODEL_FORMAT: &str = "sindy-model/1";
+pub(crate) const MODEL_FORMAT: &str = "sindy-model/1";
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -244,12 +244,6 @@ impl RegressionFit {
             mean,
         })
     }
-
-    /// The chosen penalty value of each target column (λ for ridge, the absolute λ for LASSO is
-    /// not kept: the fraction of λ_max is, as for the STLSQ threshold).
-    pub fn chosen(&self) -> Vec<f64> {
-        self.selections.iter().map(|s| s.chosen).collect()
-    }
 }
 
 impl RegressionSpec {
@@ -285,7 +279,8 @@ impl RegressionSpec {
     }
 
     /// Checks the settings against a segment of `n` samples: the folds fit in it
-    /// ([`BlockedFolds::checked`]) and a bagging block is at most `n` samples long.
+    /// (at least two samples per fold besides the gaps) and a bagging block is at most `n`
+    /// samples long.
     pub fn check_rows(&self, n: usize) -> Result<()> {
         self.folds.checked(n)?;
         if let Some(bagging) = self.bagging
@@ -304,6 +299,20 @@ impl RegressionSpec {
 
     /// Chooses each target's penalty by blocked cross-validation on the rows of `theta` and
     /// `targets` (and nothing else), refits on all of them, then fits the bagged members.
+    ///
+    /// ```
+    /// use sindy::{Mat, RegressionSpec};
+    /// // y = 2 + 3·θ₀ (θ₁ irrelevant), ridge penalty chosen among three
+    /// let theta = Mat::from_fn(200, 2, |i, j| ((i * (j + 2)) as f64 * 0.37).sin());
+    /// let y = Mat::from_fn(200, 1, |i, _| 2.0 + 3.0 * theta[(i, 0)]);
+    /// let spec: RegressionSpec = serde_json::from_str(
+    ///     r#"{"penalty": {"kind": "ridge", "lambdas": [0, 0.01, 1]}}"#,
+    /// ).unwrap();
+    /// let fit = spec.fit(theta.as_ref(), y.as_ref(), 1)?;
+    /// let (raw, intercepts) = fit.full.raw_coefficients();
+    /// assert!((raw[(0, 0)] - 3.0).abs() < 1e-6 && (intercepts[0] - 2.0).abs() < 1e-6);
+    /// # Ok::<(), sindy::SindyError>(())
+    /// ```
     pub fn fit(
         &self,
         theta: MatRef<'_, f64>,
@@ -539,7 +548,7 @@ mod tests {
                 "{penalty:?}: {intercepts:?}"
             );
             // A heavy ridge penalty loses against the light ones in cross-validation.
-            assert_ne!(fit.chosen()[0], 1.0);
+            assert_ne!(fit.selections[0].chosen, 1.0);
         }
     }
 

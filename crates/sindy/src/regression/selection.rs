@@ -25,7 +25,8 @@ fn default_gap() -> usize {
     10
 }
 
-/// How a segment is cut for blocked cross-validation (unchecked; see [`BlockedFolds::checked`]).
+/// How a segment is cut for blocked cross-validation (unchecked; see [`BlockedFolds::validate`]
+/// and [`crate::RegressionSpec::check_rows`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BlockedFolds {

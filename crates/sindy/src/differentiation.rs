@@ -115,6 +115,14 @@ impl Derivative {
     }
 
     /// Estimates the derivative of `x` sampled every `dt` seconds.
+    ///
+    /// ```
+    /// use sindy::Derivative;
+    /// let x: Vec<f64> = (0..20).map(|k| (k as f64 * 0.1).powi(2)).collect();
+    /// let dx = Derivative::Central.apply(&x, 0.1)?;
+    /// assert!((dx[10] - 2.0).abs() < 1e-12); // d(t²)/dt at t = 1
+    /// # Ok::<(), sindy::DifferentiationError>(())
+    /// ```
     pub fn apply(&self, x: &[f64], dt: f64) -> Result<Vec<f64>> {
         self.validate()?;
         if x.len() < self.min_samples() {
@@ -191,10 +199,7 @@ fn savitzky_golay_weights(window: usize, order: usize, at: f64) -> Vec<f64> {
         }
     });
     // weights = V (VᵀV)⁻¹ d
-    use faer::linalg::solvers::Solve;
-    let gram = vandermonde.transpose() * &vandermonde;
-    let solved = gram.full_piv_lu().solve(&derivative_row);
-    let weights = &vandermonde * &solved;
+    let weights = crate::linalg::projection_weights(vandermonde.as_ref(), derivative_row.as_ref());
     (0..window).map(|j| weights[(j, 0)]).collect()
 }
 

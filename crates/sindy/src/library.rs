@@ -20,11 +20,11 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Result, SindyError, invalid};
 
 /// The most features a library may have on the inputs it is applied to (polynomial, Fourier,
-/// custom and concatenated libraries, and [`crate::CausalLibrary`]). It is checked on the feature
-/// count computed in closed form, before any feature is enumerated or any Θ(X) allocated. Far above
-/// every committed configuration (the paper's library, Fourier K = 1, has 2·K·n = 20 features on
-/// the 10 inputs of the full formulation; the largest committed variant library 42), and low
-/// enough that a flight's Θ stays within hundreds of MB.
+/// custom and concatenated libraries, and the `pipeline` crate's causal library). It is checked on
+/// the feature count computed in closed form, before any feature is enumerated or any Θ(X)
+/// allocated. Far above every committed configuration (the paper's library, Fourier K = 1, has
+/// 2·K·n = 20 features on the 10 inputs of the full formulation; the largest committed variant
+/// library 42), and low enough that a flight's Θ stays within hundreds of MB.
 pub const MAX_FEATURES: usize = 10_000;
 
 /// A serialisable description of a library made of polynomial and Fourier parts.
@@ -375,6 +375,15 @@ impl FeatureLibrary {
     }
 
     /// Θ(X): one row per sample of `inputs`, one column per feature.
+    ///
+    /// ```
+    /// use sindy::{FeatureLibrary, LibrarySpec, Mat};
+    /// let library = FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2")?)?;
+    /// assert_eq!(library.feature_names(&["x", "u"]), ["1", "x", "u", "x^2", "x*u", "u^2"]);
+    /// let theta = library.transform(Mat::from_fn(1, 2, |_, j| [3.0, 2.0][j]).as_ref());
+    /// assert_eq!(theta[(0, 4)], 6.0);
+    /// # Ok::<(), sindy::SindyError>(())
+    /// ```
     pub fn transform(&self, inputs: MatRef<'_, f64>) -> Mat<f64> {
         crate::linalg::clear_upper_vector_state();
         let (n, dim) = (inputs.nrows(), inputs.ncols());
@@ -427,7 +436,7 @@ impl FeatureLibrary {
     }
 
     /// Θ of one sample `x`, written into `out` (cleared first). Used by simulation.
-    pub fn transform_row(&self, x: &[f64], out: &mut Vec<f64>) {
+    pub(crate) fn transform_row(&self, x: &[f64], out: &mut Vec<f64>) {
         out.clear();
         for part in &self.parts {
             match part {

@@ -1,37 +1,110 @@
-//! Small dense solvers on top of faer: least squares (as `numpy.linalg.lstsq` / scikit-learn's
-//! `LinearRegression`) and the ridge normal equations (as scikit-learn's `ridge_regression`,
-//! Cholesky solver).
+//! The crate's dense linear algebra on faer, and the only module that calls faer's kernels: least
+//! squares (as `numpy.linalg.lstsq` / scikit-learn's `LinearRegression`), the ridge normal
+//! equations (as scikit-learn's `ridge_regression`, Cholesky solver), products, QR triangles and
+//! triangular solves.
+//!
+//! # The vector state after faer
+//! faer's matrix products (its assembly gemm kernels) return with the upper halves of the vector
+//! registers still in use. The scalar code that follows — compiled for baseline x86-64 in the SSE
+//! encoding, libm's `sin`/`cos` with it — then pays a penalty on every instruction until a
+//! `vzeroupper`: the feature evaluation after a fit ran ~20x slower on the machine that found it
+//! (2.6x for `sin` on an AMD EPYC). Every function here therefore runs its faer calls inside
+//! [`kernels`], the one place that clears that state (thread by thread: the optimizers call these
+//! functions from rayon's workers too), so that nothing built on this module — an optimizer, a
+//! prediction, the row-block reduction — can forget it. `tests/vector_state.rs` checks it on every
+//! public entry point.
 
 use faer::linalg::solvers::{Qr, Solve, SolveLstsq};
-use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
 use faer::{Mat, MatRef, Par, Side};
+
+/// Runs `work`, which calls faer, and leaves the vector registers' upper halves clear (see the
+/// module documentation): every faer call of the crate runs inside it.
+fn kernels<T>(work: impl FnOnce() -> T) -> T {
+    let result = work();
+    clear_upper_vector_state();
+    result
+}
 
 /// Minimum-norm least-squares solution of `a·x ≈ b` (every column of `b` a right-hand side).
 ///
 /// Full column rank (the usual case): Householder QR. Otherwise the SVD pseudo-inverse with
 /// singular values below `ε·max(m, n)·σ_max` treated as zero, like LAPACK's `gelsd` in NumPy.
+///
+/// ```
+/// use sindy::{Mat, least_squares};
+/// // y = 2 − 0.5·t at t = 1..6
+/// let a = Mat::from_fn(6, 2, |i, j| (i as f64 + 1.0).powi(j as i32));
+/// let b = Mat::from_fn(6, 1, |i, _| 2.0 - 0.5 * (i as f64 + 1.0));
+/// let x = least_squares(a.as_ref(), b.as_ref());
+/// assert!((x[(0, 0)] - 2.0).abs() < 1e-12 && (x[(1, 0)] + 0.5).abs() < 1e-12);
+/// ```
 pub fn least_squares(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
-    if a.ncols() == 0 {
-        return Mat::zeros(0, b.ncols());
-    }
-    let solution = match full_rank_qr(a) {
-        Some((qr, _)) => qr.solve_lstsq(b),
-        None => pseudo_inverse_solve(a, b),
-    };
-    clear_upper_vector_state();
-    solution
+    kernels(|| {
+        if a.ncols() == 0 {
+            return Mat::zeros(0, b.ncols());
+        }
+        match full_rank_qr(a) {
+            Some((qr, _)) => qr.solve_lstsq(b),
+            None => pseudo_inverse_solve(a, b),
+        }
+    })
+}
+
+/// The product `a·b` (`a.transpose()` for `aᵀ·b`: the Gram matrix, the moments).
+pub(crate) fn product(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
+    kernels(|| a * b)
+}
+
+/// Householder least squares of a tall `a` of full column rank: its triangular factor R and the
+/// solution for every column of `b`; `None` when `a` is wide or rank-deficient (see
+/// [`full_rank_qr`]).
+pub(crate) fn householder_least_squares(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+) -> Option<(Mat<f64>, Mat<f64>)> {
+    kernels(|| {
+        let (qr, r) = full_rank_qr(a)?;
+        Some((r, qr.solve_lstsq(b)))
+    })
 }
 
 /// The Householder QR of a tall `a` and its triangular factor R, if no diagonal entry of R is
-/// negligible (`|R_ii| ≤ 1000·ε·max(m, n)·max|R_jj|` counts as rank-deficient).
-pub fn full_rank_qr(a: MatRef<'_, f64>) -> Option<(Qr<f64>, Mat<f64>)> {
+/// negligible (`|R_ii| ≤ 1000·ε·max(m, n)·max|R_jj|` counts as rank-deficient). Inside
+/// [`kernels`] only.
+fn full_rank_qr(a: MatRef<'_, f64>) -> Option<(Qr<f64>, Mat<f64>)> {
     if a.nrows() < a.ncols() {
         return None;
     }
     let qr = a.qr();
     let r = qr.thin_R().to_owned();
-    clear_upper_vector_state();
     full_rank_triangular(a, r.as_ref()).then_some((qr, r))
+}
+
+/// The upper triangle R (at most `stacked.ncols()` rows) of the QR factorisation of `stacked`.
+pub(crate) fn qr_triangle(stacked: MatRef<'_, f64>) -> Mat<f64> {
+    kernels(|| stacked.qr().thin_R().to_owned())
+}
+
+/// `r⁻¹·rhs` for an upper triangular `r`.
+pub(crate) fn solve_upper(r: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
+    kernels(|| {
+        let mut solution = rhs.to_owned();
+        solve_upper_triangular_in_place(r, solution.as_mut(), Par::Seq);
+        solution
+    })
+}
+
+/// `a·(aᵀa)⁻¹·d` (full-pivoting LU of the small Gram matrix): the weights of a least-squares
+/// projection, e.g. a Savitzky–Golay filter's from its Vandermonde matrix `a`.
+pub(crate) fn projection_weights(a: MatRef<'_, f64>, d: MatRef<'_, f64>) -> Mat<f64> {
+    kernels(|| {
+        let gram = a.transpose() * a;
+        let solved = gram.full_piv_lu().solve(d);
+        a * &solved
+    })
 }
 
 /// A thin QR factorisation `a = Q·R` (Q: n × p with orthonormal columns, R: p × p upper
@@ -59,9 +132,7 @@ impl CholeskyQr {
         if a.nrows() < p || p == 0 || gram.nrows() != p || gram.ncols() != p {
             return None;
         }
-        let factorisation = Self::factor(a, gram);
-        clear_upper_vector_state();
-        factorisation
+        kernels(|| Self::factor(a, gram))
     }
 
     fn factor(a: MatRef<'_, f64>, gram: MatRef<'_, f64>) -> Option<Self> {
@@ -89,10 +160,15 @@ impl CholeskyQr {
 
     /// Qᵀ·b for every column of `b` (n rows).
     pub(crate) fn project(&self, b: MatRef<'_, f64>) -> Mat<f64> {
-        let mut projected = self.first_q.transpose() * b;
-        solve_lower_triangular_in_place(self.second_r.transpose(), projected.as_mut(), Par::Seq);
-        clear_upper_vector_state();
-        projected
+        kernels(|| {
+            let mut projected = self.first_q.transpose() * b;
+            solve_lower_triangular_in_place(
+                self.second_r.transpose(),
+                projected.as_mut(),
+                Par::Seq,
+            );
+            projected
+        })
     }
 }
 
@@ -114,7 +190,7 @@ fn upper_triangular_inverse(r: MatRef<'_, f64>) -> Mat<f64> {
 
 /// Whether the triangular factor R of a tall matrix `a` has full numerical rank: no diagonal
 /// entry `|R_ii| ≤ 1000·ε·max(m, n)·max|R_jj|`.
-pub(crate) fn full_rank_triangular(a: MatRef<'_, f64>, r: MatRef<'_, f64>) -> bool {
+fn full_rank_triangular(a: MatRef<'_, f64>, r: MatRef<'_, f64>) -> bool {
     let diagonal: Vec<f64> = (0..r.ncols()).map(|i| r[(i, i)].abs()).collect();
     let largest = diagonal.iter().copied().fold(0.0, f64::max);
     let tolerance = 1e3 * rank_tolerance(a) * largest;
@@ -133,6 +209,7 @@ fn rank_tolerance(a: MatRef<'_, f64>) -> f64 {
     f64::EPSILON * a.nrows().max(a.ncols()) as f64
 }
 
+/// Inside [`kernels`] only.
 fn pseudo_inverse_solve(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
     let Ok(svd) = a.thin_svd() else {
         return Mat::from_fn(a.ncols(), b.ncols(), |_, _| f64::NAN);
@@ -152,24 +229,20 @@ fn pseudo_inverse_solve(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
 
 /// Solves the ridge normal equations `(G + α·I)·x = g` for a symmetric positive semi-definite
 /// Gram matrix `G = AᵀA` and `g = Aᵀb`: Cholesky, or the pseudo-inverse if `G + αI` is singular.
-pub fn ridge_from_gram(gram: MatRef<'_, f64>, rhs: MatRef<'_, f64>, alpha: f64) -> Mat<f64> {
+pub(crate) fn ridge_from_gram(gram: MatRef<'_, f64>, rhs: MatRef<'_, f64>, alpha: f64) -> Mat<f64> {
     let mut shifted = gram.to_owned();
     for i in 0..shifted.nrows() {
         shifted[(i, i)] += alpha;
     }
-    let solution = match shifted.llt(Side::Lower) {
+    kernels(|| match shifted.llt(Side::Lower) {
         Ok(cholesky) => cholesky.solve(rhs),
         Err(_) => pseudo_inverse_solve(shifted.as_ref(), rhs),
-    };
-    clear_upper_vector_state();
-    solution
+    })
 }
 
-/// Clears the upper halves of the AVX registers (`vzeroupper`).
-///
-/// faer's SIMD kernels can return with the upper register state dirty; the scalar code that follows
-/// (compiled for baseline x86-64, SSE encoding), and libm's `sin`/`cos` with it, then pays a
-/// transition penalty on every instruction: measured ~20x slower feature evaluation after a fit.
+/// Clears the upper halves of the AVX registers (`vzeroupper`); called by [`kernels`] after faer
+/// and by [`crate::FeatureLibrary::transform`] before its scalar `sin`/`cos`, against state a
+/// caller's own vector code left behind.
 #[inline]
 pub(crate) fn clear_upper_vector_state() {
     #[cfg(target_arch = "x86_64")]

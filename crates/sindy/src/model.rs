@@ -5,8 +5,9 @@ use faer::{Mat, MatRef};
 
 use crate::error::{Result, SindyError, invalid, shape};
 use crate::library::{FeatureLibrary, LibrarySpec};
-use crate::optimizer::OptimizerSpec;
-use crate::reduced::{BLOCK_ROWS, ReducedProblem};
+use crate::linalg::product;
+use crate::optimizers::tsqr::{BLOCK_ROWS, reduce_row_blocks};
+use crate::optimizers::{Optimizer, OptimizerSpec, Problem};
 
 /// One recorded trajectory: states x(t), optional controls u(t), optional derivatives ẋ(t).
 /// Samples must be uniformly spaced in time when derivatives are estimated from the states.
@@ -124,7 +125,8 @@ impl Score {
 }
 
 /// Entries (rows × features) above which a library is evaluated by blocks of rows and the fit
-/// reduced as it is built ([`ReducedProblem`]) instead of forming Θ whole: 2²² entries, 32 MB.
+/// reduced as it is built (see [`Problem::reduced`]) instead of forming Θ whole: 2²² entries,
+/// 32 MB.
 pub const LARGE_LIBRARY_ENTRIES: usize = 1 << 22;
 
 /// Settings of a SINDy fit, checked when [`SindyParams::fit`] runs.
@@ -206,8 +208,20 @@ impl SindyParams {
     /// Fits on inputs X = [x, u] and targets ẋ given as matrices (one row per sample).
     ///
     /// A library of more than [`LARGE_LIBRARY_ENTRIES`] entries is never formed whole: it is
-    /// evaluated and reduced by blocks of rows ([`ReducedProblem`]), in memory independent of
-    /// the number of rows, with the same coefficients up to rounding.
+    /// evaluated and reduced by blocks of rows (see [`Problem::reduced`]), in memory independent
+    /// of the number of rows, with the same coefficients up to rounding.
+    ///
+    /// ```
+    /// use sindy::{Mat, SindyParams};
+    /// // ẋ = u − x at scattered points (x, u), the derivatives known
+    /// let inputs = Mat::from_fn(100, 2, |i, j| ((i * (j + 3)) as f64 * 0.77).sin());
+    /// let targets = Mat::from_fn(100, 1, |i, _| inputs[(i, 1)] - inputs[(i, 0)]);
+    /// let model = SindyParams::new(&["x"], &["u"]).fit_matrices(inputs.as_ref(), targets.as_ref())?;
+    /// assert_eq!(model.equations(2), vec!["x' = -1.00 x + 1.00 u"]);
+    /// let predicted = model.predict_inputs(inputs.as_ref())?;
+    /// assert!((predicted[(7, 0)] - targets[(7, 0)]).abs() < 1e-12);
+    /// # Ok::<(), sindy::SindyError>(())
+    /// ```
     pub fn fit_matrices(
         &self,
         inputs: MatRef<'_, f64>,
@@ -222,15 +236,14 @@ impl SindyParams {
         let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
         let feature_names = self.library.feature_names(&input_names);
         let sizes = FeatureSizes::new(features);
-        let reduced =
-            ReducedProblem::from_row_blocks(inputs.nrows(), features, targets.ncols(), |rows| {
-                let inputs = inputs.subrows(rows.start, rows.len());
-                let theta = self.library_block(inputs, rows.start, &feature_names, &sizes)?;
-                Ok::<_, SindyError>((theta, targets.subrows(rows.start, rows.len()).to_owned()))
-            })?;
+        let reduced = reduce_row_blocks(inputs.nrows(), features, targets.ncols(), |rows| {
+            let inputs = inputs.subrows(rows.start, rows.len());
+            let theta = self.library_block(inputs, rows.start, &feature_names, &sizes)?;
+            Ok::<_, SindyError>((theta, targets.subrows(rows.start, rows.len()).to_owned()))
+        })?;
         let sizes = sizes.into_vec();
         check_scale(&sizes, &feature_names)?;
-        let coefficients = optimizer.fit_reduced(&reduced, &self.state_names)?;
+        let coefficients = optimizer.solve(&reduced.with_target_names(&self.state_names))?;
         Ok(self.model(feature_names, coefficients))
     }
 
@@ -267,7 +280,8 @@ impl SindyParams {
             format!("feature '{}'", feature_names[j])
         })?;
         check_scale(&column_sizes(theta.as_ref()), &feature_names)?;
-        let coefficients = optimizer.fit(theta.as_ref(), targets, &self.state_names)?;
+        let problem = Problem::new(theta.as_ref(), targets).with_target_names(&self.state_names);
+        let coefficients = optimizer.solve(&problem)?;
         Ok((self.model(feature_names, coefficients), theta))
     }
 
@@ -279,8 +293,7 @@ impl SindyParams {
         targets: MatRef<'_, f64>,
     ) -> Result<(SindyModel, Mat<f64>)> {
         let (model, theta) = self.fit_with_library_matrix(inputs, targets)?;
-        let prediction = theta * model.coefficients().transpose();
-        crate::linalg::clear_upper_vector_state();
+        let prediction = product(theta.as_ref(), model.coefficients().transpose());
         Ok((model, prediction))
     }
 
@@ -302,7 +315,7 @@ impl SindyParams {
         &self,
         inputs: MatRef<'_, f64>,
         targets: MatRef<'_, f64>,
-    ) -> Result<crate::Optimizer> {
+    ) -> Result<Box<dyn Optimizer>> {
         self.check_names()?;
         let optimizer = self.optimizer.checked()?;
         let (dim_x, dim_u) = (self.state_names.len(), self.control_names.len());
@@ -352,7 +365,7 @@ impl SindyParams {
     }
 
     /// The names are checked and the optimizer with them.
-    pub(crate) fn checked_optimizer(&self) -> Result<crate::Optimizer> {
+    pub(crate) fn checked_optimizer(&self) -> Result<Box<dyn Optimizer>> {
         self.check_names()?;
         self.optimizer.checked()
     }
@@ -473,9 +486,7 @@ impl SindyModel {
         let features = self.coefficients.ncols();
         if inputs.nrows().saturating_mul(features) <= LARGE_LIBRARY_ENTRIES {
             let theta = self.library.transform(inputs);
-            let prediction = theta * self.coefficients.transpose();
-            crate::linalg::clear_upper_vector_state();
-            return Ok(prediction);
+            return Ok(product(theta.as_ref(), self.coefficients.transpose()));
         }
         // A large library is evaluated by blocks of rows, never whole.
         let mut prediction = Mat::zeros(inputs.nrows(), self.coefficients.nrows());
@@ -485,8 +496,7 @@ impl SindyModel {
             prediction
                 .as_mut()
                 .subrows_mut(start, rows)
-                .copy_from(&theta * self.coefficients.transpose());
-            crate::linalg::clear_upper_vector_state();
+                .copy_from(product(theta.as_ref(), self.coefficients.transpose()));
         }
         Ok(prediction)
     }
@@ -590,6 +600,18 @@ impl SindyModel {
     /// per interval. The controls (one row per time, or zero columns without control) are
     /// interpolated linearly between samples, so the mid-step control is the mean of the two
     /// neighbouring samples. Returns the states at every time (first row = `x0`).
+    ///
+    /// ```
+    /// use sindy::{Mat, SindyParams};
+    /// // ẋ = −x, fitted from exact derivatives, then integrated from x = 1 for one second
+    /// let inputs = Mat::from_fn(50, 1, |i, _| i as f64 * 0.1 - 2.5);
+    /// let targets = Mat::from_fn(50, 1, |i, _| -inputs[(i, 0)]);
+    /// let model = SindyParams::new(&["x"], &[]).fit_matrices(inputs.as_ref(), targets.as_ref())?;
+    /// let time: Vec<f64> = (0..=100).map(|k| k as f64 * 0.01).collect();
+    /// let states = model.simulate(&[1.0], &time, Mat::<f64>::zeros(101, 0).as_ref())?;
+    /// assert!((states[(100, 0)] - (-1.0f64).exp()).abs() < 1e-9);
+    /// # Ok::<(), sindy::SindyError>(())
+    /// ```
     pub fn simulate(
         &self,
         x0: &[f64],
@@ -693,7 +715,7 @@ pub(crate) fn constant_columns(actual: MatRef<'_, f64>) -> Vec<usize> {
 pub(crate) const CONSTANT_RELATIVE_SPREAD: f64 = 1e-9;
 
 /// Coefficient of determination, averaged uniformly over columns (scikit-learn's `r2_score`).
-pub fn r2_score(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -> f64 {
+pub(crate) fn r2_score(predicted: MatRef<'_, f64>, actual: MatRef<'_, f64>) -> f64 {
     let (n, m) = actual.shape();
     let mut total = 0.0;
     for j in 0..m {
@@ -763,7 +785,7 @@ pub(crate) fn check_finite(
 
 /// The most the largest magnitudes of two features of one fit may differ by: beyond it a
 /// least-squares fit in double precision (16 digits) cannot resolve the smaller one.
-pub const MAX_FEATURE_SCALE_RATIO: f64 = 1e12;
+pub(crate) const MAX_FEATURE_SCALE_RATIO: f64 = 1e12;
 
 /// Refuses a library whose features differ in size by more than [`MAX_FEATURE_SCALE_RATIO`]
 /// (largest magnitude of each non-zero column): the fit would be noise or not finite.

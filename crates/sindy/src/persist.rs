@@ -22,10 +22,10 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Result, SindyError};
 use crate::library::{FeatureLibrary, LibrarySpec};
 use crate::model::SindyModel;
-use crate::optimizer::OptimizerSpec;
+use crate::optimizers::OptimizerSpec;
 
 /// The format tag written in every model file.
-pub const MODEL_FORMAT: &str = "sindy-model/1";
+pub(crate) const MODEL_FORMAT: &str = "sindy-model/1";
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

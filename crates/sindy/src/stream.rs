@@ -1,6 +1,6 @@
 //! Fitting a recording too long to hold whole: its rows arrive in blocks, each state's derivative
 //! is estimated with the neighbouring rows its stencil reads, and the library is evaluated and
-//! reduced segment by segment ([`crate::ReducedProblem`]). Memory is a few segments whatever the
+//! reduced segment by segment (as [`crate::Problem::reduced`]). Memory is a few segments whatever the
 //! length; the coefficients are those of [`SindyParams::fit_matrices`] on the whole recording (the
 //! same segments, merged in the same order), and the score follows from the reduced problem.
 
@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::error::{Result, SindyError, shape};
 use crate::model::{CONSTANT_RELATIVE_SPREAD, FeatureSizes, Score, SindyModel, SindyParams};
-use crate::reduced::{Reduction, SEGMENT_ROWS, segment_triangle};
+use crate::optimizers::tsqr::{Reduction, SEGMENT_ROWS, segment_triangle};
 
 /// Consecutive rows of a recording: one vector per state, then one per control.
 #[derive(Clone, Debug, Default)]
@@ -165,8 +165,8 @@ impl SindyParams {
         }
         let names = self.feature_names_for_inputs();
         crate::model::check_scale(&sizes, &names)?;
-        let reduced = reduction.finish();
-        let coefficients = optimizer.fit_reduced(&reduced, self.state_names())?;
+        let reduced = reduction.finish().with_target_names(self.state_names());
+        let coefficients = optimizer.solve(&reduced)?;
         let residuals = reduced.residual_sum_of_squares(coefficients.as_ref());
         let model = self.model(names, coefficients);
         Ok(StreamedFit {

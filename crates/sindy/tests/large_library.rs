@@ -163,7 +163,7 @@ fn a_streamed_recording_fits_as_the_whole_one() {
         }
         let library = FeatureLibrary::from_spec(&LibrarySpec::parse("poly:3").unwrap()).unwrap();
         let theta = library.transform(inputs.as_ref());
-        let reduced = sindy::ReducedProblem::new(theta.as_ref(), y.as_ref());
+        let reduced = sindy::Problem::reduced(theta.as_ref(), y.as_ref());
         let rss: f64 = reduced
             .residual_sum_of_squares(whole.coefficients())
             .iter()

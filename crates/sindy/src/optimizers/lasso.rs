@@ -18,10 +18,21 @@ use clarabel::solver::{
 use faer::{Mat, MatRef};
 use rayon::prelude::*;
 
+use super::{Optimizer, Problem};
 use crate::error::{Result, SindyError, invalid};
-use crate::linalg::ridge_from_gram;
 
 /// Checked LASSO settings.
+///
+/// ```
+/// use sindy::{Lasso, Mat};
+/// // y = θ₀ − 2·θ₁ exactly: a small λ keeps both terms and drops the third
+/// let theta = Mat::from_fn(80, 3, |i, j| ((i * (j + 2)) as f64 * 0.21).sin());
+/// let y = Mat::from_fn(80, 1, |i, _| theta[(i, 0)] - 2.0 * theta[(i, 1)]);
+/// let xi = Lasso::new(1e-3)?.fit(theta.as_ref(), y.as_ref(), &["y".to_string()])?;
+/// assert!((xi[(0, 0)] - 1.0).abs() < 1e-3 && (xi[(0, 1)] + 2.0).abs() < 1e-3);
+/// assert_eq!(xi[(0, 2)], 0.0);
+/// # Ok::<(), sindy::SindyError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lasso {
     lambda: f64,
@@ -37,49 +48,24 @@ impl Lasso {
     }
 
     /// Fits every column of `targets` on `theta`; ξ one row per target, one column per feature.
+    /// `target_names` label errors.
     pub fn fit(
         &self,
         theta: MatRef<'_, f64>,
         targets: MatRef<'_, f64>,
         target_names: &[String],
     ) -> Result<Mat<f64>> {
-        let gram = theta.transpose() * theta;
-        let moments = theta.transpose() * targets;
-        self.fit_gram(gram.as_ref(), moments.as_ref(), target_names)
+        self.solve(&Problem::new(theta, targets).with_target_names(target_names))
     }
 
-    /// [`Self::fit`] from ΘᵀΘ and ΘᵀY (the objective up to a constant).
-    pub fn fit_gram(
-        &self,
-        gram: MatRef<'_, f64>,
-        moments: MatRef<'_, f64>,
-        target_names: &[String],
-    ) -> Result<Mat<f64>> {
-        let columns = (0..moments.ncols())
-            .into_par_iter()
-            .map(|i| {
-                let name = target_names
-                    .get(i)
-                    .cloned()
-                    .unwrap_or_else(|| format!("column {i}"));
-                self.fit_one(gram, moments.col(i).as_mat(), &name)
-            })
-            .collect::<Result<Vec<_>>>()?;
-        Ok(Mat::from_fn(moments.ncols(), gram.ncols(), |i, j| {
-            columns[i][j]
-        }))
-    }
-
-    fn fit_one(
-        &self,
-        gram: MatRef<'_, f64>,
-        moments: MatRef<'_, f64>,
-        name: &str,
-    ) -> Result<Vec<f64>> {
+    /// One target: the QP on ΘᵀΘ and Θᵀy (the objective up to a constant), then the polish.
+    fn fit_one(&self, problem: &Problem<'_>, target: usize) -> Result<Vec<f64>> {
+        let (gram, moments) = (problem.gram(), problem.moments().col(target).as_mat());
+        let name = problem.target_name(target);
         let p = gram.nrows();
         let solver_error = |message: String| SindyError::Solver {
             solver: "clarabel LASSO",
-            target: name.to_string(),
+            target: name.clone(),
             message,
         };
         // P: upper triangle of ΘᵀΘ in the ξ block, column by column.
@@ -120,15 +106,13 @@ impl Lasso {
             status => return Err(solver_error(format!("status {status:?}"))),
         }
         let solution: Vec<f64> = solver.solution.x[..p].to_vec();
-        Ok(self.polish(gram, moments, solution))
+        Ok(self.polish(problem, target, solution))
     }
 
-    fn polish(
-        &self,
-        gram: MatRef<'_, f64>,
-        moments: MatRef<'_, f64>,
-        solution: Vec<f64>,
-    ) -> Vec<f64> {
+    /// The exact optimum on the support and signs of the interior-point `solution`, if it keeps
+    /// those signs and satisfies the KKT conditions at least as well.
+    fn polish(&self, problem: &Problem<'_>, target: usize, solution: Vec<f64>) -> Vec<f64> {
+        let (gram, moments) = (problem.gram(), problem.moments().col(target).as_mat());
         let scale = solution
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs()))
@@ -138,13 +122,10 @@ impl Lasso {
             .collect();
         let mut polished = vec![0.0; solution.len()];
         if !support.is_empty() {
-            let sub_gram = Mat::from_fn(support.len(), support.len(), |a, b| {
-                gram[(support[a], support[b])]
-            });
             let rhs = Mat::from_fn(support.len(), 1, |a, _| {
                 moments[(support[a], 0)] - self.lambda * solution[support[a]].signum()
             });
-            let exact = ridge_from_gram(sub_gram.as_ref(), rhs.as_ref(), 0.0);
+            let exact = problem.ridge_on(&support, rhs.as_ref(), 0.0);
             for (a, &j) in support.iter().enumerate() {
                 polished[j] = exact[(a, 0)];
             }
@@ -172,10 +153,9 @@ pub fn kkt_violation(
     coefficients: &[f64],
     lambda: f64,
 ) -> f64 {
-    let gram = theta.transpose() * theta;
     let y = Mat::from_fn(target.len(), 1, |i, _| target[i]);
-    let moments = theta.transpose() * &y;
-    gram_kkt_violation(gram.as_ref(), moments.as_ref(), coefficients, lambda)
+    let problem = Problem::new(theta, y.as_ref());
+    gram_kkt_violation(problem.gram(), problem.moments(), coefficients, lambda)
 }
 
 fn gram_kkt_violation(
@@ -197,4 +177,19 @@ fn gram_kkt_violation(
             }
         })
         .fold(0.0, f64::max)
+}
+
+impl Optimizer for Lasso {
+    /// Every target in parallel (one QP each).
+    fn solve(&self, problem: &Problem<'_>) -> Result<Mat<f64>> {
+        let columns = (0..problem.targets())
+            .into_par_iter()
+            .map(|i| self.fit_one(problem, i))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Mat::from_fn(
+            problem.targets(),
+            problem.features(),
+            |i, j| columns[i][j],
+        ))
+    }
 }

@@ -1,20 +1,53 @@
-//! Sparse regression of the targets on the library: STLSQ (PySINDy's default) and LASSO.
+//! The regressions of the targets on the library, behind one trait ([`Optimizer`]) and on one
+//! representation ([`Problem`]: ΘᵀΘ and ΘᵀY for the ridge and LASSO steps, the QR triangle for
+//! the least-squares steps, made from Θ whole or reduced by blocks of rows):
+//! - [`Stlsq`], sequentially thresholded least squares, PySINDy's default (`pysindy.STLSQ`);
+//! - [`Lasso`], `min ½‖Θξ − y‖² + λ‖ξ‖₁` as a quadratic program solved by clarabel;
+//! - [`Ridge`], `min ‖Θξ − y‖² + α‖ξ‖²`.
+//!
+//! [`OptimizerSpec`] is the serialisable choice a model records (STLSQ or LASSO); the
+//! regularised regressions with cross-validated penalties ([`crate::RegressionSpec`]) use the same
+//! optimizers. Every dense computation of an optimizer goes through [`Problem`]'s methods, and
+//! from there through [`crate::linalg`], which owns the faer calls and the vector-state clearing
+//! after them: an optimizer written against this trait cannot skip it.
 
 mod lasso;
+mod problem;
+mod ridge;
 mod stlsq;
+pub(crate) mod tsqr;
 
-use faer::{Mat, MatRef};
+use faer::Mat;
 use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
 
 pub use lasso::{Lasso, kkt_violation};
+pub use problem::Problem;
+pub use ridge::Ridge;
 pub use stlsq::{Stlsq, StlsqFit};
 
 /// PySINDy's default ridge strength of STLSQ.
 pub const DEFAULT_ALPHA: f64 = 0.05;
 /// PySINDy's default iteration limit of STLSQ.
 pub const DEFAULT_MAX_ITER: usize = 20;
+
+/// A regression of the targets on the library: ξ from a [`Problem`].
+///
+/// ```
+/// use sindy::{Mat, Optimizer, OptimizerSpec, Problem};
+/// let theta = Mat::from_fn(60, 3, |i, j| ((i * (j + 1)) as f64 * 0.3).sin());
+/// let y = Mat::from_fn(60, 2, |i, j| theta[(i, j)] * (j as f64 + 1.0));
+/// let optimizer = OptimizerSpec::stlsq(0.1).checked()?;
+/// let xi = optimizer.solve(&Problem::new(theta.as_ref(), y.as_ref()))?;
+/// assert_eq!(xi.shape(), (2, 3)); // one row per target
+/// assert!((xi[(1, 1)] - 2.0).abs() < 1e-12 && xi[(1, 0)] == 0.0);
+/// # Ok::<(), sindy::SindyError>(())
+/// ```
+pub trait Optimizer: std::fmt::Debug + Send + Sync {
+    /// ξ: one row per target of `problem`, one column per feature.
+    fn solve(&self, problem: &Problem<'_>) -> Result<Mat<f64>>;
+}
 
 fn default_alpha() -> f64 {
     DEFAULT_ALPHA
@@ -50,56 +83,16 @@ impl OptimizerSpec {
         }
     }
 
-    /// Validates the parameters once.
-    pub fn checked(&self) -> Result<Optimizer> {
+    /// The optimizer, its parameters validated.
+    pub fn checked(&self) -> Result<Box<dyn Optimizer>> {
         Ok(match *self {
             Self::Stlsq {
                 threshold,
                 alpha,
                 max_iter,
-            } => Optimizer::Stlsq(Stlsq::new(threshold, alpha, max_iter)?),
-            Self::Lasso { lambda } => Optimizer::Lasso(Lasso::new(lambda)?),
+            } => Box::new(Stlsq::new(threshold, alpha, max_iter)?),
+            Self::Lasso { lambda } => Box::new(Lasso::new(lambda)?),
         })
-    }
-}
-
-/// A validated optimizer.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Optimizer {
-    Stlsq(Stlsq),
-    Lasso(Lasso),
-}
-
-impl Optimizer {
-    /// ξ (one row per target column, one column per feature) fitted on `theta` (n × features) and
-    /// `targets` (n × targets). `target_names` only label errors.
-    pub fn fit(
-        &self,
-        theta: MatRef<'_, f64>,
-        targets: MatRef<'_, f64>,
-        target_names: &[String],
-    ) -> Result<Mat<f64>> {
-        match self {
-            Self::Stlsq(stlsq) => Ok(stlsq.fit(theta, targets).coefficients),
-            Self::Lasso(lasso) => lasso.fit(theta, targets, target_names),
-        }
-    }
-
-    /// [`Self::fit`] on a problem reduced by rows: the same coefficients up to rounding, without
-    /// the library's rows.
-    pub fn fit_reduced(
-        &self,
-        reduced: &crate::ReducedProblem,
-        target_names: &[String],
-    ) -> Result<Mat<f64>> {
-        match self {
-            Self::Stlsq(stlsq) => Ok(stlsq.fit_reduced(reduced).coefficients),
-            Self::Lasso(lasso) => lasso.fit_gram(
-                reduced.gram().as_ref(),
-                reduced.moments().as_ref(),
-                target_names,
-            ),
-        }
     }
 }
 

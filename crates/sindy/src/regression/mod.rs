@@ -1,5 +1,5 @@
 //! Regularised linear regression of targets on any feature matrix Θ, with the regularisation chosen
-//! by blocked cross-validation inside the rows it is given ([`crate::selection`]), and bagged
+//! by blocked cross-validation inside the rows it is given ([`selection`]), and bagged
 //! ensembles that give a spread.
 //!
 //! Columns of Θ are standardised with the training rows' statistics (centred when there is an
@@ -22,10 +22,14 @@
 use faer::{Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
+mod selection;
+
 use crate::error::{Result, field, shape};
-use crate::linalg::ridge_from_gram;
-use crate::optimizer::{Lasso, Stlsq};
-use crate::selection::{BlockedFolds, Fold, Selection, cross_validate};
+use crate::linalg::product;
+use crate::optimizers::{DEFAULT_MAX_ITER, Lasso, Optimizer, Problem, Ridge, Stlsq};
+use selection::{Fold, cross_validate};
+
+pub use selection::{BlockedFolds, MAX_FOLDS, Selection};
 
 /// The most candidate values of a penalty (each is cross-validated on every fold; the committed
 /// variants use up to 8).
@@ -153,7 +157,7 @@ impl LinearFit {
     /// Predictions, one row per row of `theta`, one column per target.
     pub fn predict(&self, theta: MatRef<'_, f64>) -> Mat<f64> {
         let z = standardised(theta, &self.feature_centre, &self.feature_scale);
-        let mut prediction = &z * &self.coefficients;
+        let mut prediction = product(z.as_ref(), self.coefficients.as_ref());
         for j in 0..prediction.ncols() {
             for i in 0..prediction.nrows() {
                 prediction[(i, j)] += self.target_centre[j];
@@ -240,12 +244,6 @@ impl RegressionFit {
             mean,
         })
     }
-
-    /// The chosen penalty value of each target column (λ for ridge, the absolute λ for LASSO is
-    /// not kept: the fraction of λ_max is, as for the STLSQ threshold).
-    pub fn chosen(&self) -> Vec<f64> {
-        self.selections.iter().map(|s| s.chosen).collect()
-    }
 }
 
 impl RegressionSpec {
@@ -281,7 +279,8 @@ impl RegressionSpec {
     }
 
     /// Checks the settings against a segment of `n` samples: the folds fit in it
-    /// ([`BlockedFolds::checked`]) and a bagging block is at most `n` samples long.
+    /// (at least two samples per fold besides the gaps) and a bagging block is at most `n`
+    /// samples long.
     pub fn check_rows(&self, n: usize) -> Result<()> {
         self.folds.checked(n)?;
         if let Some(bagging) = self.bagging
@@ -300,6 +299,20 @@ impl RegressionSpec {
 
     /// Chooses each target's penalty by blocked cross-validation on the rows of `theta` and
     /// `targets` (and nothing else), refits on all of them, then fits the bagged members.
+    ///
+    /// ```
+    /// use sindy::{Mat, RegressionSpec};
+    /// // y = 2 + 3·θ₀ (θ₁ irrelevant), ridge penalty chosen among three
+    /// let theta = Mat::from_fn(200, 2, |i, j| ((i * (j + 2)) as f64 * 0.37).sin());
+    /// let y = Mat::from_fn(200, 1, |i, _| 2.0 + 3.0 * theta[(i, 0)]);
+    /// let spec: RegressionSpec = serde_json::from_str(
+    ///     r#"{"penalty": {"kind": "ridge", "lambdas": [0, 0.01, 1]}}"#,
+    /// ).unwrap();
+    /// let fit = spec.fit(theta.as_ref(), y.as_ref(), 1)?;
+    /// let (raw, intercepts) = fit.full.raw_coefficients();
+    /// assert!((raw[(0, 0)] - 3.0).abs() < 1e-6 && (intercepts[0] - 2.0).abs() < 1e-6);
+    /// # Ok::<(), sindy::SindyError>(())
+    /// ```
     pub fn fit(
         &self,
         theta: MatRef<'_, f64>,
@@ -379,34 +392,30 @@ impl RegressionSpec {
                 }
             })
             .collect();
-        let gram = z.transpose() * &z;
+        // One Gram matrix for every target's problem.
+        let gram = product(z.transpose(), z.as_ref());
         let mut coefficients = Mat::<f64>::zeros(p, y.ncols());
         for j in 0..y.ncols() {
             let centred = Mat::from_fn(n, 1, |i, _| y[(i, j)] - target_centre[j]);
             let value = values[j.min(values.len() - 1)];
-            let column: Vec<f64> = match &self.penalty {
-                Penalty::Ridge { .. } => {
-                    let rhs = z.transpose() * &centred;
-                    let b = ridge_from_gram(gram.as_ref(), rhs.as_ref(), value * n as f64);
-                    (0..p).map(|i| b[(i, 0)]).collect()
-                }
+            let problem = Problem::with_gram(z.as_ref(), centred.as_ref(), gram.clone())
+                .with_target_names(&[format!("column {j}")]);
+            let optimizer: Box<dyn Optimizer> = match &self.penalty {
+                Penalty::Ridge { .. } => Box::new(Ridge::new(value * n as f64)?),
                 Penalty::Lasso { .. } => {
-                    let moments = z.transpose() * &centred;
+                    let moments = problem.moments();
                     let largest = (0..p).map(|i| moments[(i, 0)].abs()).fold(0.0, f64::max);
-                    let lasso = Lasso::new(value * largest)?;
-                    let b = lasso.fit(z.as_ref(), centred.as_ref(), &[format!("column {j}")])?;
-                    (0..p).map(|i| b[(0, i)]).collect()
+                    Box::new(Lasso::new(value * largest)?)
                 }
                 Penalty::Stlsq { alpha, .. } => {
                     let deviation =
                         (centred.col(0).iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
-                    let stlsq = Stlsq::new(value * deviation, *alpha, 20)?;
-                    let b = stlsq.fit(z.as_ref(), centred.as_ref()).coefficients;
-                    (0..p).map(|i| b[(0, i)]).collect()
+                    Box::new(Stlsq::new(value * deviation, *alpha, DEFAULT_MAX_ITER)?)
                 }
             };
-            for (i, c) in column.into_iter().enumerate() {
-                coefficients[(i, j)] = c;
+            let b = optimizer.solve(&problem)?;
+            for i in 0..p {
+                coefficients[(i, j)] = b[(0, i)];
             }
         }
         Ok(LinearFit {
@@ -435,7 +444,7 @@ fn check_finite(matrix: MatRef<'_, f64>, what: &str) -> Result<()> {
 }
 
 /// The rows `rows` of `matrix`, in that order.
-pub fn select_rows(matrix: MatRef<'_, f64>, rows: &[usize]) -> Mat<f64> {
+fn select_rows(matrix: MatRef<'_, f64>, rows: &[usize]) -> Mat<f64> {
     Mat::from_fn(rows.len(), matrix.ncols(), |i, j| matrix[(rows[i], j)])
 }
 
@@ -539,7 +548,7 @@ mod tests {
                 "{penalty:?}: {intercepts:?}"
             );
             // A heavy ridge penalty loses against the light ones in cross-validation.
-            assert_ne!(fit.chosen()[0], 1.0);
+            assert_ne!(fit.selections[0].chosen, 1.0);
         }
     }
 

@@ -25,7 +25,8 @@ fn default_gap() -> usize {
     10
 }
 
-/// How a segment is cut for blocked cross-validation (unchecked; see [`BlockedFolds::checked`]).
+/// How a segment is cut for blocked cross-validation (unchecked; see [`BlockedFolds::validate`]
+/// and [`crate::RegressionSpec::check_rows`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BlockedFolds {
@@ -48,7 +49,7 @@ impl Default for BlockedFolds {
 
 /// One fold: the training rows and the contiguous validation block.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Fold {
+pub(crate) struct Fold {
     pub training: Vec<usize>,
     pub validation: Range<usize>,
 }
@@ -71,7 +72,7 @@ impl BlockedFolds {
     }
 
     /// Checks the settings against a segment of `n` samples and returns its folds.
-    pub fn checked(&self, n: usize) -> Result<Vec<Fold>> {
+    pub(crate) fn checked(&self, n: usize) -> Result<Vec<Fold>> {
         self.validate()?;
         let block = n / self.folds;
         let needed = self
@@ -117,7 +118,7 @@ pub struct Selection {
 /// Scores every candidate by blocked cross-validation and picks the lowest mean validation MSE.
 /// `validation_mse(candidate, fold)` fits on `fold.training` and returns the MSE on
 /// `fold.validation`; non-finite scores never win.
-pub fn cross_validate(
+pub(crate) fn cross_validate(
     folds: &[Fold],
     candidates: &[f64],
     mut validation_mse: impl FnMut(f64, &Fold) -> Result<f64>,

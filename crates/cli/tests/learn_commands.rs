@@ -6,7 +6,8 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{learn_in, scratch};
-use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Protocol, Standardiser};
+use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Standardiser};
+use pipeline::Protocol;
 use serde_json::{Value, json};
 
 fn workspace() -> PathBuf {
@@ -64,7 +65,7 @@ fn checkpoint(dir: &Path, name: &str, edit: impl FnOnce(&mut MetaTrainedModel)) 
         format: CHECKPOINT_FORMAT.to_string(),
         trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
             formulation,
-            protocol: Protocol::LeaveConditionOut,
+            protocol: Protocol::LeaveConditionOut.name().to_string(),
             held_out_condition: Some("35wind".to_string()),
         }),
         seed: 1,

@@ -224,7 +224,7 @@ impl LearnConfig {
         let parameters = Formulation::ALL
             .iter()
             .map(|&formulation| {
-                crate::experiment::architecture(formulation, &self).parameter_count()
+                crate::formulation::architecture(formulation, &self).parameter_count()
             })
             .max()
             .unwrap_or(0);

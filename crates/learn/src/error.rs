@@ -25,26 +25,6 @@ pub enum LearnError {
     },
     #[error("{}: not a LeARN checkpoint: {message}", path.display())]
     Checkpoint { path: PathBuf, message: String },
-    #[error(
-        "protocol '{protocol}': no meta-training flight for evaluation condition '{condition}' ({detail})"
-    )]
-    NoTrainingFlights {
-        protocol: String,
-        condition: String,
-        detail: String,
-    },
-    /// A condition asked for as a table row (evaluated, the held-out fold) that is only used to
-    /// meta-train.
-    #[error(
-        "condition '{condition}' is not an evaluation condition (its role is {role}); the evaluation conditions are: {evaluation}"
-    )]
-    NotEvaluationCondition {
-        condition: String,
-        role: String,
-        evaluation: String,
-    },
-    #[error("unknown protocol '{name}' (known: paper, leave-condition-out, auto)")]
-    UnknownProtocol { name: String },
     #[error("{what}: {message}")]
     Mismatch { what: String, message: String },
     #[error(
@@ -59,9 +39,6 @@ pub enum LearnError {
     /// interval), named by its file.
     #[error("{}: {message}", path.display())]
     Task { path: PathBuf, message: String },
-    /// A flight that cannot serve LeARN (e.g. too short to split), named by its file.
-    #[error("{}: {message}", path.display())]
-    Flight { path: PathBuf, message: String },
 }
 
 /// Result with a [`LearnError`].

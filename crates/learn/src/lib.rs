@@ -71,8 +71,8 @@ mod columns;
 mod config;
 mod dataset;
 mod error;
-mod experiment;
 mod explain;
+mod formulation;
 mod kernels;
 mod maml;
 mod model;
@@ -81,7 +81,6 @@ mod scalar;
 mod tasks;
 mod train;
 pub mod variants;
-mod work;
 
 pub use adapt::adapt_online;
 pub use batched::ModelWorkspace;
@@ -91,18 +90,14 @@ pub use config::{
     limits,
 };
 pub use dataset::{
-    InputCoverage, InputRange, Protocol, RangeCoverage, Standardiser, flight_segments,
-    from_row_major, row_major, segment_batch,
+    InputCoverage, InputRange, RangeCoverage, Standardiser, from_row_major, row_major,
 };
 pub use error::{LearnError, Result};
-pub use experiment::{
-    CellResult, CellSummary, Experiment, SegmentPrediction, ValidationDetail, architecture,
-    evaluation_condition_of, explain_flight,
-};
 pub use explain::{
     EquationRule, Explanation, InputImportance, ModelNames, OutputExplanation, Term, explain,
     explain_named, output_symbol,
 };
+pub use formulation::architecture;
 pub use maml::{
     Batch, InnerLoop, MetaGradient, MetaOrder, MetaWorkspace, Task, hessian_vector_product,
     inner_updates, meta_gradient, meta_gradient_in, meta_gradient_into, meta_gradients,
@@ -115,5 +110,6 @@ pub use tasks::{
     RecordingEvaluation, TaskSet, column_training, evaluate_recording, explain_recording,
     meta_train_tasks, read_column_tasks, read_recording, segment_data,
 };
-pub use train::{MetaTrainingOutcome, TaskData, meta_train, meta_train_from, meta_train_observed};
-pub use work::{Cells, Spread, SpreadCell, WorkItem, spread_cells};
+pub use train::{
+    MetaTrainingOutcome, TaskData, check_sampling, meta_train, meta_train_from, meta_train_observed,
+};

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::adapt::adapt_online;
 use crate::columns::ColumnTraining;
 use crate::config::{AdaptationConfig, LearnConfig};
-use crate::dataset::{Protocol, Standardiser, row_major, segment_batch};
+use crate::dataset::{Standardiser, row_major, segment_batch};
 use crate::error::{LearnError, Result};
 use crate::network::Architecture;
 
@@ -60,7 +60,9 @@ pub enum TrainedOn {
 #[derive(Clone, Debug, PartialEq)]
 pub struct FlightTraining {
     pub formulation: Formulation,
-    pub protocol: Protocol,
+    /// The name of the protocol that chose the meta-training flights (`paper` or
+    /// `leave-condition-out`: the pipeline's protocols; to this crate only a record).
+    pub protocol: String,
     /// The evaluation condition left out of meta-training (`leave-condition-out`), if any.
     pub held_out_condition: Option<String>,
 }
@@ -73,7 +75,7 @@ struct CheckpointFields {
     #[serde(default)]
     formulation: Option<Formulation>,
     #[serde(default)]
-    protocol: Option<Protocol>,
+    protocol: Option<String>,
     #[serde(default)]
     held_out_condition: Option<String>,
     #[serde(default)]
@@ -138,7 +140,7 @@ impl<'de> Deserialize<'de> for MetaTrainedModel {
 struct FlightCheckpoint<'a> {
     format: &'a str,
     formulation: Formulation,
-    protocol: Protocol,
+    protocol: &'a str,
     held_out_condition: &'a Option<String>,
     #[serde(flatten)]
     rest: CheckpointBody<'a>,
@@ -183,7 +185,7 @@ impl Serialize for MetaTrainedModel {
             TrainedOn::Flights(flights) => FlightCheckpoint {
                 format: &self.format,
                 formulation: flights.formulation,
-                protocol: flights.protocol,
+                protocol: &flights.protocol,
                 held_out_condition: &flights.held_out_condition,
                 rest,
             }

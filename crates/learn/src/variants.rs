@@ -96,7 +96,7 @@ mod tests {
             format: crate::model::CHECKPOINT_FORMAT.to_string(),
             trained_on: crate::model::TrainedOn::Flights(crate::model::FlightTraining {
                 formulation,
-                protocol: crate::dataset::Protocol::LeaveConditionOut,
+                protocol: "leave-condition-out".to_string(),
                 held_out_condition: None,
             }),
             seed: 3,

@@ -5,7 +5,7 @@ mod common;
 use common::{small_architecture, synthetic_batch, synthetic_tasks};
 use learn::{
     AdaptationConfig, CHECKPOINT_FORMAT, InputRange, LearnConfig, MetaOrder, MetaTrainedModel,
-    MetaTrainingConfig, Optimizer, Protocol, Standardiser, TaskGrouping, adapt_online, meta_train,
+    MetaTrainingConfig, Optimizer, Standardiser, TaskGrouping, adapt_online, meta_train,
 };
 
 fn meta_config(iterations: usize) -> MetaTrainingConfig {
@@ -245,7 +245,7 @@ fn example_model() -> MetaTrainedModel {
         format: CHECKPOINT_FORMAT.to_string(),
         trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
             formulation: data::Formulation::Translational,
-            protocol: Protocol::LeaveConditionOut,
+            protocol: "leave-condition-out".to_string(),
             held_out_condition: Some("35wind".to_string()),
         }),
         seed: 9,

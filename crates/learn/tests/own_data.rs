@@ -174,7 +174,7 @@ fn a_flight_checkpoint_is_written_with_the_fields_it_always_had() {
         format: learn::CHECKPOINT_FORMAT.to_string(),
         trained_on: TrainedOn::Flights(learn::FlightTraining {
             formulation,
-            protocol: learn::Protocol::Paper,
+            protocol: "paper".to_string(),
             held_out_condition: None,
         }),
         seed: 1,

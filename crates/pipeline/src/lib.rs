@@ -14,7 +14,7 @@
 //! `report` crate), argument parsing (the `learn` binary).
 //!
 //! **Work items and shards.** Each run enumerates its work once, in a fixed order, as
-//! [`learn::WorkItem`]s (one meta-training: formulation, cells, seed) — [`run`] and
+//! [`WorkItem`]s (one meta-training: formulation, cells, seed) — [`run`] and
 //! [`run_variants`] (the ablations) and [`spread_sweep`] (the seed spread) alike — and renders the
 //! items' results with one function per run. [`run_shard`], [`run_variants_shard`] and
 //! [`run_spread`] with a [`ShardSpec`] run only the items at positions ≡ K (mod N) and return a
@@ -37,9 +37,12 @@ mod causal_library;
 mod cells;
 mod config;
 mod error;
+mod experiment;
+mod flights;
 mod output;
 pub mod own_data;
 mod run;
+mod segment;
 mod shard;
 mod sindy_column;
 mod sindy_variant;
@@ -58,6 +61,12 @@ pub use causal_library::{CausalLibrary, MAX_CONTROL_LAGS, first_order_lag};
 pub use cells::figure_file_name;
 pub use config::{CheckedRunConfig, LearnRun, MAX_SEEDS, RunConfig, merge_patch};
 pub use error::{PipelineError, Result};
+pub use experiment::{
+    CellResult, CellSummary, Cells, EVALUATION_DERIVATIVE, EVALUATION_SPLIT, EvaluationCell,
+    Experiment, SegmentPrediction, Spread, SpreadCell, ValidationDetail, WorkItem, explain_flight,
+    spread_cells,
+};
+pub use flights::{Flight, Protocol, evaluation_condition_of, read_evaluation_flights};
 pub use output::{
     OutputPaths, README_BEGIN, README_END, ablation_files, check_paper, check_readme, latex_files,
     result_files, update_readme, updated_readme, write_outputs,
@@ -66,6 +75,7 @@ pub use run::{
     GENERATED_PATHS, ReproduceShard, RunOptions, RunOutcome, git_commit, merged_run, run,
     run_shard, shard_timings, uncommitted_inputs,
 };
+pub use segment::{flight_segments, segment_batch};
 pub use shard::{
     ItemResult, MergedSweep, SHARD_FILE, SHARD_FORMAT, ShardDocument, ShardFile, ShardProvenance,
     ShardSpec, Sweep, SweepKind, merge, read_shard, write_shard,

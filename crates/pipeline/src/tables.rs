@@ -6,9 +6,10 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use crate::experiment::CellSummary;
 use crate::sindy_column::SindyConfig;
 use data::{Formulation, SplitSpec};
-use learn::{CellSummary, DataFile, Explanation, LearnConfig, RangeCoverage};
+use learn::{DataFile, Explanation, LearnConfig, RangeCoverage};
 use report::{Mse, PublishedTables, QualitativeFigure, ResultsTable, Row};
 use serde::{Deserialize, Serialize};
 use sindy::Derivative;

@@ -21,15 +21,18 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use crate::causal_library::CausalLibrary;
+use crate::experiment::Experiment;
+use crate::flights::Flight;
 use crate::sindy_variant::LibraryRegression;
 use crate::sindy_variant::SegmentPredictions;
 use crate::sindy_variant::VariantEvaluation;
 use crate::sindy_variant::evaluate_features;
 use data::{Formulation, Segment};
+use learn::MetaTrainedModel;
 use learn::variants::{LearnedFeatures, learned_features};
-use learn::{Experiment, MetaTrainedModel};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sindy::{Mat, RegressionFit, RegressionSpec};
@@ -619,14 +622,16 @@ fn learned_basis_config(config: &CheckedVariants) -> Result<learn::CheckedConfig
 pub(crate) fn learned_basis_experiment(
     config: &CheckedVariants,
     data_dir: &Path,
+    evaluation: &[Arc<Flight>],
 ) -> Result<Experiment> {
     let run = &config.run;
-    Ok(Experiment::load(
+    Experiment::load_with(
         learned_basis_config(config)?,
         run.conditions.clone(),
         data_dir,
         run.protocol,
-    )?)
+        evaluation,
+    )
 }
 
 /// Every variant of `variants` on one support/query pair with one seed, in declaration order.
@@ -816,7 +821,8 @@ fn outcome_of(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use learn::{CHECKPOINT_FORMAT, Protocol, Standardiser};
+    use crate::flights::Protocol;
+    use learn::{CHECKPOINT_FORMAT, Standardiser};
 
     /// A synthetic attitude segment of `n` samples with targets that depend on the inputs.
     fn segment(n: usize, phase: f64) -> Segment {
@@ -845,7 +851,7 @@ mod tests {
             format: CHECKPOINT_FORMAT.to_string(),
             trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
                 formulation: Formulation::Attitude,
-                protocol: Protocol::LeaveConditionOut,
+                protocol: Protocol::LeaveConditionOut.name().to_string(),
                 held_out_condition: None,
             }),
             seed: 2,

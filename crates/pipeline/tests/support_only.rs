@@ -7,7 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use data::{FlightLog, Formulation, Segment, SplitSpec};
-use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Protocol, Standardiser};
+use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Standardiser};
+use pipeline::Protocol;
 use pipeline::{VariantKind, VariantsConfig, evaluate_variants};
 use sindy::Derivative;
 
@@ -43,7 +44,7 @@ fn untrained_model(formulation: Formulation, config: &LearnConfig) -> MetaTraine
         format: CHECKPOINT_FORMAT.to_string(),
         trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
             formulation,
-            protocol: Protocol::LeaveConditionOut,
+            protocol: Protocol::LeaveConditionOut.name().to_string(),
             held_out_condition: None,
         }),
         seed: 1,

@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use data::{ExperimentConditions, FlightLog};
-use learn::{EquationRule, Explanation, MetaTrainedModel, explain_flight};
+use learn::{EquationRule, Explanation, MetaTrainedModel};
+use pipeline::explain_flight;
 
 use outputs::{Existing, OutputSet};
 
@@ -106,7 +107,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         let value = serde_json::json!({
             "checkpoint": args.checkpoint,
             "flight": flight,
-            "protocol": flights.protocol.name(),
+            "protocol": flights.protocol,
             "seed": model.seed,
             "adapted": !args.no_adapt,
             "explanation": explanation,
@@ -118,7 +119,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     say!(
         "{} model ({} protocol, seed {}) over {} ({} samples, {})",
         flights.formulation.name(),
-        flights.protocol.name(),
+        flights.protocol,
         model.seed,
         flight.display(),
         explanation.samples,

@@ -1,11 +1,34 @@
-//! The experiment on the real flights, with a tiny budget (skipped without data, fails under CI).
+//! The LeARN experiment on the real flights, with a tiny budget (skipped without data, fails
+//! under CI).
 
-mod common;
+use std::path::{Path, PathBuf};
 
 use data::{ExperimentConditions, Formulation};
-use learn::{
-    EquationRule, Experiment, LearnConfig, MetaTrainedModel, Protocol, TaskGrouping, explain_flight,
-};
+use learn::{EquationRule, LearnConfig, MetaTrainedModel, TaskGrouping};
+use pipeline::{Experiment, PipelineError, Protocol, explain_flight};
+
+mod common {
+    use super::*;
+
+    /// The real data directory (see `data::real_data_dir_for_tests`: skips locally, fails under
+    /// CI).
+    pub fn real_data_dir() -> Option<PathBuf> {
+        data::real_data_dir_for_tests(&workspace())
+    }
+
+    /// The workspace root.
+    pub fn workspace() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    }
+
+    /// A fresh temporary directory for one test, removed with everything in it when dropped.
+    pub fn temp_dir(name: &str) -> tempfile::TempDir {
+        tempfile::Builder::new()
+            .prefix(&format!("{name}-"))
+            .tempdir()
+            .unwrap()
+    }
+}
 
 fn log_rows(data_dir: &std::path::Path) -> usize {
     data::FlightLog::read(&data_dir.join("experiment/custom_figure8_baseline_70p20sint.csv"))
@@ -43,7 +66,7 @@ fn leave_condition_out_cell_runs_end_to_end() {
         .unwrap();
     let model = &cell.model;
     let flights = model.flights().expect("a flight model");
-    assert_eq!(flights.protocol, Protocol::LeaveConditionOut);
+    assert_eq!(flights.protocol, Protocol::LeaveConditionOut.name());
     assert_eq!(flights.held_out_condition.as_deref(), Some("70p20sint"));
     // 4 other conditions × 6 controllers; none of them the held-out condition.
     assert_eq!(model.data_files.len(), 24);
@@ -72,6 +95,35 @@ fn leave_condition_out_cell_runs_end_to_end() {
     }
     let mse = sum / (p.nrows() * p.ncols()) as f64;
     assert!((mse - summary.gen_mse).abs() < 1e-12 * mse);
+    // LeARN is scored against the experiment's cell, whose segments the run fits SINDy on: the
+    // targets of the run's split and derivative (the only ones a run configuration accepts).
+    let evaluation = experiment
+        .cell(Formulation::Translational, "70p20sint")
+        .unwrap();
+    let log =
+        data::FlightLog::read(&data_dir.join("experiment/custom_figure8_baseline_70p20sint.csv"))
+            .unwrap();
+    let (support, query) = pipeline::flight_segments(
+        &log,
+        Formulation::Translational,
+        pipeline::EVALUATION_SPLIT,
+        pipeline::EVALUATION_DERIVATIVE,
+    )
+    .unwrap();
+    for (learn, cut, sindy) in [
+        (
+            &cell.support.targets,
+            &support.targets,
+            &evaluation.support.targets,
+        ),
+        (
+            &cell.query.targets,
+            &query.targets,
+            &evaluation.query.targets,
+        ),
+    ] {
+        assert!(learn == cut && learn == sindy);
+    }
 
     // A model of another fold is refused; the checkpoint round-trips and explains.
     assert!(experiment.evaluate(model, "35wind").is_err());
@@ -86,7 +138,7 @@ fn leave_condition_out_cell_runs_end_to_end() {
         experiment.evaluate(model, "nowind").unwrap_err(),
     ] {
         assert!(
-            matches!(&error, learn::LearnError::NotEvaluationCondition { condition, .. } if condition == "nowind"),
+            matches!(&error, PipelineError::NotEvaluationCondition { condition, .. } if condition == "nowind"),
             "{error}"
         );
     }

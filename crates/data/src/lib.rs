@@ -2,7 +2,8 @@
 //!
 //! What it is for: reading Neural-Fly flight logs into a typed, validated [`FlightLog`]; reading plain
 //! numeric CSVs by column name ([`NumericTable`], [`ColumnRef`] for `v[k]`); several CSV
-//! recordings of one system as the tasks of meta-learning ([`read_tasks`]); the paper's three
+//! recordings of one system as the tasks of meta-learning ([`read_file_tasks`],
+//! [`read_column_tasks`]); the paper's three
 //! [`Formulation`]s as data (which state, which inputs, with which scalings) and their segments,
 //! with targets estimated by `sindy::Derivative`; support/query
 //! splits ([`SplitSpec`]); the experiment's wind conditions ([`ExperimentConditions`]); finding the
@@ -48,7 +49,7 @@ pub use source::{
 pub use split::{Split, SplitSpec};
 pub use stream::{NumericBlock, NumericStream};
 pub use table::ColumnRef;
-pub use tasks::{MAX_TASKS, TaskSource, TaskTable, interval_text, read_tasks};
+pub use tasks::{MAX_TASKS, TaskTable, interval_text, read_column_tasks, read_file_tasks};
 pub use time::{DEFAULT_UNIFORM_TOLERANCE, StreamedTimeAxis, check_time_axis};
 
 /// Re-exported so that downstream crates name the same matrix type.

@@ -6,8 +6,6 @@ use std::path::PathBuf;
 /// Each variant renders as one line naming the file, field or condition involved.
 #[derive(Debug, thiserror::Error)]
 pub enum LearnError {
-    #[error(transparent)]
-    Data(#[from] data::DataError),
     /// A derivative estimator misconfigured or given too few samples.
     #[error(transparent)]
     Differentiation(#[from] sindy::DifferentiationError),
@@ -35,8 +33,7 @@ pub enum LearnError {
     /// non-finite number: reported instead of printing NaN.
     #[error("{cell}: {message}")]
     NotFinite { cell: String, message: String },
-    /// A CSV task or recording that cannot serve LeARN (too few rows, another sampling
-    /// interval), named by its file.
+    /// A task or recording that cannot serve LeARN (e.g. too few rows), named by its file.
     #[error("{}: {message}", path.display())]
     Task { path: PathBuf, message: String },
 }

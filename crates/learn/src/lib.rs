@@ -84,7 +84,7 @@ pub mod variants;
 
 pub use adapt::adapt_online;
 pub use batched::ModelWorkspace;
-pub use columns::{ColumnSpec, ColumnTraining, TaskConfig, TaskRows};
+pub use columns::{ColumnSpec, ColumnTraining, TaskConfig, TaskRows, TaskSource};
 pub use config::{
     AdaptationConfig, CheckedConfig, LearnConfig, MetaTrainingConfig, Optimizer, TaskGrouping,
     limits,
@@ -107,8 +107,8 @@ pub use model::{CHECKPOINT_FORMAT, DataFile, FlightTraining, MetaTrainedModel, T
 pub use network::{Architecture, PAPER_HIDDEN, mean_squared_error};
 pub use scalar::{Dual, Scalar, gelu, gelu_derivative, gelu_second_derivative};
 pub use tasks::{
-    RecordingEvaluation, TaskSet, column_training, evaluate_recording, explain_recording,
-    meta_train_tasks, read_column_tasks, read_recording, segment_data,
+    Recording, RecordingEvaluation, TaskSet, column_training, evaluate_recording,
+    explain_recording, meta_train_tasks, segment_data,
 };
 pub use train::{
     MetaTrainingOutcome, TaskData, check_sampling, meta_train, meta_train_from, meta_train_observed,

@@ -59,7 +59,7 @@ fn meta_train(dir: &Path, data: &Path, extra: &[&str]) -> common::Run {
 /// `edit`), written as `dir/name`.
 fn checkpoint(dir: &Path, name: &str, edit: impl FnOnce(&mut MetaTrainedModel)) -> PathBuf {
     let config = LearnConfig::load(&workspace().join("experiments/learn.json")).unwrap();
-    let formulation = data::Formulation::Translational;
+    let formulation = learn::Formulation::Translational;
     let architecture = learn::architecture(formulation, config.get());
     let mut model = MetaTrainedModel {
         format: CHECKPOINT_FORMAT.to_string(),

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use data::Formulation;
+use crate::formulation::Formulation;
 
 use crate::error::{LearnError, Result};
 use crate::maml::MetaOrder;

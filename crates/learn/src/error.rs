@@ -23,6 +23,8 @@ pub enum LearnError {
     },
     #[error("{}: not a LeARN checkpoint: {message}", path.display())]
     Checkpoint { path: PathBuf, message: String },
+    #[error("unknown formulation '{name}' (known: translational, attitude, full)")]
+    UnknownFormulation { name: String },
     #[error("{what}: {message}")]
     Mismatch { what: String, message: String },
     #[error(

@@ -2,15 +2,15 @@
 
 use std::path::{Path, PathBuf};
 
-use data::{Formulation, Segment};
 use serde::{Deserialize, Serialize};
 
 use crate::adapt::adapt_online;
 use crate::columns::ColumnTraining;
 use crate::config::{AdaptationConfig, LearnConfig};
-use crate::dataset::{Standardiser, row_major, segment_batch};
 use crate::error::{LearnError, Result};
+use crate::formulation::Formulation;
 use crate::network::Architecture;
+use crate::standardiser::Standardiser;
 
 /// The format tag written into every checkpoint.
 pub const CHECKPOINT_FORMAT: &str = "learn-checkpoint/1";
@@ -328,18 +328,6 @@ impl MetaTrainedModel {
             &self.scaled_targets(targets),
             adaptation,
         )
-    }
-
-    /// θ adapted online on `support` (a flight segment), see [`Self::adapt_on`].
-    pub fn adapt(&self, support: &Segment, adaptation: &AdaptationConfig) -> Vec<f64> {
-        let batch = segment_batch(support);
-        self.adapt_on(&batch.inputs, &batch.targets, adaptation)
-    }
-
-    /// Predictions (samples × I, row-major) of the networks with `parameters` (e.g. adapted by
-    /// [`Self::adapt`]) on every sample of `segment`.
-    pub fn predict_segment(&self, parameters: &[f64], segment: &Segment) -> Vec<f64> {
-        self.predict_with(parameters, &row_major(&segment.inputs()))
     }
 
     /// Writes the checkpoint as JSON, creating parent directories.

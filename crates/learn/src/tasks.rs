@@ -20,12 +20,12 @@ use std::path::Path;
 
 use crate::columns::{ColumnSpec, ColumnTraining, TaskConfig, TaskRows, TaskSource};
 use crate::config::{TaskGrouping, limits};
-use crate::dataset::{InputRange, Standardiser};
 use crate::error::{LearnError, Result};
 use crate::explain::{EquationRule, Explanation, ModelNames, explain_named};
 use crate::maml::Batch;
 use crate::model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel, TrainedOn};
 use crate::network::mean_squared_error;
+use crate::standardiser::{InputRange, Standardiser};
 use crate::train::{TaskData, check_sampling, meta_train_observed};
 
 /// One recording (a task, or a new recording to adapt on) in memory: the columns of a

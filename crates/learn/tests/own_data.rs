@@ -181,7 +181,7 @@ fn a_checkpoint_is_either_a_flight_model_or_a_model_of_csv_tasks() {
 fn a_flight_checkpoint_is_written_with_the_fields_it_always_had() {
     let config: learn::LearnConfig =
         serde_json::from_str(include_str!("../../../experiments/learn.json")).unwrap();
-    let formulation = data::Formulation::Attitude;
+    let formulation = learn::Formulation::Attitude;
     let architecture = learn::architecture(formulation, &config);
     let model = MetaTrainedModel {
         format: learn::CHECKPOINT_FORMAT.to_string(),

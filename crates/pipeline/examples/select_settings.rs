@@ -10,8 +10,8 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use data::{ExperimentConditions, Formulation};
-use learn::{AdaptationConfig, LearnConfig};
+use data::ExperimentConditions;
+use learn::{AdaptationConfig, Formulation, LearnConfig};
 use pipeline::{Experiment, Protocol};
 use rayon::prelude::*;
 use serde_json::json;

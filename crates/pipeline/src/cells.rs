@@ -1,10 +1,12 @@
 //! The qualitative figure of a cell: time and ground truth over both segments of an evaluation
 //! flight, one trace per method.
 
-use data::{Condition, Formulation, Mat, Segment};
+use data::{Condition, Mat};
+use learn::Formulation;
 use report::{MethodTrace, OutputAxis, QualitativeFigure};
 
 use crate::error::Result;
+use crate::segment::Segment;
 
 /// Column `j` of two stacked matrices.
 fn stacked_column(top: &Mat<f64>, bottom: &Mat<f64>, j: usize) -> Vec<f64> {

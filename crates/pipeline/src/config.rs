@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use crate::sindy_column::SindyConfig;
-use data::{ExperimentConditions, Formulation, SplitSpec, file_sha256};
-use learn::{CheckedConfig, LearnConfig};
+use data::{ExperimentConditions, SplitSpec, file_sha256};
+use learn::{CheckedConfig, Formulation, LearnConfig};
 use serde::{Deserialize, Serialize};
 use sindy::Derivative;
 

@@ -13,12 +13,12 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use data::{Condition, ExperimentConditions, FlightLog, Formulation, Mat, Segment, SplitSpec};
+use data::{Condition, ExperimentConditions, FlightLog, Mat, SplitSpec};
 use learn::{
     AdaptationConfig, Architecture, Batch, CHECKPOINT_FORMAT, CheckedConfig, DataFile,
-    FlightTraining, InputRange, LearnConfig, LearnError, MetaTrainedModel, MetaTrainingOutcome,
-    RangeCoverage, Standardiser, TaskData, TaskGrouping, TrainedOn, architecture, check_sampling,
-    from_row_major, mean_squared_error, meta_train,
+    FlightTraining, Formulation, InputRange, LearnConfig, LearnError, MetaTrainedModel,
+    MetaTrainingOutcome, RangeCoverage, Standardiser, TaskData, TaskGrouping, TrainedOn,
+    architecture, check_sampling, from_row_major, mean_squared_error, meta_train,
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -28,7 +28,7 @@ use crate::error::{PipelineError, Result};
 use crate::flights::{
     Flight, Protocol, evaluation_condition_of, evaluation_flight_path, read_evaluation_flights,
 };
-use crate::segment::{flight_segments, segment_batch};
+use crate::segment::{Segment, flight_segments, segment_batch};
 
 pub use nested::ValidationDetail;
 pub use work::{Cells, Spread, SpreadCell, WorkItem, spread_cells};

@@ -1,17 +1,27 @@
-//! The experiments of the paper, end to end: what `make reproduce` and `learn reproduce` run.
+//! The experiments of the paper, end to end: what `make reproduce` and `learn reproduce` run. The
+//! home of the paper's protocol, for both methods.
 //!
 //! What it is for: reading a run configuration ([`RunConfig`], `experiments/reproduce.json` or
-//! `experiments/ci.json`); running SINDy (`sindy`) and LeARN (`learn`) on every formulation ×
-//! evaluation condition of `experiments/conditions.json` ([`run`]); turning the numbers and
-//! predictions into the paper's tables and figures and a `summary.json` with full provenance
-//! ([`write_outputs`]); and the check of the results against the paper ([`check_paper`]).
+//! `experiments/ci.json`); the flights (each log read and hashed once, [`Flight`]); a
+//! formulation's columns of a flight log and its support and query segments ([`Segment::cut`],
+//! [`flight_segments`]: halves, forward-difference targets on each); the protocols choosing the
+//! meta-training flights of an evaluation condition ([`Protocol`]); the LeARN experiment on them
+//! ([`Experiment`]: meta-training per formulation and evaluation condition, adaptation on the
+//! evaluation flight's support segment, prediction of its query segment, nested validation, the
+//! seed spread), whose cells ([`EvaluationCell`]) SINDy (`sindy`) is fitted on too; running both on
+//! every formulation × evaluation condition of `experiments/conditions.json` ([`run`]); turning the
+//! numbers and predictions into the paper's tables and figures and a `summary.json` with full
+//! provenance ([`write_outputs`]); and the check of the results against the paper
+//! ([`check_paper`]).
 //!
-//! LeARN on your own data ([`own_data`]): a model of CSV tasks next to SINDy on the same rows of a
-//! new recording ([`own_data::compare_on_recording`], `learn evaluate`) and the worked example's
-//! learning curve ([`own_data::example`], `make own-data-example`).
+//! LeARN on your own data ([`own_data`]): reading CSV tasks and recordings for `learn`
+//! ([`own_data::read_tasks`], [`own_data::read_recording`]), a model of CSV tasks next to SINDy on
+//! the same rows of a new recording ([`own_data::compare_on_recording`], `learn evaluate`) and the
+//! worked example's learning curve ([`own_data::example`], `make own-data-example`).
 //!
-//! What it is not for: any model or metric (those live in `sindy` and `learn`), rendering (the
-//! `report` crate), argument parsing (the `learn` binary).
+//! What it is not for: any model, training algorithm or metric (those live in `sindy` and
+//! `learn`, which work on matrices in memory), parsing files (the `data` crate reads flight logs
+//! and CSVs), rendering (the `report` crate), argument parsing (the `learn` binary).
 //!
 //! **Work items and shards.** Each run enumerates its work once, in a fixed order, as
 //! [`WorkItem`]s (one meta-training: formulation, cells, seed) — [`run`] and
@@ -27,7 +37,8 @@
 //! conditions file make a new row in every table and a new figure per table.
 //!
 //! Definitions, shared by both methods: support = the first half of each evaluation flight, query =
-//! the second half; targets = forward differences on each segment. **Adaptation MSE**: the model
+//! the second half ([`EVALUATION_SPLIT`]); targets = forward differences on each segment
+//! ([`EVALUATION_DERIVATIVE`]), built once per cell for both. **Adaptation MSE**: the model
 //! fitted (SINDy) or adapted online (LeARN) on the support segment, scored on that segment.
 //! **Generalisation MSE**: the same model, unchanged, scored on the query segment.
 
@@ -75,7 +86,7 @@ pub use run::{
     GENERATED_PATHS, ReproduceShard, RunOptions, RunOutcome, git_commit, merged_run, run,
     run_shard, shard_timings, uncommitted_inputs,
 };
-pub use segment::{flight_segments, segment_batch};
+pub use segment::{Segment, SegmentModel, flight_segments, segment_batch};
 pub use shard::{
     ItemResult, MergedSweep, SHARD_FILE, SHARD_FORMAT, ShardDocument, ShardFile, ShardProvenance,
     ShardSpec, Sweep, SweepKind, merge, read_shard, write_shard,

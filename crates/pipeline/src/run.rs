@@ -13,9 +13,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use crate::sindy_column::SegmentEvaluation;
-use data::{Formulation, file_sha256};
+use data::file_sha256;
 use indicatif::{ProgressBar, ProgressStyle};
-use learn::{EquationRule, explain, row_major};
+use learn::{EquationRule, Formulation, explain, row_major};
 use rayon::prelude::*;
 use report::{MethodTrace, PublishedTables, QualitativeFigure, ResultsTable};
 

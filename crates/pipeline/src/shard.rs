@@ -387,7 +387,7 @@ mod tests {
             kind: SweepKind::Reproduce,
             context: "c".to_string(),
             items: vec![WorkItem {
-                formulation: data::Formulation::Full,
+                formulation: learn::Formulation::Full,
                 cells: crate::experiment::Cells::Every,
                 seed: 7,
             }],

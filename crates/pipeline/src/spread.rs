@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use data::Formulation;
+use learn::Formulation;
 use learn::LearnConfig;
 use serde::{Deserialize, Serialize};
 use serde_json::json;

@@ -8,7 +8,8 @@ use std::path::PathBuf;
 
 use crate::experiment::CellSummary;
 use crate::sindy_column::SindyConfig;
-use data::{Formulation, SplitSpec};
+use data::SplitSpec;
+use learn::Formulation;
 use learn::{DataFile, Explanation, LearnConfig, RangeCoverage};
 use report::{Mse, PublishedTables, QualitativeFigure, ResultsTable, Row};
 use serde::{Deserialize, Serialize};

@@ -3,7 +3,7 @@
 //! published columns and an estimate of the targets' noise floor.
 //!
 //! Protocol (the same as the paper's tables): support = first half of the flight, query = second
-//! half, forward-difference targets on each segment, inputs X = [x, u] of `data::Formulation`.
+//! half, forward-difference targets on each segment, inputs X = [x, u] of `learn::Formulation`.
 //! Every hyper-parameter of a variant (penalty, library for `select`) is chosen by blocked
 //! cross-validation inside the support segment; the query segment is only ever scored.
 //!
@@ -26,13 +26,13 @@ use std::sync::Arc;
 use crate::causal_library::CausalLibrary;
 use crate::experiment::Experiment;
 use crate::flights::Flight;
+use crate::segment::{Segment, SegmentModel};
 use crate::sindy_variant::LibraryRegression;
 use crate::sindy_variant::SegmentPredictions;
 use crate::sindy_variant::VariantEvaluation;
 use crate::sindy_variant::evaluate_features;
-use data::{Formulation, Segment};
-use learn::MetaTrainedModel;
 use learn::variants::{LearnedFeatures, learned_features};
+use learn::{Formulation, MetaTrainedModel};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sindy::{Mat, RegressionFit, RegressionSpec};
@@ -193,7 +193,8 @@ impl LearnedBasisSpec {
         seed: u64,
     ) -> Result<VariantEvaluation> {
         let features = |segment: &Segment| -> Result<(Mat<f64>, Vec<String>)> {
-            let (learned, learned_names) = learned_features(model, segment, self.features);
+            let (learned, learned_names) =
+                learned_features(model, &segment.inputs(), self.features);
             let Some(library) = &self.library else {
                 return Ok((learned, learned_names));
             };

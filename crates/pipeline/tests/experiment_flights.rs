@@ -1,11 +1,12 @@
-//! The LeARN experiment on the real flights, with a tiny budget (skipped without data, fails
-//! under CI).
+//! The formulations' segments and the LeARN experiment on the real flights, with a tiny budget
+//! (skipped without data, fails under CI).
 
 use std::path::{Path, PathBuf};
 
-use data::{ExperimentConditions, Formulation};
-use learn::{EquationRule, LearnConfig, MetaTrainedModel, TaskGrouping};
-use pipeline::{Experiment, PipelineError, Protocol, explain_flight};
+use data::ExperimentConditions;
+use learn::{EquationRule, Formulation, LearnConfig, MetaTrainedModel, TaskGrouping};
+use pipeline::{Experiment, PipelineError, Protocol, Segment, explain_flight};
+use sindy::Derivative;
 
 mod common {
     use super::*;
@@ -343,4 +344,39 @@ fn nested_validation_detail_agrees_with_nested_validation() {
             .to_string();
         assert!(message.contains("between 0 and 1"), "{message}");
     }
+}
+
+#[test]
+fn formulations_build_paper_segments() {
+    let Some(dir) = common::real_data_dir() else {
+        return;
+    };
+    let log =
+        data::FlightLog::read(&dir.join("experiment/custom_figure8_baseline_35wind.csv")).unwrap();
+    let split = data::SplitSpec::Halves.split(log.len()).unwrap();
+    assert_eq!(split.support, 0..1255);
+    let segment = Segment::cut(
+        &log,
+        Formulation::Full,
+        split.query.clone(),
+        Derivative::Forward,
+    )
+    .unwrap();
+    assert_eq!(segment.len(), 1256);
+    assert_eq!(segment.inputs().ncols(), 10);
+    let k = split.query.start;
+    let n1 = log.motor_command[k][0] / 1000.0;
+    assert!((segment.controls[(0, 0)] - n1 * n1).abs() < 1e-15);
+    // target = forward difference on the segment alone
+    let expected = (log.velocity[k + 1][0] - log.velocity[k][0]) / log.sample_interval();
+    assert!((segment.targets[(0, 0)] - expected).abs() < 1e-9);
+    let translational = Segment::cut(
+        &log,
+        Formulation::Translational,
+        split.support,
+        Derivative::Forward,
+    )
+    .unwrap();
+    let thrust_z = log.rotation[0][2][2] * log.thrust_setpoint[0];
+    assert!((translational.controls[(0, 2)] - thrust_z).abs() < 1e-15);
 }

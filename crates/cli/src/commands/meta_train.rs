@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
-use data::{ExperimentConditions, Formulation};
+use data::ExperimentConditions;
 use indicatif::{ProgressBar, ProgressStyle};
-use learn::LearnConfig;
+use learn::{Formulation, LearnConfig};
 use pipeline::{CellSummary, Experiment, Protocol, ShardSpec, evaluation_condition_of};
 use report::{Method, PublishedTables};
 use serde_json::{Value, json};

@@ -13,7 +13,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use crate::experiment::{Cells, WorkItem};
-use data::{Formulation, NoiseFloor};
+use data::NoiseFloor;
+use learn::Formulation;
 use report::QualitativeFigure;
 use serde::{Deserialize, Serialize};
 

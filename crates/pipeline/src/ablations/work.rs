@@ -5,9 +5,10 @@ use std::path::Path;
 
 use crate::experiment::{Cells, Experiment, WorkItem};
 use crate::flights::read_evaluation_flights;
+use crate::segment::Segment;
 use crate::sindy_variant::SegmentPredictions;
-use data::{Condition, FlightLog, Formulation, Segment, forward_difference_noise_floor};
-use learn::MetaTrainedModel;
+use data::{Condition, FlightLog, forward_difference_noise_floor};
+use learn::{Formulation, MetaTrainedModel};
 use report::{MethodTrace, PublishedTables, QualitativeFigure};
 use sindy::{EnsemblePrediction, Mat, RegressionFit};
 
@@ -170,8 +171,11 @@ impl<'c> AblationsWork<'c> {
                 adaptation: sindy.support_mse,
                 generalisation: sindy.query_mse,
             },
-            noise_floor_support: forward_difference_noise_floor(&cell.support, self.dt)?,
-            noise_floor_query: forward_difference_noise_floor(&cell.query, self.dt)?,
+            noise_floor_support: forward_difference_noise_floor(
+                cell.support.states.as_ref(),
+                self.dt,
+            )?,
+            noise_floor_query: forward_difference_noise_floor(cell.query.states.as_ref(), self.dt)?,
             headline_equations,
             figure,
         })

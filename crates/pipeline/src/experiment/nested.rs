@@ -1,9 +1,10 @@
 //! Nested validation inside the meta-training sets (leave-condition-out only): settings chosen
 //! with these scores never see the evaluation flight of the fold they are used on.
 
-use data::{Condition, Formulation};
+use data::Condition;
 use learn::{
-    AdaptationConfig, Architecture, LearnConfig, MetaTrainingOutcome, Standardiser, adapt_online,
+    AdaptationConfig, Architecture, Formulation, LearnConfig, MetaTrainingOutcome, Standardiser,
+    adapt_online,
 };
 
 use super::{Experiment, check_window, standardised};

@@ -6,7 +6,7 @@
 
 use std::fmt;
 
-use data::Formulation;
+use learn::Formulation;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 

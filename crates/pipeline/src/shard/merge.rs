@@ -329,7 +329,7 @@ mod tests {
     use super::*;
     use crate::experiment::Cells;
     use crate::shard::{SHARD_FORMAT, Sweep};
-    use data::Formulation;
+    use learn::Formulation;
 
     /// A sweep of five items whose context is `context`, over one data file.
     fn sweep(context: &str) -> Sweep<String> {

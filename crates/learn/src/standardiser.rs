@@ -1,9 +1,9 @@
-//! From matrices to regression data, and standardisation.
+//! Input standardisation ([`Standardiser`]: the meta-training statistics, optionally clamping to
+//! the range the meta-training inputs span), how much of a segment lies outside that range
+//! ([`RangeCoverage`]), and matrices as the row-major values the networks read.
 
-use data::{Mat, Segment};
+use faer::Mat;
 use serde::{Deserialize, Serialize};
-
-use crate::maml::Batch;
 
 /// The rows of a matrix, concatenated.
 pub fn row_major(matrix: &Mat<f64>) -> Vec<f64> {
@@ -21,14 +21,6 @@ pub fn from_row_major(values: &[f64], columns: usize) -> Mat<f64> {
     Mat::from_fn(values.len() / columns, columns, |i, j| {
         values[i * columns + j]
     })
-}
-
-/// A segment as regression data with raw (not standardised) inputs.
-pub(crate) fn segment_batch(segment: &Segment) -> Batch {
-    Batch {
-        inputs: row_major(&segment.inputs()),
-        targets: row_major(&segment.targets),
-    }
 }
 
 /// The z-score of each input feature, (x − mean) / std, optionally of x first clamped to the range

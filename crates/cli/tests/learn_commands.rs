@@ -6,7 +6,8 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{learn_in, scratch};
-use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Protocol, Standardiser};
+use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Standardiser};
+use pipeline::Protocol;
 use serde_json::{Value, json};
 
 fn workspace() -> PathBuf {
@@ -58,13 +59,13 @@ fn meta_train(dir: &Path, data: &Path, extra: &[&str]) -> common::Run {
 /// `edit`), written as `dir/name`.
 fn checkpoint(dir: &Path, name: &str, edit: impl FnOnce(&mut MetaTrainedModel)) -> PathBuf {
     let config = LearnConfig::load(&workspace().join("experiments/learn.json")).unwrap();
-    let formulation = data::Formulation::Translational;
+    let formulation = learn::Formulation::Translational;
     let architecture = learn::architecture(formulation, config.get());
     let mut model = MetaTrainedModel {
         format: CHECKPOINT_FORMAT.to_string(),
         trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
             formulation,
-            protocol: Protocol::LeaveConditionOut,
+            protocol: Protocol::LeaveConditionOut.name().to_string(),
             held_out_condition: Some("35wind".to_string()),
         }),
         seed: 1,

@@ -2,14 +2,16 @@
 //!
 //! What it is for: reading Neural-Fly flight logs into a typed, validated [`FlightLog`]; reading plain
 //! numeric CSVs by column name ([`NumericTable`], [`ColumnRef`] for `v[k]`); several CSV
-//! recordings of one system as the tasks of meta-learning ([`read_tasks`]); the paper's three
-//! [`Formulation`]s as data (which state, which inputs, with which scalings) and their segments,
-//! with targets estimated by `sindy::Derivative`; support/query
-//! splits ([`SplitSpec`]); the experiment's wind conditions ([`ExperimentConditions`]); finding the
-//! data directory ([`resolve_data_dir`]); telling whether two spellings name the same file
+//! recordings of one system as the tasks of meta-learning ([`read_file_tasks`],
+//! [`read_column_tasks`]); support/query splits ([`SplitSpec`]); the experiment's wind conditions
+//! ([`ExperimentConditions`]); the noise floor of forward-difference targets
+//! ([`forward_difference_noise_floor`]); file hashes ([`file_sha256`]); finding the data directory
+//! ([`resolve_data_dir`]); telling whether two spellings name the same file
 //! ([`paths::same_file`]).
 //!
-//! What it is not for: fitting anything. Models live in `sindy` and `learn`, tables in `report`.
+//! What it is not for: fitting anything (models live in `sindy` and `learn`, tables in `report`),
+//! nor the paper's protocol: a formulation's segments of a flight, the experiment and its
+//! meta-training flights are the `pipeline` crate's.
 //!
 //! Every error is a [`DataError`] whose message is one line naming the file, and where it applies
 //! the row (line number in the file, header = line 1) and column: `file:row:column: message`.
@@ -17,7 +19,6 @@
 mod conditions;
 mod error;
 mod flight_log;
-mod formulation;
 mod noise_floor;
 mod numeric;
 mod source;
@@ -38,7 +39,6 @@ pub use flight_log::{
     FlightLog, FlightMeta, REQUIRED_COLUMNS, RateFrame, quaternion_from_rotation,
     rotation_from_quaternion,
 };
-pub use formulation::{Formulation, Segment};
 pub use noise_floor::{NoiseFloor, forward_difference_noise_floor};
 pub use numeric::NumericTable;
 pub use source::{
@@ -48,7 +48,7 @@ pub use source::{
 pub use split::{Split, SplitSpec};
 pub use stream::{NumericBlock, NumericStream};
 pub use table::ColumnRef;
-pub use tasks::{MAX_TASKS, TaskSource, TaskTable, interval_text, read_tasks};
+pub use tasks::{MAX_TASKS, TaskTable, interval_text, read_column_tasks, read_file_tasks};
 pub use time::{DEFAULT_UNIFORM_TOLERANCE, StreamedTimeAxis, check_time_axis};
 
 /// Re-exported so that downstream crates name the same matrix type.

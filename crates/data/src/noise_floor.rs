@@ -13,10 +13,10 @@
 //!   its variance), from which positively correlated fast motion subtracts, so it is a lower bound
 //!   for white noise (clipped to [0, upper]).
 
+use faer::MatRef;
 use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
-use crate::formulation::Segment;
 use sindy::Derivative;
 
 /// The noise-floor estimates of one segment's forward-difference targets.
@@ -28,14 +28,14 @@ pub struct NoiseFloor {
     pub lower: f64,
 }
 
-/// Estimates the noise floor of the forward-difference targets of `segment`'s states, sampled
-/// every `dt` seconds. The targets of the segment itself are not read: both derivatives are
-/// recomputed from its states.
-pub fn forward_difference_noise_floor(segment: &Segment, dt: f64) -> Result<NoiseFloor> {
-    let (n, dims) = (segment.len(), segment.states.ncols());
+/// Estimates the noise floor of the forward-difference targets of a segment's `states` (one row
+/// per sample, one column per state), sampled every `dt` seconds. Both derivatives are computed
+/// from the states (a segment's own targets are not needed).
+pub fn forward_difference_noise_floor(states: MatRef<'_, f64>, dt: f64) -> Result<NoiseFloor> {
+    let (n, dims) = (states.nrows(), states.ncols());
     let (mut square, mut lagged, mut pairs) = (0.0, 0.0, 0usize);
     for j in 0..dims {
-        let state: Vec<f64> = segment.states.col(j).iter().copied().collect();
+        let state: Vec<f64> = states.col(j).iter().copied().collect();
         let forward = Derivative::Forward.apply(&state, dt)?;
         let smooth = Derivative::SMOOTH.apply(&state, dt)?;
         let residual: Vec<f64> = forward.iter().zip(&smooth).map(|(f, s)| f - s).collect();
@@ -53,11 +53,10 @@ pub fn forward_difference_noise_floor(segment: &Segment, dt: f64) -> Result<Nois
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Formulation;
     use faer::Mat;
 
-    /// A smooth state plus deterministic pseudo-random noise of standard deviation `sigma`.
-    fn segment(sigma: f64) -> Segment {
+    /// Three smooth states plus deterministic pseudo-random noise of standard deviation `sigma`.
+    fn states(sigma: f64) -> Mat<f64> {
         let n = 4000;
         let dt = 0.02;
         let mut seed = 12345u64;
@@ -73,23 +72,15 @@ mod tests {
                 .sum::<f64>()
                 - 6.0
         };
-        let states = Mat::from_fn(n, 3, |i, j| {
+        Mat::from_fn(n, 3, |i, j| {
             (0.5 * i as f64 * dt + j as f64).sin() + sigma * noise()
-        });
-        Segment {
-            formulation: Formulation::Translational,
-            rows: 0..n,
-            time: (0..n).map(|i| i as f64 * dt).collect(),
-            controls: Mat::zeros(n, 3),
-            targets: Mat::zeros(n, 3),
-            states,
-        }
+        })
     }
 
     #[test]
     fn white_noise_lies_between_the_bounds() {
         let (sigma, dt) = (0.01, 0.02);
-        let floor = forward_difference_noise_floor(&segment(sigma), dt).unwrap();
+        let floor = forward_difference_noise_floor(states(sigma).as_ref(), dt).unwrap();
         let exact = 2.0 * sigma * sigma / (dt * dt);
         assert!(floor.lower <= floor.upper);
         assert!(
@@ -100,7 +91,7 @@ mod tests {
             floor.lower > 0.7 * exact && floor.lower < 1.3 * exact,
             "{floor:?} vs {exact}"
         );
-        let quiet = forward_difference_noise_floor(&segment(0.0), dt).unwrap();
+        let quiet = forward_difference_noise_floor(states(0.0).as_ref(), dt).unwrap();
         assert!(quiet.upper < 1e-3 * exact);
     }
 }

@@ -1,12 +1,11 @@
 //! Several recordings of one system, each a task of meta-learning (a robot arm with different
-//! payloads, a vehicle on different surfaces): every CSV file matched by a glob pattern, or the
-//! runs of one CSV that share a value of a task column. Each task is read as `learn sindy` reads
-//! its file ([`NumericTable`]: columns by name, `v[k]` for an element of a list column, a strictly
-//! increasing, uniformly sampled time column), and all tasks must share one sampling interval.
+//! payloads, a vehicle on different surfaces): every CSV file matched by a glob pattern
+//! ([`read_file_tasks`]), or the runs of one CSV that share a value of a task column
+//! ([`read_column_tasks`]). Each task is read as `learn sindy` reads its file ([`NumericTable`]:
+//! columns by name, `v[k]` for an element of a list column, a strictly increasing, uniformly
+//! sampled time column), and all tasks must share one sampling interval.
 
 use std::path::{Path, PathBuf};
-
-use serde::{Deserialize, Serialize};
 
 use crate::error::{DataError, Result};
 use crate::numeric::NumericTable;
@@ -15,18 +14,6 @@ use crate::time::{DEFAULT_UNIFORM_TOLERANCE, check_time_axis_at};
 
 /// The most tasks read at once.
 pub const MAX_TASKS: usize = 10_000;
-
-/// Where the tasks come from. JSON: `{"kind": "files", "pattern": "tasks/*.csv"}` or
-/// `{"kind": "column", "file": "all.csv", "column": "task"}`.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-pub enum TaskSource {
-    /// Every regular file matched by a glob pattern (`*`, `?`, `[…]`, `**`), one task each, in
-    /// sorted path order.
-    Files { pattern: String },
-    /// One CSV file, one task per run of consecutive rows with the same value of `column`.
-    Column { file: PathBuf, column: String },
-}
 
 /// One task: its rows of the time column and of the named columns.
 #[derive(Clone, Debug)]
@@ -54,18 +41,29 @@ impl TaskTable {
     }
 }
 
-/// Reads every task of `source`: the column `time` and `columns` of each. Errors name the file,
-/// row and column: a pattern that matches no file, a task without a named column, a time axis
-/// that is not uniform, tasks sampled at different intervals, a task column whose values return
-/// after another's.
-pub fn read_tasks(source: &TaskSource, time: &str, columns: &[&str]) -> Result<Vec<TaskTable>> {
-    let tasks = match source {
-        TaskSource::Files { pattern } => matched_files(pattern)?
-            .iter()
-            .map(|path| read_file_task(path, time, columns))
-            .collect::<Result<Vec<_>>>()?,
-        TaskSource::Column { file, column } => read_column_tasks(file, column, time, columns)?,
-    };
+/// Reads one task per regular file matched by the glob `pattern` (`*`, `?`, `[…]`, `**`), in
+/// sorted path order: the column `time` and `columns` of each. Errors name the file, row and
+/// column: a pattern that matches no file, a task without a named column, a time axis that is not
+/// uniform, tasks sampled at different intervals.
+pub fn read_file_tasks(pattern: &str, time: &str, columns: &[&str]) -> Result<Vec<TaskTable>> {
+    let tasks = matched_files(pattern)?
+        .iter()
+        .map(|path| read_file_task(path, time, columns))
+        .collect::<Result<Vec<_>>>()?;
+    check_common_interval(&tasks, time)?;
+    Ok(tasks)
+}
+
+/// Reads one task per run of consecutive rows of the CSV at `path` with the same value of the
+/// column `column`: the column `time` and `columns` of each. Errors name the file, row and
+/// column: as [`read_file_tasks`], and a task column whose values return after another's.
+pub fn read_column_tasks(
+    path: &Path,
+    column: &str,
+    time: &str,
+    columns: &[&str],
+) -> Result<Vec<TaskTable>> {
+    let tasks = read_task_runs(path, column, time, columns)?;
     check_common_interval(&tasks, time)?;
     Ok(tasks)
 }
@@ -116,7 +114,7 @@ fn read_file_task(path: &Path, time: &str, columns: &[&str]) -> Result<TaskTable
 }
 
 /// The tasks of one file split by the value of `column`: each a run of consecutive rows.
-fn read_column_tasks(
+fn read_task_runs(
     path: &Path,
     column: &str,
     time: &str,
@@ -253,7 +251,7 @@ mod tests {
         write(&dir, "a.csv", "t,v,u\n0,\"[0, 1]\",1\n0.1,\"[0, 2]\",1\n");
         write(&dir, "notes.txt", "not a task");
         let pattern = format!("{}/*.csv", dir.display());
-        let tasks = read_tasks(&TaskSource::Files { pattern }, "t", &["v[1]", "u"]).unwrap();
+        let tasks = read_file_tasks(&pattern, "t", &["v[1]", "u"]).unwrap();
         let names: Vec<&str> = tasks.iter().map(|t| t.name.as_str()).collect();
         assert_eq!(names, ["a.csv", "b.csv"]);
         assert_eq!(
@@ -268,18 +266,23 @@ mod tests {
         let scratch_dir = scratch("bad");
         let dir = scratch_dir.path().to_path_buf();
         let pattern = format!("{}/*.csv", dir.display());
-        let source = TaskSource::Files { pattern };
-        let message = read_tasks(&source, "t", &["x"]).unwrap_err().to_string();
+        let message = read_file_tasks(&pattern, "t", &["x"])
+            .unwrap_err()
+            .to_string();
         assert!(message.contains("matches no file"), "{message}");
         write(&dir, "a.csv", "t,x\n0,1\n0.1,2\n0.2,3\n");
         write(&dir, "b.csv", "t,x\n0,1\n0.2,2\n0.4,3\n");
-        let message = read_tasks(&source, "t", &["x"]).unwrap_err().to_string();
+        let message = read_file_tasks(&pattern, "t", &["x"])
+            .unwrap_err()
+            .to_string();
         assert!(
             message.contains("b.csv") && message.contains("a.csv"),
             "{message}"
         );
         write(&dir, "b.csv", "t,y\n0,1\n0.1,2\n");
-        let message = read_tasks(&source, "t", &["x"]).unwrap_err().to_string();
+        let message = read_file_tasks(&pattern, "t", &["x"])
+            .unwrap_err()
+            .to_string();
         assert!(message.contains("b.csv: missing column 'x'"), "{message}");
     }
 
@@ -292,11 +295,7 @@ mod tests {
             "all.csv",
             "task,t,x\nslow,0,1\nslow,0.1,2\nfast,5,3\nfast,5.1,4\nfast,5.2,5\n",
         );
-        let source = TaskSource::Column {
-            file: file.clone(),
-            column: "task".to_string(),
-        };
-        let tasks = read_tasks(&source, "t", &["x"]).unwrap();
+        let tasks = read_column_tasks(&file, "task", "t", &["x"]).unwrap();
         assert_eq!(tasks.len(), 2);
         assert_eq!(tasks[1].name, "all.csv[task=fast]");
         assert_eq!(tasks[1].table.columns[0], vec![3.0, 4.0, 5.0]);
@@ -306,7 +305,9 @@ mod tests {
             "all.csv",
             "task,t,x\na,0,1\na,0.1,2\nb,0,3\nb,0.1,3\na,0.2,4\n",
         );
-        let message = read_tasks(&source, "t", &["x"]).unwrap_err().to_string();
+        let message = read_column_tasks(&file, "task", "t", &["x"])
+            .unwrap_err()
+            .to_string();
         assert!(message.contains("all.csv:6:task"), "{message}");
         assert!(message.contains("consecutive"), "{message}");
     }

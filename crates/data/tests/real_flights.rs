@@ -2,8 +2,7 @@
 
 mod common;
 
-use data::{ExperimentConditions, FlightLog, Formulation, RateFrame, SplitSpec};
-use sindy::Derivative;
+use data::{ExperimentConditions, FlightLog, RateFrame};
 
 #[test]
 fn all_thirty_shared_flights_load() {
@@ -90,30 +89,4 @@ fn recorded_rate_matches_the_world_frame() {
     let log = FlightLog::read(&dir.join("experiment/custom_figure8_baseline_35wind.csv")).unwrap();
     let (frame, body, world) = log.rate_frame();
     assert_eq!(frame, RateFrame::World, "body {body} world {world}");
-}
-
-#[test]
-fn formulations_build_paper_segments() {
-    let Some(dir) = common::real_data_dir() else {
-        return;
-    };
-    let log = FlightLog::read(&dir.join("experiment/custom_figure8_baseline_35wind.csv")).unwrap();
-    let split = SplitSpec::Halves.split(log.len()).unwrap();
-    assert_eq!(split.support, 0..1255);
-    let segment = Formulation::Full
-        .segment(&log, split.query.clone(), Derivative::Forward)
-        .unwrap();
-    assert_eq!(segment.len(), 1256);
-    assert_eq!(segment.inputs().ncols(), 10);
-    let k = split.query.start;
-    let n1 = log.motor_command[k][0] / 1000.0;
-    assert!((segment.controls[(0, 0)] - n1 * n1).abs() < 1e-15);
-    // target = forward difference on the segment alone
-    let expected = (log.velocity[k + 1][0] - log.velocity[k][0]) / log.sample_interval();
-    assert!((segment.targets[(0, 0)] - expected).abs() < 1e-9);
-    let translational = Formulation::Translational
-        .segment(&log, split.support, Derivative::Forward)
-        .unwrap();
-    let thrust_z = log.rotation[0][2][2] * log.thrust_setpoint[0];
-    assert!((translational.controls[(0, 2)] - thrust_z).abs() < 1e-15);
 }

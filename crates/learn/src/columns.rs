@@ -1,11 +1,10 @@
 //! What a model of CSV tasks reads and was meta-trained on ([`ColumnTraining`], the checkpoint's
-//! `trained_on`), and its settings: the paper's values as defaults ([`LearnConfig::task_defaults`]),
-//! any of them overridden by a configuration file that names only what it changes
-//! ([`TaskConfig::load`]).
+//! `trained_on`, with where its tasks came from: [`TaskSource`]), and its settings: the paper's
+//! values as defaults ([`LearnConfig::task_defaults`]), any of them overridden by a configuration
+//! file that names only what it changes ([`TaskConfig::load`]).
 
 use std::path::{Path, PathBuf};
 
-use data::TaskSource;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use sindy::Derivative;
@@ -75,6 +74,19 @@ impl ColumnSpec {
             .validate()
             .map_err(|error| error.to_string())
     }
+}
+
+/// Where the tasks of a model of CSV tasks come from, as its checkpoint records it (reading them
+/// is the pipeline's). JSON: `{"kind": "files", "pattern": "tasks/*.csv"}` or
+/// `{"kind": "column", "file": "all.csv", "column": "task"}`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum TaskSource {
+    /// Every regular file matched by a glob pattern (`*`, `?`, `[…]`, `**`), one task each, in
+    /// sorted path order.
+    Files { pattern: String },
+    /// One CSV file, one task per run of consecutive rows with the same value of `column`.
+    Column { file: PathBuf, column: String },
 }
 
 /// One meta-training task of a model: its name and number of rows.

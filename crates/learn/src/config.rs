@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use data::Formulation;
+use crate::formulation::Formulation;
 
 use crate::error::{LearnError, Result};
 use crate::maml::MetaOrder;
@@ -224,7 +224,7 @@ impl LearnConfig {
         let parameters = Formulation::ALL
             .iter()
             .map(|&formulation| {
-                crate::experiment::architecture(formulation, &self).parameter_count()
+                crate::formulation::architecture(formulation, &self).parameter_count()
             })
             .max()
             .unwrap_or(0);

@@ -6,8 +6,6 @@ use std::path::PathBuf;
 /// Each variant renders as one line naming the file, field or condition involved.
 #[derive(Debug, thiserror::Error)]
 pub enum LearnError {
-    #[error(transparent)]
-    Data(#[from] data::DataError),
     /// A derivative estimator misconfigured or given too few samples.
     #[error(transparent)]
     Differentiation(#[from] sindy::DifferentiationError),
@@ -25,26 +23,8 @@ pub enum LearnError {
     },
     #[error("{}: not a LeARN checkpoint: {message}", path.display())]
     Checkpoint { path: PathBuf, message: String },
-    #[error(
-        "protocol '{protocol}': no meta-training flight for evaluation condition '{condition}' ({detail})"
-    )]
-    NoTrainingFlights {
-        protocol: String,
-        condition: String,
-        detail: String,
-    },
-    /// A condition asked for as a table row (evaluated, the held-out fold) that is only used to
-    /// meta-train.
-    #[error(
-        "condition '{condition}' is not an evaluation condition (its role is {role}); the evaluation conditions are: {evaluation}"
-    )]
-    NotEvaluationCondition {
-        condition: String,
-        role: String,
-        evaluation: String,
-    },
-    #[error("unknown protocol '{name}' (known: paper, leave-condition-out, auto)")]
-    UnknownProtocol { name: String },
+    #[error("unknown formulation '{name}' (known: translational, attitude, full)")]
+    UnknownFormulation { name: String },
     #[error("{what}: {message}")]
     Mismatch { what: String, message: String },
     #[error(
@@ -55,13 +35,9 @@ pub enum LearnError {
     /// non-finite number: reported instead of printing NaN.
     #[error("{cell}: {message}")]
     NotFinite { cell: String, message: String },
-    /// A CSV task or recording that cannot serve LeARN (too few rows, another sampling
-    /// interval), named by its file.
+    /// A task or recording that cannot serve LeARN (e.g. too few rows), named by its file.
     #[error("{}: {message}", path.display())]
     Task { path: PathBuf, message: String },
-    /// A flight that cannot serve LeARN (e.g. too short to split), named by its file.
-    #[error("{}: {message}", path.display())]
-    Flight { path: PathBuf, message: String },
 }
 
 /// Result with a [`LearnError`].

@@ -8,7 +8,7 @@
 //! most `max_terms`), each with its signed mean coefficient. As the paper says, this identifies
 //! dominant inputs; it is not a closed form of m_p, which takes the whole X.
 
-use data::Formulation;
+use crate::formulation::Formulation;
 use serde::{Deserialize, Serialize};
 
 use crate::network::Architecture;

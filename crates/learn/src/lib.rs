@@ -1,48 +1,56 @@
 //! LeARN: learnable and adaptive representations for nonlinear dynamics.
 //!
-//! What it is for: the paper's model y = Θ(X; ψ)·ℰ(X; φ)ᵀ (two GELU networks, [`Architecture`]),
-//! meta-trained with MAML (exact second order by default, [`meta_train`]), adapted online on a new
-//! flight with the Lipschitz regulariser ([`adapt_online`]), explained through ℰ ([`explain`]), and
-//! the experiment behind the paper's LeARN columns ([`Experiment`]), and the same model on any
-//! multi-task CSV set ([`meta_train_tasks`], [`evaluate_recording`], [`explain_recording`]).
+//! What it is for — the method, on data in memory: the paper's model y = Θ(X; ψ)·ℰ(X; φ)ᵀ (two
+//! GELU networks, [`Architecture`]), meta-trained with MAML on tasks of regression data
+//! (exact second order by default, [`meta_train`] on [`TaskData`]), adapted online with the
+//! Lipschitz regulariser ([`adapt_online`], [`MetaTrainedModel::adapt_on`]), explained through ℰ
+//! ([`explain`]); input standardisation ([`Standardiser`]); the model file (the JSON checkpoint,
+//! [`MetaTrainedModel`]), which names the [`Formulation`] of a flight model or the columns of a
+//! model of CSV tasks ([`ColumnTraining`]); and the same model on any multi-task set of
+//! recordings in memory ([`meta_train_tasks`], [`evaluate_recording`], [`explain_recording`] on
+//! [`Recording`]s).
 //!
-//! What it is not for: reading flight files (the `data` crate), estimating derivatives
+//! What it is not for: reading anything but its own configuration and checkpoints — flight logs,
+//! CSV files and file hashes are the `data` crate's, and the paper's protocol is the `pipeline`
+//! crate's (the experiment: which flights meta-train the model for an evaluation condition, how a
+//! flight is cut into support and query segments and a formulation's columns built from its log,
+//! the evaluation, the seed spread; reading CSV tasks). Nor estimating derivatives
 //! (`sindy::differentiation`), SINDy (`sindy`), tables and figures (`report`), the command line
-//! (`cli`).
+//! (`cli`). A test (`tests/layering.rs`) keeps `data`, CSV readers and data frames out of its
+//! dependencies.
 //!
 //! # Public API
 //!
 //! - [`LearnConfig::load`] reads `experiments/learn.json` into a [`CheckedConfig`] (all
 //!   hyper-parameters: α, β, n, μ, batches, iterations, λ, L, P, adaptation passes, seeds).
-//! - [`Experiment::load`] resolves the [`Protocol`] (`paper` when its flights are present, else
-//!   `leave-condition-out`) and reads every flight it needs once. Then, for one formulation and one
-//!   evaluation condition: [`Experiment::meta_train`] → [`MetaTrainedModel`] (the JSON checkpoint:
-//!   weights, configuration, seed, protocol, SHA-256 of the data files), and
-//!   [`Experiment::evaluate`] → [`CellResult`] (adaptation MSE, generalisation MSE, predictions on
-//!   both segments, adapted θ); [`Experiment::run_cell`] does both; [`Experiment::run_cells`] runs a
-//!   set of cells in parallel (rayon), [`Experiment::seed_spread`] repeats them over seeds. Both
-//!   enumerate their work as [`WorkItem`]s ([`Experiment::work_items`]: one meta-training and the
-//!   cells it serves) and run each with [`Experiment::run_item`], as a sharded sweep does.
-//! - CSV tasks: [`read_column_tasks`] reads the tasks of a [`data::TaskSource`] with the columns
-//!   of a [`ColumnSpec`]; [`TaskConfig::load`] gives the settings (the paper's by default, any
-//!   subset overridden by a file); [`meta_train_tasks`] → [`MetaTrainedModel`] whose
-//!   [`TrainedOn::Columns`] records the columns, derivative, sampling interval, target scales and
-//!   tasks; [`evaluate_recording`] adapts it on support rows of a new recording and scores the query
-//!   rows ([`RecordingEvaluation`]); [`explain_recording`]. See `docs/own-data.md`.
+//! - Flight models: [`architecture`] gives the networks of a [`Formulation`]; a caller (the
+//!   pipeline's experiment) standardises the meta-training tasks ([`Standardiser::fit`],
+//!   [`InputRange::spanned`]), checks its batch sizes against them ([`check_sampling`]),
+//!   meta-trains ([`meta_train`]) and records a [`MetaTrainedModel`] with
+//!   [`TrainedOn::Flights`] (formulation, protocol name, held-out condition); the model adapts on
+//!   raw inputs and targets ([`MetaTrainedModel::adapt_on`]) and predicts
+//!   ([`MetaTrainedModel::predict_with`]); [`Standardiser::coverage_with_errors`] tells how much of
+//!   a segment lies outside the meta-training inputs.
+//! - Multi-task sets: [`TaskConfig::load`] gives the settings (the paper's by default, any subset
+//!   overridden by a file); [`meta_train_tasks`] on a [`TaskSet`] of [`Recording`]s →
+//!   [`MetaTrainedModel`] whose [`TrainedOn::Columns`] records the columns, derivative, sampling
+//!   interval, target scales, tasks and their [`TaskSource`]; [`evaluate_recording`] adapts it on
+//!   support rows of a new recording and scores the query rows ([`RecordingEvaluation`]);
+//!   [`explain_recording`]. See `docs/own-data.md`.
 //! - Building blocks: [`Architecture`] (forward, gradient, prediction), [`meta_gradient`]
 //!   ([`meta_gradient_in`] with reusable [`MetaWorkspace`] buffers, [`meta_gradients_into`] for a
 //!   batch of tasks in parallel into reused results), [`hessian_vector_product`],
 //!   [`inner_updates`], [`meta_train`], [`adapt_online`], [`explain`]; [`ModelWorkspace`] for
-//!   repeated passes; `reference_*` for the generic reference implementation.
+//!   repeated passes; `reference_*` for the generic reference implementation;
+//!   [`variants::learned_features`] for the networks as a feature library.
 //!
 //! # Definitions
 //!
-//! Split, inputs and targets are those of the SINDy columns: support = first half of the flight,
-//! query = second half ([`data::SplitSpec::Halves`]), targets the forward difference of the state on
-//! each segment ([`sindy::Derivative::Forward`]). **Adaptation MSE**: the model adapted online on the
-//! support segment, evaluated on that segment; **generalisation MSE**: the same model, frozen, on the
-//! query segment. MSE = mean over all samples and all output dimensions. Inputs are z-scored with
-//! the meta-training statistics (stored in the checkpoint).
+//! **Adaptation MSE**: the model adapted online on the support data, evaluated on that data;
+//! **generalisation MSE**: the same model, frozen, on the query data. MSE = mean over all samples
+//! and all output dimensions ([`mean_squared_error`]). Inputs are z-scored with the meta-training
+//! statistics (stored in the checkpoint). How the paper cuts a flight into support and query
+//! segments and estimates their targets is the pipeline's (`docs/protocol.md`).
 //!
 //! # Derivatives and speed
 //!
@@ -69,40 +77,32 @@ mod averaging;
 mod batched;
 mod columns;
 mod config;
-mod dataset;
 mod error;
-mod experiment;
 mod explain;
+mod formulation;
 mod kernels;
 mod maml;
 mod model;
 mod network;
 mod scalar;
+mod standardiser;
 mod tasks;
 mod train;
 pub mod variants;
-mod work;
 
 pub use adapt::adapt_online;
 pub use batched::ModelWorkspace;
-pub use columns::{ColumnSpec, ColumnTraining, TaskConfig, TaskRows};
+pub use columns::{ColumnSpec, ColumnTraining, TaskConfig, TaskRows, TaskSource};
 pub use config::{
     AdaptationConfig, CheckedConfig, LearnConfig, MetaTrainingConfig, Optimizer, TaskGrouping,
     limits,
 };
-pub use dataset::{
-    InputCoverage, InputRange, Protocol, RangeCoverage, Standardiser, flight_segments,
-    from_row_major, row_major, segment_batch,
-};
 pub use error::{LearnError, Result};
-pub use experiment::{
-    CellResult, CellSummary, Experiment, SegmentPrediction, ValidationDetail, architecture,
-    evaluation_condition_of, explain_flight,
-};
 pub use explain::{
     EquationRule, Explanation, InputImportance, ModelNames, OutputExplanation, Term, explain,
     explain_named, output_symbol,
 };
+pub use formulation::{Formulation, architecture};
 pub use maml::{
     Batch, InnerLoop, MetaGradient, MetaOrder, MetaWorkspace, Task, hessian_vector_product,
     inner_updates, meta_gradient, meta_gradient_in, meta_gradient_into, meta_gradients,
@@ -111,9 +111,13 @@ pub use maml::{
 pub use model::{CHECKPOINT_FORMAT, DataFile, FlightTraining, MetaTrainedModel, TrainedOn};
 pub use network::{Architecture, PAPER_HIDDEN, mean_squared_error};
 pub use scalar::{Dual, Scalar, gelu, gelu_derivative, gelu_second_derivative};
-pub use tasks::{
-    RecordingEvaluation, TaskSet, column_training, evaluate_recording, explain_recording,
-    meta_train_tasks, read_column_tasks, read_recording, segment_data,
+pub use standardiser::{
+    InputCoverage, InputRange, RangeCoverage, Standardiser, from_row_major, row_major,
 };
-pub use train::{MetaTrainingOutcome, TaskData, meta_train, meta_train_from, meta_train_observed};
-pub use work::{Cells, Spread, SpreadCell, WorkItem, spread_cells};
+pub use tasks::{
+    Recording, RecordingEvaluation, TaskSet, column_training, evaluate_recording,
+    explain_recording, meta_train_tasks, segment_data,
+};
+pub use train::{
+    MetaTrainingOutcome, TaskData, check_sampling, meta_train, meta_train_from, meta_train_observed,
+};

@@ -37,7 +37,7 @@ pub struct Batch {
 
 impl Batch {
     /// Appends `other`'s rows (same input and output widths) after this batch's.
-    pub(crate) fn append(&mut self, other: Batch) {
+    pub fn append(&mut self, other: Batch) {
         self.inputs.extend(other.inputs);
         self.targets.extend(other.targets);
     }

@@ -2,15 +2,15 @@
 
 use std::path::{Path, PathBuf};
 
-use data::{Formulation, Segment};
 use serde::{Deserialize, Serialize};
 
 use crate::adapt::adapt_online;
 use crate::columns::ColumnTraining;
 use crate::config::{AdaptationConfig, LearnConfig};
-use crate::dataset::{Protocol, Standardiser, row_major, segment_batch};
 use crate::error::{LearnError, Result};
+use crate::formulation::Formulation;
 use crate::network::Architecture;
+use crate::standardiser::Standardiser;
 
 /// The format tag written into every checkpoint.
 pub const CHECKPOINT_FORMAT: &str = "learn-checkpoint/1";
@@ -60,7 +60,9 @@ pub enum TrainedOn {
 #[derive(Clone, Debug, PartialEq)]
 pub struct FlightTraining {
     pub formulation: Formulation,
-    pub protocol: Protocol,
+    /// The name of the protocol that chose the meta-training flights (`paper` or
+    /// `leave-condition-out`: the pipeline's protocols; to this crate only a record).
+    pub protocol: String,
     /// The evaluation condition left out of meta-training (`leave-condition-out`), if any.
     pub held_out_condition: Option<String>,
 }
@@ -73,7 +75,7 @@ struct CheckpointFields {
     #[serde(default)]
     formulation: Option<Formulation>,
     #[serde(default)]
-    protocol: Option<Protocol>,
+    protocol: Option<String>,
     #[serde(default)]
     held_out_condition: Option<String>,
     #[serde(default)]
@@ -138,7 +140,7 @@ impl<'de> Deserialize<'de> for MetaTrainedModel {
 struct FlightCheckpoint<'a> {
     format: &'a str,
     formulation: Formulation,
-    protocol: Protocol,
+    protocol: &'a str,
     held_out_condition: &'a Option<String>,
     #[serde(flatten)]
     rest: CheckpointBody<'a>,
@@ -183,7 +185,7 @@ impl Serialize for MetaTrainedModel {
             TrainedOn::Flights(flights) => FlightCheckpoint {
                 format: &self.format,
                 formulation: flights.formulation,
-                protocol: flights.protocol,
+                protocol: &flights.protocol,
                 held_out_condition: &flights.held_out_condition,
                 rest,
             }
@@ -326,18 +328,6 @@ impl MetaTrainedModel {
             &self.scaled_targets(targets),
             adaptation,
         )
-    }
-
-    /// θ adapted online on `support` (a flight segment), see [`Self::adapt_on`].
-    pub fn adapt(&self, support: &Segment, adaptation: &AdaptationConfig) -> Vec<f64> {
-        let batch = segment_batch(support);
-        self.adapt_on(&batch.inputs, &batch.targets, adaptation)
-    }
-
-    /// Predictions (samples × I, row-major) of the networks with `parameters` (e.g. adapted by
-    /// [`Self::adapt`]) on every sample of `segment`.
-    pub fn predict_segment(&self, parameters: &[f64], segment: &Segment) -> Vec<f64> {
-        self.predict_with(parameters, &row_major(&segment.inputs()))
     }
 
     /// Writes the checkpoint as JSON, creating parent directories.

@@ -1,6 +1,9 @@
-//! LeARN on any multi-task CSV set: meta-training on recordings of one system under different
+//! LeARN on any multi-task set: meta-training on recordings of one system under different
 //! conditions ([`meta_train_tasks`]), online adaptation on rows of a new recording and prediction of
-//! others ([`evaluate_recording`]), explanation over a recording ([`explain_recording`]).
+//! others ([`evaluate_recording`]), explanation over a recording ([`explain_recording`]). The
+//! recordings are in memory ([`Recording`]: named columns, one sampling interval); reading them
+//! from CSV files, and checking a recording's sampling interval against a model's, is the
+//! pipeline's (`pipeline::own_data`).
 //!
 //! The same model and algorithms as the paper's: inputs X = [x, u] (the state then control
 //! columns), outputs ẋ, the architecture of the paper's rule (I + U inputs, P·(I+U) basis
@@ -13,44 +16,51 @@
 //! tasks (`trained_on.target_scale`), so that the paper's steps suit data in any units.
 
 use std::ops::Range;
+use std::path::Path;
 
-use data::{DEFAULT_UNIFORM_TOLERANCE, TaskSource, TaskTable};
-
-use crate::columns::{ColumnSpec, ColumnTraining, TaskConfig, TaskRows};
+use crate::columns::{ColumnSpec, ColumnTraining, TaskConfig, TaskRows, TaskSource};
 use crate::config::{TaskGrouping, limits};
-use crate::dataset::{InputRange, Standardiser};
 use crate::error::{LearnError, Result};
 use crate::explain::{EquationRule, Explanation, ModelNames, explain_named};
 use crate::maml::Batch;
 use crate::model::{CHECKPOINT_FORMAT, DataFile, MetaTrainedModel, TrainedOn};
 use crate::network::mean_squared_error;
+use crate::standardiser::{InputRange, Standardiser};
 use crate::train::{TaskData, check_sampling, meta_train_observed};
 
-/// Reads the tasks of `source` with the columns of `spec` (in its order: states, then controls).
-pub fn read_column_tasks(source: &TaskSource, spec: &ColumnSpec) -> Result<Vec<TaskTable>> {
-    let names = spec.input_names();
-    let columns: Vec<&str> = names.iter().map(String::as_str).collect();
-    Ok(data::read_tasks(source, &spec.time, &columns)?)
+/// One recording (a task, or a new recording to adapt on) in memory: the columns of a
+/// [`ColumnSpec`] in its order (the states, then the controls), one value per row, uniformly
+/// sampled.
+#[derive(Clone, Copy, Debug)]
+pub struct Recording<'a> {
+    /// The task's name: a file name, or `file[column=value]` for a run of a task column.
+    pub name: &'a str,
+    /// The file it was read from (named in errors).
+    pub path: &'a Path,
+    /// One column per state, then per control, each one value per row.
+    pub columns: &'a [Vec<f64>],
+    /// The sampling interval, seconds.
+    pub interval: f64,
 }
 
-/// Reads one recording with the columns of `spec`.
-pub fn read_recording(path: &std::path::Path, spec: &ColumnSpec) -> Result<TaskTable> {
-    let names = spec.input_names();
-    let columns: Vec<&str> = names.iter().map(String::as_str).collect();
-    Ok(TaskTable::read(path, &spec.time, &columns)?)
+impl Recording<'_> {
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.columns.first().map_or(0, Vec::len)
+    }
 }
 
-/// Raw inputs X = [x, u] (row-major) and targets ẋ of rows `rows` of `recording` (read with the
+/// Raw inputs X = [x, u] (row-major) and targets ẋ of rows `rows` of `recording` (holding the
 /// columns of `spec`), the targets estimated with `spec.derivative` on those rows alone.
 /// `what` names the rows in errors (e.g. `support rows 0:100`).
 pub fn segment_data(
-    recording: &TaskTable,
+    recording: Recording<'_>,
     spec: &ColumnSpec,
     rows: Range<usize>,
     what: &str,
 ) -> Result<Batch> {
     let fail = |message: String| LearnError::Task {
-        path: recording.path.clone(),
+        path: recording.path.to_path_buf(),
         message: format!("{what}: {message}"),
     };
     let available = recording.rows();
@@ -68,7 +78,7 @@ pub fn segment_data(
             spec.derivative
         )));
     }
-    let columns = &recording.table.columns;
+    let columns = recording.columns;
     let dim = columns.len();
     let mut inputs = Vec::with_capacity(rows.len() * dim);
     for row in rows.clone() {
@@ -97,12 +107,12 @@ pub fn segment_data(
 }
 
 /// The support (first ⌊n/2⌋ rows) and query (the rest) data of a meta-training task.
-fn task_halves(task: &TaskTable, spec: &ColumnSpec) -> Result<(Batch, Batch)> {
+fn task_halves(task: Recording<'_>, spec: &ColumnSpec) -> Result<(Batch, Batch)> {
     let n = task.rows();
     let needed = spec.derivative.min_samples().max(2);
     if n / 2 < needed {
         return Err(LearnError::Task {
-            path: task.path.clone(),
+            path: task.path.to_path_buf(),
             message: format!(
                 "task '{}' has {n} data rows: meta-training cuts each task into a support and a query half of at least {needed} rows each (the {} derivative), so at least {} rows are needed",
                 task.name,
@@ -130,7 +140,8 @@ fn column_scale<'a>(batches: impl Iterator<Item = &'a [f64]> + Clone, dim: usize
 pub struct TaskSet<'a> {
     pub source: &'a TaskSource,
     pub spec: &'a ColumnSpec,
-    pub tasks: &'a [TaskTable],
+    /// The tasks, each with the columns of `spec`, all sampled at one interval.
+    pub tasks: &'a [Recording<'a>],
     /// The files read, with their SHA-256, recorded in the model.
     pub files: Vec<DataFile>,
 }
@@ -167,7 +178,7 @@ pub fn meta_train_tasks(
     let raw: Vec<(Batch, Batch)> = set
         .tasks
         .iter()
-        .map(|task| task_halves(task, set.spec))
+        .map(|&task| task_halves(task, set.spec))
         .collect::<Result<_>>()?;
     let mut model = untrained_model(&set, config, &raw)?;
     let task_data: Vec<TaskData> = set
@@ -175,7 +186,7 @@ pub fn meta_train_tasks(
         .iter()
         .zip(raw)
         .map(|(task, (support, query))| TaskData {
-            name: task.name.clone(),
+            name: task.name.to_string(),
             support: model_batch(&model, support),
             query: model_batch(&model, query),
         })
@@ -263,7 +274,7 @@ fn untrained_model(
         tasks: tasks
             .iter()
             .map(|t| TaskRows {
-                name: t.name.clone(),
+                name: t.name.to_string(),
                 rows: t.rows(),
             })
             .collect(),
@@ -324,18 +335,17 @@ pub fn column_training<'a>(model: &'a MetaTrainedModel, what: &str) -> Result<&'
     }
 }
 
-/// Adapts `model` online on `support` rows of `recording` (read with the model's columns), in
-/// time order with the model's adaptation settings, and scores it there and, frozen, on `query`
-/// rows. Errors name the file: another sampling interval than the model's tasks, rows outside the
-/// recording or too few for the derivative or the adaptation window, non-finite results.
+/// Adapts `model` online on `support` rows of `recording` (holding the model's columns, sampled at
+/// the interval of its tasks), in time order with the model's adaptation settings, and scores it
+/// there and, frozen, on `query` rows. Errors name the file: rows outside the recording or too few
+/// for the derivative or the adaptation window, non-finite results.
 pub fn evaluate_recording(
     model: &MetaTrainedModel,
-    recording: &TaskTable,
+    recording: Recording<'_>,
     support: Range<usize>,
     query: Range<usize>,
 ) -> Result<RecordingEvaluation> {
     let columns = column_training(model, "evaluation")?;
-    check_interval(columns, recording)?;
     let spec = columns.spec();
     let support_data = segment_data(
         recording,
@@ -352,7 +362,7 @@ pub fn evaluate_recording(
     let adaptation = &model.config.adaptation;
     if adaptation.window > support.len() {
         return Err(LearnError::Task {
-            path: recording.path.clone(),
+            path: recording.path.to_path_buf(),
             message: format!(
                 "support rows {}:{}: {} rows, fewer than the model's adaptation.window {}",
                 support.start,
@@ -397,29 +407,12 @@ pub fn evaluate_recording(
     Ok(evaluation)
 }
 
-/// The recording is sampled at the interval of the model's tasks.
-fn check_interval(columns: &ColumnTraining, recording: &TaskTable) -> Result<()> {
-    let reference = columns.sampling_interval;
-    if (recording.interval - reference).abs() > DEFAULT_UNIFORM_TOLERANCE * reference {
-        return Err(LearnError::Task {
-            path: recording.path.clone(),
-            message: format!(
-                "column '{}' is sampled every {} s, the model's tasks every {} s: resample the recording",
-                columns.time,
-                data::interval_text(recording.interval),
-                data::interval_text(reference)
-            ),
-        });
-    }
-    Ok(())
-}
-
 /// Explains a model of CSV tasks over every row of `recording`: first adapted online on `support`
 /// rows when given (the paper's explanation of an adapted model), then [`explain_named`] with the
 /// coefficients in the units of the targets.
 pub fn explain_recording(
     model: &MetaTrainedModel,
-    recording: &TaskTable,
+    recording: Recording<'_>,
     support: Option<Range<usize>>,
     rule: EquationRule,
 ) -> Result<Explanation> {
@@ -428,10 +421,10 @@ pub fn explain_recording(
         Some(rows) => evaluate_recording(model, recording, rows.clone(), rows)?.adapted_parameters,
         None => model.parameters.clone(),
     };
-    let dim = recording.table.columns.len();
+    let dim = recording.columns.len();
     let mut raw = Vec::with_capacity(recording.rows() * dim);
     for row in 0..recording.rows() {
-        raw.extend(recording.table.columns.iter().map(|column| column[row]));
+        raw.extend(recording.columns.iter().map(|column| column[row]));
     }
     let names = ModelNames {
         inputs: columns.input_names(),

@@ -149,7 +149,7 @@ impl TaskSampler {
 /// (they are drawn without replacement within a batch), and a task's support or query batch is no
 /// larger than the segment it is drawn from (with replacement: a larger batch holds no sample the
 /// segment does not, only repeats). `Err((field, message))` names the offending setting.
-pub(crate) fn check_sampling(
+pub fn check_sampling(
     config: &MetaTrainingConfig,
     tasks: &[TaskData],
     input_dim: usize,

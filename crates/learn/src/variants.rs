@@ -10,12 +10,11 @@
 //!   network's prediction of output i (names `{output}:m{p}[{input}]`), so c_ik = 1 reproduces the
 //!   meta-trained model.
 
-use data::Segment;
 use faer::Mat;
 use serde::{Deserialize, Serialize};
 
-use crate::dataset::row_major;
 use crate::model::MetaTrainedModel;
+use crate::standardiser::row_major;
 
 /// Which network outputs become features.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -25,17 +24,18 @@ pub enum LearnedFeatures {
     Terms,
 }
 
-/// The learned features of every sample of `segment` (one row per sample) and their names.
+/// The learned features of every sample of raw `inputs` X = [x, u] (one row per sample, as the
+/// model's inputs), one row per sample, and their names.
 pub fn learned_features(
     model: &MetaTrainedModel,
-    segment: &Segment,
+    inputs: &Mat<f64>,
     features: LearnedFeatures,
 ) -> (Mat<f64>, Vec<String>) {
     let architecture = &model.architecture;
-    let inputs = model.standardiser.apply(&row_major(&segment.inputs()));
-    let (library, selection) = architecture.library_and_selection(&model.parameters, &inputs);
+    let standardised = model.standardiser.apply(&row_major(inputs));
+    let (library, selection) = architecture.library_and_selection(&model.parameters, &standardised);
     let (n, k, states) = (
-        segment.len(),
+        inputs.nrows(),
         architecture.basis_count(),
         architecture.state_dim,
     );
@@ -69,9 +69,9 @@ pub fn learned_features(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dataset::Standardiser;
+    use crate::formulation::Formulation;
     use crate::network::Architecture;
-    use data::Formulation;
+    use crate::standardiser::Standardiser;
 
     #[test]
     fn terms_sum_to_the_network_prediction() {
@@ -84,19 +84,19 @@ mod tests {
         };
         let parameters = architecture.initial_parameters(3);
         let n = 9;
-        let segment = Segment {
-            formulation,
-            rows: 0..n,
-            time: (0..n).map(|i| i as f64 * 0.02).collect(),
-            states: Mat::from_fn(n, 3, |i, j| (i as f64 * 0.3 + j as f64).sin()),
-            controls: Mat::from_fn(n, 4, |i, j| 1.0 + 0.1 * (i as f64 - j as f64).cos()),
-            targets: Mat::zeros(n, 3),
-        };
+        // Three states, then four controls.
+        let inputs = Mat::from_fn(n, 7, |i, j| {
+            if j < 3 {
+                (i as f64 * 0.3 + j as f64).sin()
+            } else {
+                1.0 + 0.1 * (i as f64 - (j - 3) as f64).cos()
+            }
+        });
         let model = MetaTrainedModel {
             format: crate::model::CHECKPOINT_FORMAT.to_string(),
             trained_on: crate::model::TrainedOn::Flights(crate::model::FlightTraining {
                 formulation,
-                protocol: crate::dataset::Protocol::LeaveConditionOut,
+                protocol: "leave-condition-out".to_string(),
                 held_out_condition: None,
             }),
             seed: 3,
@@ -107,17 +107,17 @@ mod tests {
             data_files: Vec::new(),
             meta_loss_history: Vec::new(),
         };
-        let (terms, names) = learned_features(&model, &segment, LearnedFeatures::Terms);
+        let (terms, names) = learned_features(&model, &inputs, LearnedFeatures::Terms);
         assert_eq!(terms.ncols(), 3 * 14);
         assert_eq!(names[15], "wdot_y:m2[w_x]");
-        let prediction = model.predict(&row_major(&segment.inputs()));
+        let prediction = model.predict(&row_major(&inputs));
         for i in 0..n {
             for output in 0..3 {
                 let sum: f64 = (0..14).map(|b| terms[(i, output * 14 + b)]).sum();
                 assert!((sum - prediction[i * 3 + output]).abs() < 1e-12);
             }
         }
-        let (basis, _) = learned_features(&model, &segment, LearnedFeatures::Basis);
+        let (basis, _) = learned_features(&model, &inputs, LearnedFeatures::Basis);
         assert_eq!(basis.ncols(), 14);
     }
 }

@@ -5,7 +5,7 @@ mod common;
 use common::{small_architecture, synthetic_batch, synthetic_tasks};
 use learn::{
     AdaptationConfig, CHECKPOINT_FORMAT, InputRange, LearnConfig, MetaOrder, MetaTrainedModel,
-    MetaTrainingConfig, Optimizer, Protocol, Standardiser, TaskGrouping, adapt_online, meta_train,
+    MetaTrainingConfig, Optimizer, Standardiser, TaskGrouping, adapt_online, meta_train,
 };
 
 fn meta_config(iterations: usize) -> MetaTrainingConfig {
@@ -240,12 +240,12 @@ fn first_order_is_an_option_and_learns_too() {
 
 fn example_model() -> MetaTrainedModel {
     let config = LearnConfig::load(&common::workspace().join("experiments/learn.json")).unwrap();
-    let architecture = learn::architecture(data::Formulation::Translational, config.get());
+    let architecture = learn::architecture(learn::Formulation::Translational, config.get());
     MetaTrainedModel {
         format: CHECKPOINT_FORMAT.to_string(),
         trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
-            formulation: data::Formulation::Translational,
-            protocol: Protocol::LeaveConditionOut,
+            formulation: learn::Formulation::Translational,
+            protocol: "leave-condition-out".to_string(),
             held_out_condition: Some("35wind".to_string()),
         }),
         seed: 9,

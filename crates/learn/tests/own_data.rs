@@ -1,11 +1,10 @@
-//! LeARN on CSV tasks: a small generated family meta-trains, adapts better than the unadapted
-//! model on an unseen draw, and its checkpoint round-trips; the paper's checkpoints keep their
-//! layout.
+//! LeARN on a multi-task set in memory (the recordings of CSV tasks): a small generated family
+//! meta-trains, adapts better than the unadapted model on an unseen draw, and its checkpoint
+//! round-trips; the paper's checkpoints keep their layout.
 
 use std::path::Path;
 
-use data::TaskSource;
-use learn::{ColumnSpec, MetaTrainedModel, TaskConfig, TaskSet, TrainedOn};
+use learn::{ColumnSpec, MetaTrainedModel, Recording, TaskConfig, TaskSet, TaskSource, TrainedOn};
 use sindy::Derivative;
 
 /// A temporary folder, removed when dropped.
@@ -16,21 +15,25 @@ fn scratch(name: &str) -> tempfile::TempDir {
         .unwrap()
 }
 
-/// x' = v, v' = −k·x − c·v + u with u = cos(1.3 t), sampled every 0.05 s (RK4, 4 substeps).
-fn oscillator_csv(k: f64, c: f64, rows: usize) -> String {
+/// The sampling interval of the generated recordings, seconds.
+const INTERVAL: f64 = 0.05;
+
+/// x' = v, v' = −k·x − c·v + u with u = cos(1.3 t), sampled every 0.05 s (RK4, 4 substeps): the
+/// columns x, v and u.
+fn oscillator(k: f64, c: f64, rows: usize) -> Vec<Vec<f64>> {
     let derivative = |[x, v]: [f64; 2], t: f64| [v, -k * x - c * v + (1.3 * t).cos()];
-    let (dt, substeps) = (0.05, 4);
+    let (dt, substeps) = (INTERVAL, 4);
     let h = dt / substeps as f64;
     let mut state = [0.5, 0.0];
-    let mut text = String::from("t,x,v,u\n");
+    let mut columns = vec![Vec::new(); 3];
     for row in 0..rows {
         let t = row as f64 * dt;
-        text.push_str(&format!(
-            "{t},{},{},{}\n",
-            state[0],
-            state[1],
-            (1.3 * t).cos()
-        ));
+        for (column, value) in columns
+            .iter_mut()
+            .zip([state[0], state[1], (1.3 * t).cos()])
+        {
+            column.push(value);
+        }
         for s in 0..substeps {
             let t = t + s as f64 * h;
             let add = |a: [f64; 2], b: [f64; 2], w: f64| [a[0] + w * b[0], a[1] + w * b[1]];
@@ -43,7 +46,17 @@ fn oscillator_csv(k: f64, c: f64, rows: usize) -> String {
             }
         }
     }
-    text
+    columns
+}
+
+/// A recording named `name` (its file in errors) holding `columns`.
+fn recording<'a>(name: &'a str, columns: &'a [Vec<f64>]) -> Recording<'a> {
+    Recording {
+        name,
+        path: Path::new(name),
+        columns,
+        interval: INTERVAL,
+    }
 }
 
 fn spec() -> ColumnSpec {
@@ -57,7 +70,7 @@ fn spec() -> ColumnSpec {
 
 /// Six training draws of (k, c), a small network and a short budget (well under a second).
 fn meta_trained(dir: &Path) -> MetaTrainedModel {
-    for (i, (k, c)) in [
+    let draws: Vec<(String, Vec<Vec<f64>>)> = [
         (0.5, 0.1),
         (1.0, 0.3),
         (2.0, 0.2),
@@ -67,9 +80,8 @@ fn meta_trained(dir: &Path) -> MetaTrainedModel {
     ]
     .into_iter()
     .enumerate()
-    {
-        std::fs::write(dir.join(format!("task-{i}.csv")), oscillator_csv(k, c, 240)).unwrap();
-    }
+    .map(|(i, (k, c))| (format!("task-{i}.csv"), oscillator(k, c, 240)))
+    .collect();
     let config = dir.join("config.json");
     std::fs::write(
         &config,
@@ -81,8 +93,10 @@ fn meta_trained(dir: &Path) -> MetaTrainedModel {
     let source = TaskSource::Files {
         pattern: format!("{}/task-*.csv", dir.display()),
     };
-    let tasks = learn::read_column_tasks(&source, &spec()).unwrap();
-    assert_eq!(tasks.len(), 6);
+    let tasks: Vec<Recording> = draws
+        .iter()
+        .map(|(name, columns)| recording(name, columns))
+        .collect();
     let set = TaskSet {
         source: &source,
         spec: &spec(),
@@ -106,10 +120,9 @@ fn a_meta_trained_model_adapts_to_an_unseen_draw_better_than_without_adaptation(
     // The default batches fit in the 6 tasks and their 120-row halves: kept.
     assert_eq!(model.config.meta_training.task_batch, 4);
     assert_eq!(model.config.meta_training.support_batch, 64);
-    let unseen = dir.join("unseen.csv");
-    std::fs::write(&unseen, oscillator_csv(2.5, 0.35, 400)).unwrap();
-    let recording = learn::read_recording(&unseen, &columns.spec()).unwrap();
-    let evaluation = learn::evaluate_recording(&model, &recording, 0..200, 200..400).unwrap();
+    let unseen = oscillator(2.5, 0.35, 400);
+    let recording = recording("unseen.csv", &unseen);
+    let evaluation = learn::evaluate_recording(&model, recording, 0..200, 200..400).unwrap();
     assert!(
         evaluation.gen_mse < 0.8 * evaluation.unadapted_gen_mse,
         "adapted {} against unadapted {}",
@@ -131,14 +144,14 @@ fn a_meta_trained_model_adapts_to_an_unseen_draw_better_than_without_adaptation(
     );
 
     // Rows outside the recording, or too few for the derivative, name the file and the rows.
-    let message = learn::evaluate_recording(&model, &recording, 0..500, 200..400)
+    let message = learn::evaluate_recording(&model, recording, 0..500, 200..400)
         .unwrap_err()
         .to_string();
     assert!(
         message.contains("unseen.csv") && message.contains("support rows 0:500"),
         "{message}"
     );
-    let message = learn::evaluate_recording(&model, &recording, 0..2, 200..400)
+    let message = learn::evaluate_recording(&model, recording, 0..2, 200..400)
         .unwrap_err()
         .to_string();
     assert!(message.contains("fewer than the 3"), "{message}");
@@ -168,13 +181,13 @@ fn a_checkpoint_is_either_a_flight_model_or_a_model_of_csv_tasks() {
 fn a_flight_checkpoint_is_written_with_the_fields_it_always_had() {
     let config: learn::LearnConfig =
         serde_json::from_str(include_str!("../../../experiments/learn.json")).unwrap();
-    let formulation = data::Formulation::Attitude;
+    let formulation = learn::Formulation::Attitude;
     let architecture = learn::architecture(formulation, &config);
     let model = MetaTrainedModel {
         format: learn::CHECKPOINT_FORMAT.to_string(),
         trained_on: TrainedOn::Flights(learn::FlightTraining {
             formulation,
-            protocol: learn::Protocol::Paper,
+            protocol: "paper".to_string(),
             held_out_condition: None,
         }),
         seed: 1,

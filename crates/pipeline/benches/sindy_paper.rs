@@ -11,7 +11,9 @@ use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use data::{ExperimentConditions, FlightLog, Formulation, SplitSpec, resolve_data_dir};
+use data::{ExperimentConditions, FlightLog, SplitSpec, resolve_data_dir};
+use learn::Formulation;
+use pipeline::Segment;
 use pipeline::{SindyConfig, evaluate_flight};
 use rayon::prelude::*;
 use sindy::{Derivative, FeatureLibrary, SindyParams};
@@ -79,9 +81,13 @@ fn main() {
     let split = SplitSpec::Halves.split(first.len()).unwrap();
     let mut fits = Vec::new();
     for formulation in Formulation::ALL {
-        let support = formulation
-            .segment(&first, split.support.clone(), Derivative::Forward)
-            .unwrap();
+        let support = Segment::cut(
+            &first,
+            formulation,
+            split.support.clone(),
+            Derivative::Forward,
+        )
+        .unwrap();
         let inputs = support.inputs();
         let params = SindyParams::new(&formulation.state_names(), &formulation.control_names())
             .library(FeatureLibrary::from_spec(&config.library).unwrap())

@@ -12,7 +12,8 @@
 //! segment to the other, and nothing from the future of a sample is used. The constant is left to
 //! the regression (its intercept).
 
-use data::{Formulation, Segment};
+use crate::segment::Segment;
+use learn::Formulation;
 
 use serde::{Deserialize, Serialize};
 
@@ -206,7 +207,8 @@ pub fn first_order_lag(signal: &[f64], pole: f64) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use data::{Formulation, Segment};
+    use crate::segment::Segment;
+    use learn::Formulation;
     use sindy::SindyError;
 
     #[test]

@@ -5,12 +5,14 @@
 use std::path::{Path, PathBuf};
 
 use crate::sindy_column::SindyConfig;
-use data::{ExperimentConditions, Formulation, SplitSpec, file_sha256};
-use learn::{CheckedConfig, LearnConfig, Protocol};
+use data::{ExperimentConditions, SplitSpec, file_sha256};
+use learn::{CheckedConfig, Formulation, LearnConfig};
 use serde::{Deserialize, Serialize};
 use sindy::Derivative;
 
 use crate::error::{PipelineError, Result};
+use crate::experiment::{EVALUATION_DERIVATIVE, EVALUATION_SPLIT};
+use crate::flights::Protocol;
 
 /// The LeARN part of a run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -137,16 +139,16 @@ impl RunConfig {
                 ));
             }
         }
-        // LeARN's evaluation is defined on halves with forward-difference targets; both columns
-        // of a table must be scored on the same data.
-        if self.split != SplitSpec::Halves {
+        // The experiment's cells are cut into halves with forward-difference targets, once, for
+        // both columns of a table: a run naming another split or derivative is refused.
+        if self.split != EVALUATION_SPLIT {
             return Err(error(
                 "split",
                 "LeARN evaluates on halves ({\"kind\": \"halves\"}); both methods must share the split"
                     .to_string(),
             ));
         }
-        if self.derivative != Derivative::Forward {
+        if self.derivative != EVALUATION_DERIVATIVE {
             return Err(error(
                 "derivative",
                 "LeARN's targets are forward differences ({\"kind\": \"forward\"}); both methods must share them"

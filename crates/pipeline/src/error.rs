@@ -29,9 +29,30 @@ pub enum PipelineError {
     /// A flight that cannot be evaluated (e.g. too short to split), named by its file.
     #[error("{}: {message}", path.display())]
     Flight { path: PathBuf, message: String },
-    /// Two parts of a run disagree (e.g. the targets SINDy and LeARN were scored against).
+    /// Two parts of a run disagree (e.g. a model and the cell it is evaluated on).
     #[error("{what}: {message}")]
     Mismatch { what: String, message: String },
+    /// A protocol that finds no meta-training flight for an evaluation condition.
+    #[error(
+        "protocol '{protocol}': no meta-training flight for evaluation condition '{condition}' ({detail})"
+    )]
+    NoTrainingFlights {
+        protocol: String,
+        condition: String,
+        detail: String,
+    },
+    /// A condition asked for as a table row (evaluated, the held-out fold) that is only used to
+    /// meta-train.
+    #[error(
+        "condition '{condition}' is not an evaluation condition (its role is {role}); the evaluation conditions are: {evaluation}"
+    )]
+    NotEvaluationCondition {
+        condition: String,
+        role: String,
+        evaluation: String,
+    },
+    #[error("unknown protocol '{name}' (known: paper, leave-condition-out, auto)")]
+    UnknownProtocol { name: String },
 }
 
 impl PipelineError {

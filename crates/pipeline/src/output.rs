@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use data::Formulation;
+use learn::Formulation;
 use rayon::prelude::*;
 use report::{Comparison, PublishedTables, Tolerances, latex, load_tables, markdown};
 

@@ -1,24 +1,28 @@
 //! Running the experiment: SINDy and LeARN on every formulation × evaluation condition.
 //!
-//! Every process of a run (the unsharded one, or each shard) loads the flights, cuts the segments
-//! and fits SINDy (milliseconds); the LeARN work is the sweep of [`learn::WorkItem`]s, each
-//! item's cells carrying what the tables need ([`LearnCellOutcome`]), assembled by
-//! [`crate::tables::render`]. Progress goes to the caller's observer ([`Progress`]): each stage,
-//! and each LeARN cell as it ends.
+//! Every process of a run (the unsharded one, or each shard) loads the flights (each read and
+//! hashed once, by the [`Experiment`]), takes the experiment's cells and fits SINDy on them
+//! (milliseconds); the LeARN work is the sweep of [`WorkItem`]s, evaluated on the same cells, each
+//! item's cells carrying what the tables need ([`LearnCellOutcome`]), rendered by
+//! [`crate::tables::render`]. SINDy and LeARN are scored against the targets of one
+//! [`EvaluationCell`], built once. Progress goes to the caller's observer ([`Progress`]): each
+//! stage, and each LeARN cell as it ends.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use crate::sindy_column::SegmentEvaluation;
-use data::{Condition, FlightLog, Formulation, Mat, Segment, file_sha256};
-use learn::{CellResult, Cells, DataFile, EquationRule, Experiment, WorkItem, explain, row_major};
+use data::file_sha256;
+use learn::{EquationRule, Formulation, explain, row_major};
 use rayon::prelude::*;
 use report::{MethodTrace, PublishedTables, QualitativeFigure, ResultsTable};
 
-use crate::cells::{cell_figure, flight_segments, stacked_columns};
+use crate::cells::{cell_figure, stacked_columns};
 use crate::config::CheckedRunConfig;
 use crate::error::{PipelineError, Result, in_flight};
+use crate::experiment::{CellResult, Cells, EvaluationCell, Experiment, WorkItem};
 use crate::progress::{Progress, Stage, Stopwatch};
 use crate::shard::{
     ItemResult, MergedSweep, ShardFile, ShardProvenance, ShardSpec, Sweep, SweepKind,
@@ -43,21 +47,10 @@ pub struct RunOutcome {
 /// A shard of a reproduce run: each work item's cells.
 pub type ReproduceShard = ShardFile<ReproduceContext, Vec<LearnCellOutcome>>;
 
-/// One formulation on one evaluation flight, with SINDy fitted.
+/// One formulation on one evaluation flight (the experiment's cell), with SINDy fitted.
 struct Cell {
-    formulation: Formulation,
-    condition: Condition,
-    flight: DataFile,
-    /// The flight's file as read (errors name it).
-    flight_path: PathBuf,
-    support: Segment,
-    query: Segment,
+    evaluation: Arc<EvaluationCell>,
     sindy: SegmentEvaluation,
-}
-
-struct EvaluationFlight {
-    log: FlightLog,
-    file: DataFile,
 }
 
 /// The stage in which the work items run.
@@ -164,32 +157,26 @@ impl<'c> ReproduceWork<'c> {
         root: &Path,
         stopwatch: &mut Stopwatch,
     ) -> Result<Self> {
-        let conditions: Vec<&Condition> = config.conditions.evaluation().collect();
-        let (experiment, flights) = stopwatch.time("load flights", || {
-            let experiment = Experiment::load(
+        let experiment = stopwatch.time("load flights", || {
+            Experiment::load(
                 config.learn.clone(),
                 config.conditions.clone(),
                 data_dir,
                 config.protocol,
-            )?;
-            let flights = conditions
-                .par_iter()
-                .map(|condition| load_evaluation_flight(config, data_dir, condition))
-                .collect::<Result<Vec<_>>>()?;
-            Ok((experiment, flights))
+            )
         })?;
-        let cells = stopwatch.time("SINDy", || sindy_cells(config, &conditions, &flights))?;
+        let cells = stopwatch.time("SINDy", || sindy_cells(config, &experiment))?;
         // The extra columns' folds and bagging blocks against the segments, before LeARN runs.
         let variants = match &config.variants_path {
             Some(path) => {
                 let variants = VariantsConfig::read(path)?;
-                for cell in &cells {
+                for Cell { evaluation, .. } in &cells {
                     let segment = format!(
                         "the {} support segment of {}",
-                        cell.formulation.name(),
-                        cell.flight_path.display()
+                        evaluation.formulation.name(),
+                        evaluation.flight.log.path.display()
                     );
-                    variants.check_rows(path, cell.support.len(), &segment, true)?;
+                    variants.check_rows(path, evaluation.support.len(), &segment, true)?;
                 }
                 Some(variants)
             }
@@ -198,7 +185,7 @@ impl<'c> ReproduceWork<'c> {
         let items = experiment.work_items(&config.raw.formulations, &config.raw.learn.seeds);
         let sweep = Sweep {
             kind: SweepKind::Reproduce,
-            context: context(config, root, &experiment, &flights)?,
+            context: context(config, root, &experiment)?,
             items,
             data_files: experiment.data_files(),
         };
@@ -236,7 +223,7 @@ impl<'c> ReproduceWork<'c> {
 
     /// One work item: LeARN on its cells; with the first seed, each cell's detail too.
     fn run_item(&self, item: &WorkItem, progress: &dyn Progress) -> Result<Vec<LearnCellOutcome>> {
-        let cell_done = |cell: &learn::CellSummary| {
+        let cell_done = |cell: &crate::experiment::CellSummary| {
             progress.advance(format_args!(
                 "{} {} seed {}",
                 cell.formulation.name(),
@@ -250,7 +237,6 @@ impl<'c> ReproduceWork<'c> {
             .iter()
             .map(|result| {
                 let cell = self.cell(item.formulation, &result.summary.condition)?;
-                check_same_targets(cell, result)?;
                 let detail = if first_seed {
                     Some(self.cell_detail(cell, result)?)
                 } else {
@@ -269,7 +255,9 @@ impl<'c> ReproduceWork<'c> {
     fn cell(&self, formulation: Formulation, condition: &str) -> Result<&Cell> {
         self.cells
             .iter()
-            .find(|c| c.formulation == formulation && c.condition.name == condition)
+            .find(|c| {
+                c.evaluation.formulation == formulation && c.evaluation.condition.name == condition
+            })
             .ok_or_else(|| PipelineError::Mismatch {
                 what: format!("{} {condition}", formulation.name()),
                 message: "LeARN evaluated a cell the run does not have".to_string(),
@@ -279,10 +267,12 @@ impl<'c> ReproduceWork<'c> {
     /// What the tables take from the first seed's cell: SINDy and the flight, the figure, the
     /// explanation of the adapted model, the variant columns with its model.
     fn cell_detail(&self, cell: &Cell, result: &CellResult) -> Result<CellDetail> {
-        let model = &result.model;
-        let support_inputs = model.standardiser.apply(&row_major(&cell.support.inputs()));
+        let (evaluation, model) = (&cell.evaluation, &result.model);
+        let support_inputs = model
+            .standardiser
+            .apply(&row_major(&evaluation.support.inputs()));
         let explanation = explain(
-            cell.formulation,
+            evaluation.formulation,
             &model.architecture,
             &result.adapted_parameters,
             &support_inputs,
@@ -291,16 +281,16 @@ impl<'c> ReproduceWork<'c> {
         let variant_columns = match &self.variants {
             Some(variants) => crate::variants::reproduce_columns(
                 variants,
-                &[(&cell.support, &cell.query, model)],
+                &[(&evaluation.support, &evaluation.query, model)],
             )?
             .pop()
             .unwrap_or_default(),
             None => BTreeMap::new(),
         };
         Ok(CellDetail {
-            flight: cell.flight.clone(),
-            support_rows: [cell.support.rows.start, cell.support.rows.end],
-            query_rows: [cell.query.rows.start, cell.query.rows.end],
+            flight: evaluation.flight.file.clone(),
+            support_rows: [evaluation.support.rows.start, evaluation.support.rows.end],
+            query_rows: [evaluation.query.rows.start, evaluation.query.rows.end],
             sindy: SindyOutcome {
                 adapt: cell.sindy.support_mse,
                 r#gen: cell.sindy.query_mse,
@@ -319,7 +309,6 @@ fn context(
     config: &CheckedRunConfig,
     root: &Path,
     experiment: &Experiment,
-    flights: &[EvaluationFlight],
 ) -> Result<ReproduceContext> {
     let run_config_path = config
         .path
@@ -361,107 +350,36 @@ fn context(
             learn: config.learn.get().clone(),
         },
         input_sha256,
-        evaluation_files: flights.iter().map(|f| f.file.clone()).collect(),
+        evaluation_files: experiment
+            .evaluation_flights()
+            .iter()
+            .map(|f| f.file.clone())
+            .collect(),
     })
 }
 
-fn load_evaluation_flight(
-    config: &CheckedRunConfig,
-    data_dir: &Path,
-    condition: &Condition,
-) -> Result<EvaluationFlight> {
-    let path = config.conditions.flight_path(
-        data_dir,
-        condition,
-        &config.conditions.evaluation_controller,
-    );
-    let log = FlightLog::read(&path)?;
-    let file = DataFile {
-        path: path.strip_prefix(data_dir).unwrap_or(&path).to_path_buf(),
-        sha256: file_sha256(&path)?,
-    };
-    Ok(EvaluationFlight { log, file })
-}
-
-/// SINDy on every formulation × evaluation flight, in table order.
-fn sindy_cells(
-    config: &CheckedRunConfig,
-    conditions: &[&Condition],
-    flights: &[EvaluationFlight],
-) -> Result<Vec<Cell>> {
-    let jobs: Vec<(Formulation, usize)> = config
+/// SINDy on every formulation × evaluation flight of the run, in table order, on the
+/// experiment's cells.
+fn sindy_cells(config: &CheckedRunConfig, experiment: &Experiment) -> Result<Vec<Cell>> {
+    let conditions = experiment.evaluation_conditions();
+    let jobs: Vec<(Formulation, &str)> = config
         .raw
         .formulations
         .iter()
-        .flat_map(|&f| (0..conditions.len()).map(move |c| (f, c)))
+        .flat_map(|&f| conditions.iter().map(move |c| (f, c.as_str())))
         .collect();
     jobs.par_iter()
-        .map(|&(formulation, index)| {
-            sindy_cell(config, formulation, conditions[index], &flights[index])
+        .map(|&(formulation, condition)| {
+            let evaluation = Arc::clone(experiment.cell(formulation, condition)?);
+            let sindy = crate::sindy_column::fit_and_evaluate(
+                &config.raw.sindy,
+                &evaluation.support,
+                &evaluation.query,
+            )
+            .map_err(|error| in_flight(&evaluation.flight.log.path, error))?;
+            Ok(Cell { evaluation, sindy })
         })
         .collect()
-}
-
-fn sindy_cell(
-    config: &CheckedRunConfig,
-    formulation: Formulation,
-    condition: &Condition,
-    flight: &EvaluationFlight,
-) -> Result<Cell> {
-    let (support, query) = flight_segments(
-        &flight.log,
-        formulation,
-        config.raw.split,
-        config.raw.derivative,
-    )?;
-    let sindy = crate::sindy_column::fit_and_evaluate(&config.raw.sindy, &support, &query)
-        .map_err(|error| in_flight(&flight.log.path, error))?;
-    Ok(Cell {
-        formulation,
-        condition: condition.clone(),
-        flight: flight.file.clone(),
-        flight_path: flight.log.path.clone(),
-        support,
-        query,
-        sindy,
-    })
-}
-
-/// Both methods must be scored against the same targets on the same rows.
-fn check_same_targets(cell: &Cell, result: &CellResult) -> Result<()> {
-    let pairs = [
-        (&cell.support.targets, &result.support.targets, "support"),
-        (&cell.query.targets, &result.query.targets, "query"),
-    ];
-    for (ours, theirs, segment) in pairs {
-        let same_shape = ours.nrows() == theirs.nrows() && ours.ncols() == theirs.ncols();
-        let largest = if same_shape {
-            max_abs_difference(ours, theirs)
-        } else {
-            f64::INFINITY
-        };
-        if largest > 1e-12 {
-            return Err(PipelineError::Mismatch {
-                what: format!(
-                    "{} {} {segment} segment",
-                    cell.formulation.name(),
-                    cell.condition.label()
-                ),
-                message: format!("SINDy and LeARN targets differ (largest difference {largest:e})"),
-            });
-        }
-    }
-    Ok(())
-}
-
-fn max_abs_difference(a: &Mat<f64>, b: &Mat<f64>) -> f64 {
-    let mut largest = 0.0f64;
-    for j in 0..a.ncols() {
-        for i in 0..a.nrows() {
-            largest = largest.max((a[(i, j)] - b[(i, j)]).abs());
-        }
-    }
-    largest
 }
 
 /// SINDy's query predictions scored on the same split as LeARN's query coverage: the samples
@@ -469,12 +387,13 @@ fn max_abs_difference(a: &Mat<f64>, b: &Mat<f64>) -> f64 {
 /// flights; the split only asks whether the samples where LeARN extrapolates are hard for SINDy
 /// too). `None` without a range.
 fn sindy_query_coverage(cell: &Cell, learn_result: &CellResult) -> Option<learn::RangeCoverage> {
-    let names = cell.formulation.input_names();
+    let query = &cell.evaluation.query;
+    let names = cell.evaluation.formulation.input_names();
     learn_result.model.standardiser.coverage_with_errors(
-        &row_major(&cell.query.inputs()),
+        &row_major(&query.inputs()),
         &names,
         &row_major(&cell.sindy.query_prediction),
-        &row_major(&cell.query.targets),
+        &row_major(&query.targets),
     )
 }
 
@@ -497,11 +416,12 @@ fn figure(cell: &Cell, learn_result: &CellResult) -> Result<(String, Qualitative
             band: None,
         },
     ];
+    let evaluation = &cell.evaluation;
     cell_figure(
-        cell.formulation,
-        &cell.condition,
-        &cell.support,
-        &cell.query,
+        evaluation.formulation,
+        &evaluation.condition,
+        &evaluation.support,
+        &evaluation.query,
         methods,
     )
 }

@@ -18,7 +18,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-use learn::{DataFile, WorkItem};
+use crate::experiment::WorkItem;
+use learn::DataFile;
 use rayon::prelude::*;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -385,9 +386,9 @@ mod tests {
         let sweep = Sweep {
             kind: SweepKind::Reproduce,
             context: "c".to_string(),
-            items: vec![learn::WorkItem {
-                formulation: data::Formulation::Full,
-                cells: learn::Cells::Every,
+            items: vec![WorkItem {
+                formulation: learn::Formulation::Full,
+                cells: crate::experiment::Cells::Every,
                 seed: 7,
             }],
             data_files: Vec::new(),

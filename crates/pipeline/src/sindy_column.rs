@@ -1,7 +1,7 @@
 //! The paper's SINDy baseline as one call: fit on a support segment, predict on it and on a query
 //! segment, report both mean squared errors.
 //!
-//! [`fit_and_evaluate`]`(config, support, query)` takes two `data::Segment`s (states, controls,
+//! [`fit_and_evaluate`]`(config, support, query)` takes two [`Segment`]s (states, controls,
 //! targets already estimated on each segment), fits `config` on the support segment, predicts ẋ on
 //! both without refitting and returns both predictions and both MSEs (mean over all samples and all
 //! output dimensions) in a [`SegmentEvaluation`]. With [`SindyConfig::paper`] (Fourier K = 1 on
@@ -14,7 +14,8 @@
 //! `FiniteDifference`) while still scoring against forward differences; it halves the mean distance
 //! to the published cells (largest attitude gap 0.065 → 0.025, full 0.036 → 0.017).
 
-use data::{FlightLog, Formulation, Segment, SplitSpec};
+use data::{FlightLog, SplitSpec};
+use learn::Formulation;
 
 use serde::{Deserialize, Serialize};
 use sindy::{
@@ -23,6 +24,7 @@ use sindy::{
 };
 
 use crate::error::Result;
+use crate::segment::Segment;
 
 /// What a SINDy baseline fits: the library and the optimizer (serialisable, e.g. in a run config).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -136,7 +138,7 @@ pub fn evaluate_flight(
     derivative: Derivative,
 ) -> Result<SegmentEvaluation> {
     let rows = split.split(log.len())?;
-    let support = formulation.segment(log, rows.support, derivative)?;
-    let query = formulation.segment(log, rows.query, derivative)?;
+    let support = Segment::cut(log, formulation, rows.support, derivative)?;
+    let query = Segment::cut(log, formulation, rows.query, derivative)?;
     Ok(fit_and_evaluate(config, &support, &query)?)
 }

@@ -1,7 +1,7 @@
 //! Variants of the SINDy column evaluated on the paper's protocol: a library and a regression whose
 //! penalty is chosen inside the support segment, scored on support (adapt) and query (gen).
 
-use data::Segment;
+use crate::segment::Segment;
 
 use serde::{Deserialize, Serialize};
 

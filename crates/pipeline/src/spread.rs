@@ -6,12 +6,14 @@
 
 use std::path::Path;
 
-use data::Formulation;
-use learn::{CellSummary, Experiment, LearnConfig, Protocol, SpreadCell, WorkItem, spread_cells};
+use learn::Formulation;
+use learn::LearnConfig;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 use crate::error::{PipelineError, Result};
+use crate::experiment::{CellSummary, Experiment, SpreadCell, WorkItem, spread_cells};
+use crate::flights::Protocol;
 use crate::shard::{ItemResult, ShardFile, ShardSpec, Sweep, SweepKind};
 
 /// What the spread file takes from the configuration: the same for every shard.

@@ -7,9 +7,10 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use crate::experiment::CellSummary;
 use crate::sindy_column::SindyConfig;
-use data::{Formulation, SplitSpec};
-use learn::{CellSummary, DataFile, Explanation, LearnConfig, RangeCoverage};
+use data::SplitSpec;
+use learn::{DataFile, Explanation, Formulation, LearnConfig, RangeCoverage};
 use report::{
     FarthestInput, Mse, PublishedTables, QualitativeFigure, QueryCoverage, ResultsTable, Row,
 };

@@ -3,7 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use data::{ExperimentConditions, FlightLog, Formulation, SplitSpec};
+use data::{ExperimentConditions, FlightLog, SplitSpec};
+use learn::Formulation;
 use pipeline::{SindyConfig, evaluate_flight};
 use sindy::{Derivative, Mat};
 

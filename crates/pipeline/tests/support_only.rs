@@ -6,8 +6,11 @@
 
 use std::path::{Path, PathBuf};
 
-use data::{FlightLog, Formulation, Segment, SplitSpec};
-use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Protocol, Standardiser};
+use data::{FlightLog, SplitSpec};
+use learn::Formulation;
+use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Standardiser};
+use pipeline::Protocol;
+use pipeline::Segment;
 use pipeline::{VariantKind, VariantsConfig, evaluate_variants};
 use sindy::Derivative;
 
@@ -43,7 +46,7 @@ fn untrained_model(formulation: Formulation, config: &LearnConfig) -> MetaTraine
         format: CHECKPOINT_FORMAT.to_string(),
         trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
             formulation,
-            protocol: Protocol::LeaveConditionOut,
+            protocol: Protocol::LeaveConditionOut.name().to_string(),
             held_out_condition: None,
         }),
         seed: 1,
@@ -69,12 +72,15 @@ fn perturbing_the_query_changes_no_choice() {
     let split = SplitSpec::Halves.split(1200.min(log.len())).unwrap();
     // Attitude: every kind of feature (inputs, sin/cos, control lags, learned basis) is present.
     for formulation in [Formulation::Attitude] {
-        let support = formulation
-            .segment(&log, split.support.clone(), Derivative::Forward)
-            .unwrap();
-        let query = formulation
-            .segment(&log, split.query.clone(), Derivative::Forward)
-            .unwrap();
+        let support = Segment::cut(
+            &log,
+            formulation,
+            split.support.clone(),
+            Derivative::Forward,
+        )
+        .unwrap();
+        let query =
+            Segment::cut(&log, formulation, split.query.clone(), Derivative::Forward).unwrap();
         let changed = perturbed(&query);
         let learn_config = config.run.learn.get().clone();
         let model = |_| Ok(untrained_model(formulation, &learn_config));

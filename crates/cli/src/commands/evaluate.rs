@@ -69,7 +69,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     }
     let model = MetaTrainedModel::load(&args.model)?;
     let columns = learn::column_training(&model, &args.model.display().to_string())?;
-    let recording = learn::read_recording(&args.csv, &columns.spec())?;
+    let recording = pipeline::own_data::read_recording(&args.csv, &columns.spec())?;
     let comparison = compare_on_recording(
         &model,
         &recording,

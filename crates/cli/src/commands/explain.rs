@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use data::{ExperimentConditions, FlightLog};
-use learn::{EquationRule, Explanation, MetaTrainedModel, explain_flight};
+use learn::{EquationRule, Explanation, MetaTrainedModel};
+use pipeline::{explain_flight, own_data};
 
 use outputs::{Existing, OutputSet};
 
@@ -106,7 +107,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         let value = serde_json::json!({
             "checkpoint": args.checkpoint,
             "flight": flight,
-            "protocol": flights.protocol.name(),
+            "protocol": flights.protocol,
             "seed": model.seed,
             "adapted": !args.no_adapt,
             "explanation": explanation,
@@ -118,7 +119,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     say!(
         "{} model ({} protocol, seed {}) over {} ({} samples, {})",
         flights.formulation.name(),
-        flights.protocol.name(),
+        flights.protocol,
         model.seed,
         flight.display(),
         explanation.samples,
@@ -167,7 +168,7 @@ fn explain_columns(
     let columns = learn::column_training(model, &args.checkpoint.display().to_string())?;
     set.input("the --csv input", recording_path);
     let staged = set.prepare()?;
-    let recording = learn::read_recording(recording_path, &columns.spec())?;
+    let recording = own_data::read_recording(recording_path, &columns.spec())?;
     let support = match (&args.support_rows, args.no_adapt) {
         (_, true) => None,
         (Some(rows), false) => Some(rows.clone()),
@@ -177,7 +178,16 @@ fn explain_columns(
         max_terms: args.max_terms,
         ..EquationRule::default()
     };
-    let explanation = learn::explain_recording(model, &recording, support.clone(), rule)?;
+    // Adapting on rows of the recording needs its sampling interval to be the tasks'.
+    if support.is_some() {
+        own_data::check_interval(columns, &recording)?;
+    }
+    let explanation = learn::explain_recording(
+        model,
+        own_data::recording(&recording),
+        support.clone(),
+        rule,
+    )?;
     if let (Some(path), Some(file)) = (&args.json, json_file) {
         let value = serde_json::json!({
             "checkpoint": args.checkpoint,

@@ -134,7 +134,7 @@ fn merge_spread(
     documents: Vec<ShardDocument>,
     inputs: &[(String, PathBuf)],
 ) -> anyhow::Result<()> {
-    let merged: pipeline::MergedSweep<pipeline::SpreadContext, Vec<learn::CellSummary>> =
+    let merged: pipeline::MergedSweep<pipeline::SpreadContext, Vec<pipeline::CellSummary>> =
         merged(documents)?;
     let mut set = OutputSet::new(super::meta_train::PRODUCER);
     for (what, path) in inputs {

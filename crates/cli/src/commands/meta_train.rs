@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
-use data::{ExperimentConditions, Formulation};
-use learn::{CellSummary, Experiment, LearnConfig, Protocol, evaluation_condition_of};
-use pipeline::ShardSpec;
+use data::ExperimentConditions;
+use learn::{Formulation, LearnConfig};
+use pipeline::{CellSummary, Experiment, Protocol, ShardSpec, evaluation_condition_of};
 use report::{Method, PublishedTables};
 use serde_json::{Value, json};
 
@@ -355,7 +355,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
                 bar.inc(1);
                 cell
             })
-            .collect::<learn::Result<Vec<_>>>(),
+            .collect::<pipeline::Result<Vec<_>>>(),
         None => experiment.run_cells_observed(&formulations, seed, &|_| bar.inc(1)),
     };
     bar.finish_and_clear();

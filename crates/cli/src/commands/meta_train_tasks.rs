@@ -5,10 +5,11 @@
 use std::path::PathBuf;
 
 use anyhow::bail;
-use data::{TaskSource, file_sha256};
+use data::file_sha256;
 use indicatif::{ProgressBar, ProgressStyle};
-use learn::{ColumnSpec, DataFile, TaskConfig, TaskSet};
+use learn::{ColumnSpec, DataFile, TaskConfig, TaskSet, TaskSource};
 use outputs::{Existing, OutputSet};
+use pipeline::own_data::{read_tasks, recording};
 use sindy::Derivative;
 
 use super::Global;
@@ -109,7 +110,7 @@ pub fn run(global: &Global, args: &Args) -> anyhow::Result<()> {
     }
     let model_file = set.file(out, "--out", Existing::from_force(args.force));
     set.check()?;
-    let tasks = learn::read_column_tasks(&source, &spec)?;
+    let tasks = read_tasks(&source, &spec)?;
     // No task may be the output, however its path is spelt.
     for task in &tasks {
         set.input(format!("the task {}", task.name), &task.path);
@@ -128,11 +129,12 @@ pub fn run(global: &Global, args: &Args) -> anyhow::Result<()> {
         global.show_progress(),
         settings.get().meta_training.iterations,
     );
+    let recordings: Vec<learn::Recording> = tasks.iter().map(recording).collect();
     let model = learn::meta_train_tasks(
         TaskSet {
             source: &source,
             spec: &spec,
-            tasks: &tasks,
+            tasks: &recordings,
             files,
         },
         &settings,

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use data::ExperimentConditions;
-use learn::{Experiment, LearnConfig, Protocol, SpreadCell};
+use learn::LearnConfig;
 use outputs::{Existing, OutputSet, Staged};
-use pipeline::{ShardProvenance, ShardSpec, StageTiming};
+use pipeline::{Experiment, Protocol, ShardProvenance, ShardSpec, SpreadCell, StageTiming};
 
 use super::Global;
 use super::meta_train::{Args, PRODUCER, formulations, write_json};
@@ -115,13 +115,13 @@ fn stage(name: &str, seconds: f64) -> StageTiming {
 }
 
 /// How many cells the items of `shard` evaluate.
-fn shard_cells(items: &[learn::WorkItem], shard: ShardSpec, conditions: usize) -> usize {
+fn shard_cells(items: &[pipeline::WorkItem], shard: ShardSpec, conditions: usize) -> usize {
     shard
         .positions(items.len())
         .iter()
         .map(|&p| match items[p].cells {
-            learn::Cells::Condition(_) => 1,
-            learn::Cells::Every => conditions,
+            pipeline::Cells::Condition(_) => 1,
+            pipeline::Cells::Every => conditions,
         })
         .sum()
 }

@@ -1,4 +1,4 @@
-//! Synthetic tasks and the real-data directory for the behaviour tests.
+//! Synthetic tasks, the workspace and temporary directories for the behaviour tests.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
@@ -40,11 +40,6 @@ pub fn synthetic_tasks(count: usize) -> Vec<TaskData> {
             }
         })
         .collect()
-}
-
-/// The real data directory (see `data::real_data_dir_for_tests`: skips locally, fails under CI).
-pub fn real_data_dir() -> Option<PathBuf> {
-    data::real_data_dir_for_tests(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
 }
 
 /// The workspace root.

@@ -2,7 +2,7 @@
 //! evaluation condition, over the configuration's seeds (see [`crate::VariantsConfig`] for the
 //! variants and the protocol).
 //!
-//! The work is a sweep of (formulation, condition, seed) items ([`learn::WorkItem`]), each
+//! The work is a sweep of (formulation, condition, seed) items ([`crate::WorkItem`]), each
 //! evaluating every variant on its cell with its seed ([`AblationSeedOutcome`]); the first seed's
 //! item also carries the cell's SINDy, noise floors, headline equations and figure. The
 //! unsharded run, each shard and `learn merge` render the same results through the same code.
@@ -12,8 +12,9 @@ mod work;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use data::{Formulation, NoiseFloor};
-use learn::{Cells, WorkItem};
+use crate::experiment::{Cells, WorkItem};
+use data::NoiseFloor;
+use learn::Formulation;
 use report::{AblationRow, AblationTables, QualitativeFigure, SeedCell, VariantCell, VariantNote};
 use serde::{Deserialize, Serialize};
 

@@ -3,17 +3,20 @@
 
 use std::path::Path;
 
+use crate::experiment::{Cells, Experiment, WorkItem};
+use crate::flights::read_evaluation_flights;
+use crate::segment::Segment;
 use crate::sindy_variant::SegmentPredictions;
-use data::{Condition, FlightLog, Formulation, Segment, forward_difference_noise_floor};
-use learn::{Cells, Experiment, MetaTrainedModel, WorkItem};
-use rayon::prelude::*;
+use data::{Condition, FlightLog, forward_difference_noise_floor};
+use learn::{Formulation, MetaTrainedModel};
 use report::{MethodTrace, PublishedTables, QualitativeFigure, SeedCell};
 use sindy::{EnsemblePrediction, Mat, RegressionFit};
 
 use super::{AblationCell, AblationCellDetail, AblationSeedOutcome, AblationsContext};
-use crate::cells::{cell_figure, flight_segments};
+use crate::cells::cell_figure;
 use crate::error::{PipelineError, Result};
 use crate::progress::Progress;
+use crate::segment::flight_segments;
 use crate::shard::{ItemResult, ShardSpec, Sweep, SweepKind};
 use crate::tables::ConditionName;
 use crate::variants::{CheckedVariants, Outcome, evaluate_variants, learned_basis_experiment};
@@ -43,23 +46,11 @@ impl<'c> AblationsWork<'c> {
     pub(super) fn plan(config: &'c CheckedVariants, data_dir: &Path) -> Result<Self> {
         let run = &config.run;
         let conditions: Vec<&Condition> = run.conditions.evaluation().collect();
-        let logs = conditions
-            .par_iter()
-            .map(|condition| {
-                let path = run.conditions.flight_path(
-                    data_dir,
-                    condition,
-                    &run.conditions.evaluation_controller,
-                );
-                let file = learn::DataFile {
-                    path: path.strip_prefix(data_dir).unwrap_or(&path).to_path_buf(),
-                    sha256: data::file_sha256(&path)?,
-                };
-                Ok((FlightLog::read(&path)?, file))
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let (logs, evaluation_files): (Vec<FlightLog>, Vec<learn::DataFile>) =
-            logs.into_iter().unzip();
+        let flights = read_evaluation_flights(&run.conditions, data_dir)?;
+        let (logs, evaluation_files): (Vec<FlightLog>, Vec<learn::DataFile>) = flights
+            .iter()
+            .map(|flight| (flight.log.clone(), flight.file.clone()))
+            .unzip();
         let cells = cut_cells(config, &conditions, &logs)?;
         let needs_learn = config
             .raw
@@ -67,7 +58,7 @@ impl<'c> AblationsWork<'c> {
             .iter()
             .any(|v| v.kind.needs_meta_training());
         let experiment = if needs_learn {
-            Some(learned_basis_experiment(config, data_dir)?)
+            Some(learned_basis_experiment(config, data_dir, &flights)?)
         } else {
             None
         };
@@ -181,8 +172,11 @@ impl<'c> AblationsWork<'c> {
                 adaptation: sindy.support_mse,
                 generalisation: sindy.query_mse,
             },
-            noise_floor_support: forward_difference_noise_floor(&cell.support, self.dt)?,
-            noise_floor_query: forward_difference_noise_floor(&cell.query, self.dt)?,
+            noise_floor_support: forward_difference_noise_floor(
+                cell.support.states.as_ref(),
+                self.dt,
+            )?,
+            noise_floor_query: forward_difference_noise_floor(cell.query.states.as_ref(), self.dt)?,
             headline_equations,
             figure,
         })
@@ -262,7 +256,7 @@ fn evaluate_all(
 ) -> Result<Vec<Outcome>> {
     let meta_train = |seed: u64| -> Result<MetaTrainedModel> {
         let experiment = experiment.expect("loaded when a variant needs the LeARN networks");
-        Ok(experiment.meta_train(cell.formulation, &cell.condition.name, seed)?)
+        experiment.meta_train(cell.formulation, &cell.condition.name, seed)
     };
     evaluate_variants(
         &config.raw.variants,

@@ -10,8 +10,8 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use data::{TaskSource, TaskTable};
-use learn::{Batch, ColumnSpec, MetaTrainedModel, TaskConfig, TaskSet};
+use data::TaskTable;
+use learn::{Batch, ColumnSpec, MetaTrainedModel, TaskConfig, TaskSet, TaskSource};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sindy::Derivative;
@@ -229,7 +229,8 @@ pub fn run_example(
     let source = TaskSource::Files {
         pattern: training_pattern.to_string(),
     };
-    let tasks = learn::read_column_tasks(&source, &spec)?;
+    let tables = super::read_tasks(&source, &spec)?;
+    let tasks: Vec<learn::Recording> = tables.iter().map(super::recording).collect();
     let settings = TaskConfig::load(config.learn_config.as_deref())?;
     let meta_train = |seed: u64, observe: &dyn Fn(usize)| {
         let set = TaskSet {
@@ -245,8 +246,8 @@ pub fn run_example(
     let meta_training_seconds = started.elapsed().as_secs_f64();
     let recordings: Vec<TaskTable> = test
         .iter()
-        .map(|(path, _)| learn::read_recording(path, &spec))
-        .collect::<learn::Result<_>>()?;
+        .map(|(path, _)| super::read_recording(path, &spec))
+        .collect::<Result<_>>()?;
     let baselines = Baselines::new(config)?;
     let query = config.query_rows[0]..config.query_rows[1];
     // scores[task][size] = [learn, sindy, ridge, unadapted]
@@ -297,7 +298,7 @@ fn learn_scores(
             sizes
                 .iter()
                 .map(|&n| {
-                    let e = learn::evaluate_recording(model, recording, 0..n, query.clone())?;
+                    let e = super::tasks::evaluate_on(model, recording, 0..n, query.clone())?;
                     Ok([e.gen_mse, f64::NAN, f64::NAN, e.unadapted_gen_mse])
                 })
                 .collect::<Result<Vec<_>>>()
@@ -401,7 +402,7 @@ fn score_task(
         support.start,
         support.end
     );
-    let evaluation = learn::evaluate_recording(model, recording, support, query)?;
+    let evaluation = super::tasks::evaluate_on(model, recording, support, query)?;
     let (sindy, _) = sindy_scores(
         &baselines.sindy.params(columns),
         &baselines.sindy.library,

@@ -1,5 +1,7 @@
 //! LeARN on your own data next to the baselines, on the same rows: what `learn evaluate` reports
-//! ([`compare_on_recording`]) and the worked example's learning curve ([`example`]).
+//! ([`compare_on_recording`]) and the worked example's learning curve ([`example`]); reading the
+//! CSV tasks and recordings LeARN meta-trains, adapts and explains on ([`read_tasks`],
+//! [`read_recording`], [`recording`]).
 //!
 //! A model of CSV tasks is adapted online on the support rows of a new recording
 //! ([`learn::evaluate_recording`]); SINDy is fitted on the same support rows, with the same
@@ -8,6 +10,7 @@
 
 pub mod example;
 mod family;
+mod tasks;
 
 use std::ops::Range;
 
@@ -20,6 +23,7 @@ use sindy::{FeatureLibrary, OptimizerSpec, SindyModel, SindyParams};
 use crate::error::{PipelineError, Result};
 
 pub use family::{FamilyConfig, ParameterRange, SimulatedTask, TaskParameters, simulate_task};
+pub use tasks::{check_interval, read_recording, read_tasks, recording};
 
 /// Adaptation (support rows) and generalisation (query rows) MSE of one method.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -124,7 +128,7 @@ pub fn compare_on_recording(
     settings: &SindySettings,
 ) -> Result<RecordingComparison> {
     let columns = learn::column_training(model, "evaluation")?;
-    let evaluation = learn::evaluate_recording(model, recording, support.clone(), query)?;
+    let evaluation = tasks::evaluate_on(model, recording, support.clone(), query)?;
     let sindy = settings.params(columns);
     let (inputs, states) = (
         columns.state.len() + columns.control.len(),

@@ -5,7 +5,8 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-use learn::{DataFile, WorkItem};
+use crate::experiment::WorkItem;
+use learn::DataFile;
 use serde::Serialize;
 
 use super::{ShardFile, ShardProvenance, ShardSpec, SweepKind, configuration_sha256};
@@ -326,9 +327,9 @@ fn value_difference(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::experiment::Cells;
     use crate::shard::{SHARD_FORMAT, Sweep};
-    use data::Formulation;
-    use learn::Cells;
+    use learn::Formulation;
 
     /// A sweep of five items whose context is `context`, over one data file.
     fn sweep(context: &str) -> Sweep<String> {

@@ -3,8 +3,8 @@
 //! prediction) and the mean of a `learn_ensemble`'s members. Nothing here reads the query segment
 //! but to score.
 
+use crate::segment::Segment;
 use crate::sindy_variant::SegmentPredictions;
-use data::Segment;
 use sindy::Mat;
 
 use super::run::Outcome;

@@ -3,7 +3,7 @@
 //! published columns and an estimate of the targets' noise floor.
 //!
 //! Protocol (the same as the paper's tables): support = first half of the flight, query = second
-//! half, forward-difference targets on each segment, inputs X = [x, u] of `data::Formulation`.
+//! half, forward-difference targets on each segment, inputs X = [x, u] of `learn::Formulation`.
 //! Every hyper-parameter of a variant (penalty, library for `select`) is chosen by blocked
 //! cross-validation inside the support segment; the query segment is only ever scored.
 //!

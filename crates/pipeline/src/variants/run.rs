@@ -4,11 +4,14 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::Arc;
 
+use crate::experiment::Experiment;
+use crate::flights::Flight;
+use crate::segment::{Segment, SegmentModel};
 use crate::sindy_variant::{SegmentPredictions, VariantEvaluation, evaluate_features};
-use data::{Formulation, Segment};
 use learn::variants::learned_features;
-use learn::{Experiment, MetaTrainedModel};
+use learn::{Formulation, MetaTrainedModel};
 use rayon::prelude::*;
 use sindy::{Mat, RegressionFit};
 
@@ -68,7 +71,8 @@ impl LearnedBasisSpec {
         seed: u64,
     ) -> Result<VariantEvaluation> {
         let features = |segment: &Segment| -> Result<(Mat<f64>, Vec<String>)> {
-            let (learned, learned_names) = learned_features(model, segment, self.features);
+            let (learned, learned_names) =
+                learned_features(model, &segment.inputs(), self.features);
             let Some(library) = &self.library else {
                 return Ok((learned, learned_names));
             };
@@ -135,14 +139,16 @@ pub fn reproduce_columns(
 pub(crate) fn learned_basis_experiment(
     config: &CheckedVariants,
     data_dir: &Path,
+    evaluation: &[Arc<Flight>],
 ) -> Result<Experiment> {
     let run = &config.run;
-    Ok(Experiment::load(
+    Experiment::load_with(
         learned_basis_config(config)?,
         run.conditions.clone(),
         data_dir,
         run.protocol,
-    )?)
+        evaluation,
+    )
 }
 
 /// Every variant of `variants` on one support/query pair with one seed, in declaration order.
@@ -323,8 +329,9 @@ fn outcome_of(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::flights::Protocol;
     use crate::variants::testing::{RIDGE, config, segment, write};
-    use learn::{CHECKPOINT_FORMAT, Protocol, Standardiser};
+    use learn::{CHECKPOINT_FORMAT, Standardiser};
 
     fn untrained_model() -> MetaTrainedModel {
         let mut config: learn::LearnConfig =
@@ -336,7 +343,7 @@ mod tests {
             format: CHECKPOINT_FORMAT.to_string(),
             trained_on: learn::TrainedOn::Flights(learn::FlightTraining {
                 formulation: Formulation::Attitude,
-                protocol: Protocol::LeaveConditionOut,
+                protocol: Protocol::LeaveConditionOut.name().to_string(),
                 held_out_condition: None,
             }),
             seed: 2,

@@ -1,7 +1,8 @@
 //! What the variants' tests share: variants files written to temporary files, and a synthetic
 //! segment.
 
-use data::{Formulation, Segment};
+use crate::segment::Segment;
+use learn::Formulation;
 use sindy::Mat;
 
 /// A synthetic attitude segment of `n` samples with targets that depend on the inputs.

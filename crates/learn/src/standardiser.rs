@@ -1,126 +1,9 @@
-//! From flight logs to regression data: protocols, meta-training flights, standardisation.
+//! Input standardisation ([`Standardiser`]: the meta-training statistics, optionally clamping to
+//! the range the meta-training inputs span), how much of a segment lies outside that range
+//! ([`RangeCoverage`]), and matrices as the row-major values the networks read.
 
-use std::path::{Path, PathBuf};
-
-use data::{ExperimentConditions, FlightLog, Formulation, Mat, Segment, SplitSpec};
+use faer::Mat;
 use serde::{Deserialize, Serialize};
-use sindy::Derivative;
-
-use crate::error::{LearnError, Result};
-use crate::maml::Batch;
-
-/// Which flights meta-train the model for an evaluation condition.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Protocol {
-    /// The paper's meta-training flights `training/custom_random3_baseline_*.csv` (all six).
-    Paper,
-    /// For evaluation condition c: every shared figure-8 flight whose condition is not c, all
-    /// controllers. The evaluated flight and its wind speed are never seen during meta-training.
-    LeaveConditionOut,
-}
-
-impl Protocol {
-    /// The name used in files and on the command line.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Self::Paper => "paper",
-            Self::LeaveConditionOut => "leave-condition-out",
-        }
-    }
-
-    /// Parses `paper`, `leave-condition-out` or `auto` (None: decide from the data present).
-    pub fn parse(text: &str) -> Result<Option<Self>> {
-        match text {
-            "paper" => Ok(Some(Self::Paper)),
-            "leave-condition-out" => Ok(Some(Self::LeaveConditionOut)),
-            "auto" => Ok(None),
-            other => Err(LearnError::UnknownProtocol {
-                name: other.to_string(),
-            }),
-        }
-    }
-
-    /// `requested`, or when None: `paper` if the paper's training flights are present, otherwise
-    /// `leave-condition-out`.
-    pub fn resolve(
-        requested: Option<Self>,
-        conditions: &ExperimentConditions,
-        data_dir: &Path,
-    ) -> Self {
-        requested.unwrap_or(if conditions.paper_training_present(data_dir) {
-            Self::Paper
-        } else {
-            Self::LeaveConditionOut
-        })
-    }
-
-    /// The meta-training flight files for `evaluation_condition` (a name or label).
-    pub fn training_files(
-        &self,
-        conditions: &ExperimentConditions,
-        data_dir: &Path,
-        evaluation_condition: &str,
-    ) -> Result<Vec<PathBuf>> {
-        let held_out = conditions.condition(evaluation_condition)?;
-        let files = conditions.flight_files(data_dir);
-        let chosen: Vec<PathBuf> = match self {
-            Self::Paper => {
-                let paper: Vec<_> = files
-                    .iter()
-                    .filter(|f| f.controller == "paper-training")
-                    .collect();
-                if let Some(missing) = paper.iter().find(|f| !f.present) {
-                    return Err(LearnError::NoTrainingFlights {
-                        protocol: self.name().to_string(),
-                        condition: held_out.name.clone(),
-                        detail: format!("{} is missing", missing.path.display()),
-                    });
-                }
-                paper.iter().map(|f| f.path.clone()).collect()
-            }
-            Self::LeaveConditionOut => files
-                .iter()
-                .filter(|f| {
-                    f.controller != "paper-training" && f.condition != held_out.name && f.present
-                })
-                .map(|f| f.path.clone())
-                .collect(),
-        };
-        if chosen.is_empty() {
-            return Err(LearnError::NoTrainingFlights {
-                protocol: self.name().to_string(),
-                condition: held_out.name.clone(),
-                detail: format!("no flight file present under {}", data_dir.display()),
-            });
-        }
-        Ok(chosen)
-    }
-}
-
-/// The support and query segments of a flight (SplitSpec::Halves, forward-difference targets on
-/// each segment separately): the same data as the SINDy columns.
-/// Errors name the flight's file.
-pub fn flight_segments(log: &FlightLog, formulation: Formulation) -> Result<(Segment, Segment)> {
-    let segments = || -> std::result::Result<(Segment, Segment), data::DataError> {
-        let split = SplitSpec::Halves.split(log.len())?;
-        let support = formulation.segment(log, split.support, Derivative::Forward)?;
-        let query = formulation.segment(log, split.query, Derivative::Forward)?;
-        Ok((support, query))
-    };
-    segments().map_err(|error| {
-        let message = error.to_string();
-        let path = log.path.display().to_string();
-        if path.is_empty() || message.contains(&path) {
-            LearnError::Data(error)
-        } else {
-            LearnError::Flight {
-                path: log.path.clone(),
-                message,
-            }
-        }
-    })
-}
 
 /// The rows of a matrix, concatenated.
 pub fn row_major(matrix: &Mat<f64>) -> Vec<f64> {
@@ -138,14 +21,6 @@ pub fn from_row_major(values: &[f64], columns: usize) -> Mat<f64> {
     Mat::from_fn(values.len() / columns, columns, |i, j| {
         values[i * columns + j]
     })
-}
-
-/// A segment as regression data with raw (not standardised) inputs.
-pub fn segment_batch(segment: &Segment) -> Batch {
-    Batch {
-        inputs: row_major(&segment.inputs()),
-        targets: row_major(&segment.targets),
-    }
 }
 
 /// The z-score of each input feature, (x − mean) / std, optionally of x first clamped to the range

@@ -6,13 +6,13 @@
 
 use std::fmt;
 
-use data::Formulation;
+use learn::Formulation;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::dataset::Protocol;
+use super::{CellResult, CellSummary, Experiment};
 use crate::error::Result;
-use crate::experiment::{CellResult, CellSummary, Experiment};
+use crate::flights::Protocol;
 
 /// The evaluation cells one meta-trained model serves.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
@@ -261,7 +261,7 @@ mod tests {
             gen_mse: r#gen,
             unadapted_adapt_mse: 1.0,
             unadapted_gen_mse: 1.0,
-            evaluation_file: crate::DataFile {
+            evaluation_file: learn::DataFile {
                 path: format!("{condition}.csv").into(),
                 sha256: String::new(),
             },

@@ -1,11 +1,35 @@
-//! The experiment on the real flights, with a tiny budget (skipped without data, fails under CI).
+//! The formulations' segments and the LeARN experiment on the real flights, with a tiny budget
+//! (skipped without data, fails under CI).
 
-mod common;
+use std::path::{Path, PathBuf};
 
-use data::{ExperimentConditions, Formulation};
-use learn::{
-    EquationRule, Experiment, LearnConfig, MetaTrainedModel, Protocol, TaskGrouping, explain_flight,
-};
+use data::ExperimentConditions;
+use learn::{EquationRule, Formulation, LearnConfig, MetaTrainedModel, TaskGrouping};
+use pipeline::{Experiment, PipelineError, Protocol, Segment, explain_flight};
+use sindy::Derivative;
+
+mod common {
+    use super::*;
+
+    /// The real data directory (see `data::real_data_dir_for_tests`: skips locally, fails under
+    /// CI).
+    pub fn real_data_dir() -> Option<PathBuf> {
+        data::real_data_dir_for_tests(&workspace())
+    }
+
+    /// The workspace root.
+    pub fn workspace() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    }
+
+    /// A fresh temporary directory for one test, removed with everything in it when dropped.
+    pub fn temp_dir(name: &str) -> tempfile::TempDir {
+        tempfile::Builder::new()
+            .prefix(&format!("{name}-"))
+            .tempdir()
+            .unwrap()
+    }
+}
 
 fn log_rows(data_dir: &std::path::Path) -> usize {
     data::FlightLog::read(&data_dir.join("experiment/custom_figure8_baseline_70p20sint.csv"))
@@ -43,7 +67,7 @@ fn leave_condition_out_cell_runs_end_to_end() {
         .unwrap();
     let model = &cell.model;
     let flights = model.flights().expect("a flight model");
-    assert_eq!(flights.protocol, Protocol::LeaveConditionOut);
+    assert_eq!(flights.protocol, Protocol::LeaveConditionOut.name());
     assert_eq!(flights.held_out_condition.as_deref(), Some("70p20sint"));
     // 4 other conditions × 6 controllers; none of them the held-out condition.
     assert_eq!(model.data_files.len(), 24);
@@ -72,6 +96,35 @@ fn leave_condition_out_cell_runs_end_to_end() {
     }
     let mse = sum / (p.nrows() * p.ncols()) as f64;
     assert!((mse - summary.gen_mse).abs() < 1e-12 * mse);
+    // LeARN is scored against the experiment's cell, whose segments the run fits SINDy on: the
+    // targets of the run's split and derivative (the only ones a run configuration accepts).
+    let evaluation = experiment
+        .cell(Formulation::Translational, "70p20sint")
+        .unwrap();
+    let log =
+        data::FlightLog::read(&data_dir.join("experiment/custom_figure8_baseline_70p20sint.csv"))
+            .unwrap();
+    let (support, query) = pipeline::flight_segments(
+        &log,
+        Formulation::Translational,
+        pipeline::EVALUATION_SPLIT,
+        pipeline::EVALUATION_DERIVATIVE,
+    )
+    .unwrap();
+    for (learn, cut, sindy) in [
+        (
+            &cell.support.targets,
+            &support.targets,
+            &evaluation.support.targets,
+        ),
+        (
+            &cell.query.targets,
+            &query.targets,
+            &evaluation.query.targets,
+        ),
+    ] {
+        assert!(learn == cut && learn == sindy);
+    }
 
     // A model of another fold is refused; the checkpoint round-trips and explains.
     assert!(experiment.evaluate(model, "35wind").is_err());
@@ -86,7 +139,7 @@ fn leave_condition_out_cell_runs_end_to_end() {
         experiment.evaluate(model, "nowind").unwrap_err(),
     ] {
         assert!(
-            matches!(&error, learn::LearnError::NotEvaluationCondition { condition, .. } if condition == "nowind"),
+            matches!(&error, PipelineError::NotEvaluationCondition { condition, .. } if condition == "nowind"),
             "{error}"
         );
     }
@@ -291,4 +344,39 @@ fn nested_validation_detail_agrees_with_nested_validation() {
             .to_string();
         assert!(message.contains("between 0 and 1"), "{message}");
     }
+}
+
+#[test]
+fn formulations_build_paper_segments() {
+    let Some(dir) = common::real_data_dir() else {
+        return;
+    };
+    let log =
+        data::FlightLog::read(&dir.join("experiment/custom_figure8_baseline_35wind.csv")).unwrap();
+    let split = data::SplitSpec::Halves.split(log.len()).unwrap();
+    assert_eq!(split.support, 0..1255);
+    let segment = Segment::cut(
+        &log,
+        Formulation::Full,
+        split.query.clone(),
+        Derivative::Forward,
+    )
+    .unwrap();
+    assert_eq!(segment.len(), 1256);
+    assert_eq!(segment.inputs().ncols(), 10);
+    let k = split.query.start;
+    let n1 = log.motor_command[k][0] / 1000.0;
+    assert!((segment.controls[(0, 0)] - n1 * n1).abs() < 1e-15);
+    // target = forward difference on the segment alone
+    let expected = (log.velocity[k + 1][0] - log.velocity[k][0]) / log.sample_interval();
+    assert!((segment.targets[(0, 0)] - expected).abs() < 1e-9);
+    let translational = Segment::cut(
+        &log,
+        Formulation::Translational,
+        split.support,
+        Derivative::Forward,
+    )
+    .unwrap();
+    let thrust_z = log.rotation[0][2][2] * log.thrust_setpoint[0];
+    assert!((translational.controls[(0, 2)] - thrust_z).abs() < 1e-15);
 }

@@ -5,13 +5,14 @@
 //! on fold c's flights without condition c′. Prints, per formulation and fold, every candidate's
 //! score and the one fold c's own validation prefers, and writes all numbers as JSON.
 //!
-//! cargo run -p learn --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation|window|basis|clamp|tasks|restarts]
+//! cargo run -p pipeline --example select_settings -- [OUT_JSON] [SEED] [grid|iterations|averaging|adaptation-averaging|lipschitz|batch|passes|outer|regularisation|window|basis|clamp|tasks|restarts]
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use data::{ExperimentConditions, Formulation};
-use learn::{AdaptationConfig, Experiment, LearnConfig, Protocol};
+use data::ExperimentConditions;
+use learn::{AdaptationConfig, Formulation, LearnConfig};
+use pipeline::{Experiment, Protocol};
 use rayon::prelude::*;
 use serde_json::json;
 
@@ -360,7 +361,7 @@ fn restarts(
 ) -> Result<(), Box<dyn std::error::Error>> {
     let jobs = pair_jobs(folds, &RESTART_SEEDS);
     eprintln!("{} meta-trainings", jobs.len());
-    let results: Vec<[learn::ValidationDetail; 2]> = jobs
+    let results: Vec<[pipeline::ValidationDetail; 2]> = jobs
         .par_iter()
         .map(|(formulation, a, b, seed)| {
             experiment.nested_validation_detail(*formulation, [a, b], *seed, SUPPORT_TAIL)
@@ -368,7 +369,7 @@ fn restarts(
         .collect::<Result<_, _>>()?;
     // details[(formulation, fold, validated condition)][seed index]: fold a's validation scores
     // condition b and fold b's scores condition a.
-    let mut details: BTreeMap<(String, String, String), Vec<&learn::ValidationDetail>> =
+    let mut details: BTreeMap<(String, String, String), Vec<&pipeline::ValidationDetail>> =
         BTreeMap::new();
     for ((formulation, a, b, _), [on_a, on_b]) in jobs.iter().zip(&results) {
         let name = formulation.name().to_string();
@@ -488,7 +489,7 @@ fn restarts(
 
 /// A way to build one model from a group of seeds (indices into the per-seed details), scored by
 /// its generalisation MSE.
-type Strategy = fn(&[&learn::ValidationDetail], &[usize]) -> f64;
+type Strategy = fn(&[&pipeline::ValidationDetail], &[usize]) -> f64;
 
 /// Every subset of `size` indices out of `0..count`, in lexicographic order.
 fn groups_of(count: usize, size: usize) -> Vec<Vec<usize>> {

@@ -192,9 +192,17 @@ impl LearnConfig {
             field: field.to_string(),
             message: message.to_string(),
         };
-        let positive = |value: f64| value.is_finite() && value > 0.0;
-        let meta = &self.meta_training;
-        let adaptation = &self.adaptation;
+        self.check_architecture(&error)?;
+        self.check_training(&error)?;
+        self.check_spread_seeds(&error)?;
+        Ok(CheckedConfig {
+            config: self,
+            origin: origin.to_path_buf(),
+        })
+    }
+
+    /// The networks' sizes and their parameter count.
+    fn check_architecture(&self, error: &dyn Fn(&str, &str) -> LearnError) -> Result<()> {
         if !(1..=limits::BASIS_PER_INPUT).contains(&self.basis_per_input) {
             return Err(error(
                 "basis_per_input",
@@ -224,7 +232,7 @@ impl LearnConfig {
         let parameters = Formulation::ALL
             .iter()
             .map(|&formulation| {
-                crate::formulation::architecture(formulation, &self).parameter_count()
+                crate::formulation::architecture(formulation, self).parameter_count()
             })
             .max()
             .unwrap_or(0);
@@ -237,6 +245,14 @@ impl LearnConfig {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    /// Meta-training's and adaptation's steps, rounds, batches and weights.
+    fn check_training(&self, error: &dyn Fn(&str, &str) -> LearnError) -> Result<()> {
+        let positive = |value: f64| value.is_finite() && value > 0.0;
+        let meta = &self.meta_training;
+        let adaptation = &self.adaptation;
         if !positive(meta.inner_step) {
             return Err(error(
                 "meta_training.inner_step",
@@ -299,6 +315,11 @@ impl LearnConfig {
         if !(adaptation.lipschitz_bound.is_finite() && adaptation.lipschitz_bound >= 0.0) {
             return Err(error("adaptation.lipschitz_bound", "must be ≥ 0"));
         }
+        Ok(())
+    }
+
+    /// At least two different seeds for the seed-to-seed spread.
+    fn check_spread_seeds(&self, error: &dyn Fn(&str, &str) -> LearnError) -> Result<()> {
         // The spread is a sample standard deviation (n − 1): undefined over fewer than two seeds.
         if self.spread_seeds.len() < 2 {
             return Err(error(
@@ -317,10 +338,7 @@ impl LearnConfig {
                 &format!("seed {} appears more than once", pair[0]),
             ));
         }
-        Ok(CheckedConfig {
-            config: self,
-            origin: origin.to_path_buf(),
-        })
+        Ok(())
     }
 }
 

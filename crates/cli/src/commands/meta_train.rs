@@ -275,6 +275,78 @@ struct Outputs {
 /// `--config` for the flights when not given.
 const DEFAULT_CONFIG: &str = "experiments/learn.json";
 
+/// The cells a run meta-trains: every formulation on every evaluated condition, one seed.
+struct CellsPlanned<'a> {
+    protocol: Protocol,
+    formulations: &'a [Formulation],
+    evaluated: &'a [String],
+    seed: u64,
+}
+
+/// Plans every checkpoint in the output set; refuses a checkpoint that is also `--out`.
+fn plan_checkpoints(
+    set: &mut OutputSet,
+    outputs: &Outputs,
+    cells: &CellsPlanned,
+    out: &Path,
+) -> anyhow::Result<()> {
+    for &formulation in cells.formulations {
+        for condition in cells.evaluated {
+            let name = checkpoint_path(
+                Path::new(""),
+                cells.protocol,
+                formulation,
+                condition,
+                cells.seed,
+            );
+            let path = set.file_in(outputs.checkpoints, name);
+            if super::same_file(&path, out) {
+                anyhow::bail!(
+                    "{}: is both --out and a checkpoint of this run ({}), refusing to write the summary over it",
+                    out.display(),
+                    path.display()
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Meta-trains and adapts every planned cell (only `condition`'s when given), with a bar.
+fn train_cells(
+    global: &Global,
+    experiment: &Experiment,
+    cells: &CellsPlanned,
+    condition: Option<&str>,
+) -> anyhow::Result<Vec<pipeline::CellResult>> {
+    let started = Instant::now();
+    let bar = progress_bar(
+        global.show_progress(),
+        cells.formulations.len() * cells.evaluated.len(),
+        "meta-train",
+    );
+    let results = match condition {
+        Some(condition) => cells
+            .formulations
+            .iter()
+            .map(|&f| {
+                let cell = experiment.run_cell(f, condition, cells.seed);
+                bar.inc(1);
+                cell
+            })
+            .collect::<pipeline::Result<Vec<_>>>(),
+        None => experiment.run_cells_observed(cells.formulations, cells.seed, &|_| bar.inc(1)),
+    };
+    bar.finish_and_clear();
+    let results = results?;
+    let elapsed = started.elapsed().as_secs_f64();
+    say!(
+        "meta-training and adaptation of {} cells: {elapsed:.1} s",
+        results.len()
+    );
+    Ok(results)
+}
+
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     if args.tasks.tasks.is_some() {
         return super::meta_train_tasks::run(global, &args);
@@ -323,48 +395,24 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let protocol = Protocol::resolve(protocol, &conditions, &data_dir);
 
     let seed = config.get().seed;
-    for &formulation in &formulations {
-        for condition in &evaluated {
-            let name = checkpoint_path(Path::new(""), protocol, formulation, condition, seed);
-            let path = set.file_in(outputs.checkpoints, name);
-            if super::same_file(&path, &out) {
-                anyhow::bail!(
-                    "{}: is both --out and a checkpoint of this run ({}), refusing to write the summary over it",
-                    out.display(),
-                    path.display()
-                );
-            }
-        }
-    }
+    let cells_planned = CellsPlanned {
+        protocol,
+        formulations: &formulations,
+        evaluated: &evaluated,
+        seed,
+    };
+    plan_checkpoints(&mut set, &outputs, &cells_planned, &out)?;
     // Every output is proven writable (and its folder locked) before any training.
     let staged = set.prepare()?;
     let experiment = Experiment::load(config.clone(), conditions, &data_dir, Some(protocol))?;
     say!("protocol: {}", protocol.name());
 
-    let started = Instant::now();
-    let bar = progress_bar(
-        global.show_progress(),
-        formulations.len() * evaluated.len(),
-        "meta-train",
-    );
-    let cells = match &args.condition {
-        Some(condition) => formulations
-            .iter()
-            .map(|&f| {
-                let cell = experiment.run_cell(f, condition, seed);
-                bar.inc(1);
-                cell
-            })
-            .collect::<pipeline::Result<Vec<_>>>(),
-        None => experiment.run_cells_observed(&formulations, seed, &|_| bar.inc(1)),
-    };
-    bar.finish_and_clear();
-    let cells = cells?;
-    let elapsed = started.elapsed().as_secs_f64();
-    say!(
-        "meta-training and adaptation of {} cells: {elapsed:.1} s",
-        cells.len()
-    );
+    let cells = train_cells(
+        global,
+        &experiment,
+        &cells_planned,
+        args.condition.as_deref(),
+    )?;
     let Outputs {
         out: out_file,
         checkpoints: checkpoint_folder,

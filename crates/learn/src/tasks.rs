@@ -306,13 +306,13 @@ pub struct RecordingEvaluation {
     pub support_rows: Range<usize>,
     pub query_rows: Range<usize>,
     /// The model adapted online on the support rows, on those rows.
-    pub adapt_mse: f64,
+    pub adaptation: f64,
     /// The same adapted model, frozen, on the query rows.
-    pub gen_mse: f64,
+    pub generalisation: f64,
     /// The meta-trained model before adaptation, on the support rows.
-    pub unadapted_adapt_mse: f64,
+    pub unadapted_adaptation: f64,
     /// The meta-trained model before adaptation, on the query rows.
-    pub unadapted_gen_mse: f64,
+    pub unadapted_generalisation: f64,
     /// θ after adaptation.
     pub adapted_parameters: Vec<f64>,
     /// Raw inputs and targets of the support rows (for a baseline fitted on the same data).
@@ -377,10 +377,10 @@ pub fn evaluate_recording(
         mean_squared_error(&model.predict_with(parameters, &data.inputs), &data.targets)
     };
     let evaluation = RecordingEvaluation {
-        adapt_mse: mse(&adapted, &support_data),
-        gen_mse: mse(&adapted, &query_data),
-        unadapted_adapt_mse: mse(&model.parameters, &support_data),
-        unadapted_gen_mse: mse(&model.parameters, &query_data),
+        adaptation: mse(&adapted, &support_data),
+        generalisation: mse(&adapted, &query_data),
+        unadapted_adaptation: mse(&model.parameters, &support_data),
+        unadapted_generalisation: mse(&model.parameters, &query_data),
         support_rows: support,
         query_rows: query,
         adapted_parameters: adapted,
@@ -390,10 +390,10 @@ pub fn evaluate_recording(
     for (name, value) in [
         (
             "meta-trained model's support MSE",
-            evaluation.unadapted_adapt_mse,
+            evaluation.unadapted_adaptation,
         ),
-        ("adaptation MSE", evaluation.adapt_mse),
-        ("generalisation MSE", evaluation.gen_mse),
+        ("adaptation MSE", evaluation.adaptation),
+        ("generalisation MSE", evaluation.generalisation),
     ] {
         if !value.is_finite() {
             return Err(LearnError::NotFinite {

@@ -124,12 +124,12 @@ fn a_meta_trained_model_adapts_to_an_unseen_draw_better_than_without_adaptation(
     let recording = recording("unseen.csv", &unseen);
     let evaluation = learn::evaluate_recording(&model, recording, 0..200, 200..400).unwrap();
     assert!(
-        evaluation.gen_mse < 0.8 * evaluation.unadapted_gen_mse,
+        evaluation.generalisation < 0.8 * evaluation.unadapted_generalisation,
         "adapted {} against unadapted {}",
-        evaluation.gen_mse,
-        evaluation.unadapted_gen_mse
+        evaluation.generalisation,
+        evaluation.unadapted_generalisation
     );
-    assert!(evaluation.adapt_mse < evaluation.unadapted_adapt_mse);
+    assert!(evaluation.adaptation < evaluation.unadapted_adaptation);
 
     // The checkpoint round-trips, with what it was trained on.
     let path = dir.join("model.json");

@@ -69,7 +69,7 @@ fn cells(logs: &[FlightLog], config: &SindyConfig) -> Vec<f64> {
                 Derivative::Forward,
             )
             .expect("a cell");
-            [e.support_mse, e.query_mse]
+            [e.adaptation, e.generalisation]
         })
         .collect()
 }

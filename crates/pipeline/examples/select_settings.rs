@@ -385,7 +385,7 @@ fn restarts(
     let groups = groups_of(RESTART_SEEDS.len(), RESTART_GROUP);
     let strategies: [(&str, Strategy); 4] = [
         ("single-seed", |seeds, _| {
-            seeds.iter().map(|d| d.query_mse).sum::<f64>() / seeds.len() as f64
+            seeds.iter().map(|d| d.generalisation).sum::<f64>() / seeds.len() as f64
         }),
         ("select-by-support-tail", |seeds, group| {
             let chosen = group
@@ -397,7 +397,7 @@ fn restarts(
                 })
                 .copied()
                 .unwrap_or(0);
-            seeds[chosen].query_mse
+            seeds[chosen].generalisation
         }),
         ("ensemble", |seeds, group| {
             let targets = &seeds[group[0]].query_targets;
@@ -415,7 +415,7 @@ fn restarts(
         ("best-by-query", |seeds, group| {
             group
                 .iter()
-                .map(|&i| seeds[i].query_mse)
+                .map(|&i| seeds[i].generalisation)
                 .fold(f64::INFINITY, f64::min)
         }),
     ];
@@ -426,7 +426,7 @@ fn restarts(
         for ((f, _, _), seeds) in &details {
             if f == formulation {
                 let tail: Vec<f64> = seeds.iter().map(|d| d.support_tail_mse).collect();
-                let query: Vec<f64> = seeds.iter().map(|d| d.query_mse).collect();
+                let query: Vec<f64> = seeds.iter().map(|d| d.generalisation).collect();
                 correlations.push(correlation(&tail, &query));
             }
         }

@@ -86,13 +86,17 @@ pub struct CellSummary {
     pub protocol: Protocol,
     pub seed: u64,
     /// The adapted model on the support segment.
-    pub adapt_mse: f64,
+    #[serde(rename = "adapt_mse")]
+    pub adaptation: f64,
     /// The adapted model, frozen, on the query segment.
-    pub gen_mse: f64,
+    #[serde(rename = "gen_mse")]
+    pub generalisation: f64,
     /// The meta-trained model before adaptation, on the support segment.
-    pub unadapted_adapt_mse: f64,
+    #[serde(rename = "unadapted_adapt_mse")]
+    pub unadapted_adaptation: f64,
     /// The meta-trained model before adaptation, on the query segment.
-    pub unadapted_gen_mse: f64,
+    #[serde(rename = "unadapted_gen_mse")]
+    pub unadapted_generalisation: f64,
     /// The evaluated flight.
     pub evaluation_file: DataFile,
     /// How much of the support segment lies outside the range of the meta-training inputs.
@@ -439,16 +443,16 @@ impl Experiment {
         let name = format!("{} {}", formulation.name(), condition.name);
         // The meta-trained model before adaptation: when it already gives non-finite numbers the
         // adaptation settings are not the cause.
-        let unadapted_adapt_mse = architecture.loss(
+        let unadapted_adaptation = architecture.loss(
             &model.parameters,
             &support_batch.inputs,
             &support_batch.targets,
         );
-        let unadapted_gen_mse =
+        let unadapted_generalisation =
             architecture.loss(&model.parameters, &query_batch.inputs, &query_batch.targets);
         for (what, value) in [
-            ("unadapted adaptation MSE", unadapted_adapt_mse),
-            ("unadapted generalisation MSE", unadapted_gen_mse),
+            ("unadapted adaptation MSE", unadapted_adaptation),
+            ("unadapted generalisation MSE", unadapted_generalisation),
         ] {
             if !value.is_finite() {
                 return Err(not_finite(
@@ -486,17 +490,17 @@ impl Experiment {
             label: condition.label().to_string(),
             protocol,
             seed: model.seed,
-            adapt_mse: mean_squared_error(&support_predictions, &support_batch.targets),
-            gen_mse: mean_squared_error(&query_predictions, &query_batch.targets),
-            unadapted_adapt_mse,
-            unadapted_gen_mse,
+            adaptation: mean_squared_error(&support_predictions, &support_batch.targets),
+            generalisation: mean_squared_error(&query_predictions, &query_batch.targets),
+            unadapted_adaptation,
+            unadapted_generalisation,
             evaluation_file: cell.flight.file.clone(),
             support_coverage,
             query_coverage,
         };
         for (what, value) in [
-            ("adaptation MSE", summary.adapt_mse),
-            ("generalisation MSE", summary.gen_mse),
+            ("adaptation MSE", summary.adaptation),
+            ("generalisation MSE", summary.generalisation),
         ] {
             if !value.is_finite() {
                 return Err(not_finite(

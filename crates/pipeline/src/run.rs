@@ -292,8 +292,8 @@ impl<'c> ReproduceWork<'c> {
             support_rows: [evaluation.support.rows.start, evaluation.support.rows.end],
             query_rows: [evaluation.query.rows.start, evaluation.query.rows.end],
             sindy: SindyOutcome {
-                adapt: cell.sindy.support_mse,
-                r#gen: cell.sindy.query_mse,
+                adaptation: cell.sindy.adaptation,
+                generalisation: cell.sindy.generalisation,
                 equations: cell.sindy.model.equations(3),
                 query_coverage: sindy_query_coverage(cell, result),
             },

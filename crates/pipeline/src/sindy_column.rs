@@ -74,9 +74,9 @@ pub struct SegmentEvaluation {
     pub query_prediction: Mat<f64>,
     /// MSE against the support segment's targets: mean over samples and state dimensions
     /// (the paper's "adapt" error).
-    pub support_mse: f64,
+    pub adaptation: f64,
     /// MSE against the query segment's targets (the paper's "gen" error).
-    pub query_mse: f64,
+    pub generalisation: f64,
 }
 
 /// Fits `config` on `support` (its states, controls and targets as built by the data crate),
@@ -108,8 +108,8 @@ pub fn fit_and_evaluate(
         params.fit_and_predict(support.inputs().as_ref(), fit_targets.as_ref())?;
     let query_prediction = model.predict_inputs(query.inputs().as_ref())?;
     Ok(SegmentEvaluation {
-        support_mse: mean_squared_error(support_prediction.as_ref(), support.targets.as_ref()),
-        query_mse: mean_squared_error(query_prediction.as_ref(), query.targets.as_ref()),
+        adaptation: mean_squared_error(support_prediction.as_ref(), support.targets.as_ref()),
+        generalisation: mean_squared_error(query_prediction.as_ref(), query.targets.as_ref()),
         model,
         support_prediction,
         query_prediction,

@@ -27,8 +27,8 @@ pub struct SegmentPredictions {
     pub support_prediction: Mat<f64>,
     pub query_prediction: Mat<f64>,
     /// MSE on the support segment (adapt) and on the query segment (gen).
-    pub support_mse: f64,
-    pub query_mse: f64,
+    pub adaptation: f64,
+    pub generalisation: f64,
     /// The ensemble band on both segments, when bagged.
     pub support_band: Option<EnsemblePrediction>,
     pub query_band: Option<EnsemblePrediction>,
@@ -43,8 +43,8 @@ impl SegmentPredictions {
         query_targets: MatRef<'_, f64>,
     ) -> Self {
         Self {
-            support_mse: mean_squared_error(support_prediction.as_ref(), support_targets),
-            query_mse: mean_squared_error(query_prediction.as_ref(), query_targets),
+            adaptation: mean_squared_error(support_prediction.as_ref(), support_targets),
+            generalisation: mean_squared_error(query_prediction.as_ref(), query_targets),
             support_prediction,
             query_prediction,
             support_band: None,

@@ -48,8 +48,10 @@ pub struct Provenance {
 /// SINDy on one flight.
 #[derive(Clone, Debug, Serialize)]
 pub struct SindyCell {
-    pub adapt: f64,
-    pub r#gen: f64,
+    #[serde(rename = "adapt")]
+    pub adaptation: f64,
+    #[serde(rename = "gen")]
+    pub generalisation: f64,
     /// The fitted equations, three decimals.
     pub equations: Vec<String>,
     /// SINDy's generalisation MSE over the query samples inside the range of the LeARN
@@ -76,8 +78,10 @@ pub struct InputContribution {
 #[derive(Clone, Debug, Serialize)]
 pub struct LearnSeedCell {
     pub seed: u64,
-    pub adapt: f64,
-    pub r#gen: f64,
+    #[serde(rename = "adapt")]
+    pub adaptation: f64,
+    #[serde(rename = "gen")]
+    pub generalisation: f64,
     /// The meta-trained model before online adaptation.
     pub unadapted_adapt: f64,
     pub unadapted_gen: f64,
@@ -88,8 +92,10 @@ pub struct LearnSeedCell {
 /// LeARN on one flight: the mean over seeds, each seed, and the adapted model explained.
 #[derive(Clone, Debug, Serialize)]
 pub struct LearnCell {
-    pub adapt: f64,
-    pub r#gen: f64,
+    #[serde(rename = "adapt")]
+    pub adaptation: f64,
+    #[serde(rename = "gen")]
+    pub generalisation: f64,
     pub seeds: Vec<LearnSeedCell>,
     /// The first seed's adapted model, explained over the support segment.
     pub explanation: Explanation,

@@ -120,8 +120,10 @@ pub struct CellDetail {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SindyOutcome {
-    pub adapt: f64,
-    pub r#gen: f64,
+    #[serde(rename = "adapt")]
+    pub adaptation: f64,
+    #[serde(rename = "gen")]
+    pub generalisation: f64,
     /// Three decimals.
     pub equations: Vec<String>,
     /// SINDy's query predictions split as LeARN's query coverage (first seed's range).
@@ -223,8 +225,8 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
 /// The LeARN errors of a cell, averaged over seeds.
 fn learn_mse(cell: &CellOutcomes) -> Mse {
     Mse {
-        adaptation: mean(cell.seeds.iter().map(|s| s.summary.adapt_mse)),
-        generalisation: mean(cell.seeds.iter().map(|s| s.summary.gen_mse)),
+        adaptation: mean(cell.seeds.iter().map(|s| s.summary.adaptation)),
+        generalisation: mean(cell.seeds.iter().map(|s| s.summary.generalisation)),
     }
 }
 
@@ -261,8 +263,8 @@ fn table(
             let mut row = Row::new(
                 &cell.condition.label,
                 Mse {
-                    adaptation: sindy.adapt,
-                    generalisation: sindy.r#gen,
+                    adaptation: sindy.adaptation,
+                    generalisation: sindy.generalisation,
                 },
                 learn_mse(cell),
             );
@@ -344,8 +346,8 @@ fn record(cell: &CellOutcomes) -> CellRecord {
         support_rows: detail.support_rows,
         query_rows: detail.query_rows,
         sindy: SindyCell {
-            adapt: detail.sindy.adapt,
-            r#gen: detail.sindy.r#gen,
+            adaptation: detail.sindy.adaptation,
+            generalisation: detail.sindy.generalisation,
             equations: detail.sindy.equations.clone(),
             gen_inside_range: sindy_split.and_then(|c| c.mse_inside),
             gen_outside_range: sindy_split.and_then(|c| c.mse_outside),
@@ -361,17 +363,17 @@ fn record(cell: &CellOutcomes) -> CellRecord {
                 .collect(),
         },
         learn: LearnCell {
-            adapt: mse.adaptation,
-            r#gen: mse.generalisation,
+            adaptation: mse.adaptation,
+            generalisation: mse.generalisation,
             seeds: cell
                 .seeds
                 .iter()
                 .map(|seed| LearnSeedCell {
                     seed: seed.summary.seed,
-                    adapt: seed.summary.adapt_mse,
-                    r#gen: seed.summary.gen_mse,
-                    unadapted_adapt: seed.summary.unadapted_adapt_mse,
-                    unadapted_gen: seed.summary.unadapted_gen_mse,
+                    adaptation: seed.summary.adaptation,
+                    generalisation: seed.summary.generalisation,
+                    unadapted_adapt: seed.summary.unadapted_adaptation,
+                    unadapted_gen: seed.summary.unadapted_generalisation,
                     final_meta_loss: seed.final_meta_loss,
                 })
                 .collect(),

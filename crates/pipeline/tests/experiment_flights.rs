@@ -78,7 +78,7 @@ fn leave_condition_out_cell_runs_end_to_end() {
             .all(|f| { !f.path.to_string_lossy().contains("70p20sint") && f.sha256.len() == 64 })
     );
     let summary = &cell.summary;
-    assert!(summary.adapt_mse.is_finite() && summary.gen_mse.is_finite());
+    assert!(summary.adaptation.is_finite() && summary.generalisation.is_finite());
     assert_eq!(summary.label, "70psin20");
     assert_eq!(
         cell.support.predictions.nrows() + cell.query.predictions.nrows(),
@@ -95,7 +95,7 @@ fn leave_condition_out_cell_runs_end_to_end() {
         }
     }
     let mse = sum / (p.nrows() * p.ncols()) as f64;
-    assert!((mse - summary.gen_mse).abs() < 1e-12 * mse);
+    assert!((mse - summary.generalisation).abs() < 1e-12 * mse);
     // LeARN is scored against the experiment's cell, whose segments the run fits SINDy on: the
     // targets of the run's split and derivative (the only ones a run configuration accepts).
     let evaluation = experiment
@@ -329,9 +329,9 @@ fn nested_validation_detail_agrees_with_nested_validation() {
         .unwrap();
     for (detail, score) in detail.iter().zip(&scores) {
         // The same meta-training and adaptation: the same generalisation MSE, bit for bit.
-        assert_eq!(detail.query_mse, score[0]);
+        assert_eq!(detail.generalisation, score[0]);
         assert_eq!(
-            detail.query_mse,
+            detail.generalisation,
             learn::mean_squared_error(&detail.query_predictions, &detail.query_targets)
         );
         assert_eq!(detail.query_predictions.len(), detail.query_targets.len());

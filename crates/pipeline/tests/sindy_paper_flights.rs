@@ -82,8 +82,8 @@ fn check_cells(config: &SindyConfig, table: &str, tolerance: fn(Formulation) -> 
             let paper = &published["tables"][formulation.name()][label]["sindy"];
             let reference = &pysindy[table][formulation.name()][label];
             for (name, ours) in [
-                ("adapt", evaluation.support_mse),
-                ("gen", evaluation.query_mse),
+                ("adapt", evaluation.adaptation),
+                ("gen", evaluation.generalisation),
             ] {
                 let paper_value = paper[name].as_f64().unwrap();
                 let pysindy_value = reference[name].as_f64().unwrap();

@@ -98,16 +98,13 @@ fn perturbing_the_query_changes_no_choice() {
             assert_eq!(!a.chosen.is_empty(), chooses, "{what}: choices recorded");
             assert_eq!(a.chosen, b.chosen, "{what}: a choice moved with the query");
             assert_eq!(a.support_cv, b.support_cv, "{what}");
-            assert_eq!(
-                a.predictions.support_mse, b.predictions.support_mse,
-                "{what}"
-            );
+            assert_eq!(a.predictions.adaptation, b.predictions.adaptation, "{what}");
             assert_eq!(
                 a.predictions.support_prediction, b.predictions.support_prediction,
                 "{what}"
             );
             assert_ne!(
-                a.predictions.query_mse, b.predictions.query_mse,
+                a.predictions.generalisation, b.predictions.generalisation,
                 "{what}: not perturbed"
             );
         }

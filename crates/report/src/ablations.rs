@@ -13,8 +13,10 @@ use crate::table::{MethodPair, Mse};
 /// Mean and spread of one variant on one cell over the seeds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct VariantCell {
-    pub adapt: f64,
-    pub r#gen: f64,
+    #[serde(rename = "adapt")]
+    pub adaptation: f64,
+    #[serde(rename = "gen")]
+    pub generalisation: f64,
     /// Sample standard deviation over seeds (0 for one seed).
     pub adapt_std: f64,
     pub gen_std: f64,
@@ -25,8 +27,10 @@ pub struct VariantCell {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SeedCell {
     pub seed: u64,
-    pub adapt: f64,
-    pub r#gen: f64,
+    #[serde(rename = "adapt")]
+    pub adaptation: f64,
+    #[serde(rename = "gen")]
+    pub generalisation: f64,
     /// Mean over outputs of the best support cross-validation MSE (variants that fit a
     /// regression).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -154,11 +158,11 @@ fn headline_section(tables: &AblationTables, out: &mut String) {
             .unwrap_or(("–".to_string(), "–".to_string()));
         let (target, versus, below) = match row.target {
             Some(target) => {
-                let below = headline.r#gen < target;
+                let below = headline.generalisation < target;
                 wins += usize::from(below);
                 (
                     format!("{target:.3}"),
-                    format!("{:+.1} %", 100.0 * (headline.r#gen / target - 1.0)),
+                    format!("{:+.1} %", 100.0 * (headline.generalisation / target - 1.0)),
                     if below { "yes" } else { "**no**" }.to_string(),
                 )
             }
@@ -169,11 +173,11 @@ fn headline_section(tables: &AblationTables, out: &mut String) {
             row.table,
             row.condition,
             row.sindy.generalisation,
-            headline.r#gen,
+            headline.generalisation,
             headline.gen_std,
             row.noise_floor_query.lower,
             row.noise_floor_query.upper,
-            headline.r#gen / row.noise_floor_query.upper,
+            headline.generalisation / row.noise_floor_query.upper,
         ));
     }
     out.push_str(&format!(
@@ -202,7 +206,7 @@ fn noise_floor_section(tables: &AblationTables, out: &mut String) {
         let best = row
             .variants
             .values()
-            .map(|v| v.r#gen)
+            .map(|v| v.generalisation)
             .fold(f64::INFINITY, f64::min);
         out.push_str(&format!(
             "| {} | {} | {:.3}–{floor:.3} | {pub_sindy} | {pub_learn} | {} | {} | {} |\n",
@@ -210,7 +214,7 @@ fn noise_floor_section(tables: &AblationTables, out: &mut String) {
             row.condition,
             row.noise_floor_query.lower,
             ratio(row.sindy.generalisation),
-            ratio(row.variants[tables.headline].r#gen),
+            ratio(row.variants[tables.headline].generalisation),
             ratio(best),
         ));
     }
@@ -250,11 +254,11 @@ fn best_variant_section(tables: &AblationTables, out: &mut String) {
         let (name, cell) = row
             .variants
             .iter()
-            .min_by(|a, b| a.1.r#gen.total_cmp(&b.1.r#gen))
+            .min_by(|a, b| a.1.generalisation.total_cmp(&b.1.generalisation))
             .expect("at least one variant");
         let versus = row
             .target
-            .map(|t| format!("{:+.1} %", 100.0 * (cell.r#gen / t - 1.0)))
+            .map(|t| format!("{:+.1} %", 100.0 * (cell.generalisation / t - 1.0)))
             .unwrap_or_else(|| "–".to_string());
         let target = row
             .target
@@ -262,7 +266,7 @@ fn best_variant_section(tables: &AblationTables, out: &mut String) {
             .unwrap_or_else(|| "–".to_string());
         out.push_str(&format!(
             "| {} | {} | `{name}` | {:.3} | {target} | {versus} |\n",
-            row.table, row.condition, cell.r#gen
+            row.table, row.condition, cell.generalisation
         ));
     }
     out.push_str("\n(Picking the best variant per cell by its query error is itself a choice made on the query segment: this table is descriptive. The headline column above is declared in `experiments/variants.json`; its description says when it was chosen.)\n\n");
@@ -294,9 +298,9 @@ fn every_variant_section(tables: &AblationTables, metric: &str, out: &mut String
         for name in &names {
             let cell = &row.variants[*name];
             let (mean, std) = if metric == "gen" {
-                (cell.r#gen, cell.gen_std)
+                (cell.generalisation, cell.gen_std)
             } else {
-                (cell.adapt, cell.adapt_std)
+                (cell.adaptation, cell.adapt_std)
             };
             out.push_str(&format!(" {mean:.3} ± {std:.3} |"));
         }
@@ -357,16 +361,16 @@ mod tests {
         assert_eq!(shorten(equation, 3), equation);
     }
 
-    fn cell(r#gen: f64, coverage: Option<f64>) -> VariantCell {
+    fn cell(generalisation: f64, coverage: Option<f64>) -> VariantCell {
         VariantCell {
-            adapt: r#gen / 2.0,
-            r#gen,
+            adaptation: generalisation / 2.0,
+            generalisation,
             adapt_std: 0.0,
             gen_std: 0.01,
             seeds: vec![SeedCell {
                 seed: 3,
-                adapt: r#gen / 2.0,
-                r#gen,
+                adaptation: generalisation / 2.0,
+                generalisation,
                 support_cv: None,
                 chosen: BTreeMap::new(),
                 query_band_coverage: coverage,

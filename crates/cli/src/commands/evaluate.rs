@@ -109,7 +109,7 @@ fn print_table(args: &Args, comparison: &RecordingComparison) {
     ] {
         say!(
             "{name:<22} {:>14.6} {:>14.6}",
-            scores.adapt,
+            scores.adaptation,
             scores.generalisation
         );
     }

@@ -189,7 +189,7 @@ fn print_cells(cells: &[CellSummary], table: &Option<PublishedTables>) {
         let sindy = published(table, cell, Method::Sindy);
         let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
         let verdict = match learn {
-            Some((_, gen_mse)) if cell.gen_mse <= gen_mse => "ok",
+            Some((_, gen_mse)) if cell.generalisation <= gen_mse => "ok",
             Some(_) => "WORSE",
             None => "",
         };
@@ -201,9 +201,9 @@ fn print_cells(cells: &[CellSummary], table: &Option<PublishedTables>) {
             "{:<14} {:<10} {:>8.3} {:>8.3} {:>14.3} | {:>15} {:>6} {:<5} | {:>17} | {:>13}",
             cell.formulation.name(),
             cell.label,
-            cell.adapt_mse,
-            cell.gen_mse,
-            cell.unadapted_gen_mse,
+            cell.adaptation,
+            cell.generalisation,
+            cell.unadapted_generalisation,
             show(learn.map(|l| l.0)),
             show(learn.map(|l| l.1)),
             verdict,

@@ -144,11 +144,11 @@ pub fn print_spread(spread: &[SpreadCell], seeds: &[u64], took: &str) {
             "{:<14} {:<10} {:>9.4} {:>9.4} {:>9.4} {:>9.4} {:>9.4}",
             cell.formulation.name(),
             cell.label,
-            cell.gen_mse.mean,
-            cell.gen_mse.std,
-            cell.gen_mse.min,
-            cell.gen_mse.max,
-            cell.adapt_mse.std
+            cell.generalisation.mean,
+            cell.generalisation.std,
+            cell.generalisation.min,
+            cell.generalisation.max,
+            cell.adaptation.std
         );
     }
 }

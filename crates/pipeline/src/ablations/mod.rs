@@ -312,11 +312,11 @@ fn summarise(seeds: Vec<SeedCell>) -> VariantCell {
         };
         (mean, variance.sqrt())
     };
-    let (adapt, adapt_std) = stats(seeds.iter().map(|s| s.adapt).collect());
-    let (r#gen, gen_std) = stats(seeds.iter().map(|s| s.r#gen).collect());
+    let (adaptation, adapt_std) = stats(seeds.iter().map(|s| s.adaptation).collect());
+    let (generalisation, gen_std) = stats(seeds.iter().map(|s| s.generalisation).collect());
     VariantCell {
-        adapt,
-        r#gen,
+        adaptation,
+        generalisation,
         adapt_std,
         gen_std,
         seeds,

@@ -123,8 +123,8 @@ impl<'c> AblationsWork<'c> {
             .iter()
             .map(|outcome| SeedCell {
                 seed: item.seed,
-                adapt: outcome.predictions.support_mse,
-                r#gen: outcome.predictions.query_mse,
+                adaptation: outcome.predictions.adaptation,
+                generalisation: outcome.predictions.generalisation,
                 support_cv: outcome.support_cv,
                 chosen: outcome.chosen.clone(),
                 query_band_coverage: outcome
@@ -169,8 +169,8 @@ impl<'c> AblationsWork<'c> {
         };
         Ok(AblationCellDetail {
             sindy: report::Mse {
-                adaptation: sindy.support_mse,
-                generalisation: sindy.query_mse,
+                adaptation: sindy.adaptation,
+                generalisation: sindy.generalisation,
             },
             noise_floor_support: forward_difference_noise_floor(
                 cell.support.states.as_ref(),

@@ -25,7 +25,7 @@ struct NestedModel<'a> {
 #[derive(Clone, Debug)]
 pub struct ValidationDetail {
     /// Generalisation MSE after adaptation on the whole support segment.
-    pub query_mse: f64,
+    pub generalisation: f64,
     /// MSE on the support segment's tail after adaptation on the rest of it.
     pub support_tail_mse: f64,
     /// The adapted model's query predictions, row-major, samples × I.
@@ -193,7 +193,7 @@ impl Experiment {
             );
             let adapted = adapt(rows);
             Ok(ValidationDetail {
-                query_mse: architecture.loss(&adapted, &query.inputs, &query.targets),
+                generalisation: architecture.loss(&adapted, &query.inputs, &query.targets),
                 support_tail_mse,
                 query_predictions: architecture.predict(&adapted, &query.inputs),
                 query_targets: query.targets,

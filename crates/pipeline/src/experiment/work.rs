@@ -194,8 +194,8 @@ pub fn spread_cells(items: &[WorkItem], summaries: &[Vec<CellSummary>]) -> Vec<S
                 label: first.label.clone(),
                 protocol: first.protocol,
                 seeds: seeds.clone(),
-                gen_mse: Spread::of(runs.iter().map(|r| r[cell].gen_mse).collect()),
-                adapt_mse: Spread::of(runs.iter().map(|r| r[cell].adapt_mse).collect()),
+                generalisation: Spread::of(runs.iter().map(|r| r[cell].generalisation).collect()),
+                adaptation: Spread::of(runs.iter().map(|r| r[cell].adaptation).collect()),
             }
         })
         .collect()
@@ -242,25 +242,32 @@ pub struct SpreadCell {
     pub label: String,
     pub protocol: Protocol,
     pub seeds: Vec<u64>,
-    pub gen_mse: Spread,
-    pub adapt_mse: Spread,
+    #[serde(rename = "gen_mse")]
+    pub generalisation: Spread,
+    #[serde(rename = "adapt_mse")]
+    pub adaptation: Spread,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn summary(formulation: Formulation, condition: &str, seed: u64, r#gen: f64) -> CellSummary {
+    fn summary(
+        formulation: Formulation,
+        condition: &str,
+        seed: u64,
+        generalisation: f64,
+    ) -> CellSummary {
         CellSummary {
             formulation,
             condition: condition.to_string(),
             label: condition.to_string(),
             protocol: Protocol::LeaveConditionOut,
             seed,
-            adapt_mse: r#gen / 2.0,
-            gen_mse: r#gen,
-            unadapted_adapt_mse: 1.0,
-            unadapted_gen_mse: 1.0,
+            adaptation: generalisation / 2.0,
+            generalisation,
+            unadapted_adaptation: 1.0,
+            unadapted_generalisation: 1.0,
             evaluation_file: learn::DataFile {
                 path: format!("{condition}.csv").into(),
                 sha256: String::new(),
@@ -291,8 +298,8 @@ mod tests {
         assert_eq!(spread.len(), 2);
         assert_eq!(spread[1].condition, "b");
         assert_eq!(spread[1].seeds, [1, 2]);
-        assert_eq!(spread[1].gen_mse.values, [1.0, 2.0]);
-        assert_eq!(spread[0].adapt_mse.values, [0.5, 1.0]);
+        assert_eq!(spread[1].generalisation.values, [1.0, 2.0]);
+        assert_eq!(spread[0].adaptation.values, [0.5, 1.0]);
         assert_eq!(items[3].to_string(), "attitude b seed 2");
         let every = WorkItem {
             cells: Cells::Every,

@@ -299,7 +299,12 @@ fn learn_scores(
                 .iter()
                 .map(|&n| {
                     let e = super::tasks::evaluate_on(model, recording, 0..n, query.clone())?;
-                    Ok([e.gen_mse, f64::NAN, f64::NAN, e.unadapted_gen_mse])
+                    Ok([
+                        e.generalisation,
+                        f64::NAN,
+                        f64::NAN,
+                        e.unadapted_generalisation,
+                    ])
                 })
                 .collect::<Result<Vec<_>>>()
         })
@@ -413,10 +418,10 @@ fn score_task(
     )?;
     let ridge = baselines.ridge(&evaluation.support, &evaluation.query, dims)?;
     Ok([
-        evaluation.gen_mse,
+        evaluation.generalisation,
         sindy.generalisation,
         ridge,
-        evaluation.unadapted_gen_mse,
+        evaluation.unadapted_generalisation,
     ])
 }
 

@@ -28,7 +28,8 @@ pub use tasks::{check_interval, read_recording, read_tasks, recording};
 /// Adaptation (support rows) and generalisation (query rows) MSE of one method.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Scores {
-    pub adapt: f64,
+    #[serde(rename = "adapt")]
+    pub adaptation: f64,
     #[serde(rename = "gen")]
     pub generalisation: f64,
 }
@@ -111,7 +112,7 @@ pub(crate) fn sindy_scores(
         Ok(mse(&predictions, &batch.targets))
     };
     let scores = Scores {
-        adapt: score(fit)?,
+        adaptation: score(fit)?,
         generalisation: score(query)?,
     };
     Ok((scores, model))
@@ -149,7 +150,7 @@ pub fn compare_on_recording(
         &rows_text,
     )?;
     for (what, value) in [
-        ("SINDy's adaptation MSE", sindy_scores.adapt),
+        ("SINDy's adaptation MSE", sindy_scores.adaptation),
         ("SINDy's generalisation MSE", sindy_scores.generalisation),
     ] {
         if !value.is_finite() {
@@ -161,12 +162,12 @@ pub fn compare_on_recording(
     }
     Ok(RecordingComparison {
         learn: Scores {
-            adapt: evaluation.adapt_mse,
-            generalisation: evaluation.gen_mse,
+            adaptation: evaluation.adaptation,
+            generalisation: evaluation.generalisation,
         },
         learn_unadapted: Scores {
-            adapt: evaluation.unadapted_adapt_mse,
-            generalisation: evaluation.unadapted_gen_mse,
+            adaptation: evaluation.unadapted_adaptation,
+            generalisation: evaluation.unadapted_generalisation,
         },
         sindy: sindy_scores,
         sindy_model,

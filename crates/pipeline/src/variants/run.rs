@@ -124,8 +124,8 @@ pub fn reproduce_columns(
                     (
                         spec.name.clone(),
                         report::Mse {
-                            adaptation: outcome.predictions.support_mse,
-                            generalisation: outcome.predictions.query_mse,
+                            adaptation: outcome.predictions.adaptation,
+                            generalisation: outcome.predictions.generalisation,
                         },
                     )
                 })
@@ -387,10 +387,10 @@ mod tests {
         let error = |prediction: &Mat<f64>, segment: &Segment| {
             sindy::mean_squared_error(prediction.as_ref(), segment.targets.as_ref())
         };
-        assert_eq!(learn.query_mse, error(&learn.query_prediction, &query));
+        assert_eq!(learn.generalisation, error(&learn.query_prediction, &query));
         let average = &outcomes[2].predictions;
         assert_eq!(
-            average.support_mse,
+            average.adaptation,
             error(&average.support_prediction, &support)
         );
         assert!(outcomes[1].support_cv.is_none() && outcomes[2].chosen.is_empty());

@@ -6,6 +6,8 @@
 //! cell is judged against fixed targets ([`summary`]).
 
 mod summary;
+#[cfg(test)]
+mod tests;
 
 use std::path::{Path, PathBuf};
 

@@ -32,6 +32,8 @@ mod joint;
 mod report;
 mod scale_report;
 mod sensitivity;
+#[cfg(test)]
+mod tests;
 
 use std::path::{Path, PathBuf};
 

@@ -50,8 +50,7 @@ pub use evidence::{Evidence, EvidenceSettings};
 pub use fit::FittedSet;
 pub use library::{Candidate, CandidateId, Term, build_library};
 pub use output::{
-    check_directory, check_outputs, check_run_outputs, markdown_text, output_paths, write_figure,
-    write_outputs,
+    check_directory, check_outputs, check_run_outputs, output_paths, write_figure, write_outputs,
 };
 pub use problem::{CHANNEL_NAMES, Channels, Problem};
 pub use recording::Recording;

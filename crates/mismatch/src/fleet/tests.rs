@@ -8,10 +8,10 @@ use physics::{EffectId, Effects};
 use serde::de::DeserializeOwned;
 use serde_json::Value;
 
-use super::report::{FlightHeldout, VehicleEffect, VehicleParameters, VehicleReport, write};
+use super::report::{VehicleEffect, VehicleParameters, VehicleReport, write};
 use super::{
-    AttitudeCheck, FleetReport, FleetSettings, FlightSpeedRange, FlightWind, ScaleReport,
-    SelectionStep, Targets,
+    AttitudeCheck, FleetReport, FleetSettings, FlightHeldout, FlightSpeedRange, FlightWind,
+    ScaleReport, SelectionStep, Targets,
 };
 use crate::weak_form::TestFunction;
 
@@ -199,7 +199,7 @@ fn the_committed_report_prints_one_line_per_flight_and_the_targets() {
     let json: Value =
         serde_json::from_str(&std::fs::read_to_string(committed("neural-fly.json")).unwrap())
             .unwrap();
-    let lines = committed_report(&json).lines();
+    let lines = committed_report(&json).view().lines();
     assert_eq!(lines.len(), 63);
     assert_eq!(
         lines[30],

@@ -89,7 +89,7 @@ fn committed_summary() -> DemoSummary {
 #[test]
 fn the_committed_summary_renders_its_committed_markdown() {
     let summary = committed_summary();
-    assert_eq!(summary.markdown(), read("summary.md"));
+    assert_eq!(summary.view().markdown(), read("summary.md"));
 }
 
 #[test]
@@ -103,7 +103,7 @@ fn the_committed_summary_is_read_back_whole() {
 
 #[test]
 fn the_committed_summary_prints_one_line_per_cell_and_the_total() {
-    let text = committed_summary().table_text();
+    let text = committed_summary().view().table_text();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 185);
     assert_eq!(

@@ -48,12 +48,12 @@ use crate::problem::Problem;
 use crate::recording::Recording;
 use crate::weak_form::TestFunction;
 
+pub use self::report::FleetReport;
 pub use ::report::mismatch::fleet::{
     AttitudeCheck, FlightHeldout, FlightSpeedRange, FlightWind, ScaleReport, Targets,
 };
 pub use joint::{Air, Vehicle, VehicleParameter};
 use joint::{JointFit, JointFlight, JointSettings};
-pub use report::FleetReport;
 pub use scale_report::scale_report;
 pub use sensitivity::{LAG_GRID_S, LagProfile, LagSensitivity};
 

@@ -1,8 +1,9 @@
 //! The whole analysis of one recording: compare, locate, explain, fit, judge the evidence, validate
 //! on held-out data.
 
-use data::{FlightLog, RateFrame};
+use data::FlightLog;
 use physics::{EffectId, EffectParameters, Effects, Logger, NominalModel};
+pub use report::mismatch::recording::{ChannelReport, Fit, Heldout, Mse, RateFrameReport, Window};
 use serde::Serialize;
 
 use crate::describe::describe;
@@ -54,34 +55,6 @@ impl Default for AnalysisSettings {
     }
 }
 
-/// One analysed channel.
-#[derive(Clone, Debug, Serialize)]
-pub struct ChannelReport {
-    pub name: String,
-    /// RMS of the nominal model's residual over all analysed rows.
-    pub residual_rms: f64,
-    pub noise_floor: f64,
-    /// The part of the noise floor on the model's side (noise in the commands and attitude it
-    /// reads; the rest is the recorded velocity's or rate's own noise).
-    pub noise_floor_model_side: f64,
-    /// Whether the nominal model's residual exceeds the noise floor significantly.
-    pub significant: bool,
-    /// RMS of the fitted model's residual.
-    pub residual_rms_after: f64,
-    /// Whether a significant residual remains with the effects found.
-    pub significant_after: bool,
-    pub heldout_mse_before: f64,
-    pub heldout_mse_after: f64,
-}
-
-/// A stretch of time where one channel disagrees significantly.
-#[derive(Clone, Debug, Serialize)]
-pub struct Window {
-    pub channel: String,
-    pub t_start: f64,
-    pub t_end: f64,
-}
-
 /// One effect found.
 #[derive(Clone, Debug, Serialize)]
 pub struct EffectReport {
@@ -93,31 +66,6 @@ pub struct EffectReport {
     pub explained_fraction: f64,
     /// Why it is named ([`crate::evidence`]).
     pub evidence: Evidence,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct Mse {
-    pub mse: f64,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct Heldout {
-    pub before: Mse,
-    pub after: Mse,
-    pub t_start: f64,
-    pub t_end: f64,
-}
-
-/// Mean squared residuals (all analysed channels, raw units) before and after.
-#[derive(Clone, Debug, Serialize)]
-pub struct Fit {
-    pub before: Mse,
-    pub after: Mse,
-    pub heldout: Heldout,
-    /// What the MSEs are computed on.
-    pub comparison: String,
-    pub t_start: f64,
-    pub t_end: f64,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -138,13 +86,6 @@ pub struct SelectionReport {
     pub alternatives: FitAlternatives,
     /// The effects the evidence rule dropped, with their evidence when dropped.
     pub dropped: Vec<Evidence>,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct RateFrameReport {
-    pub used: RateFrame,
-    pub body_rms: f64,
-    pub world_rms: f64,
 }
 
 /// Everything written to `mismatch.json`.

@@ -51,6 +51,20 @@ pub enum MismatchError {
         field: String,
         message: String,
     },
+    /// An output the `report` crate could not render (a figure that cannot be drawn is [`Plot`]).
+    ///
+    /// [`Plot`]: MismatchError::Plot
+    #[error(transparent)]
+    Report(report::ReportError),
+}
+
+impl From<report::ReportError> for MismatchError {
+    fn from(error: report::ReportError) -> Self {
+        match error {
+            report::ReportError::Plot { path, message } => Self::Plot { path, message },
+            other => Self::Report(other),
+        }
+    }
 }
 
 /// Shorthand for results of this crate.

@@ -7,7 +7,12 @@
 //! prove it on simulated recordings with concealed effects ([`demo`]) and run it on the real
 //! Neural-Fly flights together ([`fleet`]).
 //!
-//! What it is not for: simulating (the `physics` crate) or reading logs (the `data` crate).
+//! What it is not for: simulating (the `physics` crate), reading logs (the `data` crate), or
+//! rendering its outputs: the Markdown, the terminal text and the SVG figures are rendered by the
+//! `report` crate ([`report::mismatch`]) from views this crate fills ([`Analysis::view`] and
+//! [`Analysis::figure`], [`fleet::FleetReport::view`], [`demo::DemoSummary::view`]); the plain
+//! parts of the results (windows, channels, fit errors, every flight's air, the targets) are
+//! `report`'s types, re-exported here. This crate computes the results and writes the files.
 //!
 //! Method in one paragraph (the long version: `docs/mismatch.md`): the recording and the model are
 //! compared in the weak form ([`weak_form`]: the recorded velocity and body rate against the model's
@@ -50,8 +55,7 @@ pub use evidence::{Evidence, EvidenceSettings};
 pub use fit::FittedSet;
 pub use library::{Candidate, CandidateId, Term, build_library};
 pub use output::{
-    check_directory, check_outputs, check_run_outputs, markdown_text, output_paths, write_figure,
-    write_outputs,
+    check_directory, check_outputs, check_run_outputs, output_paths, write_figure, write_outputs,
 };
 pub use problem::{CHANNEL_NAMES, Channels, Problem};
 pub use recording::Recording;

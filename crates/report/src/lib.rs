@@ -15,6 +15,10 @@
 //! What it is not for: computing any number. It knows nothing of flights, SINDy or LeARN and does
 //! not depend on the crates that do: the `pipeline` crate runs the experiments and hands the
 //! numbers and traces to this crate in its own plain types.
+//!
+//! The sim-to-real mismatch tool's outputs are rendered here too ([`mismatch`]: the Markdown, the
+//! terminal text and the SVG figures of one recording, of several flights analysed together and
+//! of the demo matrix), from plain result types and views that the `mismatch` crate fills.
 
 mod ablations;
 mod compare;
@@ -22,6 +26,7 @@ mod coverage;
 mod curve;
 mod error;
 mod figure;
+pub mod mismatch;
 mod published;
 mod render;
 mod table;

@@ -103,7 +103,7 @@ fn run_demo(manifest: &Path, args: &Args) -> anyhow::Result<()> {
     let staged_plan = plan.with_out(staged.dir(out));
     let summary = super::staged_write(&staged, || staged_plan.run(args.force))?;
     staged.commit()?;
-    say_part!("{}", summary.table_text());
+    say_part!("{}", summary.view().table_text());
     say!("wrote {}", plan.summary_paths()[0].display());
     Ok(())
 }

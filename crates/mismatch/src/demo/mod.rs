@@ -6,6 +6,8 @@
 //! cell is judged against fixed targets ([`summary`]).
 
 mod summary;
+#[cfg(test)]
+mod tests;
 
 use std::path::{Path, PathBuf};
 
@@ -398,7 +400,7 @@ impl DemoPlan {
             serde_json::to_string_pretty(&summary).expect("serialises") + "\n",
         )
         .map_err(io_error(&json))?;
-        std::fs::write(&markdown, summary.markdown()).map_err(io_error(&markdown))?;
+        std::fs::write(&markdown, summary.view().markdown()).map_err(io_error(&markdown))?;
         Ok(summary)
     }
 

@@ -6,33 +6,12 @@
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
-use serde::Serialize;
+use report::mismatch::fleet::AttitudeCheck;
 
 use super::FleetFlight;
 
 /// The largest lag of the motor commands behind the body's response tried, rows.
 const MAX_LAG_ROWS: usize = 6;
-
-/// What the attitude check finds.
-#[derive(Clone, Debug, Serialize)]
-pub struct AttitudeCheck {
-    /// The smallest and largest motor command logged.
-    pub pwm_range: [f64; 2],
-    /// The mean of the four motor commands as `offset + slope · T_sp`, with its residual RMS, at
-    /// the lag (rows behind `T_sp`) that fits best.
-    pub mean_pwm_offset: f64,
-    pub mean_pwm_slope: f64,
-    pub mean_pwm_lag_rows: usize,
-    pub mean_pwm_lag_s: f64,
-    pub mean_pwm_residual_rms: f64,
-    /// The lag (rows) of the torque map `ω̇ = c + B · pwm` chosen on the calm flights' held-out
-    /// part.
-    pub torque_map_lag_rows: usize,
-    /// Share of the weak-form `ω̇` variance (per body axis) the map explains: on the calm flights'
-    /// held-out part, and on the windy flights (not fitted on them at all).
-    pub explained_calm_heldout: [f64; 3],
-    pub explained_windy: Option<[f64; 3]>,
-}
 
 /// Per flight and row: the weak-form target of the body rate, and the weak form of the lagged
 /// motor commands.

@@ -32,6 +32,8 @@ mod joint;
 mod report;
 mod scale_report;
 mod sensitivity;
+#[cfg(test)]
+mod tests;
 
 use std::path::{Path, PathBuf};
 
@@ -46,11 +48,13 @@ use crate::problem::Problem;
 use crate::recording::Recording;
 use crate::weak_form::TestFunction;
 
-pub use attitude::AttitudeCheck;
+pub use self::report::FleetReport;
+pub use ::report::mismatch::fleet::{
+    AttitudeCheck, FlightHeldout, FlightSpeedRange, FlightWind, ScaleReport, Targets,
+};
 pub use joint::{Air, Vehicle, VehicleParameter};
 use joint::{JointFit, JointFlight, JointSettings};
-pub use report::{FleetReport, FlightWind, Targets};
-pub use scale_report::{FlightSpeedRange, ScaleReport};
+pub use scale_report::scale_report;
 pub use sensitivity::{LAG_GRID_S, LagProfile, LagSensitivity};
 
 /// Settings of the joint analysis (recorded in the output).
@@ -310,7 +314,7 @@ impl FleetPlan {
             settings,
         );
         report::write(&report, &self.outputs(), force)?;
-        let lines = report.lines();
+        let lines = report.view().lines();
         Ok((report, lines))
     }
 }

@@ -1,0 +1,294 @@
+//! The demo matrix on simulated recordings with concealed effects (`summary.md` and the terminal
+//! table): the targets every cell is judged against ([`Targets`], recorded as they are in
+//! `summary.json`), and [`DemoView`], what the summary says of the configurations and the cells
+//! with names and numbers in place of the simulator's and the analysis's types.
+
+use std::fmt::Write as _;
+
+use serde::{Deserialize, Serialize};
+
+/// The targets every cell is judged against (fixed before any run; recorded in the output).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Targets {
+    /// Each parameter's relative error at most this (factor parameters relative to |k − 1|).
+    pub parameters_within: f64,
+    /// Held-out MSE with the effects at most this fraction of the nominal model's (cases with an
+    /// effect) ...
+    pub heldout_ratio_at_most: f64,
+    /// ... or, when the noise alone keeps it above that (an effect at the level of the noise), at
+    /// most this multiple of the noise level: the nominal model's held-out MSE on the same
+    /// configuration's no-effect controls.
+    pub heldout_noise_multiple_at_most: f64,
+}
+
+/// The simulator's jitter of a configuration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JitterLine {
+    /// RMS of the collective-thrust jitter over the mass, m/s², and of each body torque's over
+    /// the axis's inertia, rad/s².
+    pub translational_m_s2: f64,
+    pub angular_rad_s2: f64,
+    /// Lowest and highest frequency, Hz.
+    pub band_hz: [f64; 2],
+}
+
+/// One configuration in words and numbers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConfigurationLine<'a> {
+    pub name: &'a str,
+    /// What sets it apart.
+    pub description: &'a str,
+    pub vehicle: &'a str,
+    pub controller_rate_hz: f64,
+    pub log_rate_hz: f64,
+    /// How the command is logged (`sample`, `held` …), and how late, s.
+    pub command: &'a str,
+    pub command_time_offset_s: f64,
+    /// The gyro filter's cutoff, Hz.
+    pub rate_low_pass_hz: Option<f64>,
+    pub jitter: Option<JitterLine>,
+    /// Noise standard deviations of the velocity (m/s) and the body rate (rad/s).
+    pub velocity_noise_m_s: f64,
+    pub rate_noise_rad_s: f64,
+    pub trajectory: &'a str,
+}
+
+/// One parameter, true against found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParameterLine<'a> {
+    /// The effect's id and the parameter's name.
+    pub effect: &'a str,
+    pub parameter: &'a str,
+    pub truth: &'a serde_json::Value,
+    pub found: &'a serde_json::Value,
+    pub relative_error: f64,
+}
+
+/// One cell's outcome.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CellLine<'a> {
+    pub configuration: &'a str,
+    pub case: &'a str,
+    /// The ids of the concealed effects and of those found.
+    pub true_effects: Vec<&'a str>,
+    pub found_effects: Vec<&'a str>,
+    pub named_exactly: bool,
+    pub parameters: Vec<ParameterLine<'a>>,
+    pub heldout_mse_before: f64,
+    pub heldout_mse_after: f64,
+    pub heldout_ratio: f64,
+    /// Every target met; why not, in a few words.
+    pub passed: bool,
+    pub failures: &'a [String],
+}
+
+/// What the demo's summary says.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DemoView<'a> {
+    pub targets: &'a Targets,
+    pub configurations: Vec<ConfigurationLine<'a>>,
+    /// Case names and purposes, in order.
+    pub cases: &'a [(String, String)],
+    /// Configuration by configuration, case by case.
+    pub cells: Vec<CellLine<'a>>,
+}
+
+fn compact(value: &serde_json::Value) -> String {
+    value.to_string().replace(',', ", ")
+}
+
+impl DemoView<'_> {
+    fn cell(&self, configuration: &str, case: &str) -> Option<&CellLine<'_>> {
+        self.cells
+            .iter()
+            .find(|c| c.configuration == configuration && c.case == case)
+    }
+
+    /// One line per cell, for the terminal.
+    pub fn table_text(&self) -> String {
+        let mut text = String::new();
+        for c in &self.cells {
+            let _ = writeln!(
+                text,
+                "{:<10} {:<34} {} found [{}] held-out MSE ×{:.3}{}",
+                c.configuration,
+                c.case,
+                if c.passed { "OK  " } else { "MISS" },
+                c.found_effects.join(", "),
+                c.heldout_ratio,
+                if c.failures.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", c.failures.join("; "))
+                }
+            );
+        }
+        let passed = self.cells.iter().filter(|c| c.passed).count();
+        let _ = writeln!(
+            text,
+            "{passed} of {} cells meet every target",
+            self.cells.len()
+        );
+        text
+    }
+
+    /// The summary in Markdown: the configurations, the matrix, the totals, every cell's numbers.
+    pub fn markdown(&self) -> String {
+        let mut md = String::new();
+        let _ = writeln!(
+            md,
+            "# Mismatch tool on simulated recordings with concealed effects\n"
+        );
+        let _ = writeln!(
+            md,
+            "Generated by `make mismatch-demo` (`learn mismatch --demo experiments/mismatch/demo.json`). Every case (a set of effects the plant has, or none) is flown under every configuration. The closed-loop controller knows only the nominal model and has integral action, so the position follows the reference and the effects show only in the dynamics and the commands. The tool runs blind on each written CSV with only the configuration's nominal model and its logger description (`<work>/<configuration>/model.json`). MSEs are of the weak-form residual (m/s² and rad/s², all six channels) on the held-out last 30% of each flight.\n"
+        );
+        let _ = writeln!(
+            md,
+            "A cell passes when the effects are named exactly (nothing missing, nothing extra; nothing on a no-effect control), every parameter is within {:.0}% (factor parameters relative to |k − 1|), and, with an effect, the held-out MSE is at most {} × the nominal model's or, for an effect at the level of the noise, at most {} × the noise level (the nominal model's held-out MSE on the configuration's no-effect control).\n",
+            100.0 * self.targets.parameters_within,
+            self.targets.heldout_ratio_at_most,
+            self.targets.heldout_noise_multiple_at_most
+        );
+        self.configurations_markdown(&mut md);
+        self.matrix_markdown(&mut md);
+        self.details_markdown(&mut md);
+        md
+    }
+
+    fn configurations_markdown(&self, md: &mut String) {
+        let _ = writeln!(md, "## Configurations\n");
+        let _ = writeln!(
+            md,
+            "| name | vehicle | controller / log rate | command logged | gyro filter | jitter (RMS, band) | noise (v, w) | trajectory | what sets it apart |\n|---|---|---|---|---|---|---|---|---|"
+        );
+        for c in &self.configurations {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} / {} Hz | {}{} | {} | {} | {} m/s, {} rad/s | {} | {} |",
+                c.name,
+                c.vehicle,
+                c.controller_rate_hz,
+                c.log_rate_hz,
+                c.command,
+                if c.command_time_offset_s != 0.0 {
+                    format!(", {:+} ms", 1000.0 * c.command_time_offset_s)
+                } else {
+                    String::new()
+                },
+                c.rate_low_pass_hz
+                    .map(|f| format!("{f} Hz"))
+                    .unwrap_or_else(|| "none".into()),
+                c.jitter
+                    .map(|j| format!(
+                        "{} m/s², {} rad/s², {}–{} Hz",
+                        j.translational_m_s2, j.angular_rad_s2, j.band_hz[0], j.band_hz[1]
+                    ))
+                    .unwrap_or_else(|| "none".into()),
+                c.velocity_noise_m_s,
+                c.rate_noise_rad_s,
+                c.trajectory,
+                c.description
+            );
+        }
+    }
+
+    fn matrix_markdown(&self, md: &mut String) {
+        let names: Vec<&str> = self.configurations.iter().map(|c| c.name).collect();
+        let _ = writeln!(md, "\n## The matrix\n");
+        let _ = writeln!(
+            md,
+            "| case | purpose | {} |\n|---|---|{}",
+            names.join(" | "),
+            "---|".repeat(names.len())
+        );
+        for (case, purpose) in self.cases {
+            let cells: Vec<String> = names
+                .iter()
+                .map(|configuration| match self.cell(configuration, case) {
+                    Some(c) if c.passed => "✓".to_string(),
+                    Some(c) => format!("✗ {}", c.failures.join("; ")),
+                    None => "–".to_string(),
+                })
+                .collect();
+            let _ = writeln!(md, "| {case} | {purpose} | {} |", cells.join(" | "));
+        }
+        let passed = self.cells.iter().filter(|c| c.passed).count();
+        let controls: Vec<&CellLine> = self
+            .cells
+            .iter()
+            .filter(|c| c.true_effects.is_empty())
+            .collect();
+        let clean = controls
+            .iter()
+            .filter(|c| c.found_effects.is_empty())
+            .count();
+        let named = self.cells.iter().filter(|c| c.named_exactly).count();
+        let parameters: Vec<&ParameterLine> =
+            self.cells.iter().flat_map(|c| &c.parameters).collect();
+        let within = parameters
+            .iter()
+            .filter(|p| p.relative_error <= self.targets.parameters_within)
+            .count();
+        let _ = writeln!(
+            md,
+            "\n**{passed} of {} cells meet every target.** Named exactly: {named} of {}; parameters within {:.0}%: {within} of {} (of the true effects found); no-effect controls with nothing found: {clean} of {}.",
+            self.cells.len(),
+            self.cells.len(),
+            100.0 * self.targets.parameters_within,
+            parameters.len(),
+            controls.len()
+        );
+    }
+
+    fn details_markdown(&self, md: &mut String) {
+        let _ = writeln!(md, "\n## Every cell\n");
+        let _ = writeln!(
+            md,
+            "| configuration | case | true effects | found | parameters (true → found, error) | held-out MSE nominal | with effects | ratio |\n|---|---|---|---|---|---|---|---|"
+        );
+        for c in &self.cells {
+            let parameters: Vec<String> = c
+                .parameters
+                .iter()
+                .map(|p| {
+                    format!(
+                        "{}.{}: {} → {} ({:.1}%)",
+                        p.effect,
+                        p.parameter,
+                        compact(p.truth),
+                        compact(p.found),
+                        100.0 * p.relative_error
+                    )
+                })
+                .collect();
+            let list = |v: &[&str]| {
+                if v.is_empty() {
+                    "none".to_string()
+                } else {
+                    v.join(", ")
+                }
+            };
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {:.5} | {:.5} | {:.3} |",
+                c.configuration,
+                c.case,
+                list(&c.true_effects),
+                list(&c.found_effects),
+                if parameters.is_empty() {
+                    "–".to_string()
+                } else {
+                    parameters.join("; ")
+                },
+                c.heldout_mse_before,
+                c.heldout_mse_after,
+                c.heldout_ratio
+            );
+        }
+        let _ = writeln!(
+            md,
+            "\nPer-cell outputs (recording, mismatch.json/svg/md) and each configuration's `model.json` are written under the demo's work directory (`target/mismatch-demo/<configuration>/<case>/`, not committed)."
+        );
+    }
+}

@@ -1,0 +1,542 @@
+//! One recording against a nominal model (`mismatch.md`, and its figure [`ResidualFigure`]): the
+//! plain parts of the analysis's results (channels, windows, the fit's errors, the rate frame),
+//! which `mismatch.json` records as they are, and [`RecordingView`], what the Markdown says of the
+//! rest (effects, evidence, candidates) with names and numbers in place of the analysis's types.
+
+use std::fmt::Write as _;
+
+use data::RateFrame;
+use serde::{Deserialize, Serialize};
+
+pub use super::residual_figure::ResidualFigure;
+
+/// One analysed channel.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ChannelReport {
+    pub name: String,
+    /// RMS of the nominal model's residual over all analysed rows.
+    pub residual_rms: f64,
+    pub noise_floor: f64,
+    /// The part of the noise floor on the model's side (noise in the commands and attitude it
+    /// reads; the rest is the recorded velocity's or rate's own noise).
+    pub noise_floor_model_side: f64,
+    /// Whether the nominal model's residual exceeds the noise floor significantly.
+    pub significant: bool,
+    /// RMS of the fitted model's residual.
+    pub residual_rms_after: f64,
+    /// Whether a significant residual remains with the effects found.
+    pub significant_after: bool,
+    pub heldout_mse_before: f64,
+    pub heldout_mse_after: f64,
+}
+
+/// A stretch of time where one channel disagrees significantly.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Window {
+    pub channel: String,
+    pub t_start: f64,
+    pub t_end: f64,
+}
+
+/// A mean squared error.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Mse {
+    pub mse: f64,
+}
+
+/// The errors on the held-out part and where it lies.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Heldout {
+    pub before: Mse,
+    pub after: Mse,
+    pub t_start: f64,
+    pub t_end: f64,
+}
+
+/// Mean squared residuals (all analysed channels, raw units) before and after.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fit {
+    pub before: Mse,
+    pub after: Mse,
+    pub heldout: Heldout,
+    /// What the MSEs are computed on.
+    pub comparison: String,
+    pub t_start: f64,
+    pub t_end: f64,
+}
+
+/// The frame the recording's body rates were read in, and how well each frame matches the rate
+/// implied by the recorded attitude (RMS, rad/s).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RateFrameReport {
+    pub used: RateFrame,
+    pub body_rms: f64,
+    pub world_rms: f64,
+}
+
+/// The thresholds an effect passes to be named.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EvidenceRule {
+    /// The χ² quantile the likelihood ratio must exceed.
+    pub significance: f64,
+    /// Least gain per row and channel on the fit part, in noise-floor units.
+    pub min_gain: f64,
+    /// Least gain once the two blocks that gain most are left out.
+    pub min_trimmed_gain: f64,
+    /// Least fractional reduction of the held-out residual.
+    pub min_heldout_reduction: f64,
+    /// Length of the blocks, s.
+    pub block_s: f64,
+}
+
+/// The evidence for one effect: named, or dropped by the rule.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EvidenceLine<'a> {
+    /// The effect's id as the outputs spell it (`linear_drag`).
+    pub id: &'a str,
+    pub likelihood_ratio: f64,
+    pub likelihood_ratio_threshold: f64,
+    pub fit_gain: f64,
+    pub trimmed_gain: f64,
+    /// Held-out noise-normalised sums of squares without and with the effect.
+    pub heldout_without: f64,
+    pub heldout_with: f64,
+    pub heldout_reduction: f64,
+}
+
+/// One effect found: its evidence, in words, and its share of the residual removed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NamedEffect<'a> {
+    pub evidence: EvidenceLine<'a>,
+    pub description: &'a str,
+    pub explained_fraction: f64,
+}
+
+/// One term of a candidate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TermLine<'a> {
+    pub name: &'a str,
+    pub formula: &'a str,
+    pub units: &'a str,
+}
+
+/// One candidate of the library and how often the selection chose it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CandidateLine<'a> {
+    /// The candidate's id (an effect's, or `delay_or_motor_lag`).
+    pub id: &'a str,
+    pub terms: Vec<TermLine<'a>>,
+    pub selection_frequency: f64,
+    pub kept: bool,
+}
+
+/// What `mismatch.md` says about one analysis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordingView<'a> {
+    pub recording: &'a str,
+    pub model: &'a str,
+    pub rate_frame: &'a RateFrameReport,
+    pub channels: &'a [ChannelReport],
+    /// Only the translational channels were compared (the model predicts no torques).
+    pub translational_only: bool,
+    /// A window is located where the moving RMS exceeds this multiple of the noise floor.
+    pub window_factor: f64,
+    /// Where the nominal model disagrees with the recording.
+    pub windows: &'a [Window],
+    pub rule: EvidenceRule,
+    pub effects: Vec<NamedEffect<'a>>,
+    /// The effects the evidence rule dropped.
+    pub dropped: Vec<EvidenceLine<'a>>,
+    /// Where a significant residual remains with the effects found.
+    pub unexplained: &'a [Window],
+    /// The number of bootstrap resamples of the selection.
+    pub resamples: usize,
+    pub candidates: Vec<CandidateLine<'a>>,
+    /// Noise-normalised fit errors of the timing explanations, when the timing term was kept.
+    pub timing: Option<&'a serde_json::Map<String, serde_json::Value>>,
+    pub fit: &'a Fit,
+}
+
+impl RecordingView<'_> {
+    /// The report in plain words (`mismatch.md`).
+    pub fn markdown(&self) -> String {
+        let mut md = String::new();
+        self.header_markdown(&mut md);
+        self.disagreement_markdown(&mut md);
+        self.effects_markdown(&mut md);
+        self.candidates_markdown(&mut md);
+        self.fit_markdown(&mut md);
+        md
+    }
+
+    /// The title, the comparison and the frame of the body rates.
+    fn header_markdown(&self, md: &mut String) {
+        let _ = writeln!(md, "# Sim-to-real mismatch: {}\n", self.recording);
+        let _ = writeln!(
+            md,
+            "Nominal model: `{}`. The recording's velocity and body rate are compared with what the nominal model predicts from the recorded attitude and commands in the weak form: both weighted by the same smooth test function over ±0.2 s, so that a right model leaves only noise. Every mean squared error below is of that weak-form residual.\n",
+            self.model
+        );
+        let frame = match self.rate_frame.used {
+            RateFrame::Body => "the body frame",
+            RateFrame::World => "the world frame (converted to body rates)",
+        };
+        let _ = writeln!(
+            md,
+            "The `w` column was read in {frame}: it matches the rate implied by the recorded attitude with an RMS error of {:.4} rad/s in the body frame and {:.4} rad/s in the world frame.\n",
+            self.rate_frame.body_rms, self.rate_frame.world_rms
+        );
+    }
+
+    /// The channels against their noise floors and the stretches that disagree.
+    fn disagreement_markdown(&self, md: &mut String) {
+        let _ = writeln!(md, "## Where the model and the recording disagree\n");
+        let _ = writeln!(
+            md,
+            "| channel | residual RMS | noise floor | significant |\n|---|---|---|---|"
+        );
+        for c in self.channels {
+            let _ = writeln!(
+                md,
+                "| {} | {:.4} | {:.4} | {} |",
+                c.name,
+                c.residual_rms,
+                c.noise_floor,
+                if c.significant { "yes" } else { "no" }
+            );
+        }
+        if self.translational_only {
+            let _ = writeln!(
+                md,
+                "\nThe model has no mixer, so it predicts no torques: only the translational channels are compared."
+            );
+        }
+        if self.windows.is_empty() {
+            let _ = writeln!(
+                md,
+                "\nNo stretch of the flight disagrees by more than {:.1} times the noise floor.",
+                self.window_factor
+            );
+        } else {
+            let _ = writeln!(
+                md,
+                "\nStretches where the residual exceeds {:.1} times the noise floor (1 s moving RMS):\n",
+                self.window_factor
+            );
+            for w in self.windows {
+                let _ = writeln!(
+                    md,
+                    "- {} from {:.1} s to {:.1} s",
+                    w.channel, w.t_start, w.t_end
+                );
+            }
+        }
+    }
+
+    /// The evidence rule, the effects named and those not named, what remains unexplained.
+    fn effects_markdown(&self, md: &mut String) {
+        let _ = writeln!(md, "\n## What is missing from the model\n");
+        let rule = self.rule;
+        let _ = writeln!(
+            md,
+            "An effect is named only when, with the others refitted without it, it passes four tests: on the fit part, its likelihood ratio (corrected for the correlation of neighbouring rows) exceeds the {} quantile of χ², it lowers the noise-normalised residual by at least {} per row and channel, and by at least {} when the two {} s blocks that gain most are left out (not one transient); and it lowers the held-out residual by at least {:.0}%.\n",
+            rule.significance,
+            rule.min_gain,
+            rule.min_trimmed_gain,
+            rule.block_s,
+            100.0 * rule.min_heldout_reduction
+        );
+        if self.effects.is_empty() {
+            let _ = writeln!(
+                md,
+                "Nothing: no candidate term explains the residual clearly better than noise."
+            );
+        } else {
+            for e in &self.effects {
+                let evidence = &e.evidence;
+                let _ = writeln!(
+                    md,
+                    "- **{}** — {} It accounts for {:.0}% of the nominal model's (noise-normalised) residual; without it the held-out residual is {:.0}% higher (likelihood ratio {:.0} against {:.1}, gain {:.2} per row and channel, {:.2} without its two largest blocks).",
+                    evidence.id,
+                    e.description,
+                    100.0 * e.explained_fraction,
+                    100.0 * (evidence.heldout_without / evidence.heldout_with.max(1e-300) - 1.0),
+                    evidence.likelihood_ratio,
+                    evidence.likelihood_ratio_threshold,
+                    evidence.fit_gain,
+                    evidence.trimmed_gain
+                );
+            }
+        }
+        for d in &self.dropped {
+            let _ = writeln!(
+                md,
+                "- not named: {} (likelihood ratio {:.1} against {:.1}, gain {:.3}, {:.3} without its two largest blocks, held-out reduction {:.1}%): below the evidence rule.",
+                d.id,
+                d.likelihood_ratio,
+                d.likelihood_ratio_threshold,
+                d.fit_gain,
+                d.trimmed_gain,
+                100.0 * d.heldout_reduction
+            );
+        }
+        self.unexplained_markdown(md);
+    }
+
+    /// What remains unexplained with the effects named.
+    fn unexplained_markdown(&self, md: &mut String) {
+        if self.unexplained.is_empty() {
+            let _ = writeln!(
+                md,
+                "\nWith the effects named, no stretch of the flight disagrees by more than {:.1} times the noise floor.",
+                self.window_factor
+            );
+        } else {
+            let _ = writeln!(
+                md,
+                "\nA significant residual remains that no effect of the vocabulary explains:\n"
+            );
+            for w in self.unexplained {
+                let _ = writeln!(
+                    md,
+                    "- unexplained residual on {}, {:.1}–{:.1} s",
+                    w.channel, w.t_start, w.t_end
+                );
+            }
+        }
+    }
+
+    /// Every candidate with its selection frequency, and the command-rate alternatives.
+    fn candidates_markdown(&self, md: &mut String) {
+        let _ = writeln!(
+            md,
+            "\nCandidates and how often each was chosen in {} bootstrap resamples:\n",
+            self.resamples
+        );
+        for c in &self.candidates {
+            let terms: Vec<String> = c
+                .terms
+                .iter()
+                .map(|t| format!("`{}` = {} [{}]", t.name, t.formula, t.units))
+                .collect();
+            let _ = writeln!(
+                md,
+                "- {} ({}): {:.0}%{}",
+                c.id,
+                terms.join(", "),
+                100.0 * c.selection_frequency,
+                if c.kept { ", kept" } else { "" }
+            );
+        }
+        if let Some(timing) = self.timing {
+            let _ = writeln!(
+                md,
+                "\nThe command-rate term was resolved by fitting a pure delay, a first-order motor lag and both exactly; noise-normalised fit errors: {}. The smallest was kept, then judged by the evidence rule.",
+                serde_json::Value::Object(timing.clone())
+            );
+        }
+    }
+
+    /// The fit and held-out errors before and after.
+    fn fit_markdown(&self, md: &mut String) {
+        let fit = self.fit;
+        let reduction = |before: f64, after: f64| 100.0 * (1.0 - after / before.max(1e-300));
+        let _ = writeln!(md, "\n## Does the fit improve?\n");
+        let _ = writeln!(
+            md,
+            "The parameters were fitted on {:.1}–{:.1} s and checked on the held-out {:.1}–{:.1} s.\n",
+            fit.t_start, fit.t_end, fit.heldout.t_start, fit.heldout.t_end
+        );
+        let _ = writeln!(
+            md,
+            "| part | MSE nominal | MSE with effects | reduction |\n|---|---|---|---|"
+        );
+        let _ = writeln!(
+            md,
+            "| fit | {:.5} | {:.5} | {:.1}% |",
+            fit.before.mse,
+            fit.after.mse,
+            reduction(fit.before.mse, fit.after.mse)
+        );
+        let _ = writeln!(
+            md,
+            "| held out | {:.5} | {:.5} | {:.1}% |",
+            fit.heldout.before.mse,
+            fit.heldout.after.mse,
+            reduction(fit.heldout.before.mse, fit.heldout.after.mse)
+        );
+        let _ = writeln!(md, "\nFigure: `mismatch.svg`.");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn channel(name: &str, rms: f64, significant: bool) -> ChannelReport {
+        ChannelReport {
+            name: name.to_string(),
+            residual_rms: rms,
+            noise_floor: 0.01,
+            noise_floor_model_side: 0.002,
+            significant,
+            residual_rms_after: rms / 2.0,
+            significant_after: false,
+            heldout_mse_before: rms * rms,
+            heldout_mse_after: rms * rms / 4.0,
+        }
+    }
+
+    fn window(channel: &str, t_start: f64, t_end: f64) -> Window {
+        Window {
+            channel: channel.to_string(),
+            t_start,
+            t_end,
+        }
+    }
+
+    fn evidence(id: &str, likelihood_ratio: f64) -> EvidenceLine<'_> {
+        EvidenceLine {
+            id,
+            likelihood_ratio,
+            likelihood_ratio_threshold: 16.27,
+            fit_gain: 0.75,
+            trimmed_gain: 0.5,
+            heldout_without: 3.0,
+            heldout_with: 2.0,
+            heldout_reduction: 1.0 / 3.0,
+        }
+    }
+
+    fn fit() -> Fit {
+        let mse = |mse| Mse { mse };
+        Fit {
+            before: mse(0.5),
+            after: mse(0.125),
+            heldout: Heldout {
+                before: mse(0.4),
+                after: mse(0.2),
+                t_start: 14.0,
+                t_end: 20.0,
+            },
+            comparison: "weak form".to_string(),
+            t_start: 0.2,
+            t_end: 13.98,
+        }
+    }
+
+    #[test]
+    fn a_recording_with_an_effect_a_dropped_one_and_an_unexplained_stretch_reads_so() {
+        let rate_frame = RateFrameReport {
+            used: RateFrame::World,
+            body_rms: 0.0123,
+            world_rms: 0.00456,
+        };
+        let channels = [
+            channel("vdot_x", 0.25, true),
+            channel("vdot_y", 0.005, false),
+        ];
+        let (windows, unexplained) = ([window("vdot_x", 1.25, 7.5)], [window("vdot_x", 2.0, 2.75)]);
+        let timing = serde_json::json!({"delay": 1.5, "both": 1.25});
+        let fit = fit();
+        let view = RecordingView {
+            recording: "flight.csv",
+            model: "model.json",
+            rate_frame: &rate_frame,
+            channels: &channels,
+            translational_only: true,
+            window_factor: 2.5,
+            windows: &windows,
+            rule: EvidenceRule {
+                significance: 0.999,
+                min_gain: 0.25,
+                min_trimmed_gain: 0.1,
+                min_heldout_reduction: 0.15,
+                block_s: 1.0,
+            },
+            effects: vec![NamedEffect {
+                evidence: evidence("linear_drag", 120.4),
+                description: "Drag.",
+                explained_fraction: 0.625,
+            }],
+            dropped: vec![evidence("wind", 3.25)],
+            unexplained: &unexplained,
+            resamples: 40,
+            candidates: vec![CandidateLine {
+                id: "linear_drag",
+                terms: vec![TermLine {
+                    name: "drag_x",
+                    formula: "−v_x",
+                    units: "m/s",
+                }],
+                selection_frequency: 0.875,
+                kept: true,
+            }],
+            timing: timing.as_object(),
+            fit: &fit,
+        };
+        let md = view.markdown();
+        for line in [
+            "# Sim-to-real mismatch: flight.csv\n",
+            "The `w` column was read in the world frame (converted to body rates): it matches the rate implied by the recorded attitude with an RMS error of 0.0123 rad/s in the body frame and 0.0046 rad/s in the world frame.\n",
+            "| vdot_x | 0.2500 | 0.0100 | yes |\n| vdot_y | 0.0050 | 0.0100 | no |\n",
+            "\nThe model has no mixer, so it predicts no torques: only the translational channels are compared.\n",
+            "(1 s moving RMS):\n\n- vdot_x from 1.2 s to 7.5 s\n",
+            "- **linear_drag** — Drag. It accounts for 62% of the nominal model's (noise-normalised) residual; without it the held-out residual is 50% higher (likelihood ratio 120 against 16.3, gain 0.75 per row and channel, 0.50 without its two largest blocks).\n",
+            "- not named: wind (likelihood ratio 3.2 against 16.3, gain 0.750, 0.500 without its two largest blocks, held-out reduction 33.3%): below the evidence rule.\n",
+            "- unexplained residual on vdot_x, 2.0–2.8 s\n",
+            "- linear_drag (`drag_x` = −v_x [m/s]): 88%, kept\n",
+            "noise-normalised fit errors: {\"both\":1.25,\"delay\":1.5}. The smallest",
+            "The parameters were fitted on 0.2–14.0 s and checked on the held-out 14.0–20.0 s.\n",
+            "| fit | 0.50000 | 0.12500 | 75.0% |\n| held out | 0.40000 | 0.20000 | 50.0% |\n",
+        ] {
+            assert!(md.contains(line), "missing {line:?} in\n{md}");
+        }
+        assert!(md.ends_with("\nFigure: `mismatch.svg`.\n"));
+    }
+
+    #[test]
+    fn a_recording_that_agrees_with_its_model_says_so() {
+        let rate_frame = RateFrameReport {
+            used: RateFrame::Body,
+            body_rms: 0.001,
+            world_rms: 0.02,
+        };
+        let channels = [channel("vdot_x", 0.005, false)];
+        let fit = fit();
+        let view = RecordingView {
+            recording: "calm.csv",
+            model: "model.json",
+            rate_frame: &rate_frame,
+            channels: &channels,
+            translational_only: false,
+            window_factor: 2.5,
+            windows: &[],
+            rule: EvidenceRule {
+                significance: 0.999,
+                min_gain: 0.25,
+                min_trimmed_gain: 0.1,
+                min_heldout_reduction: 0.15,
+                block_s: 1.0,
+            },
+            effects: Vec::new(),
+            dropped: Vec::new(),
+            unexplained: &[],
+            resamples: 40,
+            candidates: Vec::new(),
+            timing: None,
+            fit: &fit,
+        };
+        let md = view.markdown();
+        assert!(md.contains("The `w` column was read in the body frame: "));
+        assert!(!md.contains("no mixer"));
+        assert!(md.contains(
+            "\nNo stretch of the flight disagrees by more than 2.5 times the noise floor.\n"
+        ));
+        assert!(md.contains(
+            "Nothing: no candidate term explains the residual clearly better than noise.\n"
+        ));
+        assert!(md.contains("\nWith the effects named, no stretch of the flight disagrees by more than 2.5 times the noise floor.\n"));
+        assert!(!md.contains("command-rate"));
+    }
+}

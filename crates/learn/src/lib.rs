@@ -16,7 +16,7 @@
 //! flight is cut into support and query segments and a formulation's columns built from its log,
 //! the evaluation, the seed spread; reading CSV tasks). Nor estimating derivatives
 //! (`sindy::differentiation`), SINDy (`sindy`), tables and figures (`report`), the command line
-//! (`cli`). A test (`tests/layering.rs`) keeps `data`, CSV readers and data frames out of its
+//! (`cli`). A test (`crates/cli/tests/layering.rs`) keeps `data`, CSV readers and data frames out of its
 //! dependencies.
 //!
 //! # Public API

@@ -4,6 +4,7 @@
 //! when a drag was kept.
 
 use physics::{EffectId, Effects};
+use report::mismatch::recording::TimingScores;
 use serde::Serialize;
 
 use crate::library::{Candidate, CandidateId};
@@ -73,10 +74,17 @@ pub struct FitAlternatives {
     /// Whitened fit error of each timing explanation (`delay`, `motor_lag`, `both`), when the
     /// timing term was kept.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub timing: Option<serde_json::Map<String, serde_json::Value>>,
+    pub timing: Option<TimingScores>,
     /// Whitened fit error without and with an air velocity, when a drag was kept.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub wind: Option<serde_json::Value>,
+    pub wind: Option<WindScores>,
+}
+
+/// Whitened fit errors of a drag in still air and with a fitted air velocity.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct WindScores {
+    pub still_air: f64,
+    pub with_wind: f64,
 }
 
 /// Grid of delays and lag time constants profiled, s.
@@ -283,7 +291,10 @@ pub fn fit_parameters(
         with_wind.parameters.extend((0..3).map(Parameter::Wind));
         with_wind.values.extend(wind_start);
         let windy = with_wind.refit(problem, iterations);
-        alternatives.wind = Some(serde_json::json!({"still_air": still, "with_wind": windy}));
+        alternatives.wind = Some(WindScores {
+            still_air: still,
+            with_wind: windy,
+        });
         // The evidence rule decides whether the wind stays; here only whether it fits better.
         if windy < still {
             set = with_wind;
@@ -302,8 +313,7 @@ fn fit_timing(
     linear: &FittedSet,
     iterations: usize,
     block_rows: usize,
-) -> (FittedSet, serde_json::Map<String, serde_json::Value>) {
-    let mut scores = serde_json::Map::new();
+) -> (FittedSet, TimingScores) {
     let mut singles = Vec::new();
     for kind in [Parameter::Delay, Parameter::MotorLag] {
         let (start, _) = profile_search(
@@ -319,7 +329,6 @@ fn fit_timing(
         set.parameters.push(kind);
         set.values.push(start);
         let sse = set.refit(problem, iterations);
-        scores.insert(kind.effect_id().name().to_string(), serde_json::json!(sse));
         singles.push((set, sse));
     }
     let delay = singles[0].0.values.last().copied().unwrap_or(0.0);
@@ -336,7 +345,11 @@ fn fit_timing(
         }
     }
     let both = best_both.expect("three starts");
-    scores.insert("both".to_string(), serde_json::json!(both.1));
+    let scores = TimingScores {
+        both: both.1,
+        delay: singles[0].1,
+        motor_lag: singles[1].1,
+    };
     singles.push(both);
     let best = singles
         .into_iter()

@@ -156,6 +156,75 @@ impl EffectParameters {
             Self::WindGradient(_) => EffectId::WindGradient,
         }
     }
+
+    /// Each parameter's name and value, in the order of the keys of its JSON.
+    pub fn values(&self) -> Vec<(&'static str, ParameterValue)> {
+        use ParameterValue::{Matrix, Number, Vector};
+        match *self {
+            Self::LinearDrag(p) => vec![("d", Vector(p.d.to_vec()))],
+            Self::QuadraticDrag(p) => vec![("c", Number(p.c))],
+            Self::Wind(p) => vec![("w_air", Vector(p.w_air.to_vec()))],
+            Self::ThrustScale(p) => vec![("k", Number(p.k))],
+            Self::MotorLag(p) => vec![("tau_s", Number(p.tau_s))],
+            Self::GroundEffect(p) => vec![("r_m", Number(p.r_m))],
+            Self::TorqueBias(p) => vec![("b", Vector(p.b.to_vec()))],
+            Self::InertiaScale(p) => vec![("k", Vector(p.k.to_vec()))],
+            Self::Delay(p) => vec![("delay_s", Number(p.delay_s))],
+            Self::ThrustMap(p) => vec![("k", Vector(p.k.to_vec()))],
+            Self::ThrustTilt(p) => vec![("angles_rad", Vector(p.angles_rad.to_vec()))],
+            Self::RotorDrag(p) => vec![("d", Vector(p.d.to_vec()))],
+            Self::TranslationalLift(p) => vec![("c", Number(p.c))],
+            Self::DragLag(p) => vec![("tau_s", Number(p.tau_s))],
+            Self::WindGradient(p) => vec![
+                (
+                    "per_m",
+                    Matrix(p.per_m.iter().map(|row| row.to_vec()).collect()),
+                ),
+                ("reference_m", Vector(p.reference_m.to_vec())),
+            ],
+        }
+    }
+}
+
+/// One parameter's value: a number, a vector or a matrix (by rows). Serialises as its JSON value
+/// and displays as compact JSON with a space after each comma (`[1.25, 0.85, 1.15]`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ParameterValue {
+    Number(f64),
+    Vector(Vec<f64>),
+    Matrix(Vec<Vec<f64>>),
+}
+
+impl ParameterValue {
+    /// Every number, row by row.
+    pub fn numbers(&self) -> Vec<f64> {
+        match self {
+            Self::Number(v) => vec![*v],
+            Self::Vector(v) => v.clone(),
+            Self::Matrix(rows) => rows.concat(),
+        }
+    }
+
+    /// The same shape with `f` applied to every number.
+    pub fn map(&self, f: impl Fn(f64) -> f64) -> Self {
+        match self {
+            Self::Number(v) => Self::Number(f(*v)),
+            Self::Vector(v) => Self::Vector(v.iter().map(|x| f(*x)).collect()),
+            Self::Matrix(rows) => Self::Matrix(
+                rows.iter()
+                    .map(|r| r.iter().map(|x| f(*x)).collect())
+                    .collect(),
+            ),
+        }
+    }
+}
+
+impl std::fmt::Display for ParameterValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let json = serde_json::to_string(self).map_err(|_| std::fmt::Error)?;
+        f.write_str(&json.replace(',', ", "))
+    }
 }
 
 /// A set of effects; `None` means absent. Serialises as `{"<id>": {<parameters>}, ...}`.
@@ -612,6 +681,39 @@ mod tests {
             assert_eq!(serde_json::to_value(parameters).unwrap(), json[id.name()]);
             assert!(Effects::default().parameters(id).is_none(), "{id}");
         }
+    }
+
+    /// The named values of each effect's parameters are its JSON entry's keys, in order, with its
+    /// values; their display is the compact JSON of the value.
+    #[test]
+    fn named_values_are_the_entries_keys_and_values() {
+        let every = every_effect();
+        let json = serde_json::to_value(every).unwrap();
+        for id in EffectId::ALL {
+            let values = every.parameters(id).unwrap().values();
+            let entry = json[id.name()].as_object().unwrap();
+            let keys: Vec<&str> = entry.keys().map(|k| k.as_str()).collect();
+            let names: Vec<&str> = values.iter().map(|(name, _)| *name).collect();
+            assert_eq!(names, keys, "{id}");
+            for (name, value) in &values {
+                assert_eq!(
+                    &serde_json::to_value(value).unwrap(),
+                    &entry[*name],
+                    "{id}.{name}"
+                );
+                assert_eq!(
+                    value.to_string(),
+                    entry[*name].to_string().replace(',', ", ")
+                );
+                assert_eq!(value.map(|x| x).numbers(), value.numbers());
+            }
+        }
+        let matrix = ParameterValue::Matrix(vec![vec![1.0, 2.5], vec![3.0, 4.0]]);
+        assert_eq!(matrix.numbers(), [1.0, 2.5, 3.0, 4.0]);
+        assert_eq!(
+            matrix.map(|x| 2.0 * x).to_string(),
+            "[[2.0, 5.0], [6.0, 8.0]]"
+        );
     }
 
     #[test]

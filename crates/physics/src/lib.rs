@@ -35,8 +35,8 @@ pub use controller::{ControlOutput, Gains, GeometricController, MeasuredState};
 pub use effect_id::{EffectId, UnknownEffectId};
 pub use effects::{
     Delay, DragLag, EffectParameters, Effects, GROUND_EFFECT_MAX_RATIO, GroundEffect, InertiaScale,
-    LinearDrag, MAX_TILT_RAD, MotorLag, QuadraticDrag, RotorDrag, ThrustMap, ThrustScale,
-    ThrustTilt, TorqueBias, TranslationalLift, Wind, WindGradient, ground_ratio,
+    LinearDrag, MAX_TILT_RAD, MotorLag, ParameterValue, QuadraticDrag, RotorDrag, ThrustMap,
+    ThrustScale, ThrustTilt, TorqueBias, TranslationalLift, Wind, WindGradient, ground_ratio,
 };
 pub use error::{PhysicsError, Result};
 pub use jitter::{Jitter, JitterSignal, MAX_JITTER};

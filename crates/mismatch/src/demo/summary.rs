@@ -2,7 +2,7 @@
 //! Markdown and the terminal table are rendered by the `report` crate, [`report::mismatch::demo`],
 //! from the view [`DemoSummary::view`] fills).
 
-use physics::{EffectId, Effects, NominalModel, Scenario, Trajectory};
+use physics::{EffectId, Effects, NominalModel, ParameterValue, Scenario, Trajectory};
 pub use report::mismatch::demo::Targets;
 use report::mismatch::demo::{CellLine, ConfigurationLine, DemoView, JitterLine, ParameterLine};
 use serde::Serialize;
@@ -23,8 +23,9 @@ pub const TARGETS: Targets = Targets {
 pub struct ParameterCheck {
     pub effect: EffectId,
     pub parameter: String,
-    pub truth: serde_json::Value,
-    pub found: serde_json::Value,
+    pub truth: ParameterValue,
+    /// Rounded to 4 decimals; `None` (null) when the fit has no such parameter.
+    pub found: Option<ParameterValue>,
     /// |found − true| / |true| (vectors: Euclidean norms); for the factors `thrust_scale.k` and
     /// `inertia_scale.k`, relative to |true − 1|.
     pub relative_error: f64,
@@ -129,19 +130,9 @@ impl CellOutcome {
     }
 }
 
-fn numbers(value: &serde_json::Value) -> Vec<f64> {
-    match value {
-        serde_json::Value::Number(n) => vec![n.as_f64().unwrap_or(f64::NAN)],
-        serde_json::Value::Array(a) => a.iter().flat_map(numbers).collect(),
-        _ => Vec::new(),
-    }
-}
-
 /// Relative errors of every parameter of every true effect that was found; the effects in the
 /// alphabetical order of their ids, as in their JSON.
 pub fn compare_parameters(truth: &Effects, found: &Effects) -> Vec<ParameterCheck> {
-    let truth_json = serde_json::to_value(truth).expect("serialises");
-    let found_json = serde_json::to_value(found).expect("serialises");
     let mut found_true: Vec<EffectId> = truth
         .ids()
         .into_iter()
@@ -150,7 +141,7 @@ pub fn compare_parameters(truth: &Effects, found: &Effects) -> Vec<ParameterChec
     found_true.sort_by_key(|id| id.name());
     found_true
         .into_iter()
-        .flat_map(|id| parameter_checks(id, &truth_json[id.name()], &found_json[id.name()]))
+        .flat_map(|id| parameter_checks(id, truth, found))
         .collect()
 }
 
@@ -175,20 +166,29 @@ fn is_factor(id: EffectId) -> bool {
     }
 }
 
-/// One check per parameter of `effect`, from its true and found parameters (JSON objects).
-fn parameter_checks(
-    effect: EffectId,
-    truth: &serde_json::Value,
-    found: &serde_json::Value,
-) -> Vec<ParameterCheck> {
+/// One check per parameter of `effect`, from its true and found parameters.
+fn parameter_checks(effect: EffectId, truth: &Effects, found: &Effects) -> Vec<ParameterCheck> {
     let reference = if is_factor(effect) { 1.0 } else { 0.0 };
+    let found_values = found
+        .parameters(effect)
+        .map(|p| p.values())
+        .unwrap_or_default();
     truth
-        .as_object()
+        .parameters(effect)
+        .map(|p| p.values())
+        .unwrap_or_default()
         .into_iter()
-        .flatten()
         .map(|(name, value)| {
-            let found_value = found.get(name).cloned().unwrap_or(serde_json::Value::Null);
-            let (t, f) = (numbers(value), numbers(&found_value));
+            let found_value = found_values
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, v)| v.map(|x| (x * 1e4).round() / 1e4));
+            let t = value.numbers();
+            let f = found_values
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, v)| v.numbers())
+                .unwrap_or_default();
             let difference: f64 = t
                 .iter()
                 .zip(&f)
@@ -202,9 +202,9 @@ fn parameter_checks(
                 .sqrt();
             ParameterCheck {
                 effect,
-                parameter: name.clone(),
-                truth: value.clone(),
-                found: round_json(&found_value),
+                parameter: name.to_string(),
+                truth: value,
+                found: found_value,
                 relative_error: if f.len() == t.len() {
                     difference / magnitude.max(1e-300)
                 } else {
@@ -213,17 +213,6 @@ fn parameter_checks(
             }
         })
         .collect()
-}
-
-fn round_json(value: &serde_json::Value) -> serde_json::Value {
-    match value {
-        serde_json::Value::Number(n) => {
-            let v = n.as_f64().unwrap_or(f64::NAN);
-            serde_json::json!((v * 1e4).round() / 1e4)
-        }
-        serde_json::Value::Array(a) => serde_json::Value::Array(a.iter().map(round_json).collect()),
-        other => other.clone(),
-    }
 }
 
 /// One configuration in words and numbers.
@@ -360,8 +349,11 @@ fn cell_line(c: &CellOutcome) -> CellLine<'_> {
             .map(|p| ParameterLine {
                 effect: p.effect.name(),
                 parameter: &p.parameter,
-                truth: &p.truth,
-                found: &p.found,
+                truth: p.truth.to_string(),
+                found: p
+                    .found
+                    .as_ref()
+                    .map_or("null".to_string(), ToString::to_string),
                 relative_error: p.relative_error,
             })
             .collect(),

@@ -51,8 +51,8 @@ fn cell(c: &Value) -> CellOutcome {
             .map(|p| ParameterCheck {
                 effect: from(&p["effect"]),
                 parameter: from(&p["parameter"]),
-                truth: p["truth"].clone(),
-                found: p["found"].clone(),
+                truth: from(&p["truth"]),
+                found: from(&p["found"]),
                 relative_error: from(&p["relative_error"]),
             })
             .collect(),

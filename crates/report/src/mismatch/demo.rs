@@ -54,13 +54,14 @@ pub struct ConfigurationLine<'a> {
 }
 
 /// One parameter, true against found.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ParameterLine<'a> {
     /// The effect's id and the parameter's name.
     pub effect: &'a str,
     pub parameter: &'a str,
-    pub truth: &'a serde_json::Value,
-    pub found: &'a serde_json::Value,
+    /// The values as compact JSON (`[1.25, 0.85, 1.15]`; `null` when not found).
+    pub truth: String,
+    pub found: String,
     pub relative_error: f64,
 }
 
@@ -91,10 +92,6 @@ pub struct DemoView<'a> {
     pub cases: &'a [(String, String)],
     /// Configuration by configuration, case by case.
     pub cells: Vec<CellLine<'a>>,
-}
-
-fn compact(value: &serde_json::Value) -> String {
-    value.to_string().replace(',', ", ")
 }
 
 impl DemoView<'_> {
@@ -256,8 +253,8 @@ impl DemoView<'_> {
                         "{}.{}: {} → {} ({:.1}%)",
                         p.effect,
                         p.parameter,
-                        compact(p.truth),
-                        compact(p.found),
+                        p.truth,
+                        p.found,
                         100.0 * p.relative_error
                     )
                 })

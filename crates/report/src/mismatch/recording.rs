@@ -130,6 +130,15 @@ pub struct CandidateLine<'a> {
     pub kept: bool,
 }
 
+/// Noise-normalised fit errors of the three explanations of a timing term (serialised in this order).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct TimingScores {
+    /// A delay and a motor lag together.
+    pub both: f64,
+    pub delay: f64,
+    pub motor_lag: f64,
+}
+
 /// What `mismatch.md` says about one analysis.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RecordingView<'a> {
@@ -153,7 +162,7 @@ pub struct RecordingView<'a> {
     pub resamples: usize,
     pub candidates: Vec<CandidateLine<'a>>,
     /// Noise-normalised fit errors of the timing explanations, when the timing term was kept.
-    pub timing: Option<&'a serde_json::Map<String, serde_json::Value>>,
+    pub timing: Option<&'a TimingScores>,
     pub fit: &'a Fit,
 }
 
@@ -332,7 +341,7 @@ impl RecordingView<'_> {
             let _ = writeln!(
                 md,
                 "\nThe command-rate term was resolved by fitting a pure delay, a first-order motor lag and both exactly; noise-normalised fit errors: {}. The smallest was kept, then judged by the evidence rule.",
-                serde_json::Value::Object(timing.clone())
+                serde_json::to_string(timing).expect("numbers serialise")
             );
         }
     }
@@ -437,7 +446,11 @@ mod tests {
             channel("vdot_y", 0.005, false),
         ];
         let (windows, unexplained) = ([window("vdot_x", 1.25, 7.5)], [window("vdot_x", 2.0, 2.75)]);
-        let timing = serde_json::json!({"delay": 1.5, "both": 1.25});
+        let timing = TimingScores {
+            both: 1.25,
+            delay: 1.5,
+            motor_lag: 2.0,
+        };
         let fit = fit();
         let view = RecordingView {
             recording: "flight.csv",
@@ -472,7 +485,7 @@ mod tests {
                 selection_frequency: 0.875,
                 kept: true,
             }],
-            timing: timing.as_object(),
+            timing: Some(&timing),
             fit: &fit,
         };
         let md = view.markdown();
@@ -486,7 +499,7 @@ mod tests {
             "- not named: wind (likelihood ratio 3.2 against 16.3, gain 0.750, 0.500 without its two largest blocks, held-out reduction 33.3%): below the evidence rule.\n",
             "- unexplained residual on vdot_x, 2.0–2.8 s\n",
             "- linear_drag (`drag_x` = −v_x [m/s]): 88%, kept\n",
-            "noise-normalised fit errors: {\"both\":1.25,\"delay\":1.5}. The smallest",
+            "noise-normalised fit errors: {\"both\":1.25,\"delay\":1.5,\"motor_lag\":2.0}. The smallest",
             "The parameters were fitted on 0.2–14.0 s and checked on the held-out 14.0–20.0 s.\n",
             "| fit | 0.50000 | 0.12500 | 75.0% |\n| held out | 0.40000 | 0.20000 | 50.0% |\n",
         ] {

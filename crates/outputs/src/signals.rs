@@ -65,13 +65,25 @@ fn install() {
             .spawn(move || {
                 if let Some(signal) = signals.forever().next() {
                     let staging = hold();
-                    for path in staging.iter() {
-                        remove(path);
-                    }
+                    remove_until_gone(&staging);
                     std::process::exit(128 + signal);
                 }
             });
     });
+}
+
+/// Removes every path, and again while a thread still at work (a writer making its file's folder)
+/// brings one back, until none has come back 2 ms later (at most about 50 ms).
+fn remove_until_gone(paths: &[PathBuf]) {
+    for _ in 0..25 {
+        for path in paths {
+            remove(path);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+        if paths.iter().all(|path| !path.exists()) {
+            return;
+        }
+    }
 }
 
 /// Removes a staging file or folder, whichever it is; errors are ignored (nothing more can be

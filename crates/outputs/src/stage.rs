@@ -140,14 +140,29 @@ fn prepare_folder(plan: &FolderPlan, created: &mut Vec<PathBuf>) -> Result<Stage
         let target = dir.join(parent);
         create_dir(&target, &plan.option, created)?;
         probe(&target, &plan.option)?;
-        let staged = staging.path().join(parent);
-        std::fs::create_dir_all(&staged).map_err(io(&staged))?;
+        create_inside(staging.path(), parent)?;
     }
     Ok(StagedFolder {
         plan: plan.clone(),
         _lock: lock,
         staging,
     })
+}
+
+/// Creates the folders of `relative` inside `root`, never `root` itself: once an interrupt has
+/// removed a staging folder, making its subfolders fails instead of bringing it back (which
+/// `create_dir_all` would, leaving it behind when the process exits).
+fn create_inside(root: &Path, relative: &Path) -> Result<()> {
+    let mut path = root.to_path_buf();
+    for component in relative.components() {
+        path.push(component);
+        match std::fs::create_dir(&path) {
+            Ok(()) => {}
+            Err(error) if error.kind() == std::io::ErrorKind::AlreadyExists && path.is_dir() => {}
+            Err(error) => return Err(io(&path)(error)),
+        }
+    }
+    Ok(())
 }
 
 /// Creates and removes a file in `dir`: a rename into it will work.
@@ -434,6 +449,22 @@ mod tests {
 
     /// The writability probe is staging like any other: registered while it exists (an interrupt
     /// then removes it; unregistered, a SIGINT at that moment left it behind), gone afterwards.
+    /// Staging subfolders are made inside an existing staging folder only: when an interrupt has
+    /// just removed it, making them fails and nothing comes back (with `create_dir_all` the
+    /// staging folder reappeared and outlived the process).
+    #[test]
+    fn subfolders_do_not_bring_back_a_removed_staging() {
+        let dir = tempfile::tempdir().unwrap();
+        let staging = dir.path().join(".learn-staging-1-x");
+        std::fs::create_dir(&staging).unwrap();
+        create_inside(&staging, Path::new("figures/svg")).unwrap();
+        create_inside(&staging, Path::new("figures")).unwrap();
+        assert!(staging.join("figures/svg").is_dir());
+        signals::remove(&staging);
+        assert!(create_inside(&staging, Path::new("figures/svg")).is_err());
+        assert!(!staging.exists(), "the removed staging stays removed");
+    }
+
     #[test]
     fn the_probe_is_registered_while_it_exists() {
         let dir = tempfile::tempdir().unwrap();

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use data::ExperimentConditions;
 use learn::{AdaptationConfig, Formulation, LearnConfig};
-use pipeline::{Experiment, Protocol};
+use pipeline::{Experiment, Protocol, Segmentation};
 use rayon::prelude::*;
 use serde_json::json;
 
@@ -47,6 +47,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         conditions,
         &data_dir,
         Some(Protocol::LeaveConditionOut),
+        Segmentation::PAPER,
     )?;
     let folds = experiment.evaluation_conditions();
     if stage == "restarts" {

@@ -42,8 +42,8 @@
 //! conditions file make a new row in every table and a new figure per table.
 //!
 //! Definitions, shared by both methods: support = the first half of each evaluation flight, query =
-//! the second half ([`EVALUATION_SPLIT`]); targets = forward differences on each segment
-//! ([`EVALUATION_DERIVATIVE`]), built once per cell for both. **Adaptation MSE**: the model
+//! the second half; targets = forward differences on each segment ([`Segmentation::PAPER`], the
+//! run configuration's `split` and `derivative`), built once per cell for both. **Adaptation MSE**: the model
 //! fitted (SINDy) or adapted online (LeARN) on the support segment, scored on that segment.
 //! **Generalisation MSE**: the same model, unchanged, scored on the query segment.
 
@@ -77,9 +77,8 @@ pub use cells::figure_file_name;
 pub use config::{CheckedRunConfig, LearnRun, MAX_SEEDS, RunConfig, merge_patch};
 pub use error::{PipelineError, Result};
 pub use experiment::{
-    CellResult, CellSummary, Cells, EVALUATION_DERIVATIVE, EVALUATION_SPLIT, EvaluationCell,
-    Experiment, SegmentPrediction, Spread, SpreadCell, ValidationDetail, WorkItem, explain_flight,
-    spread_cells,
+    CellResult, CellSummary, Cells, EvaluationCell, Experiment, SegmentPrediction, Spread,
+    SpreadCell, ValidationDetail, WorkItem, explain_flight, spread_cells,
 };
 pub use flights::{Flight, Protocol, evaluation_condition_of, read_evaluation_flights};
 pub use output::{
@@ -91,7 +90,7 @@ pub use run::{
     GENERATED_PATHS, ReproduceShard, RunOutcome, git_commit, merged_run, run, run_shard,
     shard_timings, uncommitted_inputs,
 };
-pub use segment::{Segment, SegmentModel, flight_segments, segment_batch};
+pub use segment::{Segment, SegmentModel, Segmentation, flight_segments, segment_batch};
 pub use shard::{
     ItemResult, MergedSweep, SHARD_FILE, SHARD_FORMAT, ShardDocument, ShardFile, ShardProvenance,
     ShardSpec, Sweep, SweepKind, merge, read_shard, write_shard,

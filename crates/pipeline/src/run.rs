@@ -163,6 +163,7 @@ impl<'c> ReproduceWork<'c> {
                 config.conditions.clone(),
                 data_dir,
                 config.protocol,
+                config.segmentation(),
             )
         })?;
         let cells = stopwatch.time("SINDy", || sindy_cells(config, &experiment))?;

@@ -8,7 +8,9 @@ use std::time::Instant;
 use anyhow::Context;
 use data::ExperimentConditions;
 use learn::{Formulation, LearnConfig};
-use pipeline::{CellSummary, Experiment, Protocol, ShardSpec, evaluation_condition_of};
+use pipeline::{
+    CellSummary, Experiment, Protocol, Segmentation, ShardSpec, evaluation_condition_of,
+};
 use report::{Method, PublishedTables};
 use serde_json::{Value, json};
 
@@ -404,7 +406,15 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     plan_checkpoints(&mut set, &outputs, &cells_planned, &out)?;
     // Every output is proven writable (and its folder locked) before any training.
     let staged = set.prepare()?;
-    let experiment = Experiment::load(config.clone(), conditions, &data_dir, Some(protocol))?;
+    // The paper's segments (halves, forward differences): `learn reproduce` takes others from its
+    // run configuration.
+    let experiment = Experiment::load(
+        config.clone(),
+        conditions,
+        &data_dir,
+        Some(protocol),
+        Segmentation::PAPER,
+    )?;
     say!("protocol: {}", protocol.name());
 
     let cells = train_cells(

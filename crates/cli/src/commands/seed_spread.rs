@@ -8,7 +8,9 @@ use std::time::Instant;
 use data::ExperimentConditions;
 use learn::LearnConfig;
 use outputs::{Existing, OutputSet, Staged};
-use pipeline::{Experiment, Protocol, ShardProvenance, ShardSpec, SpreadCell, StageTiming};
+use pipeline::{
+    Experiment, Protocol, Segmentation, ShardProvenance, ShardSpec, SpreadCell, StageTiming,
+};
 
 use super::Global;
 use super::meta_train::{Args, PRODUCER, formulations, write_json};
@@ -62,7 +64,13 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
         Destination::Shard(outputs, shard) => Prepared::Shard(outputs.prepare()?, shard),
     };
     let started = Instant::now();
-    let experiment = Experiment::load(config, conditions, &data_dir, Some(protocol))?;
+    let experiment = Experiment::load(
+        config,
+        conditions,
+        &data_dir,
+        Some(protocol),
+        Segmentation::PAPER,
+    )?;
     let loaded = started.elapsed().as_secs_f64();
     say!("protocol: {}", protocol.name());
     let sweep = pipeline::spread_sweep(

@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result, write_text};
 use crate::progress::{Progress, Stage, Stopwatch};
+use crate::segment::Segmentation;
 use crate::shard::{ItemResult, MergedSweep, ShardFile, ShardProvenance, ShardSpec};
 use crate::summary::StageTiming;
 use crate::tables::ConditionName;
@@ -90,6 +91,8 @@ pub struct AblationsOutcome {
 #[serde(deny_unknown_fields)]
 pub struct AblationsContext {
     pub config: VariantsConfig,
+    /// How every flight is cut (the run configuration's `split` and `derivative`).
+    pub segmentation: Segmentation,
     /// The cells (formulation × evaluation condition), in row order.
     pub cells: Vec<AblationCell>,
     /// The evaluation flights (relative to the data directory), in row order of the conditions.
@@ -259,16 +262,16 @@ fn render_ablations(
                 data_files: context.evaluation_files.clone(),
                 learn_config: context.learn_config.clone(),
             },
-            protocol: PROTOCOL.to_string(),
+            protocol: format!(
+                "{}; every choice by blocked cross-validation inside the support segment",
+                context.segmentation.describe()
+            ),
             config: config.clone(),
             rows,
         },
         figures,
     })
 }
-
-/// The protocol line of `ablations.json`.
-const PROTOCOL: &str = "support = first half, query = second half, forward-difference targets on each segment; every choice by blocked cross-validation inside the support segment";
 
 /// One row: every variant summarised over the seeds (`per_seed`, in the configuration's order).
 fn ablation_row(

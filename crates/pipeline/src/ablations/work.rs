@@ -68,6 +68,7 @@ impl<'c> AblationsWork<'c> {
         data_files.dedup_by(|a, b| a.path == b.path);
         let context = AblationsContext {
             config: config.raw.clone(),
+            segmentation: run.segmentation(),
             cells: ablation_cells(config, &cells)?,
             evaluation_files,
             learn_config: experiment.as_ref().map(|e| e.config().get().clone()),
@@ -194,8 +195,7 @@ fn cut_cells(
     let mut cells = Vec::new();
     for &formulation in &run.raw.formulations {
         for (condition, log) in conditions.iter().zip(logs) {
-            let (support, query) =
-                flight_segments(log, formulation, run.raw.split, run.raw.derivative)?;
+            let (support, query) = flight_segments(log, formulation, run.segmentation())?;
             let segment = format!(
                 "the {} support segment of {}",
                 formulation.name(),

@@ -147,6 +147,7 @@ pub(crate) fn learned_basis_experiment(
         run.conditions.clone(),
         data_dir,
         run.protocol,
+        run.segmentation(),
         evaluation,
     )
 }

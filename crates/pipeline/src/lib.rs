@@ -4,15 +4,17 @@
 //! What it is for: reading a run configuration ([`RunConfig`], `experiments/reproduce.json` or
 //! `experiments/ci.json`); the flights (each log read and hashed once, [`Flight`]); a
 //! formulation's columns of a flight log and its support and query segments ([`Segment::cut`],
-//! [`flight_segments`]: halves, forward-difference targets on each); the protocols choosing the
+//! [`flight_segments`], cut by the run's [`Segmentation`]: the paper's halves, forward-difference
+//! targets on each); the protocols choosing the
 //! meta-training flights of an evaluation condition ([`Protocol`]); the LeARN experiment on them
 //! ([`Experiment`]: meta-training per formulation and evaluation condition, adaptation on the
 //! evaluation flight's support segment, prediction of its query segment, nested validation, the
-//! seed spread), whose cells ([`EvaluationCell`]) SINDy (`sindy`) is fitted on too; running both on
-//! every formulation × evaluation condition of `experiments/conditions.json` ([`run`]); turning the
-//! numbers and predictions into the paper's tables and figures and a `summary.json` with full
-//! provenance ([`write_outputs`]); and the check of the results against the paper
-//! ([`check_paper`]).
+//! seed spread), whose cells ([`EvaluationCell`]) SINDy (`sindy`) is fitted on too; SINDy, LeARN
+//! and every variant as peer [`Method`]s run by one [`Runner`] over cells × methods × seeds;
+//! running them on every formulation × evaluation condition of `experiments/conditions.json`
+//! ([`run`]); turning the numbers and predictions into the paper's tables and figures and a
+//! `summary.json` with full provenance ([`write_outputs`]); and the check of the results against the
+//! paper ([`check_paper`]).
 //!
 //! LeARN on your own data ([`own_data`]): reading CSV tasks and recordings for `learn`
 //! ([`own_data::read_tasks`], [`own_data::read_recording`]), a model of CSV tasks next to SINDy on
@@ -58,6 +60,7 @@ mod output;
 pub mod own_data;
 mod progress;
 mod run;
+mod runner;
 mod segment;
 mod shard;
 mod sindy_column;
@@ -90,6 +93,7 @@ pub use run::{
     GENERATED_PATHS, ReproduceShard, RunOutcome, git_commit, merged_run, run, run_shard,
     shard_timings, uncommitted_inputs,
 };
+pub use runner::{Fitted, Method, Models, Outcome, Runner, Train, Trial};
 pub use segment::{Segment, SegmentModel, Segmentation, flight_segments, segment_batch};
 pub use shard::{
     ItemResult, MergedSweep, SHARD_FILE, SHARD_FORMAT, ShardDocument, ShardFile, ShardProvenance,
@@ -109,6 +113,5 @@ pub use tables::{
 };
 pub use variants::{
     CheckedVariants, ENSEMBLE_SEED_STRIDE, LearnedBasisSpec, MAX_ENSEMBLE_MEMBERS, MAX_VARIANTS,
-    Outcome, VariantKind, VariantSpec, VariantsConfig, ensemble_member_seeds, evaluate_variants,
-    reproduce_columns,
+    VariantKind, VariantSpec, VariantsConfig, ensemble_member_seeds, reproduce_columns,
 };

@@ -14,6 +14,7 @@ use serde_json::json;
 use crate::error::{PipelineError, Result};
 use crate::experiment::{CellSummary, Experiment, SpreadCell, WorkItem, spread_cells};
 use crate::flights::Protocol;
+use crate::progress::Progress;
 use crate::shard::{ItemResult, ShardFile, ShardSpec, Sweep, SweepKind};
 
 /// What the spread file takes from the configuration: the same for every shard.
@@ -65,15 +66,15 @@ pub fn spread_sweep(
     })
 }
 
-/// Runs the items of `shard` of the spread `sweep`, calling `cell_done` as each cell ends.
+/// Runs the items of `shard` of the spread `sweep`, telling `progress` of each cell as it ends.
 pub fn run_spread(
     experiment: &Experiment,
     sweep: &Sweep<SpreadContext>,
     shard: ShardSpec,
-    cell_done: &(dyn Fn(&CellSummary) + Sync),
+    progress: &dyn Progress,
 ) -> Result<Vec<ItemResult<Vec<CellSummary>>>> {
     sweep.run(shard, |item| {
-        let cells = experiment.run_item_observed(item, cell_done)?;
+        let cells = experiment.run_item(item, progress)?;
         Ok(cells.into_iter().map(|cell| cell.summary).collect())
     })
 }

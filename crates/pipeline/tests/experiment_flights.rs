@@ -277,26 +277,35 @@ fn every_finished_cell_is_reported_once() {
         Segmentation::PAPER,
     )
     .unwrap();
-    let seen = std::sync::Mutex::new(Vec::new());
+    let seen = Units::default();
     let cells = experiment
-        .run_cells_observed(&[Formulation::Translational], 1, &|cell| {
-            seen.lock().unwrap().push(cell.condition.clone())
-        })
+        .run_cells(&[Formulation::Translational], 1, &seen)
         .unwrap();
-    let mut seen = std::mem::take(&mut *seen.lock().unwrap());
+    let mut seen = std::mem::take(&mut *seen.0.lock().unwrap());
     seen.sort();
-    let mut expected: Vec<String> = cells.iter().map(|c| c.summary.condition.clone()).collect();
+    let mut expected: Vec<String> = cells
+        .iter()
+        .map(|c| format!("translational {} seed 1", c.summary.label))
+        .collect();
     expected.sort();
     assert_eq!(cells.len(), 4);
     assert_eq!(seen, expected);
-    let count = std::sync::atomic::AtomicUsize::new(0);
+    let count = Units::default();
     let spread = experiment
-        .seed_spread_observed(&[Formulation::Translational], &[1, 2], &|_| {
-            count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        })
+        .seed_spread(&[Formulation::Translational], &[1, 2], &count)
         .unwrap();
     assert_eq!(spread.len(), 4);
-    assert_eq!(count.into_inner(), 8);
+    assert_eq!(count.0.lock().unwrap().len(), 8);
+}
+
+/// An observer that records every unit of work it is told of.
+#[derive(Default)]
+struct Units(std::sync::Mutex<Vec<String>>);
+
+impl pipeline::Progress for Units {
+    fn advance(&self, unit: std::fmt::Arguments<'_>) {
+        self.0.lock().unwrap().push(unit.to_string());
+    }
 }
 
 #[test]

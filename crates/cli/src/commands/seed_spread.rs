@@ -14,7 +14,7 @@ use pipeline::{
 
 use super::Global;
 use super::meta_train::{Args, PRODUCER, formulations, write_json};
-use super::progress::progress_bar;
+use super::progress::{Bar, progress_bar};
 use super::shard::ShardOutputs;
 
 /// The writer of a shard's result (never removes, nor is removed by, the run's own files).
@@ -88,9 +88,9 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
         shard,
         experiment.evaluation_conditions().len(),
     );
-    let bar = progress_bar(global.show_progress(), cells, "seed spread");
-    let results = pipeline::run_spread(&experiment, &sweep, shard, &|_| bar.inc(1));
-    bar.finish_and_clear();
+    let bar = Bar(progress_bar(global.show_progress(), cells, "seed spread"));
+    let results = pipeline::run_spread(&experiment, &sweep, shard, &bar);
+    bar.0.finish_and_clear();
     let results = results?;
     match prepared {
         Prepared::Shard(staged, shard) => {

@@ -103,7 +103,10 @@ pub use sindy_column::{SegmentEvaluation, SindyConfig, evaluate_flight, fit_and_
 pub use sindy_variant::{
     LibraryRegression, SegmentPredictions, VariantEvaluation, evaluate_features,
 };
-pub use spread::{SpreadContext, SpreadShard, run_spread, spread_document, spread_sweep};
+pub use spread::{
+    SPREAD_WHAT, SpreadContext, SpreadDocument, SpreadShard, run_spread, spread_document,
+    spread_sweep,
+};
 pub use summary::{
     CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,
     StageTiming, Summary, Timings,

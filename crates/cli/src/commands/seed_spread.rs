@@ -5,6 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use anyhow::Context;
+
 use data::ExperimentConditions;
 use learn::LearnConfig;
 use outputs::{Existing, OutputSet, Staged};
@@ -13,7 +15,7 @@ use pipeline::{
 };
 
 use super::Global;
-use super::meta_train::{Args, PRODUCER, formulations, write_json};
+use super::meta_train::{Args, PRODUCER, formulations};
 use super::progress::{Bar, progress_bar};
 use super::shard::ShardOutputs;
 
@@ -103,16 +105,24 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
         }
         Prepared::File(staged, file) => {
             let summaries: Vec<_> = results.into_iter().map(|r| r.result).collect();
-            let (spread, document) =
-                pipeline::spread_document(&sweep.context, &sweep.items, &summaries);
+            let document = pipeline::spread_document(&sweep.context, &sweep.items, &summaries);
             let took = format!("{:.1} s", started.elapsed().as_secs_f64());
-            print_spread(&spread, &sweep.context.seeds, &took);
-            write_json(staged.path(file), &args.spread_out, &document)?;
+            print_spread(&document.cells, &sweep.context.seeds, &took);
+            write_spread(staged.path(file), &args.spread_out, &document)?;
             staged.commit()?;
             say!("wrote {}", args.spread_out.display());
             Ok(())
         }
     }
+}
+
+/// Writes the spread file `document` to `staging` (the output `path`, which errors name).
+pub fn write_spread(
+    staging: &Path,
+    path: &Path,
+    document: &pipeline::SpreadDocument,
+) -> anyhow::Result<()> {
+    std::fs::write(staging, document.to_json()).with_context(|| path.display().to_string())
 }
 
 fn stage(name: &str, seconds: f64) -> StageTiming {

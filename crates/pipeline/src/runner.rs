@@ -66,7 +66,7 @@ pub struct Outcome {
     /// What was fitted.
     pub fitted: Fitted,
     /// Everything chosen inside the support segment (per output penalty; `variant` for select).
-    pub chosen: BTreeMap<String, serde_json::Value>,
+    pub chosen: BTreeMap<String, report::Choice>,
     /// Mean over outputs of the best support cross-validation MSE (variants that fit a
     /// regression).
     pub support_cv: Option<f64>,

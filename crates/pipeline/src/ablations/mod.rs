@@ -346,3 +346,22 @@ pub fn write_ablations(outcome: &AblationsOutcome, dir: &Path) -> Result<Vec<Pat
     }
     Ok(written)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_committed_ablations_are_read_and_written_back_byte_for_byte() {
+        // Every typed part of the file (the variants' choices among them) keeps its bytes.
+        let text = include_str!("../../../../results/ablations/ablations.json");
+        let ablations: Ablations = serde_json::from_str(text).unwrap();
+        let written = serde_json::to_string_pretty(&ablations).unwrap() + "\n";
+        assert!(written == text, "ablations.json is not written as read");
+        assert!(ablations.rows.iter().any(|row| {
+            row.variants
+                .values()
+                .any(|cell| cell.seeds.iter().any(|s| s.chosen.contains_key("variant")))
+        }));
+    }
+}

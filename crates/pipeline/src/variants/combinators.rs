@@ -22,7 +22,7 @@ pub(super) fn select(names: &[&str], outcomes: &[Outcome], candidates: &[usize])
     let mut chosen = chosen_outcome.chosen.clone();
     chosen.insert(
         "variant".to_string(),
-        serde_json::Value::String(names[best].to_string()),
+        report::Choice::Variant(names[best].to_string()),
     );
     Outcome {
         chosen,
@@ -106,7 +106,10 @@ mod tests {
             outcome(None, 4.0, &support, &query),
         ];
         let selected = select(&["a", "b", "c"], &outcomes, &[0, 1, 2]);
-        assert_eq!(selected.chosen["variant"], "b");
+        assert_eq!(
+            selected.chosen["variant"],
+            report::Choice::Variant("b".to_string())
+        );
         assert_eq!(selected.predictions.query_prediction[(0, 0)], 2.0);
 
         let members = [&outcomes[0].predictions, &outcomes[2].predictions];

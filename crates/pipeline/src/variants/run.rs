@@ -202,7 +202,7 @@ fn outcome_of(evaluation: VariantEvaluation, formulation: &Formulation) -> Outco
     let mut chosen = BTreeMap::new();
     let selections = &evaluation.fit.selections;
     for (selection, output) in selections.iter().zip(formulation.target_names()) {
-        chosen.insert(output, serde_json::json!(selection.chosen));
+        chosen.insert(output, report::Choice::Penalty(selection.chosen));
     }
     let support_cv = selections
         .iter()

@@ -51,19 +51,25 @@ pub struct Split {
 }
 
 impl SplitSpec {
+    /// Checks the settings (a support fraction strictly between 0 and 1), whatever the rows.
+    pub fn validate(&self) -> Result<()> {
+        if let Self::Fraction { support } = *self
+            && !(support > 0.0 && support < 1.0)
+        {
+            return Err(DataError::Invalid {
+                what: "split".to_string(),
+                message: format!("support fraction {support} must lie in (0, 1)"),
+            });
+        }
+        Ok(())
+    }
+
     /// Cuts `n` rows; both segments must keep at least two rows.
     pub fn split(&self, n: usize) -> Result<Split> {
+        self.validate()?;
         let cut = match *self {
             Self::Halves => n / 2,
-            Self::Fraction { support } => {
-                if !(support > 0.0 && support < 1.0) {
-                    return Err(DataError::Invalid {
-                        what: "split".to_string(),
-                        message: format!("support fraction {support} must lie in (0, 1)"),
-                    });
-                }
-                (support * n as f64).floor() as usize
-            }
+            Self::Fraction { support } => (support * n as f64).floor() as usize,
         };
         if cut < 2 || n - cut < 2 {
             return Err(DataError::Invalid {

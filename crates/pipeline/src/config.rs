@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 use sindy::Derivative;
 
 use crate::error::{PipelineError, Result};
-use crate::experiment::{EVALUATION_DERIVATIVE, EVALUATION_SPLIT};
 use crate::flights::Protocol;
+use crate::segment::Segmentation;
 
 /// The LeARN part of a run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -49,9 +49,9 @@ pub struct RunConfig {
     pub conditions: PathBuf,
     /// The paper's numbers (`paper/published.json`).
     pub published: PathBuf,
-    /// Support / query split of each evaluation flight (the paper: halves).
+    /// Support / query split of every flight, evaluation and meta-training (the paper: halves).
     pub split: SplitSpec,
-    /// Target derivative estimate (the paper: forward differences on each segment).
+    /// Target derivative estimate on each segment (the paper: forward differences).
     pub derivative: Derivative,
     pub sindy: SindyConfig,
     pub learn: LearnRun,
@@ -82,6 +82,14 @@ pub struct CheckedRunConfig {
 }
 
 impl CheckedRunConfig {
+    /// How the run cuts every flight: its `split` and `derivative`.
+    pub fn segmentation(&self) -> Segmentation {
+        Segmentation {
+            split: self.raw.split,
+            derivative: self.raw.derivative,
+        }
+    }
+
     /// Every file the run reads besides the flights, each with what names it (the option or the
     /// field of this file): outputs must be none of them.
     pub fn input_files(&self, option: &str) -> Vec<(String, PathBuf)> {
@@ -139,21 +147,17 @@ impl RunConfig {
                 ));
             }
         }
-        // The experiment's cells are cut into halves with forward-difference targets, once, for
-        // both columns of a table: a run naming another split or derivative is refused.
-        if self.split != EVALUATION_SPLIT {
-            return Err(error(
-                "split",
-                "LeARN evaluates on halves ({\"kind\": \"halves\"}); both methods must share the split"
-                    .to_string(),
-            ));
+        // Any split and derivative the cutting of a segment accepts: the experiment's cells, the
+        // meta-training tasks and every method are cut with them (rows are checked per flight).
+        if let Err(e) = self.split.validate() {
+            let message = match e {
+                data::DataError::Invalid { message, .. } => message,
+                other => other.to_string(),
+            };
+            return Err(error("split", message));
         }
-        if self.derivative != EVALUATION_DERIVATIVE {
-            return Err(error(
-                "derivative",
-                "LeARN's targets are forward differences ({\"kind\": \"forward\"}); both methods must share them"
-                    .to_string(),
-            ));
+        if let Err(e) = self.derivative.validate() {
+            return Err(error("derivative", e.to_string()));
         }
         check_seeds(&self.learn.seeds).map_err(|message| error("learn.seeds", message))?;
         // Checked now, not after the flights are loaded and LeARN is meta-trained: the library's

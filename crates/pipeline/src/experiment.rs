@@ -3,8 +3,9 @@
 //!
 //! An [`Experiment`] holds every flight it needs, each read and hashed once ([`Flight`]), and the
 //! cells of every formulation × evaluation flight ([`EvaluationCell`]): the support and query
-//! segments (halves, forward-difference targets on each) that LeARN is adapted and scored on and
-//! that the run fits SINDy on, so both methods see the same targets by construction.
+//! segments (cut by the run's [`Segmentation`]: the paper's halves with forward-difference targets
+//! on each) that LeARN is adapted and scored on and that the run fits SINDy on, so both methods see
+//! the same targets by construction. The meta-training tasks are cut the same way.
 
 mod nested;
 mod work;
@@ -13,7 +14,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use data::{Condition, ExperimentConditions, FlightLog, Mat, SplitSpec};
+use data::{Condition, ExperimentConditions, FlightLog, Mat};
 use learn::{
     AdaptationConfig, Architecture, Batch, CHECKPOINT_FORMAT, CheckedConfig, DataFile,
     FlightTraining, Formulation, InputRange, LearnConfig, LearnError, MetaTrainedModel,
@@ -22,22 +23,15 @@ use learn::{
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use sindy::Derivative;
 
 use crate::error::{PipelineError, Result};
 use crate::flights::{
     Flight, Protocol, evaluation_condition_of, evaluation_flight_path, read_evaluation_flights,
 };
-use crate::segment::{Segment, flight_segments, segment_batch};
+use crate::segment::{Segment, Segmentation, flight_segments, segment_batch};
 
 pub use nested::ValidationDetail;
 pub use work::{Cells, Spread, SpreadCell, WorkItem, spread_cells};
-
-/// How the evaluation flights are cut: the first half is the support segment, the second the query
-/// segment (the run configuration must name the same split).
-pub const EVALUATION_SPLIT: SplitSpec = SplitSpec::Halves;
-/// How the targets are estimated, on each segment alone (the run configuration must name it).
-pub const EVALUATION_DERIVATIVE: Derivative = Derivative::Forward;
 
 /// Configuration, conditions, protocol, every flight needed (read once) and the evaluation cells.
 pub struct Experiment {
@@ -45,6 +39,8 @@ pub struct Experiment {
     conditions: ExperimentConditions,
     data_dir: PathBuf,
     protocol: Protocol,
+    /// How every flight is cut into segments (evaluation cells and meta-training tasks alike).
+    segmentation: Segmentation,
     /// Every flight read, evaluation and meta-training, by the path it was read from.
     flights: BTreeMap<PathBuf, Arc<Flight>>,
     /// The evaluation flights, in table order.
@@ -55,7 +51,7 @@ pub struct Experiment {
 }
 
 /// One formulation on one evaluation flight: the segments both methods are fitted or adapted on
-/// (support) and scored on (query), cut with [`EVALUATION_SPLIT`] and [`EVALUATION_DERIVATIVE`].
+/// (support) and scored on (query), cut by the experiment's [`Segmentation`].
 #[derive(Debug)]
 pub struct EvaluationCell {
     pub formulation: Formulation,
@@ -69,7 +65,7 @@ pub struct EvaluationCell {
 #[derive(Clone, Debug)]
 pub struct SegmentPrediction {
     pub time: Vec<f64>,
-    /// ẋ (forward difference on this segment), samples × I.
+    /// ẋ (estimated on this segment alone), samples × I.
     pub targets: Mat<f64>,
     /// The adapted model's predictions, samples × I.
     pub predictions: Mat<f64>,
@@ -119,15 +115,24 @@ pub struct CellResult {
 
 impl Experiment {
     /// Resolves the protocol (`None`: `paper` if its flights are present, else
-    /// `leave-condition-out`) and reads every flight it needs, in parallel.
+    /// `leave-condition-out`) and reads every flight it needs, in parallel; every flight is cut
+    /// by `segmentation`.
     pub fn load(
         config: CheckedConfig,
         conditions: ExperimentConditions,
         data_dir: &Path,
         protocol: Option<Protocol>,
+        segmentation: Segmentation,
     ) -> Result<Self> {
         let evaluation = read_evaluation_flights(&conditions, data_dir)?;
-        Self::load_with(config, conditions, data_dir, protocol, &evaluation)
+        Self::load_with(
+            config,
+            conditions,
+            data_dir,
+            protocol,
+            segmentation,
+            &evaluation,
+        )
     }
 
     /// [`Experiment::load`] with the evaluation flights already read (by
@@ -138,6 +143,7 @@ impl Experiment {
         conditions: ExperimentConditions,
         data_dir: &Path,
         protocol: Option<Protocol>,
+        segmentation: Segmentation,
         evaluation: &[Arc<Flight>],
     ) -> Result<Self> {
         let protocol = Protocol::resolve(protocol, &conditions, data_dir);
@@ -179,12 +185,13 @@ impl Experiment {
             .map(|path| Ok((path.clone(), Arc::new(Flight::read(path, data_dir)?))))
             .collect::<Result<_>>()?;
         flights.extend(training);
-        let cells = evaluation_cells(&evaluated, evaluation)?;
+        let cells = evaluation_cells(&Formulation::ALL, &evaluated, evaluation, segmentation)?;
         Ok(Self {
             config,
             conditions,
             data_dir: data_dir.to_path_buf(),
             protocol,
+            segmentation,
             flights,
             evaluation: evaluation.to_vec(),
             cells,
@@ -194,6 +201,11 @@ impl Experiment {
     /// The protocol every result of this experiment is produced under.
     pub fn protocol(&self) -> Protocol {
         self.protocol
+    }
+
+    /// How every flight of this experiment is cut into segments.
+    pub fn segmentation(&self) -> Segmentation {
+        self.segmentation
     }
 
     /// The configuration.
@@ -297,12 +309,8 @@ impl Experiment {
     ) -> Result<(Architecture, Standardiser, MetaTrainingOutcome)> {
         let mut raw_tasks = Vec::with_capacity(files.len());
         for path in files {
-            let (support, query) = flight_segments(
-                &self.flight(path)?.log,
-                formulation,
-                EVALUATION_SPLIT,
-                EVALUATION_DERIVATIVE,
-            )?;
+            let (support, query) =
+                flight_segments(&self.flight(path)?.log, formulation, self.segmentation)?;
             raw_tasks.push((path, segment_batch(&support), segment_batch(&query)));
         }
         let input_dim = formulation.input_names().len();
@@ -536,20 +544,18 @@ impl Experiment {
     }
 }
 
-/// The cells of every formulation on every evaluation flight (`flights[k]` of `conditions[k]`).
-fn evaluation_cells(
+/// The cells of `formulations` on every evaluation flight (`flights[k]` of `conditions[k]`), cut
+/// by `segmentation`: formulation by formulation, conditions in table order.
+pub(crate) fn evaluation_cells(
+    formulations: &[Formulation],
     conditions: &[&Condition],
     flights: &[Arc<Flight>],
+    segmentation: Segmentation,
 ) -> Result<Vec<Arc<EvaluationCell>>> {
-    let mut cells = Vec::with_capacity(Formulation::ALL.len() * conditions.len());
-    for formulation in Formulation::ALL {
+    let mut cells = Vec::with_capacity(formulations.len() * conditions.len());
+    for &formulation in formulations {
         for (condition, flight) in conditions.iter().zip(flights) {
-            let (support, query) = flight_segments(
-                &flight.log,
-                formulation,
-                EVALUATION_SPLIT,
-                EVALUATION_DERIVATIVE,
-            )?;
+            let (support, query) = flight_segments(&flight.log, formulation, segmentation)?;
             cells.push(Arc::new(EvaluationCell {
                 formulation,
                 condition: (*condition).clone(),
@@ -614,17 +620,17 @@ fn standardised(standardiser: &Standardiser, batch: Batch) -> Batch {
 }
 
 /// Explains `model` over the whole of `log`: first adapted online on the flight's support segment
-/// (with the model's own adaptation settings) when `adapt` is set, then [`learn::explain`] over
-/// every row.
+/// (cut by `segmentation`, with the model's own adaptation settings) when `adapt` is set, then
+/// [`learn::explain`] over every row.
 pub fn explain_flight(
     model: &MetaTrainedModel,
     log: &FlightLog,
+    segmentation: Segmentation,
     adapt: bool,
     rule: learn::EquationRule,
 ) -> Result<learn::Explanation> {
     let formulation = model.formulation_for(&format!("explaining over {}", log.path.display()))?;
-    let (support, query) =
-        flight_segments(log, formulation, EVALUATION_SPLIT, EVALUATION_DERIVATIVE)?;
+    let (support, query) = flight_segments(log, formulation, segmentation)?;
     let raw_support = segment_batch(&support);
     let mut inputs = model.standardiser.apply(&raw_support.inputs);
     inputs.extend(model.standardiser.apply(&segment_batch(&query).inputs));

@@ -4,15 +4,17 @@
 //! What it is for: reading a run configuration ([`RunConfig`], `experiments/reproduce.json` or
 //! `experiments/ci.json`); the flights (each log read and hashed once, [`Flight`]); a
 //! formulation's columns of a flight log and its support and query segments ([`Segment::cut`],
-//! [`flight_segments`]: halves, forward-difference targets on each); the protocols choosing the
+//! [`flight_segments`], cut by the run's [`Segmentation`]: the paper's halves, forward-difference
+//! targets on each); the protocols choosing the
 //! meta-training flights of an evaluation condition ([`Protocol`]); the LeARN experiment on them
 //! ([`Experiment`]: meta-training per formulation and evaluation condition, adaptation on the
 //! evaluation flight's support segment, prediction of its query segment, nested validation, the
-//! seed spread), whose cells ([`EvaluationCell`]) SINDy (`sindy`) is fitted on too; running both on
-//! every formulation × evaluation condition of `experiments/conditions.json` ([`run`]); turning the
-//! numbers and predictions into the paper's tables and figures and a `summary.json` with full
-//! provenance ([`write_outputs`]); and the check of the results against the paper
-//! ([`check_paper`]).
+//! seed spread), whose cells ([`EvaluationCell`]) SINDy (`sindy`) is fitted on too; SINDy, LeARN
+//! and every variant as peer [`Method`]s run by one [`Runner`] over cells × methods × seeds;
+//! running them on every formulation × evaluation condition of `experiments/conditions.json`
+//! ([`run`]); turning the numbers and predictions into the paper's tables and figures and a
+//! `summary.json` with full provenance ([`write_outputs`]); and the check of the results against the
+//! paper ([`check_paper`]).
 //!
 //! LeARN on your own data ([`own_data`]): reading CSV tasks and recordings for `learn`
 //! ([`own_data::read_tasks`], [`own_data::read_recording`]), a model of CSV tasks next to SINDy on
@@ -42,8 +44,8 @@
 //! conditions file make a new row in every table and a new figure per table.
 //!
 //! Definitions, shared by both methods: support = the first half of each evaluation flight, query =
-//! the second half ([`EVALUATION_SPLIT`]); targets = forward differences on each segment
-//! ([`EVALUATION_DERIVATIVE`]), built once per cell for both. **Adaptation MSE**: the model
+//! the second half; targets = forward differences on each segment ([`Segmentation::PAPER`], the
+//! run configuration's `split` and `derivative`), built once per cell for both. **Adaptation MSE**: the model
 //! fitted (SINDy) or adapted online (LeARN) on the support segment, scored on that segment.
 //! **Generalisation MSE**: the same model, unchanged, scored on the query segment.
 
@@ -58,6 +60,7 @@ mod output;
 pub mod own_data;
 mod progress;
 mod run;
+mod runner;
 mod segment;
 mod shard;
 mod sindy_column;
@@ -77,9 +80,8 @@ pub use cells::figure_file_name;
 pub use config::{CheckedRunConfig, LearnRun, MAX_SEEDS, RunConfig, merge_patch};
 pub use error::{PipelineError, Result};
 pub use experiment::{
-    CellResult, CellSummary, Cells, EVALUATION_DERIVATIVE, EVALUATION_SPLIT, EvaluationCell,
-    Experiment, SegmentPrediction, Spread, SpreadCell, ValidationDetail, WorkItem, explain_flight,
-    spread_cells,
+    CellResult, CellSummary, Cells, EvaluationCell, Experiment, SegmentPrediction, Spread,
+    SpreadCell, ValidationDetail, WorkItem, explain_flight, spread_cells,
 };
 pub use flights::{Flight, Protocol, evaluation_condition_of, read_evaluation_flights};
 pub use output::{
@@ -91,7 +93,8 @@ pub use run::{
     GENERATED_PATHS, ReproduceShard, RunOutcome, git_commit, merged_run, run, run_shard,
     shard_timings, uncommitted_inputs,
 };
-pub use segment::{Segment, SegmentModel, flight_segments, segment_batch};
+pub use runner::{Fitted, Method, Models, Outcome, Runner, Train, Trial};
+pub use segment::{Segment, SegmentModel, Segmentation, flight_segments, segment_batch};
 pub use shard::{
     ItemResult, MergedSweep, SHARD_FILE, SHARD_FORMAT, ShardDocument, ShardFile, ShardProvenance,
     ShardSpec, Sweep, SweepKind, merge, read_shard, write_shard,
@@ -100,7 +103,10 @@ pub use sindy_column::{SegmentEvaluation, SindyConfig, evaluate_flight, fit_and_
 pub use sindy_variant::{
     LibraryRegression, SegmentPredictions, VariantEvaluation, evaluate_features,
 };
-pub use spread::{SpreadContext, SpreadShard, run_spread, spread_document, spread_sweep};
+pub use spread::{
+    SPREAD_WHAT, SpreadContext, SpreadDocument, SpreadShard, run_spread, spread_document,
+    spread_sweep,
+};
 pub use summary::{
     CellRecord, FileRef, LearnCell, LearnSeedCell, Provenance, SUMMARY_FORMAT, SindyCell,
     StageTiming, Summary, Timings,
@@ -110,6 +116,5 @@ pub use tables::{
 };
 pub use variants::{
     CheckedVariants, ENSEMBLE_SEED_STRIDE, LearnedBasisSpec, MAX_ENSEMBLE_MEMBERS, MAX_VARIANTS,
-    Outcome, VariantKind, VariantSpec, VariantsConfig, ensemble_member_seeds, evaluate_variants,
-    reproduce_columns,
+    VariantKind, VariantSpec, VariantsConfig, ensemble_member_seeds, reproduce_columns,
 };

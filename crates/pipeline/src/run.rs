@@ -4,26 +4,26 @@
 //! hashed once, by the [`Experiment`]), takes the experiment's cells and fits SINDy on them
 //! (milliseconds); the LeARN work is the sweep of [`WorkItem`]s, evaluated on the same cells, each
 //! item's cells carrying what the tables need ([`LearnCellOutcome`]), rendered by
-//! [`crate::tables::render`]. SINDy and LeARN are scored against the targets of one
-//! [`EvaluationCell`], built once. Progress goes to the caller's observer ([`Progress`]): each
-//! stage, and each LeARN cell as it ends.
+//! [`crate::tables::render`]; the variant columns are evaluated on the first seed's cells with its
+//! LeARN model. SINDy, LeARN and the variants are methods ([`crate::Method`]) run by the one
+//! [`Runner`], scored against the targets of one [`EvaluationCell`], built once. Progress goes to
+//! the caller's observer ([`Progress`]): each stage, and each LeARN cell as it ends.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use crate::sindy_column::SegmentEvaluation;
 use data::file_sha256;
 use learn::{EquationRule, Formulation, explain, row_major};
-use rayon::prelude::*;
 use report::{MethodTrace, PublishedTables, QualitativeFigure, ResultsTable};
 
 use crate::cells::{cell_figure, stacked_columns};
 use crate::config::CheckedRunConfig;
-use crate::error::{PipelineError, Result, in_flight};
+use crate::error::{PipelineError, Result};
 use crate::experiment::{CellResult, Cells, EvaluationCell, Experiment, WorkItem};
-use crate::progress::{Progress, Stage, Stopwatch};
+use crate::progress::{NoProgress, Progress, Stage, Stopwatch};
+use crate::runner::{Method, Outcome, Runner};
 use crate::shard::{
     ItemResult, MergedSweep, ShardFile, ShardProvenance, ShardSpec, Sweep, SweepKind,
 };
@@ -50,7 +50,7 @@ pub type ReproduceShard = ShardFile<ReproduceContext, Vec<LearnCellOutcome>>;
 /// One formulation on one evaluation flight (the experiment's cell), with SINDy fitted.
 struct Cell {
     evaluation: Arc<EvaluationCell>,
-    sindy: SegmentEvaluation,
+    sindy: Outcome,
 }
 
 /// The stage in which the work items run.
@@ -163,6 +163,7 @@ impl<'c> ReproduceWork<'c> {
                 config.conditions.clone(),
                 data_dir,
                 config.protocol,
+                config.segmentation(),
             )
         })?;
         let cells = stopwatch.time("SINDy", || sindy_cells(config, &experiment))?;
@@ -223,15 +224,7 @@ impl<'c> ReproduceWork<'c> {
 
     /// One work item: LeARN on its cells; with the first seed, each cell's detail too.
     fn run_item(&self, item: &WorkItem, progress: &dyn Progress) -> Result<Vec<LearnCellOutcome>> {
-        let cell_done = |cell: &crate::experiment::CellSummary| {
-            progress.advance(format_args!(
-                "{} {} seed {}",
-                cell.formulation.name(),
-                cell.label,
-                cell.seed
-            ));
-        };
-        let results = self.experiment.run_item_observed(item, &cell_done)?;
+        let results = self.experiment.run_item(item, progress)?;
         let first_seed = item.seed == self.config.raw.learn.seeds[0];
         results
             .iter()
@@ -279,22 +272,26 @@ impl<'c> ReproduceWork<'c> {
             EquationRule::default(),
         );
         let variant_columns = match &self.variants {
-            Some(variants) => crate::variants::reproduce_columns(
-                variants,
-                &[(&evaluation.support, &evaluation.query, model)],
-            )?
-            .pop()
-            .unwrap_or_default(),
+            Some(variants) => crate::variants::reproduce_columns(variants, evaluation, model)?,
             None => BTreeMap::new(),
         };
+        let sindy = &cell.sindy.predictions;
+        let equations = cell.sindy.sindy().map(|model| model.equations(3));
         Ok(CellDetail {
             flight: evaluation.flight.file.clone(),
             support_rows: [evaluation.support.rows.start, evaluation.support.rows.end],
             query_rows: [evaluation.query.rows.start, evaluation.query.rows.end],
             sindy: SindyOutcome {
-                adaptation: cell.sindy.adaptation,
-                generalisation: cell.sindy.generalisation,
-                equations: cell.sindy.model.equations(3),
+                adaptation: sindy.adaptation,
+                generalisation: sindy.generalisation,
+                equations: equations.ok_or_else(|| PipelineError::Mismatch {
+                    what: format!(
+                        "{} {}",
+                        evaluation.formulation.name(),
+                        evaluation.condition.name
+                    ),
+                    message: "SINDy's outcome has no model".to_string(),
+                })?,
                 query_coverage: sindy_query_coverage(cell, result),
             },
             explanation,
@@ -359,24 +356,27 @@ fn context(
 }
 
 /// SINDy on every formulation × evaluation flight of the run, in table order, on the
-/// experiment's cells.
+/// experiment's cells (by the [`Runner`]: SINDy is a method like the others; its seed plays no
+/// part).
 fn sindy_cells(config: &CheckedRunConfig, experiment: &Experiment) -> Result<Vec<Cell>> {
     let conditions = experiment.evaluation_conditions();
-    let jobs: Vec<(Formulation, &str)> = config
+    let cells: Vec<Arc<EvaluationCell>> = config
         .raw
         .formulations
         .iter()
         .flat_map(|&f| conditions.iter().map(move |c| (f, c.as_str())))
-        .collect();
-    jobs.par_iter()
-        .map(|&(formulation, condition)| {
-            let evaluation = Arc::clone(experiment.cell(formulation, condition)?);
-            let sindy = crate::sindy_column::fit_and_evaluate(
-                &config.raw.sindy,
-                &evaluation.support,
-                &evaluation.query,
-            )
-            .map_err(|error| in_flight(&evaluation.flight.log.path, error))?;
+        .map(|(formulation, condition)| experiment.cell(formulation, condition).cloned())
+        .collect::<Result<_>>()?;
+    let runner = Runner::new([&config.raw.sindy as &dyn Method], None);
+    let outcomes = runner.run_cells(&cells, config.raw.learn.seeds[0], &NoProgress)?;
+    cells
+        .into_iter()
+        .zip(outcomes)
+        .map(|(evaluation, mut outcomes)| {
+            let sindy = outcomes.pop().ok_or_else(|| PipelineError::Mismatch {
+                what: evaluation.flight.log.path.display().to_string(),
+                message: "SINDy gave no outcome".to_string(),
+            })?;
             Ok(Cell { evaluation, sindy })
         })
         .collect()
@@ -392,7 +392,7 @@ fn sindy_query_coverage(cell: &Cell, learn_result: &CellResult) -> Option<learn:
     learn_result.model.standardiser.coverage_with_errors(
         &row_major(&query.inputs()),
         &names,
-        &row_major(&cell.sindy.query_prediction),
+        &row_major(&cell.sindy.predictions.query_prediction),
         &row_major(&query.targets),
     )
 }
@@ -402,8 +402,8 @@ fn figure(cell: &Cell, learn_result: &CellResult) -> Result<(String, Qualitative
         MethodTrace {
             method: "SINDy".to_string(),
             prediction: stacked_columns(
-                &cell.sindy.support_prediction,
-                &cell.sindy.query_prediction,
+                &cell.sindy.predictions.support_prediction,
+                &cell.sindy.predictions.query_prediction,
             ),
             band: None,
         },

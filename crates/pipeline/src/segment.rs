@@ -1,7 +1,8 @@
 //! A formulation's regression data of a flight (the file side of the paper's formulations): which
 //! log columns, with which scalings, make the states x and controls u of [`Formulation`]
-//! ([`Segment::cut`]), a flight cut into support and query segments ([`flight_segments`]) and a
-//! segment as LeARN's regression data ([`segment_batch`], [`SegmentModel`]).
+//! ([`Segment::cut`]), a flight cut into support and query segments ([`Segmentation`],
+//! [`flight_segments`]) and a segment as LeARN's regression data ([`segment_batch`],
+//! [`SegmentModel`]).
 //!
 //! | formulation | state x (I) | control u (U) | target |
 //! |---|---|---|---|
@@ -17,6 +18,7 @@ use std::ops::Range;
 use data::{FlightLog, SplitSpec};
 use faer::Mat;
 use learn::{AdaptationConfig, Batch, Formulation, MetaTrainedModel, row_major};
+use serde::{Deserialize, Serialize};
 use sindy::Derivative;
 
 use crate::error::{PipelineError, Result, in_flight};
@@ -128,14 +130,52 @@ fn control(formulation: Formulation, log: &FlightLog, k: usize, out: &mut Vec<f6
     }
 }
 
-/// The support and query segments of `log` (cut by `split`, targets by `derivative` on each
-/// segment); errors name the flight's file.
+/// How every flight of a run is cut into a support and a query segment and how their targets
+/// are estimated: the run configuration's `split` and `derivative` (the paper: halves, forward
+/// differences on each segment). SINDy, LeARN, its meta-training tasks and every variant use the
+/// segments of one [`Segmentation`], so all methods see the same targets by construction.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Segmentation {
+    pub split: SplitSpec,
+    pub derivative: Derivative,
+}
+
+impl Segmentation {
+    /// The paper's: support = first half, query = second half, forward differences on each.
+    pub const PAPER: Segmentation = Segmentation {
+        split: SplitSpec::Halves,
+        derivative: Derivative::Forward,
+    };
+
+    /// The protocol in words, e.g. `support = first half, query = second half, forward-difference
+    /// targets on each segment`.
+    pub fn describe(&self) -> String {
+        let split = match self.split {
+            SplitSpec::Halves => "support = first half, query = second half".to_string(),
+            SplitSpec::Fraction { support } => {
+                format!("support = first {support} of the flight, query = the rest")
+            }
+        };
+        let targets = match self.derivative {
+            Derivative::Forward => "forward-difference".to_string(),
+            Derivative::Central => "central-difference".to_string(),
+            Derivative::SavitzkyGolay { window, order } => {
+                format!("Savitzky–Golay (window {window}, order {order})")
+            }
+        };
+        format!("{split}, {targets} targets on each segment")
+    }
+}
+
+/// The support and query segments of `log` (cut by `segmentation.split`, targets by
+/// `segmentation.derivative` on each segment); errors name the flight's file.
 pub fn flight_segments(
     log: &FlightLog,
     formulation: Formulation,
-    split: SplitSpec,
-    derivative: Derivative,
+    segmentation: Segmentation,
 ) -> Result<(Segment, Segment)> {
+    let Segmentation { split, derivative } = segmentation;
     let segments = || -> Result<(Segment, Segment)> {
         let rows = split.split(log.len())?;
         let support = Segment::cut(log, formulation, rows.support, derivative)?;
@@ -204,16 +244,31 @@ mod tests {
     }
 
     #[test]
+    fn the_segmentation_is_described_in_words() {
+        // The paper's words are those `ablations.json` has always recorded as its protocol.
+        assert_eq!(
+            Segmentation::PAPER.describe(),
+            "support = first half, query = second half, forward-difference targets on each segment"
+        );
+        let other = Segmentation {
+            split: SplitSpec::Fraction { support: 0.75 },
+            derivative: Derivative::SavitzkyGolay {
+                window: 7,
+                order: 3,
+            },
+        };
+        assert_eq!(
+            other.describe(),
+            "support = first 0.75 of the flight, query = the rest, Savitzky–Golay (window 7, order 3) targets on each segment"
+        );
+    }
+
+    #[test]
     fn a_flight_too_short_to_split_is_named() {
         let short = still_flight("/data/experiment/short.csv", 3);
-        let message = flight_segments(
-            &short,
-            Formulation::Full,
-            SplitSpec::Halves,
-            Derivative::Forward,
-        )
-        .unwrap_err()
-        .to_string();
+        let message = flight_segments(&short, Formulation::Full, Segmentation::PAPER)
+            .unwrap_err()
+            .to_string();
         assert_eq!(
             message,
             "/data/experiment/short.csv: split: 3 rows are too few to split (1 / 2)"
@@ -221,8 +276,7 @@ mod tests {
         let (support, query) = flight_segments(
             &still_flight("long.csv", 10),
             Formulation::Full,
-            SplitSpec::Halves,
-            Derivative::Forward,
+            Segmentation::PAPER,
         )
         .unwrap();
         assert_eq!((support.rows, query.rows), (0..5, 5..10));

@@ -95,10 +95,14 @@ fn bad_values_name_the_file_and_field() {
     let cases = [
         (
             "split",
-            json!({"kind": "fraction", "support": 0.7}),
-            "split",
+            json!({"kind": "fraction", "support": 1.5}),
+            "split: support fraction 1.5 must lie in (0, 1)",
         ),
-        ("derivative", json!({"kind": "central"}), "derivative"),
+        (
+            "derivative",
+            json!({"kind": "savitzky_golay", "window": 4, "order": 2}),
+            "derivative: ",
+        ),
         ("formulations", json!([]), "formulations"),
     ];
     for (field, value, expected) in cases {
@@ -256,4 +260,24 @@ fn a_fault_of_the_learn_configuration_itself_is_named_in_that_file() {
             && message.ends_with("missing field `seed`"),
         "{message}"
     );
+}
+
+#[test]
+fn any_valid_split_and_derivative_is_taken_as_the_run_s_segmentation() {
+    let mut config = committed("experiments/reproduce.json");
+    config["split"] = json!({"kind": "fraction", "support": 0.7});
+    config["derivative"] = json!({"kind": "savitzky_golay", "window": 5, "order": 2});
+    let checked = load("segmentation", &config).unwrap();
+    assert_eq!(
+        checked.segmentation(),
+        pipeline::Segmentation {
+            split: data::SplitSpec::Fraction { support: 0.7 },
+            derivative: sindy::Derivative::SavitzkyGolay {
+                window: 5,
+                order: 2
+            },
+        }
+    );
+    let committed = load("committed", &committed("experiments/reproduce.json")).unwrap();
+    assert_eq!(committed.segmentation(), pipeline::Segmentation::PAPER);
 }

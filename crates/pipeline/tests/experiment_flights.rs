@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use data::ExperimentConditions;
 use learn::{EquationRule, Formulation, LearnConfig, MetaTrainedModel, TaskGrouping};
-use pipeline::{Experiment, PipelineError, Protocol, Segment, explain_flight};
+use pipeline::{Experiment, PipelineError, Protocol, Segment, Segmentation, explain_flight};
 use sindy::Derivative;
 
 mod common {
@@ -56,6 +56,7 @@ fn leave_condition_out_cell_runs_end_to_end() {
         conditions,
         &data_dir,
         Some(Protocol::LeaveConditionOut),
+        Segmentation::PAPER,
     )
     .unwrap();
     assert_eq!(
@@ -97,20 +98,15 @@ fn leave_condition_out_cell_runs_end_to_end() {
     let mse = sum / (p.nrows() * p.ncols()) as f64;
     assert!((mse - summary.generalisation).abs() < 1e-12 * mse);
     // LeARN is scored against the experiment's cell, whose segments the run fits SINDy on: the
-    // targets of the run's split and derivative (the only ones a run configuration accepts).
+    // targets of the experiment's segmentation.
     let evaluation = experiment
         .cell(Formulation::Translational, "70p20sint")
         .unwrap();
     let log =
         data::FlightLog::read(&data_dir.join("experiment/custom_figure8_baseline_70p20sint.csv"))
             .unwrap();
-    let (support, query) = pipeline::flight_segments(
-        &log,
-        Formulation::Translational,
-        pipeline::EVALUATION_SPLIT,
-        pipeline::EVALUATION_DERIVATIVE,
-    )
-    .unwrap();
+    let (support, query) =
+        pipeline::flight_segments(&log, Formulation::Translational, Segmentation::PAPER).unwrap();
     for (learn, cut, sindy) in [
         (
             &cell.support.targets,
@@ -150,7 +146,14 @@ fn leave_condition_out_cell_runs_end_to_end() {
     assert_eq!(&loaded, model);
     let flight = data_dir.join("experiment/custom_figure8_baseline_70p20sint.csv");
     let log = data::FlightLog::read(&flight).unwrap();
-    let explanation = explain_flight(&loaded, &log, false, EquationRule::default()).unwrap();
+    let explanation = explain_flight(
+        &loaded,
+        &log,
+        Segmentation::PAPER,
+        false,
+        EquationRule::default(),
+    )
+    .unwrap();
     assert_eq!(explanation.outputs.len(), 3);
     assert!(explanation.outputs[0].equation.starts_with("v̇x = "));
     assert_eq!(explanation.outputs[0].inputs.len(), 6);
@@ -169,6 +172,7 @@ fn nested_validation_checks_its_candidate_settings() {
         conditions,
         &data_dir,
         Some(Protocol::LeaveConditionOut),
+        Segmentation::PAPER,
     )
     .unwrap();
     let base = config.get().clone();
@@ -226,6 +230,7 @@ fn condition_tasks_pool_the_flights_of_each_wind_condition() {
             conditions,
             &data_dir,
             Some(Protocol::LeaveConditionOut),
+            Segmentation::PAPER,
         )
         .unwrap()
     };
@@ -269,28 +274,38 @@ fn every_finished_cell_is_reported_once() {
         conditions,
         &data_dir,
         Some(Protocol::LeaveConditionOut),
+        Segmentation::PAPER,
     )
     .unwrap();
-    let seen = std::sync::Mutex::new(Vec::new());
+    let seen = Units::default();
     let cells = experiment
-        .run_cells_observed(&[Formulation::Translational], 1, &|cell| {
-            seen.lock().unwrap().push(cell.condition.clone())
-        })
+        .run_cells(&[Formulation::Translational], 1, &seen)
         .unwrap();
-    let mut seen = std::mem::take(&mut *seen.lock().unwrap());
+    let mut seen = std::mem::take(&mut *seen.0.lock().unwrap());
     seen.sort();
-    let mut expected: Vec<String> = cells.iter().map(|c| c.summary.condition.clone()).collect();
+    let mut expected: Vec<String> = cells
+        .iter()
+        .map(|c| format!("translational {} seed 1", c.summary.label))
+        .collect();
     expected.sort();
     assert_eq!(cells.len(), 4);
     assert_eq!(seen, expected);
-    let count = std::sync::atomic::AtomicUsize::new(0);
+    let count = Units::default();
     let spread = experiment
-        .seed_spread_observed(&[Formulation::Translational], &[1, 2], &|_| {
-            count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        })
+        .seed_spread(&[Formulation::Translational], &[1, 2], &count)
         .unwrap();
     assert_eq!(spread.len(), 4);
-    assert_eq!(count.into_inner(), 8);
+    assert_eq!(count.0.lock().unwrap().len(), 8);
+}
+
+/// An observer that records every unit of work it is told of.
+#[derive(Default)]
+struct Units(std::sync::Mutex<Vec<String>>);
+
+impl pipeline::Progress for Units {
+    fn advance(&self, unit: std::fmt::Arguments<'_>) {
+        self.0.lock().unwrap().push(unit.to_string());
+    }
 }
 
 #[test]
@@ -312,6 +327,7 @@ fn nested_validation_detail_agrees_with_nested_validation() {
         conditions,
         &data_dir,
         Some(Protocol::LeaveConditionOut),
+        Segmentation::PAPER,
     )
     .unwrap();
     let pair = ["35wind", "100wind"];

@@ -5,13 +5,15 @@
 //! get untrained networks (their meta-training never reads the evaluation flight).
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use data::{FlightLog, SplitSpec};
 use learn::Formulation;
 use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Standardiser};
-use pipeline::Protocol;
-use pipeline::Segment;
-use pipeline::{VariantKind, VariantsConfig, evaluate_variants};
+use pipeline::{
+    EvaluationCell, Flight, Method, Models, Outcome, Protocol, Runner, Segment, VariantKind,
+    VariantsConfig,
+};
 use sindy::Derivative;
 
 fn workspace() -> PathBuf {
@@ -59,6 +61,41 @@ fn untrained_model(formulation: Formulation, config: &LearnConfig) -> MetaTraine
     }
 }
 
+/// Every variant of `config` on the cell of `support` and `query` of the flight `log`, seed 3,
+/// the networks given by `model`.
+fn evaluate(
+    config: &VariantsConfig,
+    log: &FlightLog,
+    support: Segment,
+    query: Segment,
+    model: &MetaTrainedModel,
+) -> Vec<Outcome> {
+    let cell = EvaluationCell {
+        formulation: support.formulation,
+        condition: serde_json::from_str(
+            r#"{"name": "70wind", "wind_speed": "12.0 m/s", "role": "evaluation"}"#,
+        )
+        .unwrap(),
+        flight: Arc::new(Flight {
+            log: log.clone(),
+            file: learn::DataFile {
+                path: log.path.clone(),
+                sha256: String::new(),
+            },
+        }),
+        support,
+        query,
+    };
+    let train = |_: &EvaluationCell, _: u64| Ok(model.clone());
+    let runner = Runner::new(
+        config.variants.iter().map(|v| v as &dyn Method),
+        Some(&train),
+    );
+    runner
+        .evaluate(&cell, 3, &mut Models::new(&cell, Some(&train)))
+        .unwrap()
+}
+
 #[test]
 fn perturbing_the_query_changes_no_choice() {
     let Some(data_dir) = real_data_dir() else {
@@ -82,10 +119,9 @@ fn perturbing_the_query_changes_no_choice() {
         let query =
             Segment::cut(&log, formulation, split.query.clone(), Derivative::Forward).unwrap();
         let changed = perturbed(&query);
-        let learn_config = config.run.learn.get().clone();
-        let model = |_| Ok(untrained_model(formulation, &learn_config));
-        let original = evaluate_variants(&config.raw.variants, model, &support, &query, 3).unwrap();
-        let again = evaluate_variants(&config.raw.variants, model, &support, &changed, 3).unwrap();
+        let model = untrained_model(formulation, config.run.learn.get());
+        let original = evaluate(&config.raw, &log, support.clone(), query, &model);
+        let again = evaluate(&config.raw, &log, support, changed, &model);
         for ((spec, a), b) in config.raw.variants.iter().zip(&original).zip(&again) {
             let what = format!("{} {}", formulation.name(), spec.name);
             // `learn`, `learn_ensemble` and `average` choose nothing; every other variant records its choices.

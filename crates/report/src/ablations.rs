@@ -23,6 +23,17 @@ pub struct VariantCell {
     pub seeds: Vec<SeedCell>,
 }
 
+/// One choice a variant made inside the support segment. Written as the bare value (`0.001`,
+/// `"lag-ridge-cv"`), as `ablations.json` always had it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Choice {
+    /// The penalty chosen for one output.
+    Penalty(f64),
+    /// The candidate a `select` variant chose, by name.
+    Variant(String),
+}
+
 /// One seed of one variant on one cell.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SeedCell {
@@ -36,8 +47,8 @@ pub struct SeedCell {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub support_cv: Option<f64>,
     /// What was chosen inside the support segment: per output the penalty, and for `select` the
-    /// candidate.
-    pub chosen: BTreeMap<String, serde_json::Value>,
+    /// candidate (under `variant`).
+    pub chosen: BTreeMap<String, Choice>,
     /// For bagged variants: the fraction of query targets inside the predictive band.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub query_band_coverage: Option<f64>,
@@ -350,6 +361,26 @@ fn shorten(equation: &str, terms: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn choices_are_written_as_bare_values_and_read_back() {
+        let chosen: BTreeMap<String, Choice> = [
+            ("vdot_x".to_string(), Choice::Penalty(0.001)),
+            ("vdot_y".to_string(), Choice::Penalty(1.0)),
+            (
+                "variant".to_string(),
+                Choice::Variant("lag-ridge-cv".to_string()),
+            ),
+        ]
+        .into();
+        let text = serde_json::to_string(&chosen).unwrap();
+        assert_eq!(
+            text,
+            r#"{"variant":"lag-ridge-cv","vdot_x":0.001,"vdot_y":1.0}"#
+        );
+        let read: BTreeMap<String, Choice> = serde_json::from_str(&text).unwrap();
+        assert_eq!(read, chosen);
+    }
 
     #[test]
     fn equations_are_shortened_to_their_largest_terms() {

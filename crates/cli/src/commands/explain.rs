@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use data::{ExperimentConditions, FlightLog};
 use learn::{EquationRule, Explanation, MetaTrainedModel};
-use pipeline::{explain_flight, own_data};
+use pipeline::{Segmentation, explain_flight, own_data};
 
 use outputs::{Existing, OutputSet};
 
@@ -101,7 +101,8 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         max_terms: args.max_terms,
         ..EquationRule::default()
     };
-    let explanation = explain_flight(&model, &log, !args.no_adapt, rule)?;
+    // The paper's segments: the model adapts on the first half of the flight.
+    let explanation = explain_flight(&model, &log, Segmentation::PAPER, !args.no_adapt, rule)?;
     // Files first, then words.
     if let (Some(path), Some(file)) = (&args.json, json_file) {
         let value = serde_json::json!({

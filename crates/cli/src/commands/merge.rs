@@ -142,11 +142,10 @@ fn merge_spread(
     }
     let file = set.file(&args.out, "--out", Existing::from_force(args.force));
     let staged = set.prepare()?;
-    let (spread, document) =
-        pipeline::spread_document(&merged.context, &merged.items, &merged.results);
+    let document = pipeline::spread_document(&merged.context, &merged.items, &merged.results);
     let how = format!("merged from {} shards", merged.shards.len());
-    super::seed_spread::print_spread(&spread, &merged.context.seeds, &how);
-    super::meta_train::write_json(staged.path(file), &args.out, &document)?;
+    super::seed_spread::print_spread(&document.cells, &merged.context.seeds, &how);
+    super::seed_spread::write_spread(staged.path(file), &args.out, &document)?;
     staged.commit()?;
     say!("wrote {}", args.out.display());
     Ok(())

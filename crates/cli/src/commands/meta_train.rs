@@ -8,14 +8,16 @@ use std::time::Instant;
 use anyhow::Context;
 use data::ExperimentConditions;
 use learn::{Formulation, LearnConfig};
-use pipeline::{CellSummary, Experiment, Protocol, ShardSpec, evaluation_condition_of};
+use pipeline::{
+    CellSummary, Experiment, Protocol, Segmentation, ShardSpec, evaluation_condition_of,
+};
 use report::{Method, PublishedTables};
 use serde_json::{Value, json};
 
 use outputs::{Existing, FileId, FolderId, OutputSet};
 
 use super::Global;
-use super::progress::progress_bar;
+use super::progress::{Bar, progress_bar};
 use super::shard::{SHARD_HELP, parse_shard};
 
 /// What the output manifests record as the writer of the checkpoints and the spread.
@@ -320,24 +322,24 @@ fn train_cells(
     condition: Option<&str>,
 ) -> anyhow::Result<Vec<pipeline::CellResult>> {
     let started = Instant::now();
-    let bar = progress_bar(
+    let bar = Bar(progress_bar(
         global.show_progress(),
         cells.formulations.len() * cells.evaluated.len(),
         "meta-train",
-    );
+    ));
     let results = match condition {
         Some(condition) => cells
             .formulations
             .iter()
             .map(|&f| {
                 let cell = experiment.run_cell(f, condition, cells.seed);
-                bar.inc(1);
+                bar.0.inc(1);
                 cell
             })
             .collect::<pipeline::Result<Vec<_>>>(),
-        None => experiment.run_cells_observed(cells.formulations, cells.seed, &|_| bar.inc(1)),
+        None => experiment.run_cells(cells.formulations, cells.seed, &bar),
     };
-    bar.finish_and_clear();
+    bar.0.finish_and_clear();
     let results = results?;
     let elapsed = started.elapsed().as_secs_f64();
     say!(
@@ -404,7 +406,15 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     plan_checkpoints(&mut set, &outputs, &cells_planned, &out)?;
     // Every output is proven writable (and its folder locked) before any training.
     let staged = set.prepare()?;
-    let experiment = Experiment::load(config.clone(), conditions, &data_dir, Some(protocol))?;
+    // The paper's segments (halves, forward differences): `learn reproduce` takes others from its
+    // run configuration.
+    let experiment = Experiment::load(
+        config.clone(),
+        conditions,
+        &data_dir,
+        Some(protocol),
+        Segmentation::PAPER,
+    )?;
     say!("protocol: {}", protocol.name());
 
     let cells = train_cells(

@@ -24,6 +24,16 @@ pub fn progress_bar(show: bool, cells: usize, message: &str) -> ProgressBar {
     bar
 }
 
+/// A bar as an observer: one step per unit of work ([`Progress::advance`]), for a command that
+/// draws one bar over one run (`learn meta-train`, its seed spread).
+pub struct Bar(pub ProgressBar);
+
+impl Progress for Bar {
+    fn advance(&self, _unit: std::fmt::Arguments<'_>) {
+        self.0.inc(1);
+    }
+}
+
 /// `learn reproduce`'s observer: a bar over the units of a stage that counts them (when `show`),
 /// and each stage's wall time as it ends.
 pub struct StageBars {

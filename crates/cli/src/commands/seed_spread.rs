@@ -5,14 +5,18 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use anyhow::Context;
+
 use data::ExperimentConditions;
 use learn::LearnConfig;
 use outputs::{Existing, OutputSet, Staged};
-use pipeline::{Experiment, Protocol, ShardProvenance, ShardSpec, SpreadCell, StageTiming};
+use pipeline::{
+    Experiment, Protocol, Segmentation, ShardProvenance, ShardSpec, SpreadCell, StageTiming,
+};
 
 use super::Global;
-use super::meta_train::{Args, PRODUCER, formulations, write_json};
-use super::progress::progress_bar;
+use super::meta_train::{Args, PRODUCER, formulations};
+use super::progress::{Bar, progress_bar};
 use super::shard::ShardOutputs;
 
 /// The writer of a shard's result (never removes, nor is removed by, the run's own files).
@@ -62,7 +66,13 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
         Destination::Shard(outputs, shard) => Prepared::Shard(outputs.prepare()?, shard),
     };
     let started = Instant::now();
-    let experiment = Experiment::load(config, conditions, &data_dir, Some(protocol))?;
+    let experiment = Experiment::load(
+        config,
+        conditions,
+        &data_dir,
+        Some(protocol),
+        Segmentation::PAPER,
+    )?;
     let loaded = started.elapsed().as_secs_f64();
     say!("protocol: {}", protocol.name());
     let sweep = pipeline::spread_sweep(
@@ -80,9 +90,9 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
         shard,
         experiment.evaluation_conditions().len(),
     );
-    let bar = progress_bar(global.show_progress(), cells, "seed spread");
-    let results = pipeline::run_spread(&experiment, &sweep, shard, &|_| bar.inc(1));
-    bar.finish_and_clear();
+    let bar = Bar(progress_bar(global.show_progress(), cells, "seed spread"));
+    let results = pipeline::run_spread(&experiment, &sweep, shard, &bar);
+    bar.0.finish_and_clear();
     let results = results?;
     match prepared {
         Prepared::Shard(staged, shard) => {
@@ -95,16 +105,24 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
         }
         Prepared::File(staged, file) => {
             let summaries: Vec<_> = results.into_iter().map(|r| r.result).collect();
-            let (spread, document) =
-                pipeline::spread_document(&sweep.context, &sweep.items, &summaries);
+            let document = pipeline::spread_document(&sweep.context, &sweep.items, &summaries);
             let took = format!("{:.1} s", started.elapsed().as_secs_f64());
-            print_spread(&spread, &sweep.context.seeds, &took);
-            write_json(staged.path(file), &args.spread_out, &document)?;
+            print_spread(&document.cells, &sweep.context.seeds, &took);
+            write_spread(staged.path(file), &args.spread_out, &document)?;
             staged.commit()?;
             say!("wrote {}", args.spread_out.display());
             Ok(())
         }
     }
+}
+
+/// Writes the spread file `document` to `staging` (the output `path`, which errors name).
+pub fn write_spread(
+    staging: &Path,
+    path: &Path,
+    document: &pipeline::SpreadDocument,
+) -> anyhow::Result<()> {
+    std::fs::write(staging, document.to_json()).with_context(|| path.display().to_string())
 }
 
 fn stage(name: &str, seconds: f64) -> StageTiming {

@@ -19,7 +19,7 @@ use std::path::Path;
 
 use data::ExperimentConditions;
 use learn::{AdaptationConfig, Formulation, LearnConfig};
-use pipeline::{Experiment, Protocol};
+use pipeline::{Experiment, Protocol, Segmentation};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -74,6 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         conditions,
         &data_dir,
         Some(Protocol::LeaveConditionOut),
+        Segmentation::PAPER,
     )?;
     let folds = experiment.evaluation_conditions();
     if stage == Stage::Restarts {

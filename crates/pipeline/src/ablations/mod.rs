@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result, write_text};
 use crate::progress::{Progress, Stage, Stopwatch};
+use crate::segment::Segmentation;
 use crate::shard::{ItemResult, MergedSweep, ShardFile, ShardProvenance, ShardSpec};
 use crate::summary::StageTiming;
 use crate::tables::ConditionName;
@@ -90,6 +91,8 @@ pub struct AblationsOutcome {
 #[serde(deny_unknown_fields)]
 pub struct AblationsContext {
     pub config: VariantsConfig,
+    /// How every flight is cut (the run configuration's `split` and `derivative`).
+    pub segmentation: Segmentation,
     /// The cells (formulation × evaluation condition), in row order.
     pub cells: Vec<AblationCell>,
     /// The evaluation flights (relative to the data directory), in row order of the conditions.
@@ -259,16 +262,16 @@ fn render_ablations(
                 data_files: context.evaluation_files.clone(),
                 learn_config: context.learn_config.clone(),
             },
-            protocol: PROTOCOL.to_string(),
+            protocol: format!(
+                "{}; every choice by blocked cross-validation inside the support segment",
+                context.segmentation.describe()
+            ),
             config: config.clone(),
             rows,
         },
         figures,
     })
 }
-
-/// The protocol line of `ablations.json`.
-const PROTOCOL: &str = "support = first half, query = second half, forward-difference targets on each segment; every choice by blocked cross-validation inside the support segment";
 
 /// One row: every variant summarised over the seeds (`per_seed`, in the configuration's order).
 fn ablation_row(
@@ -342,4 +345,23 @@ pub fn write_ablations(outcome: &AblationsOutcome, dir: &Path) -> Result<Vec<Pat
         written.push(path);
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_committed_ablations_are_read_and_written_back_byte_for_byte() {
+        // Every typed part of the file (the variants' choices among them) keeps its bytes.
+        let text = include_str!("../../../../results/ablations/ablations.json");
+        let ablations: Ablations = serde_json::from_str(text).unwrap();
+        let written = serde_json::to_string_pretty(&ablations).unwrap() + "\n";
+        assert!(written == text, "ablations.json is not written as read");
+        assert!(ablations.rows.iter().any(|row| {
+            row.variants
+                .values()
+                .any(|cell| cell.seeds.iter().any(|s| s.chosen.contains_key("variant")))
+        }));
+    }
 }

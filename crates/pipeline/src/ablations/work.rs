@@ -1,13 +1,15 @@
 //! The ablations' work: the cells cut from the evaluation flights, the (formulation, condition,
-//! seed) items enumerated, and one item run (every variant on its cell with its seed).
+//! seed) items enumerated, and the items run: every variant on its cell with its seed, by the
+//! [`Runner`].
 
 use std::path::Path;
+use std::sync::Arc;
 
-use crate::experiment::{Cells, Experiment, WorkItem};
+use crate::experiment::{Cells, EvaluationCell, Experiment, WorkItem, evaluation_cells};
 use crate::flights::read_evaluation_flights;
-use crate::segment::Segment;
+use crate::runner::{Method, Outcome, Runner, item_cells};
 use crate::sindy_variant::SegmentPredictions;
-use data::{Condition, FlightLog, forward_difference_noise_floor};
+use data::{Condition, forward_difference_noise_floor};
 use learn::{Formulation, MetaTrainedModel};
 use report::{MethodTrace, PublishedTables, QualitativeFigure, SeedCell};
 use sindy::{EnsemblePrediction, Mat, RegressionFit};
@@ -16,24 +18,15 @@ use super::{AblationCell, AblationCellDetail, AblationSeedOutcome, AblationsCont
 use crate::cells::cell_figure;
 use crate::error::{PipelineError, Result};
 use crate::progress::Progress;
-use crate::segment::flight_segments;
 use crate::shard::{ItemResult, ShardSpec, Sweep, SweepKind};
 use crate::tables::ConditionName;
-use crate::variants::{CheckedVariants, Outcome, evaluate_variants, learned_basis_experiment};
-
-/// One formulation on one evaluation flight.
-struct CellData {
-    formulation: Formulation,
-    condition: Condition,
-    support: Segment,
-    query: Segment,
-}
+use crate::variants::{CheckedVariants, learned_basis_experiment};
 
 /// The ablations' work, planned: the cells cut, the LeARN flights loaded (when a variant needs
 /// them) and the sweep of (formulation, condition, seed) items.
 pub(super) struct AblationsWork<'c> {
     config: &'c CheckedVariants,
-    cells: Vec<CellData>,
+    cells: Vec<Arc<EvaluationCell>>,
     experiment: Option<Experiment>,
     /// The sample interval of the first evaluation flight (the noise floors' time step).
     dt: f64,
@@ -47,11 +40,9 @@ impl<'c> AblationsWork<'c> {
         let run = &config.run;
         let conditions: Vec<&Condition> = run.conditions.evaluation().collect();
         let flights = read_evaluation_flights(&run.conditions, data_dir)?;
-        let (logs, evaluation_files): (Vec<FlightLog>, Vec<learn::DataFile>) = flights
-            .iter()
-            .map(|flight| (flight.log.clone(), flight.file.clone()))
-            .unzip();
-        let cells = cut_cells(config, &conditions, &logs)?;
+        let evaluation_files: Vec<learn::DataFile> =
+            flights.iter().map(|flight| flight.file.clone()).collect();
+        let cells = cut_cells(config, &conditions, &flights)?;
         let needs_learn = config
             .raw
             .variants
@@ -68,6 +59,7 @@ impl<'c> AblationsWork<'c> {
         data_files.dedup_by(|a, b| a.path == b.path);
         let context = AblationsContext {
             config: config.raw.clone(),
+            segmentation: run.segmentation(),
             cells: ablation_cells(config, &cells)?,
             evaluation_files,
             learn_config: experiment.as_ref().map(|e| e.config().get().clone()),
@@ -82,7 +74,7 @@ impl<'c> AblationsWork<'c> {
             config,
             cells,
             experiment,
-            dt: logs.first().map_or(0.02, |l| l.sample_interval()),
+            dt: flights.first().map_or(0.02, |f| f.log.sample_interval()),
             sweep: Sweep {
                 kind: SweepKind::Ablations,
                 context,
@@ -92,33 +84,49 @@ impl<'c> AblationsWork<'c> {
         })
     }
 
-    /// Runs the items of `shard`, telling `progress` of each one as it ends.
+    /// Runs the items of `shard` (every variant on the item's cell with its seed), telling
+    /// `progress` of each one as it ends.
     pub(super) fn run_items(
         &self,
         shard: ShardSpec,
         progress: &dyn Progress,
     ) -> Result<Vec<ItemResult<AblationSeedOutcome>>> {
+        // The networks of the cell's fold, from the run's experiment with the variants file's
+        // `learn_overrides` (loaded when a variant asks for them).
+        let train = |cell: &EvaluationCell, seed: u64| -> Result<MetaTrainedModel> {
+            match &self.experiment {
+                Some(experiment) => {
+                    experiment.meta_train(cell.formulation, &cell.condition.name, seed)
+                }
+                None => Err(PipelineError::Mismatch {
+                    what: format!("{} {}", cell.formulation.name(), cell.condition.name),
+                    message: "no variant was expected to need the LeARN networks".to_string(),
+                }),
+            }
+        };
+        let variants = self.config.raw.variants.iter().map(|v| v as &dyn Method);
+        let runner = Runner::new(variants, Some(&train));
         self.sweep.run(shard, |item| {
-            let outcome = self.run_item(item)?;
-            progress.advance(format_args!("{item}"));
-            Ok(outcome)
+            let cells = item_cells(&self.cells, item)?;
+            let outcomes = runner.run_cells(&cells, item.seed, progress)?;
+            match (cells.as_slice(), outcomes.as_slice()) {
+                ([cell], [outcomes]) => self.item_outcome(item, cell, outcomes),
+                _ => Err(PipelineError::Mismatch {
+                    what: item.to_string(),
+                    message: "an ablation item is one cell".to_string(),
+                }),
+            }
         })
     }
 
-    /// Every variant on the item's cell with its seed; with the first seed the cell's detail.
-    fn run_item(&self, item: &WorkItem) -> Result<AblationSeedOutcome> {
-        let cell = self
-            .cells
-            .iter()
-            .find(|c| {
-                c.formulation == item.formulation
-                    && item.cells == Cells::Condition(c.condition.name.clone())
-            })
-            .ok_or_else(|| PipelineError::Mismatch {
-                what: item.to_string(),
-                message: "not a cell of the ablations".to_string(),
-            })?;
-        let outcomes = evaluate_all(self.config, self.experiment.as_ref(), cell, item.seed)?;
+    /// The item's result from every variant's outcome on its cell; with the first seed the
+    /// cell's detail.
+    fn item_outcome(
+        &self,
+        item: &WorkItem,
+        cell: &EvaluationCell,
+        outcomes: &[Outcome],
+    ) -> Result<AblationSeedOutcome> {
         let variants = outcomes
             .iter()
             .map(|outcome| SeedCell {
@@ -135,7 +143,7 @@ impl<'c> AblationsWork<'c> {
             })
             .collect();
         let first_seed = if item.seed == self.config.raw.seeds[0] {
-            Some(self.cell_detail(cell, &outcomes)?)
+            Some(self.cell_detail(cell, outcomes)?)
         } else {
             None
         };
@@ -147,7 +155,11 @@ impl<'c> AblationsWork<'c> {
 
     /// SINDy and the noise floors of `cell`, and from the first seed's `outcomes` the headline
     /// equations and the figure.
-    fn cell_detail(&self, cell: &CellData, outcomes: &[Outcome]) -> Result<AblationCellDetail> {
+    fn cell_detail(
+        &self,
+        cell: &EvaluationCell,
+        outcomes: &[Outcome],
+    ) -> Result<AblationCellDetail> {
         let raw = &self.config.raw;
         let position = |name: &str| raw.variants.iter().position(|v| v.name == name);
         let sindy = crate::sindy_column::fit_and_evaluate(
@@ -158,7 +170,7 @@ impl<'c> AblationsWork<'c> {
         let headline_equations = raw
             .equations_variant(&raw.headline)
             .and_then(position)
-            .map(|index| equations(&outcomes[index].regression, cell.formulation))
+            .map(|index| equations(outcomes[index].regression(), cell.formulation))
             .unwrap_or_default();
         let figure = match raw.figure_variant.as_deref() {
             Some(name) => match position(name) {
@@ -183,40 +195,38 @@ impl<'c> AblationsWork<'c> {
     }
 }
 
-/// Every formulation × evaluation flight, cut into segments, the variants' folds and bagging
-/// blocks checked against each support segment before any fit.
+/// Every formulation of the run × evaluation flight, cut by the run's segmentation, the variants'
+/// folds and bagging blocks checked against each support segment before any fit.
 fn cut_cells(
     config: &CheckedVariants,
     conditions: &[&Condition],
-    logs: &[FlightLog],
-) -> Result<Vec<CellData>> {
+    flights: &[Arc<crate::flights::Flight>],
+) -> Result<Vec<Arc<EvaluationCell>>> {
     let run = &config.run;
-    let mut cells = Vec::new();
-    for &formulation in &run.raw.formulations {
-        for (condition, log) in conditions.iter().zip(logs) {
-            let (support, query) =
-                flight_segments(log, formulation, run.raw.split, run.raw.derivative)?;
-            let segment = format!(
-                "the {} support segment of {}",
-                formulation.name(),
-                log.path.display()
-            );
-            config
-                .raw
-                .check_rows(&config.path, support.len(), &segment, false)?;
-            cells.push(CellData {
-                formulation,
-                condition: (*condition).clone(),
-                support,
-                query,
-            });
-        }
+    let cells = evaluation_cells(
+        &run.raw.formulations,
+        conditions,
+        flights,
+        run.segmentation(),
+    )?;
+    for cell in &cells {
+        let segment = format!(
+            "the {} support segment of {}",
+            cell.formulation.name(),
+            cell.flight.log.path.display()
+        );
+        config
+            .raw
+            .check_rows(&config.path, cell.support.len(), &segment, false)?;
     }
     Ok(cells)
 }
 
 /// The rows of the tables, with the paper's numbers.
-fn ablation_cells(config: &CheckedVariants, cells: &[CellData]) -> Result<Vec<AblationCell>> {
+fn ablation_cells(
+    config: &CheckedVariants,
+    cells: &[Arc<EvaluationCell>],
+) -> Result<Vec<AblationCell>> {
     let published = PublishedTables::load(&config.run.published_path)?;
     Ok(cells
         .iter()
@@ -234,7 +244,7 @@ fn ablation_cells(config: &CheckedVariants, cells: &[CellData]) -> Result<Vec<Ab
 }
 
 /// The ablations' work: every cell (in row order) × every seed (in the configuration's order).
-fn ablation_items(cells: &[CellData], seeds: &[u64]) -> Vec<WorkItem> {
+fn ablation_items(cells: &[Arc<EvaluationCell>], seeds: &[u64]) -> Vec<WorkItem> {
     cells
         .iter()
         .flat_map(|cell| {
@@ -247,31 +257,11 @@ fn ablation_items(cells: &[CellData], seeds: &[u64]) -> Vec<WorkItem> {
         .collect()
 }
 
-/// Every variant of the configuration on one cell with one seed, in declaration order.
-fn evaluate_all(
-    config: &CheckedVariants,
-    experiment: Option<&Experiment>,
-    cell: &CellData,
-    seed: u64,
-) -> Result<Vec<Outcome>> {
-    let meta_train = |seed: u64| -> Result<MetaTrainedModel> {
-        let experiment = experiment.expect("loaded when a variant needs the LeARN networks");
-        experiment.meta_train(cell.formulation, &cell.condition.name, seed)
-    };
-    evaluate_variants(
-        &config.raw.variants,
-        meta_train,
-        &cell.support,
-        &cell.query,
-        seed,
-    )
-}
-
 /// `ẋ_i = b + Σ c·feature` per output: the terms with a non-zero coefficient, ordered by the size
 /// of their standardised coefficient (their share of the prediction's spread on the support
 /// segment), coefficients in the units of the raw features.
 fn equations(
-    regression: &Option<(Vec<String>, RegressionFit)>,
+    regression: Option<(&[String], &RegressionFit)>,
     formulation: Formulation,
 ) -> Vec<String> {
     let Some((feature_names, fit)) = regression else {
@@ -323,7 +313,7 @@ fn band_series(support: &EnsemblePrediction, query: &EnsemblePrediction) -> repo
 }
 
 fn figure(
-    cell: &CellData,
+    cell: &EvaluationCell,
     name: &str,
     predictions: &SegmentPredictions,
 ) -> Result<(String, QualitativeFigure)> {

@@ -1,8 +1,9 @@
 //! The units of work of a sweep over cells and seeds: one [`WorkItem`] is one meta-training (one
 //! formulation, one seed) and the evaluation cells it serves. The table runs, the seed spread and
 //! their shards (`learn … --shard K/N`) all enumerate their work with [`Experiment::work_items`] and
-//! run it with [`Experiment::run_item`], so a sharded sweep does exactly the work of an unsharded
-//! one, item by item; each item depends on its own seed only, never on which items ran beside it.
+//! run it with [`Experiment::run_item`] (LeARN on the item's cells, by the [`Runner`]), so a
+//! sharded sweep does exactly the work of an unsharded one, item by item; each item depends on its
+//! own seed only, never on which items ran beside it.
 
 use std::fmt;
 
@@ -10,9 +11,13 @@ use learn::Formulation;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::{CellResult, CellSummary, Experiment};
-use crate::error::Result;
+use std::sync::Arc;
+
+use super::{CellResult, CellSummary, EvaluationCell, Experiment};
+use crate::error::{PipelineError, Result};
 use crate::flights::Protocol;
+use crate::progress::Progress;
+use crate::runner::{Method, Outcome, Runner, item_cells};
 
 /// The evaluation cells one meta-trained model serves.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
@@ -69,93 +74,72 @@ impl Experiment {
         items
     }
 
-    /// Meta-trains the item's model and evaluates it on its cells, in table order.
-    pub fn run_item(&self, item: &WorkItem) -> Result<Vec<CellResult>> {
-        self.run_item_observed(item, &|_| {})
+    /// The cells of `item`, in table order.
+    pub fn item_cells(&self, item: &WorkItem) -> Result<Vec<Arc<EvaluationCell>>> {
+        item_cells(&self.cells, item)
     }
 
-    /// [`Self::run_item`], calling `cell_done` (from any thread) as each cell is finished.
-    pub fn run_item_observed(
-        &self,
-        item: &WorkItem,
-        cell_done: &(dyn Fn(&CellSummary) + Sync),
-    ) -> Result<Vec<CellResult>> {
-        let observed = |result: Result<CellResult>| {
-            if let Ok(cell) = &result {
-                cell_done(&cell.summary);
-            }
-            result
+    /// Meta-trains the item's model and evaluates it on its cells (LeARN as a [`Method`], by the
+    /// [`Runner`]), telling `progress` of each cell as it ends; results in table order.
+    pub fn run_item(&self, item: &WorkItem, progress: &dyn Progress) -> Result<Vec<CellResult>> {
+        let train = |cell: &EvaluationCell, seed: u64| {
+            self.meta_train(cell.formulation, &cell.condition.name, seed)
         };
-        match &item.cells {
-            Cells::Condition(condition) => Ok(vec![observed(self.run_cell(
-                item.formulation,
-                condition,
-                item.seed,
-            ))?]),
-            Cells::Every => {
-                let conditions = self.evaluation_conditions();
-                let model = self.meta_train(item.formulation, &conditions[0], item.seed)?;
-                conditions
-                    .par_iter()
-                    .map(|condition| observed(self.evaluate(&model, condition)))
-                    .collect()
-            }
-        }
+        let runner = Runner::new([self as &dyn Method], Some(&train));
+        runner
+            .run_cells(&self.item_cells(item)?, item.seed, progress)?
+            .into_iter()
+            .map(|mut outcomes| {
+                outcomes.pop().and_then(Outcome::into_learn).ok_or_else(|| {
+                    PipelineError::Mismatch {
+                        what: item.to_string(),
+                        message: "LeARN gave no cell".to_string(),
+                    }
+                })
+            })
+            .collect()
     }
 
     /// Every item of `items`, in parallel, each item's cells in table order.
-    pub fn run_items_observed(
+    pub fn run_items(
         &self,
         items: &[WorkItem],
-        cell_done: &(dyn Fn(&CellSummary) + Sync),
+        progress: &dyn Progress,
     ) -> Result<Vec<Vec<CellResult>>> {
         items
             .par_iter()
-            .map(|item| self.run_item_observed(item, cell_done))
+            .map(|item| self.run_item(item, progress))
             .collect()
     }
 
     /// Every cell of the given formulations (× every evaluation condition), in parallel, returned
-    /// in table order. Under `paper` one model per formulation serves all conditions.
-    pub fn run_cells(&self, formulations: &[Formulation], seed: u64) -> Result<Vec<CellResult>> {
-        self.run_cells_observed(formulations, seed, &|_| {})
-    }
-
-    /// [`Self::run_cells`], calling `cell_done` (from any thread) as each cell is finished.
-    pub fn run_cells_observed(
+    /// in table order; `progress` is told of each cell as it ends. Under `paper` one model per
+    /// formulation serves all conditions.
+    pub fn run_cells(
         &self,
         formulations: &[Formulation],
         seed: u64,
-        cell_done: &(dyn Fn(&CellSummary) + Sync),
+        progress: &dyn Progress,
     ) -> Result<Vec<CellResult>> {
         let items = self.work_items(formulations, &[seed]);
         Ok(self
-            .run_items_observed(&items, cell_done)?
+            .run_items(&items, progress)?
             .into_iter()
             .flatten()
             .collect())
     }
 
-    /// Generalisation and adaptation MSE of every cell for each seed (the seed-to-seed spread).
+    /// Generalisation and adaptation MSE of every cell for each seed (the seed-to-seed spread);
+    /// `progress` is told of each cell of each seed as it ends.
     pub fn seed_spread(
         &self,
         formulations: &[Formulation],
         seeds: &[u64],
-    ) -> Result<Vec<SpreadCell>> {
-        self.seed_spread_observed(formulations, seeds, &|_| {})
-    }
-
-    /// [`Self::seed_spread`], calling `cell_done` (from any thread) as each cell of each seed is
-    /// finished.
-    pub fn seed_spread_observed(
-        &self,
-        formulations: &[Formulation],
-        seeds: &[u64],
-        cell_done: &(dyn Fn(&CellSummary) + Sync),
+        progress: &dyn Progress,
     ) -> Result<Vec<SpreadCell>> {
         let items = self.work_items(formulations, seeds);
         let summaries: Vec<Vec<CellSummary>> = self
-            .run_items_observed(&items, cell_done)?
+            .run_items(&items, progress)?
             .into_iter()
             .map(|cells| cells.into_iter().map(|c| c.summary).collect())
             .collect();

@@ -7,16 +7,11 @@ use crate::segment::Segment;
 use crate::sindy_variant::SegmentPredictions;
 use sindy::Mat;
 
-use super::run::Outcome;
-use super::schema::VariantSpec;
+use crate::runner::Outcome;
 
-/// `select`: of the `candidates` (indices into `variants` and `outcomes`, at least one), the one
+/// `select`: of the `candidates` (indices into `names` and `outcomes`, at least one), the one
 /// with the lowest support cross-validation score, its name recorded as chosen.
-pub(super) fn select(
-    variants: &[VariantSpec],
-    outcomes: &[Outcome],
-    candidates: &[usize],
-) -> Outcome {
+pub(super) fn select(names: &[&str], outcomes: &[Outcome], candidates: &[usize]) -> Outcome {
     let score = |index: usize| outcomes[index].support_cv.unwrap_or(f64::INFINITY);
     let best = candidates
         .iter()
@@ -27,7 +22,7 @@ pub(super) fn select(
     let mut chosen = chosen_outcome.chosen.clone();
     chosen.insert(
         "variant".to_string(),
-        serde_json::Value::String(variants[best].name.clone()),
+        report::Choice::Variant(names[best].to_string()),
     );
     Outcome {
         chosen,
@@ -105,19 +100,16 @@ mod tests {
     #[test]
     fn select_takes_the_lowest_support_score_and_average_and_ensemble_the_mean() {
         let (support, query) = (segment(20, 0.0), segment(10, 1.3));
-        let spec = |name: &str| VariantSpec {
-            name: name.to_string(),
-            description: String::new(),
-            kind: super::super::VariantKind::Learn,
-        };
-        let variants = [spec("a"), spec("b"), spec("c")];
         let outcomes = [
             outcome(Some(2.0), 1.0, &support, &query),
             outcome(Some(0.5), 2.0, &support, &query),
             outcome(None, 4.0, &support, &query),
         ];
-        let selected = select(&variants, &outcomes, &[0, 1, 2]);
-        assert_eq!(selected.chosen["variant"], "b");
+        let selected = select(&["a", "b", "c"], &outcomes, &[0, 1, 2]);
+        assert_eq!(
+            selected.chosen["variant"],
+            report::Choice::Variant("b".to_string())
+        );
         assert_eq!(selected.predictions.query_prediction[(0, 0)], 2.0);
 
         let members = [&outcomes[0].predictions, &outcomes[2].predictions];

@@ -20,8 +20,9 @@
 //!   so nothing can be chosen on the query segment).
 //!
 //! The module's parts: `schema.rs` (the file's types), `checks.rs` (reading and checking it),
-//! `run.rs` (every variant on one cell and seed) and `combinators.rs` (`select`, `average` and the
-//! ensemble mean, from other variants' results).
+//! `run.rs` (a variant as a [`crate::Method`], run by the [`crate::Runner`] like SINDy and LeARN)
+//! and `combinators.rs` (`select`, `average` and the ensemble mean, from other variants'
+//! results).
 
 mod checks;
 mod combinators;
@@ -31,7 +32,7 @@ mod schema;
 mod testing;
 
 pub(crate) use run::learned_basis_experiment;
-pub use run::{Outcome, evaluate_variants, reproduce_columns};
+pub use run::reproduce_columns;
 pub use schema::{
     CheckedVariants, ENSEMBLE_SEED_STRIDE, LearnedBasisSpec, MAX_ENSEMBLE_MEMBERS, MAX_VARIANTS,
     VariantKind, VariantSpec, VariantsConfig, ensemble_member_seeds,

@@ -1,19 +1,19 @@
-//! Running the variants on one cell: every variant of a file on one support/query pair with one
-//! seed ([`evaluate_variants`]), in declaration order (a `select` or `average` takes the outcomes
+//! The variants as methods ([`crate::Method`]): each variant of a file evaluated on one cell and
+//! seed by the [`crate::Runner`], in declaration order (a `select` or `average` takes the outcomes
 //! of variants before it), and `make reproduce`'s extra columns ([`reproduce_columns`]).
 
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use crate::experiment::Experiment;
+use crate::experiment::{EvaluationCell, Experiment};
 use crate::flights::Flight;
+use crate::runner::{Fitted, Method, Models, Outcome, Runner, Trial};
 use crate::segment::{Segment, SegmentModel};
 use crate::sindy_variant::{SegmentPredictions, VariantEvaluation, evaluate_features};
 use learn::variants::learned_features;
 use learn::{Formulation, MetaTrainedModel};
-use rayon::prelude::*;
-use sindy::{Mat, RegressionFit};
+use sindy::Mat;
 
 use super::checks::learned_basis_config;
 use super::combinators::{average, ensemble_mean, select};
@@ -22,43 +22,6 @@ use super::schema::{
     ensemble_member_seeds,
 };
 use crate::error::{PipelineError, Result};
-
-/// One variant's outcome on one cell and seed, with its traces.
-#[derive(Clone, Debug)]
-pub struct Outcome {
-    /// Predictions and MSE on both segments (and the band of a bagged variant).
-    pub predictions: SegmentPredictions,
-    /// The feature names and the fitted regression, for variants that fit one.
-    pub regression: Option<(Vec<String>, RegressionFit)>,
-    /// Everything chosen inside the support segment (per output penalty; `variant` for select).
-    pub chosen: BTreeMap<String, serde_json::Value>,
-    /// Mean over outputs of the best support cross-validation MSE (variants that fit a
-    /// regression).
-    pub support_cv: Option<f64>,
-}
-
-impl Outcome {
-    /// A variant without a regression (nothing chosen, no band): its predictions, scored on both
-    /// segments.
-    pub(super) fn unfitted(
-        support_prediction: Mat<f64>,
-        query_prediction: Mat<f64>,
-        support: &Segment,
-        query: &Segment,
-    ) -> Self {
-        Self {
-            predictions: SegmentPredictions::scored(
-                support_prediction,
-                query_prediction,
-                support.targets.as_ref(),
-                query.targets.as_ref(),
-            ),
-            regression: None,
-            chosen: BTreeMap::new(),
-            support_cv: None,
-        }
-    }
-}
 
 impl LearnedBasisSpec {
     /// Features of both segments from the frozen networks (and the fixed library), regression
@@ -102,36 +65,32 @@ impl LearnedBasisSpec {
 }
 
 /// The extra columns `make reproduce` shows: the `reproduce` variants of the variants file
-/// `config`, for each (support, query, the run's meta-trained LeARN model) of a cell, with the
-/// first seed of that file.
+/// `config` on `cell`, with the first seed of that file, the run's meta-trained LeARN `model`
+/// serving every variant that asks for the networks (`read` refused ensembles in these columns).
 pub fn reproduce_columns(
     config: &VariantsConfig,
-    cells: &[(&Segment, &Segment, &MetaTrainedModel)],
-) -> Result<Vec<BTreeMap<String, report::Mse>>> {
+    cell: &EvaluationCell,
+    model: &MetaTrainedModel,
+) -> Result<BTreeMap<String, report::Mse>> {
     let variants = config.reproduce_variants();
     let seed = config.seeds[0];
-    cells
-        .par_iter()
-        .map(|(support, query, model)| {
-            // The run's model serves every variant; `read` refused ensembles in these columns.
-            let run_model = |_seed: u64| -> Result<MetaTrainedModel> { Ok((*model).clone()) };
-            let outcomes = evaluate_variants(&variants, run_model, support, query, seed)?;
-            Ok(variants
-                .iter()
-                .zip(outcomes)
-                .filter(|(spec, _)| config.reproduce.contains(&spec.name))
-                .map(|(spec, outcome)| {
-                    (
-                        spec.name.clone(),
-                        report::Mse {
-                            adaptation: outcome.predictions.adaptation,
-                            generalisation: outcome.predictions.generalisation,
-                        },
-                    )
-                })
-                .collect())
+    let runner = Runner::new(variants.iter().map(|v| v as &dyn Method), None);
+    let mut models = Models::new(cell, None).with(seed, Arc::new(model.clone()));
+    let outcomes = runner.evaluate(cell, seed, &mut models)?;
+    Ok(variants
+        .iter()
+        .zip(outcomes)
+        .filter(|(spec, _)| config.reproduce.contains(&spec.name))
+        .map(|(spec, outcome)| {
+            (
+                spec.name.clone(),
+                report::Mse {
+                    adaptation: outcome.predictions.adaptation,
+                    generalisation: outcome.predictions.generalisation,
+                },
+            )
         })
-        .collect()
+        .collect())
 }
 
 /// The LeARN experiment of the learned-basis variants: the run's, with the variants file's
@@ -147,76 +106,54 @@ pub(crate) fn learned_basis_experiment(
         run.conditions.clone(),
         data_dir,
         run.protocol,
+        run.segmentation(),
         evaluation,
     )
 }
 
-/// Every variant of `variants` on one support/query pair with one seed, in declaration order.
-/// `meta_train(s)` meta-trains the LeARN networks with seed `s`: with `seed` when a learned-basis
-/// variant needs them, with each member seed of a `learn_ensemble`, at most once per seed. It must
-/// not read the query segment (the pipeline's leaves the evaluation flight out entirely).
-pub fn evaluate_variants(
-    variants: &[VariantSpec],
-    meta_train: impl Fn(u64) -> Result<MetaTrainedModel>,
-    support: &Segment,
-    query: &Segment,
-    seed: u64,
-) -> Result<Vec<Outcome>> {
-    let mut outcomes: Vec<Outcome> = Vec::with_capacity(variants.len());
-    let mut cell = Cell {
-        variants,
-        models: MetaTrainedModels {
-            train: &meta_train,
-            models: BTreeMap::new(),
-        },
-        support,
-        query,
-        seed,
-    };
-    for spec in variants {
-        let outcome = cell
-            .evaluate(spec, &outcomes)
-            .map_err(|error| match error {
-                error @ PipelineError::Mismatch { .. } => error,
-                error => PipelineError::Mismatch {
-                    what: format!("variant '{}'", spec.name),
-                    message: error.to_string(),
-                },
-            })?;
-        outcomes.push(outcome);
+/// A variant on one cell and seed. The networks it asks for must not have read the query segment
+/// (the pipeline's leave the evaluation flight out entirely); errors name the variant.
+impl Method for VariantSpec {
+    fn name(&self) -> &str {
+        &self.name
     }
-    Ok(outcomes)
+
+    fn needs_meta_training(&self) -> bool {
+        self.kind.needs_meta_training()
+    }
+
+    fn evaluate(&self, trial: &mut Trial<'_, '_>) -> Result<Outcome> {
+        self.outcome(trial).map_err(|error| match error {
+            error @ PipelineError::Mismatch { .. } => error,
+            error => PipelineError::Mismatch {
+                what: format!("variant '{}'", self.name),
+                message: error.to_string(),
+            },
+        })
+    }
 }
 
-/// The variants of one cell and seed as they run: the models meta-trained so far.
-struct Cell<'a, F> {
-    variants: &'a [VariantSpec],
-    models: MetaTrainedModels<'a, F>,
-    support: &'a Segment,
-    query: &'a Segment,
-    seed: u64,
-}
-
-impl<F: Fn(u64) -> Result<MetaTrainedModel>> Cell<'_, F> {
-    /// The variant `spec`, after those before it (`done`, their outcomes in declaration order).
-    fn evaluate(&mut self, spec: &VariantSpec, done: &[Outcome]) -> Result<Outcome> {
-        let (support, query, seed) = (self.support, self.query, self.seed);
-        Ok(match &spec.kind {
+impl VariantSpec {
+    /// [`Method::evaluate`], its errors not yet named.
+    fn outcome(&self, trial: &mut Trial<'_, '_>) -> Result<Outcome> {
+        let (cell, seed) = (trial.cell, trial.seed);
+        let (support, query) = (&cell.support, &cell.query);
+        Ok(match &self.kind {
             VariantKind::Library(variant) => {
                 let evaluation = variant.evaluate(support, query, seed)?;
-                outcome_of(evaluation, BTreeMap::new(), &support.formulation)
+                outcome_of(evaluation, &support.formulation)
             }
             VariantKind::Select { candidates } => {
-                let candidates = self.earlier(spec, done, candidates, "candidate")?;
-                select(self.variants, done, &candidates)
+                let candidates = trial.earlier(&self.name, candidates, "candidate")?;
+                select(trial.names(), trial.done(), &candidates)
             }
             VariantKind::LearnedBasis(variant) => {
-                let model = self.models.get(seed)?;
+                let model = trial.model(seed)?;
                 let evaluation = variant.evaluate(model, support, query, seed)?;
-                outcome_of(evaluation, BTreeMap::new(), &support.formulation)
+                outcome_of(evaluation, &support.formulation)
             }
             VariantKind::Learn => {
-                let model = self.models.get(seed)?;
+                let model = trial.model(seed)?;
                 let [on_support, on_query] = adapted_predictions(model, support, query);
                 Outcome::unfitted(on_support, on_query, support, query)
             }
@@ -229,63 +166,19 @@ impl<F: Fn(u64) -> Result<MetaTrainedModel>> Cell<'_, F> {
                 })?;
                 let predictions = seeds
                     .into_iter()
-                    .map(|member| {
-                        Ok(adapted_predictions(
-                            self.models.get(member)?,
-                            support,
-                            query,
-                        ))
-                    })
+                    .map(|member| Ok(adapted_predictions(trial.model(member)?, support, query)))
                     .collect::<Result<Vec<_>>>()?;
                 ensemble_mean(predictions, support, query)
             }
             VariantKind::Average { members } => {
-                let members: Vec<&SegmentPredictions> = self
-                    .earlier(spec, done, members, "member")?
+                let members: Vec<&SegmentPredictions> = trial
+                    .earlier(&self.name, members, "member")?
                     .into_iter()
-                    .map(|index| &done[index].predictions)
+                    .map(|index| &trial.done()[index].predictions)
                     .collect();
                 average(&members, support, query)
             }
         })
-    }
-
-    /// The indices of the variants `names` (each declared before `spec`, so in `done`).
-    fn earlier(
-        &self,
-        spec: &VariantSpec,
-        done: &[Outcome],
-        names: &[String],
-        what: &str,
-    ) -> Result<Vec<usize>> {
-        let found: Vec<usize> = names
-            .iter()
-            .filter_map(|name| self.variants.iter().position(|v| &v.name == name))
-            .filter(|&index| index < done.len())
-            .collect();
-        if found.len() != names.len() || found.is_empty() {
-            return Err(PipelineError::Mismatch {
-                what: format!("variant '{}'", spec.name),
-                message: format!("every {what} must be declared before it"),
-            });
-        }
-        Ok(found)
-    }
-}
-
-/// The meta-trained models of one cell, each trained by `train` on first use of its seed.
-struct MetaTrainedModels<'t, F> {
-    train: &'t F,
-    models: BTreeMap<u64, MetaTrainedModel>,
-}
-
-impl<F: Fn(u64) -> Result<MetaTrainedModel>> MetaTrainedModels<'_, F> {
-    fn get(&mut self, seed: u64) -> Result<&MetaTrainedModel> {
-        if !self.models.contains_key(&seed) {
-            let model = (self.train)(seed)?;
-            self.models.insert(seed, model);
-        }
-        Ok(&self.models[&seed])
     }
 }
 
@@ -304,14 +197,12 @@ fn adapted_predictions(
     })
 }
 
-fn outcome_of(
-    evaluation: VariantEvaluation,
-    mut chosen: BTreeMap<String, serde_json::Value>,
-    formulation: &Formulation,
-) -> Outcome {
+/// A fitted regression's outcome: the penalty chosen per output, the mean best support score.
+fn outcome_of(evaluation: VariantEvaluation, formulation: &Formulation) -> Outcome {
+    let mut chosen = BTreeMap::new();
     let selections = &evaluation.fit.selections;
     for (selection, output) in selections.iter().zip(formulation.target_names()) {
-        chosen.insert(output, serde_json::json!(selection.chosen));
+        chosen.insert(output, report::Choice::Penalty(selection.chosen));
     }
     let support_cv = selections
         .iter()
@@ -320,7 +211,10 @@ fn outcome_of(
         / selections.len().max(1) as f64;
     Outcome {
         predictions: evaluation.predictions,
-        regression: Some((evaluation.feature_names, evaluation.fit)),
+        fitted: Fitted::Regression {
+            features: evaluation.feature_names,
+            fit: evaluation.fit,
+        },
         chosen,
         support_cv: Some(support_cv),
     }
@@ -330,7 +224,7 @@ fn outcome_of(
 mod tests {
     use super::*;
     use crate::flights::Protocol;
-    use crate::variants::testing::{RIDGE, config, segment, write};
+    use crate::variants::testing::{RIDGE, cell, config, evaluate, segment, write};
     use learn::{CHECKPOINT_FORMAT, Standardiser};
 
     fn untrained_model() -> MetaTrainedModel {
@@ -367,13 +261,13 @@ mod tests {
             "",
         );
         let read = VariantsConfig::read(&write("evaluate", &text)).unwrap();
-        let (support, query) = (segment(60, 0.0), segment(40, 1.3));
+        let cell = cell(segment(60, 0.0), segment(40, 1.3));
+        let (support, query) = (&cell.support, &cell.query);
         let model = untrained_model();
-        let outcomes =
-            evaluate_variants(&read.variants, |_| Ok(model.clone()), &support, &query, 1).unwrap();
-        let adapted = model.adapt(&support, &model.config.adaptation);
+        let outcomes = evaluate(&read.variants, &|_, _| Ok(model.clone()), &cell, 1).unwrap();
+        let adapted = model.adapt(support, &model.config.adaptation);
         assert_ne!(adapted, model.parameters, "adaptation moved nothing");
-        let expected = model.predict_segment(&adapted, &query);
+        let expected = model.predict_segment(&adapted, query);
         let learn = &outcomes[1].predictions;
         for i in 0..query.len() {
             for j in 0..3 {
@@ -387,14 +281,15 @@ mod tests {
         let error = |prediction: &Mat<f64>, segment: &Segment| {
             sindy::mean_squared_error(prediction.as_ref(), segment.targets.as_ref())
         };
-        assert_eq!(learn.generalisation, error(&learn.query_prediction, &query));
+        assert_eq!(learn.generalisation, error(&learn.query_prediction, query));
         let average = &outcomes[2].predictions;
         assert_eq!(
             average.adaptation,
-            error(&average.support_prediction, &support)
+            error(&average.support_prediction, support)
         );
         assert!(outcomes[1].support_cv.is_none() && outcomes[2].chosen.is_empty());
-        assert!(outcomes[0].support_cv.is_some() && outcomes[2].regression.is_none());
+        assert!(outcomes[0].support_cv.is_some() && outcomes[2].regression().is_none());
+        assert!(outcomes[0].regression().is_some());
     }
 
     #[test]
@@ -405,7 +300,8 @@ mod tests {
             "",
         );
         let read = VariantsConfig::read(&write("ensemble", &text)).unwrap();
-        let (support, query) = (segment(60, 0.0), segment(40, 1.3));
+        let cell = cell(segment(60, 0.0), segment(40, 1.3));
+        let (support, query) = (&cell.support, &cell.query);
         // A different (untrained) model per seed; the seeds asked for are recorded.
         let asked = std::sync::Mutex::new(Vec::new());
         let model_for = |seed: u64| {
@@ -414,11 +310,11 @@ mod tests {
             model.parameters = model.architecture.initial_parameters(seed);
             model
         };
-        let train = |seed: u64| {
+        let train = |_: &EvaluationCell, seed: u64| {
             asked.lock().unwrap().push(seed);
             Ok(model_for(seed))
         };
-        let outcomes = evaluate_variants(&read.variants, train, &support, &query, 7).unwrap();
+        let outcomes = evaluate(&read.variants, &train, &cell, 7).unwrap();
         // The `learn` model (seed 7) is the ensemble's first member, trained once.
         assert_eq!(*asked.lock().unwrap(), vec![7, 1_000_007, 2_000_007]);
         assert_eq!(
@@ -427,7 +323,7 @@ mod tests {
         );
         let members: Vec<[Mat<f64>; 2]> = [7, 1_000_007, 2_000_007]
             .into_iter()
-            .map(|seed| adapted_predictions(&model_for(seed), &support, &query))
+            .map(|seed| adapted_predictions(&model_for(seed), support, query))
             .collect();
         let ensemble = &outcomes[1].predictions;
         for i in 0..query.len() {
@@ -455,16 +351,10 @@ mod tests {
             "",
         );
         let read = VariantsConfig::read(&write("evaluate-error", &text)).unwrap();
-        let (support, query) = (segment(60, 0.0), segment(40, 1.3));
-        let message = evaluate_variants(
-            &read.variants,
-            |_| Ok(untrained_model()),
-            &support,
-            &query,
-            1,
-        )
-        .unwrap_err()
-        .to_string();
+        let cell = cell(segment(60, 0.0), segment(40, 1.3));
+        let message = evaluate(&read.variants, &|_, _| Ok(untrained_model()), &cell, 1)
+            .unwrap_err()
+            .to_string();
         assert!(
             message.starts_with("variant 'a': ") && message.contains("bagging.block"),
             "{message}"

@@ -8,7 +8,7 @@ cd "$(dirname "$0")/../.."
 [ -x .venv/bin/python ] || scripts/python-env.sh
 data_dir="${NEURAL_FLY_DIR:-data/neural-fly}"
 
-rust_output=$(cargo bench --quiet --profile dev -p pipeline --bench sindy_paper 2>/dev/null)
+rust_output=$(cargo bench --quiet --profile dev -p evaluation --bench sindy_paper 2>/dev/null)
 echo "$rust_output" | grep -v '^BENCH_JSON'
 rust_json=$(echo "$rust_output" | sed -n 's/^BENCH_JSON //p')
 # OPENBLAS_CORETYPE / OPENBLAS_L2_SIZE slow a current numpy down: unset for the comparison only.

@@ -352,7 +352,7 @@ fn kinds(scratch: &Path) -> Vec<(&'static str, Value, Loader)> {
             "reproduce.json",
             run,
             Box::new(move |p: &Path| {
-                pipeline::RunConfig::load(p, &root_for_run)
+                evaluation::RunConfig::load(p, &root_for_run)
                     .map(drop)
                     .map_err(err)
             }),
@@ -361,7 +361,7 @@ fn kinds(scratch: &Path) -> Vec<(&'static str, Value, Loader)> {
             "variants.json",
             variants,
             Box::new(move |p: &Path| {
-                pipeline::VariantsConfig::load(p, &root_for_variants)
+                evaluation::VariantsConfig::load(p, &root_for_variants)
                     .map(drop)
                     .map_err(err)
             }),

@@ -1,8 +1,8 @@
 //! The workspace's layering (issue 19), read from the crates' manifests: `sindy` and `learn` are
 //! libraries on in-memory data (no flight-log crate, CSV reader, data-frame library or file hash
-//! among their dependencies, nor among those of the workspace crates they use); `pipeline` draws
+//! among their dependencies, nor among those of the workspace crates they use); `evaluation` draws
 //! no progress bar (the `learn` binary does); `report` depends on no crate that computes results
-//! (data flows cli → pipeline / mismatch → report).
+//! (data flows cli → evaluation / mismatch → report).
 
 use std::path::{Path, PathBuf};
 
@@ -49,21 +49,27 @@ fn assert_layered(name: &str, required: &[&str], forbidden: &[&str]) {
 
 #[test]
 fn sindy_depends_on_no_file_reader_or_data_frame_library() {
-    let forbidden = ["data", "polars", "csv", "sha2", "pipeline", "learn"];
+    let forbidden = ["data", "polars", "csv", "sha2", "evaluation", "learn"];
     assert_layered("sindy", &["faer"], &forbidden);
 }
 
 #[test]
 fn learn_depends_on_no_flight_log_csv_reader_or_data_frame_library() {
     let forbidden = [
-        "data", "polars", "csv", "sha2", "glob", "pipeline", "report",
+        "data",
+        "polars",
+        "csv",
+        "sha2",
+        "glob",
+        "evaluation",
+        "report",
     ];
     assert_layered("learn", &["sindy", "faer"], &forbidden);
 }
 
 #[test]
-fn the_pipeline_draws_no_progress_bar() {
-    let direct = dependencies("pipeline");
+fn the_evaluation_crate_draws_no_progress_bar() {
+    let direct = dependencies("evaluation");
     assert!(direct.contains(&"report".to_string()), "{direct:?}");
     assert!(!direct.contains(&"indicatif".to_string()), "{direct:?}");
 }
@@ -73,7 +79,7 @@ fn report_depends_on_no_crate_that_runs_the_experiments() {
     let direct = dependencies("report");
     assert!(direct.contains(&"plotters".to_string()), "{direct:?}");
     for forbidden in [
-        "pipeline",
+        "evaluation",
         "learn",
         "sindy",
         "physics",

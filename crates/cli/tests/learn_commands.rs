@@ -6,8 +6,8 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{learn_in, scratch};
+use evaluation::Protocol;
 use learn::{CHECKPOINT_FORMAT, LearnConfig, MetaTrainedModel, Standardiser};
-use pipeline::Protocol;
 use serde_json::{Value, json};
 
 fn workspace() -> PathBuf {

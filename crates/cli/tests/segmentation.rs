@@ -1,6 +1,6 @@
 //! A run configuration's `split` and `derivative` are honoured, not only accepted: every cell of a
 //! run is cut with them, and SINDy and LeARN are scored against the targets they give. On the
-//! small generated experiment (`common::sweep`), through the library (`pipeline::run`).
+//! small generated experiment (`common::sweep`), through the library (`evaluation::run`).
 
 mod common;
 
@@ -8,8 +8,8 @@ use std::path::Path;
 
 use common::sweep::small_experiment;
 use common::{scratch, workspace};
+use evaluation::Segment;
 use learn::Formulation;
-use pipeline::Segment;
 use serde_json::{Value, json};
 use sindy::Derivative;
 
@@ -35,12 +35,12 @@ fn a_run_cuts_every_cell_with_the_configured_split_and_derivative() {
     run["derivative"] = json!({"kind": "central"});
     run["learn"]["seeds"] = json!([1]);
     std::fs::write(&experiment.run, run.to_string()).unwrap();
-    let config = pipeline::RunConfig::load(&experiment.run, &workspace()).unwrap();
-    let outcome = pipeline::run(
+    let config = evaluation::RunConfig::load(&experiment.run, &workspace()).unwrap();
+    let outcome = evaluation::run(
         &config,
         &experiment.data,
         &workspace(),
-        &pipeline::NoProgress,
+        &evaluation::NoProgress,
     )
     .unwrap();
     // Every formulation × the two evaluation conditions, each flight 400 samples: 300 / 100.

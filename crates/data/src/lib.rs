@@ -11,7 +11,7 @@
 //!
 //! What it is not for: fitting anything (models live in `sindy` and `learn`, tables in `report`),
 //! nor the paper's protocol: a formulation's segments of a flight, the experiment and its
-//! meta-training flights are the `pipeline` crate's.
+//! meta-training flights are the `evaluation` crate's.
 //!
 //! Every error is a [`DataError`] whose message is one line naming the file, and where it applies
 //! the row (line number in the file, header = line 1) and column: `file:row:column: message`.

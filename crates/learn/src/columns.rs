@@ -77,7 +77,7 @@ impl ColumnSpec {
 }
 
 /// Where the tasks of a model of CSV tasks come from, as its checkpoint records it (reading them
-/// is the pipeline's). JSON: `{"kind": "files", "pattern": "tasks/*.csv"}` or
+/// is the `evaluation` crate's). JSON: `{"kind": "files", "pattern": "tasks/*.csv"}` or
 /// `{"kind": "column", "file": "all.csv", "column": "task"}`.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]

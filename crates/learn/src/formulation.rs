@@ -1,7 +1,7 @@
 //! The paper's three formulations as a model of the flights sees them: which states x are
 //! identified from which inputs X = [x, u], and the networks of each ([`architecture`]). A flight
 //! checkpoint records its formulation; how its columns are built from a flight log (which log
-//! columns, with which scalings) is the pipeline's.
+//! columns, with which scalings) is the `evaluation` crate's.
 //!
 //! | formulation | state x (I) | control u (U) | target |
 //! |---|---|---|---|

@@ -11,7 +11,7 @@
 //! [`Recording`]s).
 //!
 //! What it is not for: reading anything but its own configuration and checkpoints — flight logs,
-//! CSV files and file hashes are the `data` crate's, and the paper's protocol is the `pipeline`
+//! CSV files and file hashes are the `data` crate's, and the paper's protocol is the `evaluation`
 //! crate's (the experiment: which flights meta-train the model for an evaluation condition, how a
 //! flight is cut into support and query segments and a formulation's columns built from its log,
 //! the evaluation, the seed spread; reading CSV tasks). Nor estimating derivatives
@@ -24,7 +24,7 @@
 //! - [`LearnConfig::load`] reads `experiments/learn.json` into a [`CheckedConfig`] (all
 //!   hyper-parameters: α, β, n, μ, batches, iterations, λ, L, P, adaptation passes, seeds).
 //! - Flight models: [`architecture`] gives the networks of a [`Formulation`]; a caller (the
-//!   pipeline's experiment) standardises the meta-training tasks ([`Standardiser::fit`],
+//!   `evaluation` crate's experiment) standardises the meta-training tasks ([`Standardiser::fit`],
 //!   [`InputRange::spanned`]), checks its batch sizes against them ([`check_sampling`]),
 //!   meta-trains ([`meta_train`]) and records a [`MetaTrainedModel`] with
 //!   [`TrainedOn::Flights`] (formulation, protocol name, held-out condition); the model adapts on
@@ -50,7 +50,7 @@
 //! **generalisation MSE**: the same model, frozen, on the query data. MSE = mean over all samples
 //! and all output dimensions ([`mean_squared_error`]). Inputs are z-scored with the meta-training
 //! statistics (stored in the checkpoint). How the paper cuts a flight into support and query
-//! segments and estimates their targets is the pipeline's (`docs/protocol.md`).
+//! segments and estimates their targets is the `evaluation` crate's (`docs/protocol.md`).
 //!
 //! # Derivatives and speed
 //!

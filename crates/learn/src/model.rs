@@ -61,7 +61,7 @@ pub enum TrainedOn {
 pub struct FlightTraining {
     pub formulation: Formulation,
     /// The name of the protocol that chose the meta-training flights (`paper` or
-    /// `leave-condition-out`: the pipeline's protocols; to this crate only a record).
+    /// `leave-condition-out`: the `evaluation` crate's protocols; to this crate only a record).
     pub protocol: String,
     /// The evaluation condition left out of meta-training (`leave-condition-out`), if any.
     pub held_out_condition: Option<String>,

@@ -3,7 +3,7 @@
 //! others ([`evaluate_recording`]), explanation over a recording ([`explain_recording`]). The
 //! recordings are in memory ([`Recording`]: named columns, one sampling interval); reading them
 //! from CSV files, and checking a recording's sampling interval against a model's, is the
-//! pipeline's (`pipeline::own_data`).
+//! `evaluation` crate's (`evaluation::own_data`).
 //!
 //! The same model and algorithms as the paper's: inputs X = [x, u] (the state then control
 //! columns), outputs ẋ, the architecture of the paper's rule (I + U inputs, P·(I+U) basis

@@ -13,7 +13,7 @@
 //! ([`CurveFigure`], [`curve_markdown`]).
 //!
 //! What it is not for: computing any number. It knows nothing of flights, SINDy or LeARN and does
-//! not depend on the crates that do: the `pipeline` crate runs the experiments and hands the
+//! not depend on the crates that do: the `evaluation` crate runs the experiments and hands the
 //! numbers and traces to this crate in its own plain types.
 //!
 //! The sim-to-real mismatch tool's outputs are rendered here too ([`mismatch`]: the Markdown, the

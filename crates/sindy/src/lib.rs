@@ -22,7 +22,7 @@
 //!
 //! # What it is not for
 //! Reading recordings or CSV files (the `data` crate does: this crate depends on no file reader
-//! or data frame, its inputs are [`Mat`]s), the paper's protocol (`pipeline`), meta-learning
+//! or data frame, its inputs are [`Mat`]s), the paper's protocol (`evaluation`), meta-learning
 //! (`learn`), tables and figures (`report`). Nor is it a linear-algebra library: its dense
 //! computations are private, [`least_squares`] aside.
 //!

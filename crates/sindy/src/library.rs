@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Result, SindyError, invalid};
 
 /// The most features a library may have on the inputs it is applied to (polynomial, Fourier,
-/// custom and concatenated libraries, and the `pipeline` crate's causal library). It is checked on
+/// custom and concatenated libraries, and the `evaluation` crate's causal library). It is checked on
 /// the feature count computed in closed form, before any feature is enumerated or any Θ(X)
 /// allocated. Far above every committed configuration (the paper's library, Fourier K = 1, has
 /// 2·K·n = 20 features on the 10 inputs of the full formulation; the largest committed variant

@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use evaluation::{AblationsOutcome, ShardSpec, VariantsConfig};
 use outputs::{Existing, FolderId, OutputSet, Staged};
-use pipeline::{AblationsOutcome, ShardSpec, VariantsConfig};
 
 use super::Global;
 use super::progress::ItemLines;
@@ -57,7 +57,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let (set, folder) = plan_outputs(&inputs, &args.out, args.force)?;
     let data_dir = global.data_dir()?;
     let staged = set.prepare()?;
-    let outcome = pipeline::run_variants(&config, &data_dir, &progress(global, start))?;
+    let outcome = evaluation::run_variants(&config, &data_dir, &progress(global, start))?;
     write_outcome(&outcome, staged, folder, &args.out, start)
 }
 
@@ -65,7 +65,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
 fn run_shard(
     global: &Global,
     args: &Args,
-    config: &pipeline::CheckedVariants,
+    config: &evaluation::CheckedVariants,
     inputs: &[(String, PathBuf)],
     shard: ShardSpec,
 ) -> anyhow::Result<()> {
@@ -73,7 +73,7 @@ fn run_shard(
     let data_dir = global.data_dir()?;
     let staged = outputs.prepare()?;
     let start = Instant::now();
-    let file = pipeline::run_variants_shard(config, &data_dir, &progress(global, start), shard)?;
+    let file = evaluation::run_variants_shard(config, &data_dir, &progress(global, start), shard)?;
     staged.commit(&file)
 }
 
@@ -97,7 +97,7 @@ pub fn plan_outputs(
         set.input(format!("the {what} input"), path);
     }
     let folder = set.folder(out, "--out", Existing::from_force(force));
-    for file in pipeline::ablation_files() {
+    for file in evaluation::ablation_files() {
         set.file_in(folder, file);
     }
     // The figures' names depend on the cells: checked when the set is committed.
@@ -115,7 +115,7 @@ pub fn write_outcome(
     start: Instant,
 ) -> anyhow::Result<()> {
     super::staged_write(&staged, || {
-        pipeline::write_ablations(outcome, staged.dir(folder))
+        evaluation::write_ablations(outcome, staged.dir(folder))
     })?;
     let written = staged.commit()?;
     note!(
@@ -136,7 +136,7 @@ fn render_only(args: &Args) -> anyhow::Result<()> {
     let json = args.out.join("ablations.json");
     let text =
         inputs::read_json_text(&json).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
-    let ablations: pipeline::Ablations =
+    let ablations: evaluation::Ablations =
         inputs::json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
     let markdown = report::ablations_markdown(&ablations.tables());
     // Only ablations.md is rewritten: the run's other files stay its own.

@@ -18,7 +18,7 @@ pub struct Args {
 }
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
-    let comparison = pipeline::check_paper(&args.results, &args.published, &args.tolerances)?;
+    let comparison = evaluation::check_paper(&args.results, &args.published, &args.tolerances)?;
     say_part!("{}", comparison.render_text());
     let failed = comparison.failures().count();
     if failed > 0 {

@@ -6,8 +6,8 @@ use std::ops::Range;
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
+use evaluation::own_data::{RecordingComparison, SindySettings, compare_on_recording};
 use learn::MetaTrainedModel;
-use pipeline::own_data::{RecordingComparison, SindySettings, compare_on_recording};
 
 use super::Global;
 use super::sindy::FitArgs;
@@ -69,7 +69,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     }
     let model = MetaTrainedModel::load(&args.model)?;
     let columns = learn::column_training(&model, &args.model.display().to_string())?;
-    let recording = pipeline::own_data::read_recording(&args.csv, &columns.spec())?;
+    let recording = evaluation::own_data::read_recording(&args.csv, &columns.spec())?;
     let comparison = compare_on_recording(
         &model,
         &recording,

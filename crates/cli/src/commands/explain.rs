@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use data::{ExperimentConditions, FlightLog};
+use evaluation::{Segmentation, explain_flight, own_data};
 use learn::{EquationRule, Explanation, MetaTrainedModel};
-use pipeline::{Segmentation, explain_flight, own_data};
 
 use outputs::{Existing, OutputSet};
 

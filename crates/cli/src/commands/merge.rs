@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use evaluation::{ShardDocument, SweepKind};
 use outputs::{Existing, OutputSet};
-use pipeline::{ShardDocument, SweepKind};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
@@ -39,8 +39,8 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     let documents = args
         .shards
         .iter()
-        .map(|dir| pipeline::read_shard(dir))
-        .collect::<pipeline::Result<Vec<ShardDocument>>>()?;
+        .map(|dir| evaluation::read_shard(dir))
+        .collect::<evaluation::Result<Vec<ShardDocument>>>()?;
     let kind = one_kind(&documents)?;
     if kind != SweepKind::Reproduce
         && let Some(option) = [("--latex-dir", &args.latex_dir), ("--readme", &args.readme)]
@@ -79,7 +79,7 @@ fn one_kind(documents: &[ShardDocument]) -> anyhow::Result<SweepKind> {
 }
 
 /// The shards read as one sweep's, checked and merged.
-fn merged<C, R>(documents: Vec<ShardDocument>) -> anyhow::Result<pipeline::MergedSweep<C, R>>
+fn merged<C, R>(documents: Vec<ShardDocument>) -> anyhow::Result<evaluation::MergedSweep<C, R>>
 where
     C: DeserializeOwned + Serialize,
     R: DeserializeOwned + Serialize,
@@ -87,8 +87,8 @@ where
     let shards = documents
         .into_iter()
         .map(ShardDocument::typed)
-        .collect::<pipeline::Result<Vec<_>>>()?;
-    Ok(pipeline::merge(shards)?)
+        .collect::<evaluation::Result<Vec<_>>>()?;
+    Ok(evaluation::merge(shards)?)
 }
 
 fn merge_reproduce(
@@ -97,8 +97,10 @@ fn merge_reproduce(
     inputs: &[(String, PathBuf)],
     start: Instant,
 ) -> anyhow::Result<()> {
-    let merged: pipeline::MergedSweep<pipeline::ReproduceContext, Vec<pipeline::LearnCellOutcome>> =
-        merged(documents)?;
+    let merged: evaluation::MergedSweep<
+        evaluation::ReproduceContext,
+        Vec<evaluation::LearnCellOutcome>,
+    > = merged(documents)?;
     let to = Destinations {
         out: args.out.clone(),
         latex_dir: args
@@ -112,7 +114,7 @@ fn merge_reproduce(
     let plan =
         super::reproduce::plan_outputs(inputs, context.result_files(), context.latex_files(), &to)?;
     let staged = plan.set.prepare()?;
-    let outcome = pipeline::merged_run(merged)?;
+    let outcome = evaluation::merged_run(merged)?;
     super::reproduce::write_outcome(&outcome, staged, plan.ids, &to, start)
 }
 
@@ -125,7 +127,7 @@ fn merge_ablations(
     let merged = merged(documents)?;
     let (set, folder) = super::ablations::plan_outputs(inputs, &args.out, args.force)?;
     let staged = set.prepare()?;
-    let outcome = pipeline::merged_ablations(merged)?;
+    let outcome = evaluation::merged_ablations(merged)?;
     super::ablations::write_outcome(&outcome, staged, folder, &args.out, start)
 }
 
@@ -134,7 +136,7 @@ fn merge_spread(
     documents: Vec<ShardDocument>,
     inputs: &[(String, PathBuf)],
 ) -> anyhow::Result<()> {
-    let merged: pipeline::MergedSweep<pipeline::SpreadContext, Vec<pipeline::CellSummary>> =
+    let merged: evaluation::MergedSweep<evaluation::SpreadContext, Vec<evaluation::CellSummary>> =
         merged(documents)?;
     let mut set = OutputSet::new(super::meta_train::PRODUCER);
     for (what, path) in inputs {
@@ -142,7 +144,7 @@ fn merge_spread(
     }
     let file = set.file(&args.out, "--out", Existing::from_force(args.force));
     let staged = set.prepare()?;
-    let document = pipeline::spread_document(&merged.context, &merged.items, &merged.results);
+    let document = evaluation::spread_document(&merged.context, &merged.items, &merged.results);
     let how = format!("merged from {} shards", merged.shards.len());
     super::seed_spread::print_spread(&document.cells, &merged.context.seeds, &how);
     super::seed_spread::write_spread(staged.path(file), &args.out, &document)?;

@@ -7,10 +7,10 @@ use std::time::Instant;
 
 use anyhow::Context;
 use data::ExperimentConditions;
-use learn::{Formulation, LearnConfig};
-use pipeline::{
+use evaluation::{
     CellSummary, Experiment, Protocol, Segmentation, ShardSpec, evaluation_condition_of,
 };
+use learn::{Formulation, LearnConfig};
 use report::{Method, PublishedTables};
 use serde_json::{Value, json};
 
@@ -320,7 +320,7 @@ fn train_cells(
     experiment: &Experiment,
     cells: &CellsPlanned,
     condition: Option<&str>,
-) -> anyhow::Result<Vec<pipeline::CellResult>> {
+) -> anyhow::Result<Vec<evaluation::CellResult>> {
     let started = Instant::now();
     let bar = Bar(progress_bar(
         global.show_progress(),
@@ -336,7 +336,7 @@ fn train_cells(
                 bar.0.inc(1);
                 cell
             })
-            .collect::<pipeline::Result<Vec<_>>>(),
+            .collect::<evaluation::Result<Vec<_>>>(),
         None => experiment.run_cells(cells.formulations, cells.seed, &bar),
     };
     bar.0.finish_and_clear();

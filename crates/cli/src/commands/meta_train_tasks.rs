@@ -6,10 +6,10 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use data::file_sha256;
+use evaluation::own_data::{read_tasks, recording};
 use indicatif::{ProgressBar, ProgressStyle};
 use learn::{ColumnSpec, DataFile, TaskConfig, TaskSet, TaskSource};
 use outputs::{Existing, OutputSet};
-use pipeline::own_data::{read_tasks, recording};
 use sindy::Derivative;
 
 use super::Global;

@@ -7,12 +7,12 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use indicatif::{ProgressBar, ProgressStyle};
-use outputs::{Existing, OutputSet};
-use pipeline::own_data::SimulatedTask;
-use pipeline::own_data::example::{
+use evaluation::own_data::SimulatedTask;
+use evaluation::own_data::example::{
     CurveMethod, CurvePoint, ExampleConfig, LearningCurve, run_example,
 };
+use indicatif::{ProgressBar, ProgressStyle};
+use outputs::{Existing, OutputSet};
 use report::{CurveFigure, CurveSeries, curve_markdown};
 
 use super::Global;
@@ -85,7 +85,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     for (task, final_path) in curve.test_tasks.iter_mut().zip(&test_files) {
         task.file = final_path.clone();
     }
-    let (figure, table) = render(&curve, &pipeline::git_commit(Path::new(".")))?;
+    let (figure, table) = render(&curve, &evaluation::git_commit(Path::new(".")))?;
     let out_dir = staged.dir(out).to_path_buf();
     super::staged_write(&staged, || {
         std::fs::write(out_dir.join(CURVE_FILES[0]), &figure)?;

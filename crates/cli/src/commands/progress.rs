@@ -1,12 +1,12 @@
-//! Progress on standard error: the bars, and the observers of the pipeline's runs
-//! ([`pipeline::Progress`]). Bars and per-item lines are drawn only on a terminal and without
+//! Progress on standard error: the bars, and the observers of the evaluation's runs
+//! ([`evaluation::Progress`]). Bars and per-item lines are drawn only on a terminal and without
 //! `--quiet` ([`super::Global::show_progress`]); a run's stage times are printed always.
 
 use std::sync::Mutex;
 use std::time::Instant;
 
+use evaluation::{Progress, Stage, StageTiming};
 use indicatif::{ProgressBar, ProgressStyle};
-use pipeline::{Progress, Stage, StageTiming};
 
 /// A bar over `cells` cells on standard error, drawn only when `show` (a terminal, not --quiet).
 pub fn progress_bar(show: bool, cells: usize, message: &str) -> ProgressBar {

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::bail;
+use evaluation::{OutputPaths, RunConfig, RunOutcome, ShardSpec};
 use outputs::{Existing, FileId, FolderId, OutputSet, Staged};
-use pipeline::{OutputPaths, RunConfig, RunOutcome, ShardSpec};
 
 use super::Global;
 use super::progress::StageBars;
@@ -67,8 +67,8 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     };
     let plan = plan_outputs(
         &inputs,
-        pipeline::result_files(&config),
-        pipeline::latex_files(&config),
+        evaluation::result_files(&config),
+        evaluation::latex_files(&config),
         &to,
     )?;
     let data_dir = global.data_dir()?;
@@ -80,7 +80,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         available_threads()
     );
     let progress = StageBars::new(global.show_progress());
-    let outcome = pipeline::run(&config, &data_dir, &args.root, &progress)?;
+    let outcome = evaluation::run(&config, &data_dir, &args.root, &progress)?;
     write_outcome(&outcome, staged, plan.ids, &to, start)
 }
 
@@ -88,7 +88,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
 fn run_shard(
     global: &Global,
     args: &Args,
-    config: &pipeline::CheckedRunConfig,
+    config: &evaluation::CheckedRunConfig,
     inputs: &[(String, PathBuf)],
     shard: ShardSpec,
 ) -> anyhow::Result<()> {
@@ -102,7 +102,7 @@ fn run_shard(
         available_threads()
     );
     let progress = StageBars::new(global.show_progress());
-    let file = pipeline::run_shard(config, &data_dir, &args.root, &progress, shard)?;
+    let file = evaluation::run_shard(config, &data_dir, &args.root, &progress, shard)?;
     staged.commit(&file)
 }
 
@@ -119,9 +119,9 @@ pub fn write_outcome(
         results_dir: staged.dir(ids.results).to_path_buf(),
         latex_dir: staged.dir(ids.latex).to_path_buf(),
     };
-    pipeline::write_outputs(outcome, &staging)?;
+    evaluation::write_outputs(outcome, &staging)?;
     if let (Some(readme), Some(file)) = (&to.readme, ids.readme) {
-        let text = pipeline::updated_readme(outcome, readme, &to.out.join("figures"))?;
+        let text = evaluation::updated_readme(outcome, readme, &to.out.join("figures"))?;
         std::fs::write(staged.path(file), text)
             .map_err(|e| anyhow::anyhow!("{}: {e}", readme.display()))?;
     }
@@ -205,7 +205,7 @@ fn readme_in(set: &mut OutputSet, readme: &Path) -> anyhow::Result<FileId> {
     }
     let file = set.file(readme, "--readme", Existing::Replace);
     set.check()?;
-    pipeline::check_readme(readme)?;
+    evaluation::check_readme(readme)?;
     Ok(file)
 }
 

@@ -8,11 +8,11 @@ use std::time::Instant;
 use anyhow::Context;
 
 use data::ExperimentConditions;
-use learn::LearnConfig;
-use outputs::{Existing, OutputSet, Staged};
-use pipeline::{
+use evaluation::{
     Experiment, Protocol, Segmentation, ShardProvenance, ShardSpec, SpreadCell, StageTiming,
 };
+use learn::LearnConfig;
+use outputs::{Existing, OutputSet, Staged};
 
 use super::Global;
 use super::meta_train::{Args, PRODUCER, formulations};
@@ -75,7 +75,7 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
     )?;
     let loaded = started.elapsed().as_secs_f64();
     say!("protocol: {}", protocol.name());
-    let sweep = pipeline::spread_sweep(
+    let sweep = evaluation::spread_sweep(
         &experiment,
         &formulations,
         &args.config_path(),
@@ -91,7 +91,7 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
         experiment.evaluation_conditions().len(),
     );
     let bar = Bar(progress_bar(global.show_progress(), cells, "seed spread"));
-    let results = pipeline::run_spread(&experiment, &sweep, shard, &bar);
+    let results = evaluation::run_spread(&experiment, &sweep, shard, &bar);
     bar.0.finish_and_clear();
     let results = results?;
     match prepared {
@@ -105,7 +105,7 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
         }
         Prepared::File(staged, file) => {
             let summaries: Vec<_> = results.into_iter().map(|r| r.result).collect();
-            let document = pipeline::spread_document(&sweep.context, &sweep.items, &summaries);
+            let document = evaluation::spread_document(&sweep.context, &sweep.items, &summaries);
             let took = format!("{:.1} s", started.elapsed().as_secs_f64());
             print_spread(&document.cells, &sweep.context.seeds, &took);
             write_spread(staged.path(file), &args.spread_out, &document)?;
@@ -120,7 +120,7 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
 pub fn write_spread(
     staging: &Path,
     path: &Path,
-    document: &pipeline::SpreadDocument,
+    document: &evaluation::SpreadDocument,
 ) -> anyhow::Result<()> {
     std::fs::write(staging, document.to_json()).with_context(|| path.display().to_string())
 }
@@ -133,13 +133,13 @@ fn stage(name: &str, seconds: f64) -> StageTiming {
 }
 
 /// How many cells the items of `shard` evaluate.
-fn shard_cells(items: &[pipeline::WorkItem], shard: ShardSpec, conditions: usize) -> usize {
+fn shard_cells(items: &[evaluation::WorkItem], shard: ShardSpec, conditions: usize) -> usize {
     shard
         .positions(items.len())
         .iter()
         .map(|&p| match items[p].cells {
-            pipeline::Cells::Condition(_) => 1,
-            pipeline::Cells::Every => conditions,
+            evaluation::Cells::Condition(_) => 1,
+            evaluation::Cells::Every => conditions,
         })
         .sum()
 }

@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+use evaluation::{SHARD_FILE, ShardFile, ShardSpec};
 use outputs::{Existing, OutputSet, Staged};
-use pipeline::{SHARD_FILE, ShardFile, ShardSpec};
 use serde::Serialize;
 
 /// `--shard K/N`: a clap value parser whose message says what is wrong.
@@ -68,7 +68,7 @@ impl StagedShard {
     /// Writes `file` and moves it into place; prints where.
     pub fn commit<C: Serialize, R: Serialize>(self, file: &ShardFile<C, R>) -> anyhow::Result<()> {
         let dir = self.staged.dir(self.folder).to_path_buf();
-        super::staged_write(&self.staged, || pipeline::write_shard(file, &dir))?;
+        super::staged_write(&self.staged, || evaluation::write_shard(file, &dir))?;
         self.staged.commit()?;
         note!(
             "shard {}: {} of {} items, written to {}",

@@ -1,8 +1,10 @@
 //! The whole analysis of one recording: compare, locate, explain, fit, judge the evidence, validate
 //! on held-out data.
 
+use std::collections::BTreeMap;
+
 use data::FlightLog;
-use physics::{EffectId, EffectParameters, Effects, Logger, NominalModel};
+use physics::{EffectId, EffectParameters, Effects, Logger, NominalModel, ParameterValue};
 pub use report::mismatch::recording::{ChannelReport, Fit, Heldout, Mse, RateFrameReport, Window};
 use serde::Serialize;
 
@@ -13,6 +15,7 @@ use crate::fit::{FitAlternatives, Screened, fit_parameters, profile_nonlinear};
 use crate::library::{Candidate, build_library};
 use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
+use crate::refine::effects_from;
 use crate::selection::{Design, Selection, SelectionSettings, stability_selection};
 use crate::weak_form::TestFunction;
 
@@ -60,6 +63,11 @@ impl Default for AnalysisSettings {
 pub struct EffectReport {
     pub id: EffectId,
     pub parameters: EffectParameters,
+    /// The standard error of each parameter, by name, in the parameters' shape (from the fit's
+    /// Jacobian, the residual's variance and its autocorrelation); absent where the fit does not
+    /// determine it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub standard_errors: Option<BTreeMap<&'static str, ParameterValue>>,
     pub description: String,
     /// This effect's share of the nominal model's noise-normalised residual sum of squares (fit
     /// part) that the fitted effects remove, in [0, 1]; the shares sum to the total removed.
@@ -360,6 +368,7 @@ fn build_report(
     let nominal_sse = problem.whitened_sse(residuals.before, fit_rows.clone());
     let fitted_sse = problem.whitened_sse(residuals.after, fit_rows.clone());
     let shares = explained_fractions(&judgement.evidence, nominal_sse, fitted_sse);
+    let errors = effects_from(&judgement.set.parameters, &judgement.standard_errors);
     let effect_reports = judgement
         .evidence
         .iter()
@@ -369,6 +378,13 @@ fn build_report(
             parameters: effects
                 .parameters(evidence.id)
                 .expect("a named effect is in the fitted set"),
+            standard_errors: errors.parameters(evidence.id).and_then(|p| {
+                let values = p.values();
+                let finite = values
+                    .iter()
+                    .all(|(_, v)| v.numbers().iter().all(|x| x.is_finite()));
+                finite.then(|| values.into_iter().collect())
+            }),
             description: describe(evidence.id, &effects),
             explained_fraction: share,
             evidence: evidence.clone(),

@@ -26,6 +26,7 @@ use serde::Serialize;
 
 use crate::fit::FittedSet;
 use crate::problem::{Channels, Problem};
+use crate::refine::standard_errors;
 use crate::selection::trimmed_gain;
 
 /// The thresholds of the rule (recorded in the output).
@@ -253,6 +254,9 @@ pub struct Judgement {
     pub evidence: Vec<Evidence>,
     /// The evidence of each effect dropped, when it was dropped (in order).
     pub dropped: Vec<Evidence>,
+    /// The standard error of each value of `set` ([`crate::refine::standard_errors`], with the
+    /// final set's residual variance and autocorrelation).
+    pub standard_errors: Vec<f64>,
 }
 
 /// Applies the rule to a jointly fitted set.
@@ -271,6 +275,7 @@ pub fn apply(
                 set,
                 evidence: Vec::new(),
                 dropped,
+                standard_errors: Vec::new(),
             };
         }
         let full = scores(problem, &set, block_rows);
@@ -314,10 +319,18 @@ pub fn apply(
                 set = reduced.clone();
             }
             None => {
+                let standard_errors = standard_errors(
+                    problem,
+                    &set.parameters,
+                    &set.values,
+                    0..problem.split,
+                    judge.noise.autocorrelation * judge.noise.variance,
+                );
                 return Judgement {
-                    set,
                     evidence: outcomes.into_iter().map(|(e, _)| e).collect(),
+                    set,
                     dropped,
+                    standard_errors,
                 };
             }
         }

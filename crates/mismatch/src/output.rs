@@ -126,6 +126,12 @@ impl Analysis {
                 .map(|e| NamedEffect {
                     evidence: evidence_line(&e.evidence),
                     description: &e.description,
+                    standard_errors: e
+                        .standard_errors
+                        .iter()
+                        .flatten()
+                        .map(|(name, value)| (*name, value.numbers()))
+                        .collect(),
                     explained_fraction: e.explained_fraction,
                 })
                 .collect(),

@@ -112,6 +112,81 @@ fn whitened(problem: &Problem, residual: &[Channels], range: std::ops::Range<usi
         .collect()
 }
 
+/// The forward-difference Jacobian of `evaluate` at `values` (one column per parameter, as rows).
+fn forward_jacobian(
+    parameters: &[Parameter],
+    values: &[f64],
+    residual: &[f64],
+    evaluate: &dyn Fn(&[f64]) -> Vec<f64>,
+) -> Vec<Vec<f64>> {
+    (0..parameters.len())
+        .map(|j| {
+            let step = 1e-4 * values[j].abs().max(parameters[j].typical());
+            let mut shifted = values.to_vec();
+            shifted[j] += step;
+            evaluate(&shifted)
+                .iter()
+                .zip(residual)
+                .map(|(a, b)| (a - b) / step)
+                .collect()
+        })
+        .collect()
+}
+
+/// `JᵀJ` of a Jacobian given by columns.
+fn normal_matrix(jacobian: &[Vec<f64>]) -> Mat<f64> {
+    let k = jacobian.len();
+    let mut normal = Mat::<f64>::zeros(k, k);
+    for i in 0..k {
+        for j in 0..=i {
+            let v: f64 = jacobian[i]
+                .iter()
+                .zip(&jacobian[j])
+                .map(|(a, b)| a * b)
+                .sum();
+            normal[(i, j)] = v;
+            normal[(j, i)] = v;
+        }
+    }
+    normal
+}
+
+/// Standard errors of fitted `values`: `√diag(scale · (JᵀJ)⁻¹)` with `J` the Jacobian of the
+/// whitened residual on rows `range`, and `scale` the variance of a whitened residual element
+/// times the residual's integrated autocorrelation (neighbouring rows share samples). NaN where
+/// `JᵀJ` is singular.
+pub fn standard_errors(
+    problem: &Problem,
+    parameters: &[Parameter],
+    values: &[f64],
+    range: std::ops::Range<usize>,
+    scale: f64,
+) -> Vec<f64> {
+    let evaluate = |values: &[f64]| {
+        whitened(
+            problem,
+            &problem.residual(&effects_from(parameters, values)),
+            range.clone(),
+        )
+    };
+    let residual = evaluate(values);
+    let jacobian = forward_jacobian(parameters, values, &residual, &evaluate);
+    let k = parameters.len();
+    let inverse = normal_matrix(&jacobian)
+        .full_piv_lu()
+        .solve(Mat::<f64>::identity(k, k));
+    (0..k)
+        .map(|i| {
+            let variance = scale * inverse[(i, i)];
+            if variance.is_finite() && variance >= 0.0 {
+                variance.sqrt()
+            } else {
+                f64::NAN
+            }
+        })
+        .collect()
+}
+
 /// Levenberg–Marquardt with a forward-difference Jacobian and bounds by projection.
 pub fn levenberg_marquardt(
     problem: &Problem,
@@ -142,32 +217,11 @@ pub fn levenberg_marquardt(
     }
     let mut damping = 1e-3;
     for _ in 0..iterations {
-        let mut jacobian: Vec<Vec<f64>> = Vec::with_capacity(k);
-        for j in 0..k {
-            let step = 1e-4 * values[j].abs().max(parameters[j].typical());
-            let mut shifted = values.clone();
-            shifted[j] += step;
-            let r = evaluate(&shifted);
-            jacobian.push(
-                r.iter()
-                    .zip(&residual)
-                    .map(|(a, b)| (a - b) / step)
-                    .collect(),
-            );
-        }
-        let mut normal = Mat::<f64>::zeros(k, k);
+        let jacobian = forward_jacobian(parameters, &values, &residual, &evaluate);
+        let normal = normal_matrix(&jacobian);
         let mut gradient = Mat::<f64>::zeros(k, 1);
         for i in 0..k {
             gradient[(i, 0)] = jacobian[i].iter().zip(&residual).map(|(a, b)| a * b).sum();
-            for j in 0..=i {
-                let v: f64 = jacobian[i]
-                    .iter()
-                    .zip(&jacobian[j])
-                    .map(|(a, b)| a * b)
-                    .sum();
-                normal[(i, j)] = v;
-                normal[(j, i)] = v;
-            }
         }
         let mut improved = false;
         for _ in 0..8 {

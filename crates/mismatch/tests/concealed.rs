@@ -87,6 +87,15 @@ fn names_a_torque_bias_and_writes_outputs_once() {
         serde_json::from_str(&std::fs::read_to_string(dir.join("mismatch.json")).unwrap()).unwrap();
     assert_eq!(json["effects"][0]["id"], "torque_bias");
     assert!(json["fit"]["heldout"]["after"]["mse"].as_f64().unwrap() > 0.0);
+    // Each component comes with a standard error that is small and covers the truth.
+    let errors = &json["effects"][0]["standard_errors"]["b"];
+    for (i, truth) in [0.6, -0.4, 0.25].into_iter().enumerate() {
+        let error = errors[i].as_f64().unwrap_or(f64::NAN);
+        assert!(error > 0.0 && error < 0.05, "{errors}");
+        assert!((b[i] - truth).abs() <= 4.0 * error, "{b:?} ± {errors}");
+    }
+    let markdown = std::fs::read_to_string(dir.join("mismatch.md")).unwrap();
+    assert!(markdown.contains("Standard errors: b ± ["), "{markdown}");
     let svg = std::fs::read_to_string(dir.join("mismatch.svg")).unwrap();
     assert!(svg.contains("<text") && svg.contains("wdot_x"));
     assert!(matches!(

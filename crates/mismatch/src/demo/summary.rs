@@ -26,6 +26,10 @@ pub struct ParameterCheck {
     pub truth: ParameterValue,
     /// Rounded to 4 decimals; `None` (null) when the fit has no such parameter.
     pub found: Option<ParameterValue>,
+    /// The standard error the analysis reports for the found value (`None` when it has none).
+    pub standard_error: Option<ParameterValue>,
+    /// Whether every component of the true value lies within two standard errors of the found one.
+    pub within_two_standard_errors: Option<bool>,
     /// |found − true| / |true| (vectors: Euclidean norms); for the factors `thrust_scale.k` and
     /// `inertia_scale.k`, relative to |true − 1|.
     pub relative_error: f64,
@@ -65,7 +69,14 @@ impl CellOutcome {
         let report = &analysis.report;
         let true_effects = truth.ids();
         let found_effects = analysis.fitted.ids();
-        let parameters = compare_parameters(truth, &analysis.fitted);
+        let standard_error = |id: EffectId, name: &str| {
+            report
+                .effects
+                .iter()
+                .find(|e| e.id == id)
+                .and_then(|e| e.standard_errors.as_ref()?.get(name).cloned())
+        };
+        let parameters = compare_parameters(truth, &analysis.fitted, &standard_error);
         let (before, after) = (report.fit.heldout.before.mse, report.fit.heldout.after.mse);
         let ratio = after / before.max(1e-300);
         let mut failures = Vec::new();
@@ -130,9 +141,16 @@ impl CellOutcome {
     }
 }
 
+/// The standard error reported for a parameter (effect, name), if any.
+pub type StandardErrorOf<'a> = &'a dyn Fn(EffectId, &str) -> Option<ParameterValue>;
+
 /// Relative errors of every parameter of every true effect that was found; the effects in the
 /// alphabetical order of their ids, as in their JSON.
-pub fn compare_parameters(truth: &Effects, found: &Effects) -> Vec<ParameterCheck> {
+pub fn compare_parameters(
+    truth: &Effects,
+    found: &Effects,
+    standard_error: StandardErrorOf,
+) -> Vec<ParameterCheck> {
     let mut found_true: Vec<EffectId> = truth
         .ids()
         .into_iter()
@@ -141,7 +159,7 @@ pub fn compare_parameters(truth: &Effects, found: &Effects) -> Vec<ParameterChec
     found_true.sort_by_key(|id| id.name());
     found_true
         .into_iter()
-        .flat_map(|id| parameter_checks(id, truth, found))
+        .flat_map(|id| parameter_checks(id, truth, found, standard_error))
         .collect()
 }
 
@@ -167,7 +185,12 @@ fn is_factor(id: EffectId) -> bool {
 }
 
 /// One check per parameter of `effect`, from its true and found parameters.
-fn parameter_checks(effect: EffectId, truth: &Effects, found: &Effects) -> Vec<ParameterCheck> {
+fn parameter_checks(
+    effect: EffectId,
+    truth: &Effects,
+    found: &Effects,
+    standard_error: StandardErrorOf,
+) -> Vec<ParameterCheck> {
     let reference = if is_factor(effect) { 1.0 } else { 0.0 };
     let found_values = found
         .parameters(effect)
@@ -200,11 +223,20 @@ fn parameter_checks(effect: EffectId, truth: &Effects, found: &Effects) -> Vec<P
                 .map(|a| (a - reference).powi(2))
                 .sum::<f64>()
                 .sqrt();
+            let error = standard_error(effect, name);
+            let within = error.as_ref().map(|e| {
+                let e = e.numbers();
+                e.len() == t.len()
+                    && f.len() == t.len()
+                    && (0..t.len()).all(|i| (f[i] - t[i]).abs() <= 2.0 * e[i])
+            });
             ParameterCheck {
                 effect,
                 parameter: name.to_string(),
                 truth: value,
                 found: found_value,
+                standard_error: error,
+                within_two_standard_errors: within,
                 relative_error: if f.len() == t.len() {
                     difference / magnitude.max(1e-300)
                 } else {
@@ -354,6 +386,8 @@ fn cell_line(c: &CellOutcome) -> CellLine<'_> {
                     .found
                     .as_ref()
                     .map_or("null".to_string(), ToString::to_string),
+                standard_error: p.standard_error.as_ref().map(ParameterValue::numbers),
+                within_two_standard_errors: p.within_two_standard_errors,
                 relative_error: p.relative_error,
             })
             .collect(),

@@ -53,6 +53,8 @@ fn cell(c: &Value) -> CellOutcome {
                 parameter: from(&p["parameter"]),
                 truth: from(&p["truth"]),
                 found: from(&p["found"]),
+                standard_error: from(&p["standard_error"]),
+                within_two_standard_errors: from(&p["within_two_standard_errors"]),
                 relative_error: from(&p["relative_error"]),
             })
             .collect(),

@@ -62,6 +62,10 @@ pub struct ParameterLine<'a> {
     /// The values as compact JSON (`[1.25, 0.85, 1.15]`; `null` when not found).
     pub truth: String,
     pub found: String,
+    /// The standard error the analysis reports for the found value, component by component.
+    pub standard_error: Option<Vec<f64>>,
+    /// Whether the true value lies within two standard errors of the found one.
+    pub within_two_standard_errors: Option<bool>,
     pub relative_error: f64,
 }
 
@@ -92,6 +96,26 @@ pub struct DemoView<'a> {
     pub cases: &'a [(String, String)],
     /// Configuration by configuration, case by case.
     pub cells: Vec<CellLine<'a>>,
+}
+
+/// `[a, b]` (or `a` alone) with each number to two significant digits.
+fn two_digit_list(values: &[f64]) -> String {
+    let texts: Vec<String> = values
+        .iter()
+        .map(|&x| {
+            let decimals = if x > 0.0 {
+                (1 - x.log10().floor() as i32).max(0) as usize
+            } else {
+                0
+            };
+            format!("{x:.decimals$}")
+        })
+        .collect();
+    if texts.len() == 1 {
+        texts[0].clone()
+    } else {
+        format!("[{}]", texts.join(", "))
+    }
 }
 
 impl DemoView<'_> {
@@ -236,6 +260,32 @@ impl DemoView<'_> {
             parameters.len(),
             controls.len()
         );
+        self.coverage_markdown(md);
+    }
+
+    /// How often the true value lies within two of the reported standard errors, per
+    /// configuration: whether the uncertainty the tool reports can be trusted.
+    fn coverage_markdown(&self, md: &mut String) {
+        let counts: Vec<String> = self
+            .configurations
+            .iter()
+            .map(|configuration| {
+                let judged: Vec<bool> = self
+                    .cells
+                    .iter()
+                    .filter(|c| c.configuration == configuration.name)
+                    .flat_map(|c| &c.parameters)
+                    .filter_map(|p| p.within_two_standard_errors)
+                    .collect();
+                let within = judged.iter().filter(|w| **w).count();
+                format!("{} {within} of {}", configuration.name, judged.len())
+            })
+            .collect();
+        let _ = writeln!(
+            md,
+            "\nEvery parameter is reported with its standard error from the noise (± below). True values within two of them: {}; the rest are off by more than the noise explains (a systematic error of the comparison or the fit).",
+            counts.join(", ")
+        );
     }
 
     fn details_markdown(&self, md: &mut String) {
@@ -250,11 +300,15 @@ impl DemoView<'_> {
                 .iter()
                 .map(|p| {
                     format!(
-                        "{}.{}: {} → {} ({:.1}%)",
+                        "{}.{}: {} → {}{} ({:.1}%)",
                         p.effect,
                         p.parameter,
                         p.truth,
                         p.found,
+                        p.standard_error
+                            .as_ref()
+                            .map(|e| format!(" ± {}", two_digit_list(e)))
+                            .unwrap_or_default(),
                         100.0 * p.relative_error
                     )
                 })

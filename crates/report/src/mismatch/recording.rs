@@ -105,11 +105,37 @@ pub struct EvidenceLine<'a> {
 }
 
 /// One effect found: its evidence, in words, and its share of the residual removed.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct NamedEffect<'a> {
     pub evidence: EvidenceLine<'a>,
     pub description: &'a str,
+    /// Each parameter's name and standard errors (empty when the fit does not determine them).
+    pub standard_errors: Vec<(&'a str, Vec<f64>)>,
     pub explained_fraction: f64,
+}
+
+/// `name ± error` for each parameter, the errors to two significant digits: `k ± [0.0061, 0.016]`.
+fn standard_errors_text(errors: &[(&str, Vec<f64>)]) -> String {
+    let two_digits = |x: f64| {
+        let decimals = if x > 0.0 {
+            (1 - x.log10().floor() as i32).max(0) as usize
+        } else {
+            0
+        };
+        format!("{x:.decimals$}")
+    };
+    errors
+        .iter()
+        .map(|(name, values)| {
+            let texts: Vec<String> = values.iter().map(|x| two_digits(*x)).collect();
+            if texts.len() == 1 {
+                format!("{name} ± {}", texts[0])
+            } else {
+                format!("{name} ± [{}]", texts.join(", "))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// One term of a candidate.
@@ -263,11 +289,20 @@ impl RecordingView<'_> {
         } else {
             for e in &self.effects {
                 let evidence = &e.evidence;
+                let errors = if e.standard_errors.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        " Standard errors: {}.",
+                        standard_errors_text(&e.standard_errors)
+                    )
+                };
                 let _ = writeln!(
                     md,
-                    "- **{}** — {} It accounts for {:.0}% of the nominal model's (noise-normalised) residual; without it the held-out residual is {:.0}% higher (likelihood ratio {:.0} against {:.1}, gain {:.2} per row and channel, {:.2} without its two largest blocks).",
+                    "- **{}** — {}{} It accounts for {:.0}% of the nominal model's (noise-normalised) residual; without it the held-out residual is {:.0}% higher (likelihood ratio {:.0} against {:.1}, gain {:.2} per row and channel, {:.2} without its two largest blocks).",
                     evidence.id,
                     e.description,
+                    errors,
                     100.0 * e.explained_fraction,
                     100.0 * (evidence.heldout_without / evidence.heldout_with.max(1e-300) - 1.0),
                     evidence.likelihood_ratio,
@@ -470,6 +505,7 @@ mod tests {
             effects: vec![NamedEffect {
                 evidence: evidence("linear_drag", 120.4),
                 description: "Drag.",
+                standard_errors: vec![("d", vec![0.0123, 0.25, 3.0])],
                 explained_fraction: 0.625,
             }],
             dropped: vec![evidence("wind", 3.25)],
@@ -495,7 +531,7 @@ mod tests {
             "| vdot_x | 0.2500 | 0.0100 | yes |\n| vdot_y | 0.0050 | 0.0100 | no |\n",
             "\nThe model has no mixer, so it predicts no torques: only the translational channels are compared.\n",
             "(1 s moving RMS):\n\n- vdot_x from 1.2 s to 7.5 s\n",
-            "- **linear_drag** — Drag. It accounts for 62% of the nominal model's (noise-normalised) residual; without it the held-out residual is 50% higher (likelihood ratio 120 against 16.3, gain 0.75 per row and channel, 0.50 without its two largest blocks).\n",
+            "- **linear_drag** — Drag. Standard errors: d ± [0.012, 0.25, 3.0]. It accounts for 62% of the nominal model's (noise-normalised) residual; without it the held-out residual is 50% higher (likelihood ratio 120 against 16.3, gain 0.75 per row and channel, 0.50 without its two largest blocks).\n",
             "- not named: wind (likelihood ratio 3.2 against 16.3, gain 0.750, 0.500 without its two largest blocks, held-out reduction 33.3%): below the evidence rule.\n",
             "- unexplained residual on vdot_x, 2.0–2.8 s\n",
             "- linear_drag (`drag_x` = −v_x [m/s]): 88%, kept\n",

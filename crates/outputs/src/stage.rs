@@ -139,6 +139,8 @@ fn prepare_folder(plan: &FolderPlan, created: &mut Vec<PathBuf>) -> Result<Stage
         }
         let target = dir.join(parent);
         create_dir(&target, &plan.option, created)?;
+        // A run killed while it probed this subfolder left its probe here.
+        remove_dead_staging(&target);
         probe(&target, &plan.option)?;
         create_inside(staging.path(), parent)?;
     }

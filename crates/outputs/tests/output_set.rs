@@ -186,6 +186,23 @@ fn a_killed_commit_is_finished_and_dead_staging_removed_by_the_next_run() {
     assert_eq!(listing(&dir), [".learn-outputs.json", "a.json", "q.json"]);
 }
 
+/// A run killed (SIGKILL) while it probed a subfolder leaves its probe file there; the next run
+/// into the folder removes it (it removed dead staging only in the folder itself).
+#[test]
+fn a_dead_probe_in_a_subfolder_is_removed_by_the_next_run() {
+    let tmp = scratch("dead-probe");
+    let dir = tmp.path().to_path_buf();
+    run(&dir, "p", &[("figures/a.svg", "1")], Existing::Refuse).unwrap();
+    let probe = dir.join("figures/.learn-staging-999999999-probe");
+    std::fs::write(&probe, "").unwrap();
+    run(&dir, "p", &[("figures/a.svg", "2")], Existing::Replace).unwrap();
+    assert!(!probe.exists(), "{:?}", listing(&dir));
+    assert_eq!(
+        listing(&dir),
+        [".learn-outputs.json", "figures", "figures/a.svg"]
+    );
+}
+
 #[test]
 fn a_manifest_cannot_reach_outside_its_folder() {
     let tmp = scratch("reach");

@@ -13,13 +13,15 @@
 //!   standard deviation.
 //!
 //! Bagging ([`Bagging`]): every member refits the chosen penalties on a moving-block bootstrap of
-//! the rows (blocks of contiguous samples, drawn with replacement from a SplitMix64 stream seeded by
-//! the recorded seed); the prediction is the members' mean. The predictive band is
+//! the rows (blocks of contiguous samples, drawn with replacement from a ChaCha8 stream seeded by
+//! the recorded seed, the workspace's one generator); the prediction is the members' mean. The predictive band is
 //! mean ± 2·√(s² + σ²): s² the members' variance at that sample (the model's uncertainty) and σ²
 //! the output's cross-validation MSE on the support segment (what the model leaves unexplained,
 //! noise included), so about 95 % of the targets should fall inside it if the errors are Gaussian.
 
 use faer::{Mat, MatRef};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 mod selection;
@@ -353,7 +355,7 @@ impl RegressionSpec {
         let members = match self.bagging {
             None => Vec::new(),
             Some(bagging) => {
-                let mut stream = SplitMix64(seed);
+                let mut stream = ChaCha8Rng::seed_from_u64(seed);
                 (0..bagging.members)
                     .map(|_| {
                         let rows = block_bootstrap(n, bagging.block, &mut stream);
@@ -471,30 +473,12 @@ fn standardised(x: MatRef<'_, f64>, centre: &[f64], scale: &[f64]) -> Mat<f64> {
     })
 }
 
-/// SplitMix64 (Steele, Lea, Flood 2014): a small, seedable, well-mixed 64-bit stream.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in 0..bound (bound ≤ 2³², negligible bias).
-    fn below(&mut self, bound: usize) -> usize {
-        (((self.next() >> 32) * bound as u64) >> 32) as usize
-    }
-}
-
 /// n row indices: blocks of `block` contiguous rows starting at uniform positions, concatenated
 /// and cut to n.
-fn block_bootstrap(n: usize, block: usize, stream: &mut SplitMix64) -> Vec<usize> {
+fn block_bootstrap(n: usize, block: usize, stream: &mut ChaCha8Rng) -> Vec<usize> {
     let mut rows = Vec::with_capacity(n + block);
     while rows.len() < n {
-        let start = stream.below(n - block + 1);
+        let start = stream.random_range(0..n - block + 1);
         rows.extend(start..start + block);
     }
     rows.truncate(n);

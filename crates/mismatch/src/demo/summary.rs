@@ -30,6 +30,8 @@ pub struct ParameterCheck {
     pub standard_error: Option<ParameterValue>,
     /// Whether every component of the true value lies within two standard errors of the found one.
     pub within_two_standard_errors: Option<bool>,
+    /// The largest error of a component in its standard errors, `max |found − true| / error`.
+    pub standard_errors_off: Option<f64>,
     /// |found − true| / |true| (vectors: Euclidean norms); for the factors `thrust_scale.k` and
     /// `inertia_scale.k`, relative to |true − 1|.
     pub relative_error: f64,
@@ -96,8 +98,12 @@ impl CellOutcome {
         }
         for p in &parameters {
             if p.relative_error > TARGETS.parameters_within {
+                let noise = p
+                    .standard_errors_off
+                    .map(|z| format!(" ({z:.1} standard errors)"))
+                    .unwrap_or_default();
                 failures.push(format!(
-                    "{}.{} off by {:.0}%",
+                    "{}.{} off by {:.0}%{noise}",
                     p.effect,
                     p.parameter,
                     100.0 * p.relative_error
@@ -224,12 +230,15 @@ fn parameter_checks(
                 .sum::<f64>()
                 .sqrt();
             let error = standard_error(effect, name);
-            let within = error.as_ref().map(|e| {
+            let off = error.as_ref().and_then(|e| {
                 let e = e.numbers();
-                e.len() == t.len()
-                    && f.len() == t.len()
-                    && (0..t.len()).all(|i| (f[i] - t[i]).abs() <= 2.0 * e[i])
+                (e.len() == t.len() && f.len() == t.len()).then(|| {
+                    (0..t.len())
+                        .map(|i| (f[i] - t[i]).abs() / e[i])
+                        .fold(0.0, f64::max)
+                })
             });
+            let within = off.map(|z| z <= 2.0);
             ParameterCheck {
                 effect,
                 parameter: name.to_string(),
@@ -237,6 +246,7 @@ fn parameter_checks(
                 found: found_value,
                 standard_error: error,
                 within_two_standard_errors: within,
+                standard_errors_off: off,
                 relative_error: if f.len() == t.len() {
                     difference / magnitude.max(1e-300)
                 } else {

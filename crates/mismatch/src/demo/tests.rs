@@ -55,6 +55,7 @@ fn cell(c: &Value) -> CellOutcome {
                 found: from(&p["found"]),
                 standard_error: from(&p["standard_error"]),
                 within_two_standard_errors: from(&p["within_two_standard_errors"]),
+                standard_errors_off: from(&p["standard_errors_off"]),
                 relative_error: from(&p["relative_error"]),
             })
             .collect(),
@@ -114,7 +115,7 @@ fn the_committed_summary_prints_one_line_per_cell_and_the_total() {
     );
     assert_eq!(
         lines[8],
-        "A          inertia_scale                      MISS found [inertia_scale] held-out MSE ×0.101 (inertia_scale.k off by 15%)"
+        "A          inertia_scale                      MISS found [inertia_scale] held-out MSE ×0.101 (inertia_scale.k off by 15% (2.3 standard errors))"
     );
     assert_eq!(lines[184], "174 of 184 cells meet every target");
 }

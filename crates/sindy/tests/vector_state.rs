@@ -83,8 +83,23 @@ fn every_entry_point_leaves_the_upper_halves_clear() {
     }
     let mut failures = Vec::new();
     check(&mut failures, "the test's start");
-    // A small library (fitted whole) and a large one (reduced by row blocks, in parallel).
     let (small_inputs, small_targets) = data(2_000, 7);
+    fitted_models(&mut failures, &small_inputs, &small_targets);
+    trajectories(&mut failures, &small_inputs);
+    let library = FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap();
+    let theta = library.transform(small_inputs.as_ref());
+    optimizers(&mut failures, &theta, &small_targets);
+    regressions(&mut failures, &theta, &small_targets);
+    assert!(
+        failures.is_empty(),
+        "upper halves left in use after:\n{}",
+        failures.join("\n")
+    );
+}
+
+/// SINDy models fitted and used on a small library (fitted whole) and a large one (reduced by row
+/// blocks, in parallel).
+fn fitted_models(failures: &mut Vec<String>, small_inputs: &Mat<f64>, small_targets: &Mat<f64>) {
     let (large_inputs, large_targets) = data(40_000, 7);
     for optimizer in [
         OptimizerSpec::stlsq(0.05),
@@ -94,26 +109,28 @@ fn every_entry_point_leaves_the_upper_halves_clear() {
         let model = params
             .fit_matrices(small_inputs.as_ref(), small_targets.as_ref())
             .unwrap();
-        check(&mut failures, &format!("fit_matrices, {optimizer:?}"));
+        check(failures, &format!("fit_matrices, {optimizer:?}"));
         model.predict_inputs(small_inputs.as_ref()).unwrap();
-        check(&mut failures, "predict_inputs");
+        check(failures, "predict_inputs");
         params
             .fit_and_predict(small_inputs.as_ref(), small_targets.as_ref())
             .unwrap();
-        check(&mut failures, "fit_and_predict");
+        check(failures, "fit_and_predict");
         let large = params
             .fit_matrices(large_inputs.as_ref(), large_targets.as_ref())
             .unwrap();
         check(
-            &mut failures,
+            failures,
             &format!("fit_matrices on a large library, {optimizer:?}"),
         );
         large.predict_inputs(large_inputs.as_ref()).unwrap();
-        check(&mut failures, "predict_inputs on a large library");
+        check(failures, "predict_inputs on a large library");
     }
+}
 
-    // Trajectories: estimated derivatives (Savitzky–Golay solves for its weights), score,
-    // simulation, and the streamed fit.
+/// Trajectories: estimated derivatives (Savitzky–Golay solves for its weights), score, simulation,
+/// and the streamed fit.
+fn trajectories(failures: &mut Vec<String>, small_inputs: &Mat<f64>) {
     let rows = 3_000;
     let time: Vec<f64> = (0..rows).map(|k| k as f64 * 1e-3).collect();
     let states = Mat::from_fn(rows, 3, |i, j| small_inputs[(i % 2_000, j)]);
@@ -127,9 +144,9 @@ fn every_entry_point_leaves_the_upper_halves_clear() {
         order: 3,
     });
     let model = params.fit(std::slice::from_ref(&trajectory)).unwrap();
-    check(&mut failures, "fit on a trajectory");
+    check(failures, "fit on a trajectory");
     model.score(&trajectory).unwrap();
-    check(&mut failures, "score");
+    check(failures, "score");
     let column: Vec<f64> = (0..rows).map(|i| states[(i, 0)]).collect();
     Derivative::SavitzkyGolay {
         window: 9,
@@ -137,7 +154,7 @@ fn every_entry_point_leaves_the_upper_halves_clear() {
     }
     .apply(&column, 1e-3)
     .unwrap();
-    check(&mut failures, "a Savitzky–Golay derivative");
+    check(failures, "a Savitzky–Golay derivative");
     let mut next = 0;
     params
         .fit_streamed(rows, 1e-3, || {
@@ -153,33 +170,35 @@ fn every_entry_point_leaves_the_upper_halves_clear() {
             Ok(Some(RowBlock { columns }))
         })
         .unwrap();
-    check(&mut failures, "fit_streamed");
+    check(failures, "fit_streamed");
+}
 
-    // The optimizers and the solver on a library matrix.
-    let library = FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap();
-    let theta = library.transform(small_inputs.as_ref());
+/// The optimizers and the solver on a library matrix.
+fn optimizers(failures: &mut Vec<String>, theta: &Mat<f64>, small_targets: &Mat<f64>) {
     let fit = Stlsq::new(0.05, 0.05, 20)
         .unwrap()
         .fit(theta.as_ref(), small_targets.as_ref());
-    check(&mut failures, "Stlsq::fit");
+    check(failures, "Stlsq::fit");
     let names = ["a", "b", "c"].map(String::from);
     let lasso = Lasso::new(1.0)
         .unwrap()
         .fit(theta.as_ref(), small_targets.as_ref(), &names)
         .unwrap();
-    check(&mut failures, "Lasso::fit");
+    check(failures, "Lasso::fit");
     let target: Vec<f64> = (0..theta.nrows()).map(|i| small_targets[(i, 0)]).collect();
     let row: Vec<f64> = (0..theta.ncols()).map(|j| lasso[(0, j)]).collect();
     kkt_violation(theta.as_ref(), &target, &row, 1.0);
-    check(&mut failures, "kkt_violation");
+    check(failures, "kkt_violation");
     least_squares(theta.as_ref(), small_targets.as_ref());
-    check(&mut failures, "least_squares");
+    check(failures, "least_squares");
     let twin = Mat::from_fn(50, 2, |i, _| i as f64);
     least_squares(twin.as_ref(), small_targets.subrows(0, 50));
-    check(&mut failures, "least_squares on a rank-deficient matrix");
+    check(failures, "least_squares on a rank-deficient matrix");
     assert_eq!(fit.coefficients.ncols(), theta.ncols());
+}
 
-    // Regularised regressions with cross-validation and bagging, and their predictions.
+/// Regularised regressions with cross-validation and bagging, and their predictions.
+fn regressions(failures: &mut Vec<String>, theta: &Mat<f64>, small_targets: &Mat<f64>) {
     let penalties = [
         Penalty::Ridge {
             lambdas: vec![1e-4, 1e-2],
@@ -199,15 +218,10 @@ fn every_entry_point_leaves_the_upper_halves_clear() {
         }))
         .unwrap();
         let fit = spec.fit(theta.as_ref(), small_targets.as_ref(), 1).unwrap();
-        check(&mut failures, &format!("RegressionSpec::fit, {penalty:?}"));
+        check(failures, &format!("RegressionSpec::fit, {penalty:?}"));
         fit.ensemble(theta.as_ref()).unwrap();
-        check(&mut failures, "RegressionFit::ensemble");
+        check(failures, "RegressionFit::ensemble");
         fit.predict(theta.as_ref());
-        check(&mut failures, "RegressionFit::predict");
+        check(failures, "RegressionFit::predict");
     }
-    assert!(
-        failures.is_empty(),
-        "upper halves left in use after:\n{}",
-        failures.join("\n")
-    );
 }

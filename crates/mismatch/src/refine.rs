@@ -112,6 +112,20 @@ fn whitened(problem: &Problem, residual: &[Channels], range: std::ops::Range<usi
         .collect()
 }
 
+/// The whitened residual on rows `range` of the effects `parameters` take at `values`.
+fn whitened_residual(
+    problem: &Problem,
+    parameters: &[Parameter],
+    values: &[f64],
+    range: std::ops::Range<usize>,
+) -> Vec<f64> {
+    whitened(
+        problem,
+        &problem.residual(&effects_from(parameters, values)),
+        range,
+    )
+}
+
 /// The forward-difference Jacobian of `evaluate` at `values` (one column per parameter, as rows).
 fn forward_jacobian(
     parameters: &[Parameter],
@@ -162,13 +176,7 @@ pub fn standard_errors(
     range: std::ops::Range<usize>,
     scale: f64,
 ) -> Vec<f64> {
-    let evaluate = |values: &[f64]| {
-        whitened(
-            problem,
-            &problem.residual(&effects_from(parameters, values)),
-            range.clone(),
-        )
-    };
+    let evaluate = |values: &[f64]| whitened_residual(problem, parameters, values, range.clone());
     let residual = evaluate(values);
     let jacobian = forward_jacobian(parameters, values, &residual, &evaluate);
     let k = parameters.len();
@@ -202,13 +210,7 @@ pub fn levenberg_marquardt(
     };
     let mut values = initial.to_vec();
     project(&mut values);
-    let evaluate = |values: &[f64]| {
-        whitened(
-            problem,
-            &problem.residual(&effects_from(parameters, values)),
-            range.clone(),
-        )
-    };
+    let evaluate = |values: &[f64]| whitened_residual(problem, parameters, values, range.clone());
     let mut residual = evaluate(&values);
     let mut sse: f64 = residual.iter().map(|r| r * r).sum();
     let k = parameters.len();

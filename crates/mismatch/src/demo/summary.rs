@@ -208,15 +208,14 @@ fn parameter_checks(
         .unwrap_or_default()
         .into_iter()
         .map(|(name, value)| {
-            let found_value = found_values
+            let found_parameter = found_values
                 .iter()
                 .find(|(n, _)| *n == name)
-                .map(|(_, v)| v.map(|x| (x * 1e4).round() / 1e4));
+                .map(|(_, v)| v);
+            let found_value = found_parameter.map(|v| v.map(|x| (x * 1e4).round() / 1e4));
             let t = value.numbers();
-            let f = found_values
-                .iter()
-                .find(|(n, _)| *n == name)
-                .map(|(_, v)| v.numbers())
+            let f = found_parameter
+                .map(ParameterValue::numbers)
                 .unwrap_or_default();
             let difference: f64 = t
                 .iter()

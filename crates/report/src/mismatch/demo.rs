@@ -98,26 +98,6 @@ pub struct DemoView<'a> {
     pub cells: Vec<CellLine<'a>>,
 }
 
-/// `[a, b]` (or `a` alone) with each number to two significant digits.
-fn two_digit_list(values: &[f64]) -> String {
-    let texts: Vec<String> = values
-        .iter()
-        .map(|&x| {
-            let decimals = if x > 0.0 {
-                (1 - x.log10().floor() as i32).max(0) as usize
-            } else {
-                0
-            };
-            format!("{x:.decimals$}")
-        })
-        .collect();
-    if texts.len() == 1 {
-        texts[0].clone()
-    } else {
-        format!("[{}]", texts.join(", "))
-    }
-}
-
 impl DemoView<'_> {
     fn cell(&self, configuration: &str, case: &str) -> Option<&CellLine<'_>> {
         self.cells
@@ -307,7 +287,7 @@ impl DemoView<'_> {
                         p.found,
                         p.standard_error
                             .as_ref()
-                            .map(|e| format!(" ± {}", two_digit_list(e)))
+                            .map(|e| format!(" ± {}", super::two_digit_list(e)))
                             .unwrap_or_default(),
                         100.0 * p.relative_error
                     )

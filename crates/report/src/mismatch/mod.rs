@@ -16,6 +16,26 @@ mod residual_figure;
 mod scale;
 mod wind_figure;
 
+/// `[a, b]` (or `a` alone) with each number to two significant digits.
+pub(crate) fn two_digit_list(values: &[f64]) -> String {
+    let texts: Vec<String> = values
+        .iter()
+        .map(|&x| {
+            let decimals = if x > 0.0 {
+                (1 - x.log10().floor() as i32).max(0) as usize
+            } else {
+                0
+            };
+            format!("{x:.decimals$}")
+        })
+        .collect();
+    if texts.len() == 1 {
+        texts[0].clone()
+    } else {
+        format!("[{}]", texts.join(", "))
+    }
+}
+
 /// A drawing error as text.
 fn text(error: impl std::fmt::Display) -> String {
     error.to_string()

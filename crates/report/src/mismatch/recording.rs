@@ -116,24 +116,9 @@ pub struct NamedEffect<'a> {
 
 /// `name ± error` for each parameter, the errors to two significant digits: `k ± [0.0061, 0.016]`.
 fn standard_errors_text(errors: &[(&str, Vec<f64>)]) -> String {
-    let two_digits = |x: f64| {
-        let decimals = if x > 0.0 {
-            (1 - x.log10().floor() as i32).max(0) as usize
-        } else {
-            0
-        };
-        format!("{x:.decimals$}")
-    };
     errors
         .iter()
-        .map(|(name, values)| {
-            let texts: Vec<String> = values.iter().map(|x| two_digits(*x)).collect();
-            if texts.len() == 1 {
-                format!("{name} ± {}", texts[0])
-            } else {
-                format!("{name} ± [{}]", texts.join(", "))
-            }
-        })
+        .map(|(name, values)| format!("{name} ± {}", super::two_digit_list(values)))
         .collect::<Vec<_>>()
         .join(", ")
 }

@@ -307,6 +307,16 @@ fn rms(values: impl Iterator<Item = f64>) -> f64 {
     (sum / count.max(1) as f64).sqrt()
 }
 
+/// The variance of a series about its mean (0 for fewer than two values).
+fn variance(values: impl Iterator<Item = f64>) -> f64 {
+    let values: Vec<f64> = values.collect();
+    if values.len() < 2 {
+        return 0.0;
+    }
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64
+}
+
 /// The nominal and the fitted model's residuals.
 struct Residuals<'a> {
     before: &'a [Channels],
@@ -333,9 +343,19 @@ fn channel_reports(
             .sum::<f64>()
             / heldout_rows.len().max(1) as f64
     };
+    let fit_rows = 0..problem.split;
     (0..problem.channels)
         .map(|c| {
             let floor = problem.noise_floor[c];
+            let nominal = fit_rows
+                .clone()
+                .map(|row| problem.target[row][c] - residuals.before[row][c]);
+            let signal_variance = variance(nominal);
+            let model_noise_share = if signal_variance > 0.0 {
+                problem.model_noise[c].powi(2) / signal_variance
+            } else {
+                0.0
+            };
             let residual_rms = rms(residuals.before.iter().map(|r| r[c]));
             let residual_rms_after = rms(residuals.after.iter().map(|r| r[c]));
             ChannelReport {
@@ -343,6 +363,7 @@ fn channel_reports(
                 residual_rms,
                 noise_floor: floor,
                 noise_floor_model_side: problem.model_noise[c],
+                model_noise_share,
                 significant: residual_rms > settings.significance_factor * floor,
                 residual_rms_after,
                 significant_after: residual_rms_after > settings.significance_factor * floor,

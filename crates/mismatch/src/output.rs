@@ -160,6 +160,11 @@ impl Analysis {
                 .collect(),
             timing: report.selection.alternatives.timing.as_ref(),
             fit: &report.fit,
+            sampled_steps_per_row: self
+                .problem
+                .model
+                .logger
+                .sampled_steps_per_row(self.problem.recording.dt),
         }
     }
 

@@ -221,3 +221,54 @@ fn a_delay_behind_sampled_commands_is_measured() {
         .collect();
     assert!(shares.iter().all(|s| (0.0..=1.0).contains(s)), "{shares:?}");
 }
+
+/// Samples of a faster controller's commands carry its reaction to its sensors' noise, which the
+/// vehicle averaged: the report measures that noise against the model's signal per channel and
+/// says what it does to a fitted factor; the same flight logged as period means has none of it.
+#[test]
+fn the_noise_of_sampled_commands_is_measured_and_explained() {
+    let (log, model) = sampled(Effects::default(), 13);
+    let analysis = analyze(&log, &model, "sampled", &settings()).unwrap();
+    let largest = analysis
+        .report
+        .channels
+        .iter()
+        .map(|c| c.model_noise_share)
+        .fold(0.0, f64::max);
+    assert!(largest >= 0.05, "{:?}", analysis.report.channels);
+    let markdown = analysis.view().markdown();
+    assert!(
+        markdown.contains("**Noise on the model's side.**"),
+        "{markdown}"
+    );
+    assert!(
+        markdown.contains("a controller 10 times faster than the log"),
+        "{markdown}"
+    );
+
+    let scenario = Scenario {
+        duration_s: 30.0,
+        physics_rate_hz: 1000.0,
+        controller_rate_hz: Some(500.0),
+        logger: Some(physics::Logger {
+            command: physics::CommandLogging::PeriodMean,
+            ..physics::Logger::default()
+        }),
+        ..scenario(Effects::default(), 13)
+    };
+    let model = NominalModel {
+        logger: scenario.logger(),
+        ..common::model("vehicles/quad-a.json")
+    };
+    let log = simulate(&model, &scenario, "period-mean").unwrap();
+    let analysis = analyze(&log, &model, "period-mean", &settings()).unwrap();
+    for channel in &analysis.report.channels {
+        assert!(channel.model_noise_share < 0.01, "{channel:?}");
+    }
+    assert!(
+        !analysis
+            .view()
+            .markdown()
+            .contains("Noise on the model's side")
+    );
+}

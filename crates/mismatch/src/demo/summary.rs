@@ -98,12 +98,19 @@ impl CellOutcome {
         }
         for p in &parameters {
             if p.relative_error > TARGETS.parameters_within {
-                let noise = p
+                let mut why: Vec<String> = p
                     .standard_errors_off
-                    .map(|z| format!(" ({z:.1} standard errors)"))
-                    .unwrap_or_default();
+                    .map(|z| format!("{z:.1} standard errors"))
+                    .into_iter()
+                    .collect();
+                why.extend(model_noise_note(p.effect, &report.channels));
+                let why = if why.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", why.join("; "))
+                };
                 failures.push(format!(
-                    "{}.{} off by {:.0}%{noise}",
+                    "{}.{} off by {:.0}%{why}",
                     p.effect,
                     p.parameter,
                     100.0 * p.relative_error
@@ -167,6 +174,31 @@ pub fn compare_parameters(
         .into_iter()
         .flat_map(|id| parameter_checks(id, truth, found, standard_error))
         .collect()
+}
+
+/// The model-side noise share worth naming beside a factor that misses its target: a factor is
+/// shrunk by up to its share, and 1% of `1/k` moves `k = 0.85` by 7% of `|k − 1|`.
+const NOTED_MODEL_NOISE_SHARE: f64 = 0.01;
+
+/// For a factor, the channel it acts through whose model-side noise is the largest share of the
+/// model's value there, when that share is worth naming.
+fn model_noise_note(effect: EffectId, channels: &[crate::ChannelReport]) -> Option<String> {
+    let acts_on = match effect {
+        EffectId::ThrustScale => 0..3,
+        EffectId::InertiaScale => 3..6,
+        _ => return None,
+    };
+    let channel = channels
+        .get(acts_on)?
+        .iter()
+        .max_by(|a, b| a.model_noise_share.total_cmp(&b.model_noise_share))?;
+    (channel.model_noise_share >= NOTED_MODEL_NOISE_SHARE).then(|| {
+        format!(
+            "model-side noise {:.0}% on {}",
+            100.0 * channel.model_noise_share,
+            channel.name
+        )
+    })
 }
 
 /// Whether the effect's parameters are factors (1: no effect), whose errors are relative to

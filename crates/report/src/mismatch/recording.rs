@@ -20,6 +20,10 @@ pub struct ChannelReport {
     /// The part of the noise floor on the model's side (noise in the commands and attitude it
     /// reads; the rest is the recorded velocity's or rate's own noise).
     pub noise_floor_model_side: f64,
+    /// The model side's noise variance as a share of the variance of the nominal model's value on
+    /// the fit part: a factor fitted through this channel (an inertia or thrust scale) is shrunk
+    /// towards no effect by up to about this share (errors in variables).
+    pub model_noise_share: f64,
     /// Whether the nominal model's residual exceeds the noise floor significantly.
     pub significant: bool,
     /// RMS of the fitted model's residual.
@@ -175,7 +179,12 @@ pub struct RecordingView<'a> {
     /// Noise-normalised fit errors of the timing explanations, when the timing term was kept.
     pub timing: Option<&'a TimingScores>,
     pub fit: &'a Fit,
+    /// The commands are instantaneous samples of a controller this many times faster than the log.
+    pub sampled_steps_per_row: Option<f64>,
 }
+
+/// A channel whose model-side noise is at least this share of its signal gets a note.
+pub const MODEL_NOISE_NOTE_SHARE: f64 = 0.05;
 
 impl RecordingView<'_> {
     /// The report in plain words (`mismatch.md`).
@@ -183,6 +192,7 @@ impl RecordingView<'_> {
         let mut md = String::new();
         self.header_markdown(&mut md);
         self.disagreement_markdown(&mut md);
+        self.model_noise_markdown(&mut md);
         self.effects_markdown(&mut md);
         self.candidates_markdown(&mut md);
         self.fit_markdown(&mut md);
@@ -251,6 +261,32 @@ impl RecordingView<'_> {
                 );
             }
         }
+    }
+
+    /// The channels where the model's own inputs are noisy enough to shrink a fitted factor.
+    fn model_noise_markdown(&self, md: &mut String) {
+        let noisy: Vec<String> = self
+            .channels
+            .iter()
+            .filter(|c| c.model_noise_share >= MODEL_NOISE_NOTE_SHARE)
+            .map(|c| format!("{:.0}% on {}", 100.0 * c.model_noise_share, c.name))
+            .collect();
+        let shares = match noisy.split_last() {
+            Some((last, [])) => last.clone(),
+            Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
+            None => return,
+        };
+        let _ = write!(
+            md,
+            "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is {shares}. A factor fitted through such a channel (an inertia or thrust scale) comes out shrunk towards no effect by up to about that share, and its standard error does not include it (errors in variables; `docs/mismatch.md` §3)."
+        );
+        if let Some(steps) = self.sampled_steps_per_row {
+            let _ = write!(
+                md,
+                " Here the rows hold instantaneous samples of a controller {steps:.0} times faster than the log: each carries the controller's step-to-step reaction to its sensors' noise, which the vehicle averaged. Logging the mean command over each log period (`\"command\": \"period_mean\"`) or every command removes most of it."
+            );
+        }
+        let _ = writeln!(md);
     }
 
     /// The evidence rule, the effects named and those not named, what remains unexplained.
@@ -408,6 +444,7 @@ mod tests {
             residual_rms: rms,
             noise_floor: 0.01,
             noise_floor_model_side: 0.002,
+            model_noise_share: 0.01,
             significant,
             residual_rms_after: rms / 2.0,
             significant_after: false,
@@ -463,7 +500,10 @@ mod tests {
         };
         let channels = [
             channel("vdot_x", 0.25, true),
-            channel("vdot_y", 0.005, false),
+            ChannelReport {
+                model_noise_share: 0.125,
+                ..channel("vdot_y", 0.005, false)
+            },
         ];
         let (windows, unexplained) = ([window("vdot_x", 1.25, 7.5)], [window("vdot_x", 2.0, 2.75)]);
         let timing = TimingScores {
@@ -508,6 +548,7 @@ mod tests {
             }],
             timing: Some(&timing),
             fit: &fit,
+            sampled_steps_per_row: Some(10.0),
         };
         let md = view.markdown();
         for line in [
@@ -523,6 +564,8 @@ mod tests {
             "noise-normalised fit errors: {\"both\":1.25,\"delay\":1.5,\"motor_lag\":2.0}. The smallest",
             "The parameters were fitted on 0.2–14.0 s and checked on the held-out 14.0–20.0 s.\n",
             "| fit | 0.50000 | 0.12500 | 75.0% |\n| held out | 0.40000 | 0.20000 | 50.0% |\n",
+            "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is 12% on vdot_y.",
+            "samples of a controller 10 times faster than the log",
         ] {
             assert!(md.contains(line), "missing {line:?} in\n{md}");
         }
@@ -560,6 +603,7 @@ mod tests {
             candidates: Vec::new(),
             timing: None,
             fit: &fit,
+            sampled_steps_per_row: None,
         };
         let md = view.markdown();
         assert!(md.contains("The `w` column was read in the body frame: "));
@@ -572,5 +616,6 @@ mod tests {
         ));
         assert!(md.contains("\nWith the effects named, no stretch of the flight disagrees by more than 2.5 times the noise floor.\n"));
         assert!(!md.contains("command-rate"));
+        assert!(!md.contains("Noise on the model's side"));
     }
 }

@@ -5,8 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
+use physics::CommandLogging;
 use report::mismatch::recording::{
-    CandidateLine, EvidenceLine, EvidenceRule, NamedEffect, RecordingView, ResidualFigure, TermLine,
+    CandidateLine, CommandSampling, EvidenceLine, EvidenceRule, NamedEffect, RecordingView,
+    ResidualFigure, TermLine,
 };
 
 use crate::analysis::{Analysis, check_finite};
@@ -160,11 +162,21 @@ impl Analysis {
                 .collect(),
             timing: report.selection.alternatives.timing.as_ref(),
             fit: &report.fit,
-            sampled_steps_per_row: self
-                .problem
-                .model
-                .logger
-                .sampled_steps_per_row(self.problem.recording.dt),
+            command_sampling: self.command_sampling(),
+        }
+    }
+
+    /// How the commands were logged, from the model's logger.
+    fn command_sampling(&self) -> CommandSampling {
+        let logger = &self.problem.model.logger;
+        match logger.sampled_steps_per_row(self.problem.recording.dt) {
+            Some(steps_per_row) => CommandSampling::FasterController { steps_per_row },
+            None if logger.command == CommandLogging::Sample
+                && logger.controller_rate_hz.is_none() =>
+            {
+                CommandSampling::RateUnknown
+            }
+            None => CommandSampling::NotSampled,
         }
     }
 

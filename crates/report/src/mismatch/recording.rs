@@ -179,8 +179,19 @@ pub struct RecordingView<'a> {
     /// Noise-normalised fit errors of the timing explanations, when the timing term was kept.
     pub timing: Option<&'a TimingScores>,
     pub fit: &'a Fit,
-    /// The commands are instantaneous samples of a controller this many times faster than the log.
-    pub sampled_steps_per_row: Option<f64>,
+    /// How the commands were logged, as far as it bears on the model side's noise.
+    pub command_sampling: CommandSampling,
+}
+
+/// Whether each row's command is an instantaneous sample, and of how fast a controller.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CommandSampling {
+    /// Held from row to row or averaged over the period: what the vehicle received.
+    NotSampled,
+    /// Instantaneous samples; the controller's rate is not declared.
+    RateUnknown,
+    /// Instantaneous samples of a controller this many times faster than the log.
+    FasterController { steps_per_row: f64 },
 }
 
 /// A channel whose model-side noise is at least this share of its signal gets a note.
@@ -278,14 +289,20 @@ impl RecordingView<'_> {
         };
         let _ = write!(
             md,
-            "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is {shares}. A factor fitted through such a channel (an inertia or thrust scale) comes out shrunk towards no effect by up to about that share, and its standard error does not include it (errors in variables; `docs/mismatch.md` §3)."
+            "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is {shares}. A factor fitted through such a channel (an inertia or thrust scale) comes out shrunk towards no effect by up to about that share, and its standard error does not include it (errors in variables; `docs/mismatch.md` §3); the noise floor does include it, so a weak effect on such a channel may go unnamed."
         );
-        if let Some(steps) = self.sampled_steps_per_row {
-            let _ = write!(
+        let remedy = "Logging the mean command over each log period (`\"command\": \"period_mean\"`) or every command removes most of it.";
+        let _ = match self.command_sampling {
+            CommandSampling::NotSampled => Ok(()),
+            CommandSampling::RateUnknown => write!(
                 md,
-                " Here the rows hold instantaneous samples of a controller {steps:.0} times faster than the log: each carries the controller's step-to-step reaction to its sensors' noise, which the vehicle averaged. Logging the mean command over each log period (`\"command\": \"period_mean\"`) or every command removes most of it."
-            );
-        }
+                " If the rows hold instantaneous samples of a faster controller's commands (the model's logger does not say its rate), they carry its step-to-step reaction to its sensors' noise, which the vehicle averaged. {remedy}"
+            ),
+            CommandSampling::FasterController { steps_per_row } => write!(
+                md,
+                " Here the rows hold instantaneous samples of a controller {steps_per_row:.0} times faster than the log: each carries the controller's step-to-step reaction to its sensors' noise, which the vehicle averaged. {remedy}"
+            ),
+        };
         let _ = writeln!(md);
     }
 
@@ -548,7 +565,9 @@ mod tests {
             }],
             timing: Some(&timing),
             fit: &fit,
-            sampled_steps_per_row: Some(10.0),
+            command_sampling: CommandSampling::FasterController {
+                steps_per_row: 10.0,
+            },
         };
         let md = view.markdown();
         for line in [
@@ -603,7 +622,7 @@ mod tests {
             candidates: Vec::new(),
             timing: None,
             fit: &fit,
-            sampled_steps_per_row: None,
+            command_sampling: CommandSampling::NotSampled,
         };
         let md = view.markdown();
         assert!(md.contains("The `w` column was read in the body frame: "));

@@ -176,8 +176,8 @@ pub fn compare_parameters(
         .collect()
 }
 
-/// The model-side noise share worth naming beside a factor that misses its target: a factor is
-/// shrunk by up to its share, and 1% of `1/k` moves `k = 0.85` by 7% of `|k − 1|`.
+/// The model-side noise share worth naming beside a factor that misses its target: the gain the
+/// factor fits is smaller by up to its share, and 1% of `1/k` moves `k = 0.85` by 7% of `|k − 1|`.
 const NOTED_MODEL_NOISE_SHARE: f64 = 0.01;
 
 /// For a factor, the channel it acts through whose model-side noise is the largest share of the

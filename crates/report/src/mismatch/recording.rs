@@ -21,8 +21,8 @@ pub struct ChannelReport {
     /// reads; the rest is the recorded velocity's or rate's own noise).
     pub noise_floor_model_side: f64,
     /// The model side's noise variance as a share of the variance of the nominal model's value on
-    /// the fit part: a factor fitted through this channel (an inertia or thrust scale) is shrunk
-    /// towards no effect by up to about this share (errors in variables).
+    /// the fit part: the gain a factor fits through this channel (a thrust scale's `k`, an inertia
+    /// scale's `1/k`) comes out smaller by up to about this share (errors in variables).
     pub model_noise_share: f64,
     /// Whether the nominal model's residual exceeds the noise floor significantly.
     pub significant: bool,
@@ -289,7 +289,7 @@ impl RecordingView<'_> {
         };
         let _ = write!(
             md,
-            "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is {shares}. A factor fitted through such a channel (an inertia or thrust scale) comes out shrunk towards no effect by up to about that share, and its standard error does not include it (errors in variables; `docs/mismatch.md` §3); the noise floor does include it, so a weak effect on such a channel may go unnamed."
+            "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is {shares}. The gain a factor fits through such a channel (a thrust scale's k, an inertia scale's 1/k) comes out smaller by up to about that share, and its standard error does not include it (errors in variables; `docs/mismatch.md` §3); the noise floor does include it, so a weak effect on such a channel may go unnamed."
         );
         let remedy = "Logging the mean command over each log period (`\"command\": \"period_mean\"`) or every command removes most of it.";
         let _ = match self.command_sampling {

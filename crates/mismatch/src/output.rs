@@ -166,17 +166,19 @@ impl Analysis {
         }
     }
 
-    /// How the commands were logged, from the model's logger.
+    /// How the commands were logged, from the model's logger (samples of a controller at least
+    /// twice as fast as the log count as a faster controller's).
     fn command_sampling(&self) -> CommandSampling {
         let logger = &self.problem.model.logger;
-        match logger.sampled_steps_per_row(self.problem.recording.dt) {
-            Some(steps_per_row) => CommandSampling::FasterController { steps_per_row },
-            None if logger.command == CommandLogging::Sample
-                && logger.controller_rate_hz.is_none() =>
-            {
-                CommandSampling::RateUnknown
+        let steps_per_row = logger
+            .controller_rate_hz
+            .map(|rate| rate * self.problem.recording.dt);
+        match (logger.command, steps_per_row) {
+            (CommandLogging::Sample, None) => CommandSampling::RateUnknown,
+            (CommandLogging::Sample, Some(steps_per_row)) if steps_per_row >= 2.0 => {
+                CommandSampling::FasterController { steps_per_row }
             }
-            None => CommandSampling::NotSampled,
+            _ => CommandSampling::NotSampled,
         }
     }
 

@@ -115,13 +115,6 @@ impl Logger {
             .map(|f| 1.0 / (2.0 * std::f64::consts::PI * f))
             .unwrap_or(0.0)
     }
-
-    /// Controller steps per row when each row holds an instantaneous sample of a controller at
-    /// least twice as fast as a log of row interval `dt` (s).
-    pub fn sampled_steps_per_row(&self, dt: f64) -> Option<f64> {
-        let steps = self.controller_rate_hz? * dt;
-        (self.command == CommandLogging::Sample && steps >= 2.0).then_some(steps)
-    }
 }
 
 #[cfg(test)]

@@ -2,15 +2,16 @@
 //! geometric controller, written as a Neural-Fly flight log.
 //!
 //! Timing: the controller runs at `controller_rate_hz` (by default the log rate) and each command
-//! is held by the actuators (after any delay) until the next one. Every `controller_rate_hz /
-//! log_rate_hz` control steps a row is logged: the measured state at that instant and the command as
-//! the scenario's [`crate::Logger`] records it (the instantaneous command, the mean over the log period,
-//! either shifted by whole control steps; each command held to the next row when the controller runs
-//! at the log rate). The rigid body is integrated with RK4 at `physics_rate_hz`; with a motor lag
-//! the four motor speeds are part of the state. Measurement noise (Gaussian, from the scenario's
-//! seed) is added to position, velocity, attitude and body rate, the rate after the logger's
-//! optional first-order filter; the controller sees the noisy values, as on a real vehicle. An
-//! optional band-limited [`crate::Jitter`] is added to the commands (and logged with them).
+//! is held by the actuators (after any delay, exact even between physics steps) until the next one.
+//! Every `controller_rate_hz / log_rate_hz` control steps a row is logged: the measured state at
+//! that instant and the command as the scenario's [`crate::Logger`] records it (the instantaneous
+//! command, the mean over the log period, either shifted by whole control steps; each command held
+//! to the next row when the controller runs at the log rate). The rigid body is integrated with RK4
+//! at `physics_rate_hz`; with a motor lag the four motor speeds are part of the state. Measurement
+//! noise (Gaussian, from the scenario's seed) is added to position, velocity, attitude and body
+//! rate, the rate after the logger's optional first-order filter; the controller sees the noisy
+//! values, as on a real vehicle. An optional band-limited [`crate::Jitter`] is added to the
+//! commands (and logged with them).
 
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -299,7 +300,7 @@ impl<'a> Flight<'a> {
                 .jitter
                 .as_ref()
                 .map(|j| JitterSignal::new(j, scenario.seed ^ 0x6a69_7474_6572)),
-            applied: CommandQueue::new((scenario.effects.delay_s() / h).round() as usize),
+            applied: CommandQueue::new(scenario.effects.delay_s() / h),
             filtered_rate: [0.0; 3],
             rate_time_constant: logger.rate_time_constant_s(),
             control_dt,
@@ -348,19 +349,31 @@ impl<'a> Flight<'a> {
         reference: &crate::trajectory::Reference,
     ) -> Result<()> {
         let h = self.control_dt / self.substeps as f64;
+        let fraction = self.applied.fraction;
+        for _ in 0..self.substeps {
+            let (older, newer) = self.applied.push(speeds);
+            if fraction > 0.0 && older != newer {
+                // The delayed command changes within this step: integrate up to the change.
+                self.integrate(older, fraction * h);
+                self.integrate(newer, (1.0 - fraction) * h);
+            } else {
+                self.integrate(newer, h);
+            }
+        }
+        check_state(&self.state, &reference.position, t)
+    }
+
+    /// One integration step of length `h` with the actuators held at `command`.
+    fn integrate(&mut self, command: [f64; 4], h: f64) {
+        self.state = rk4_step(&self.plant, &self.state, command, h);
         let gain = if self.rate_time_constant > 0.0 {
             1.0 - (-h / self.rate_time_constant).exp()
         } else {
             1.0
         };
-        for _ in 0..self.substeps {
-            let command = self.applied.push(speeds);
-            self.state = rk4_step(&self.plant, &self.state, command, h);
-            for i in 0..3 {
-                self.filtered_rate[i] += gain * (self.state.body_rate[i] - self.filtered_rate[i]);
-            }
+        for i in 0..3 {
+            self.filtered_rate[i] += gain * (self.state.body_rate[i] - self.filtered_rate[i]);
         }
-        check_state(&self.state, &reference.position, t)
     }
 }
 
@@ -490,36 +503,57 @@ impl CommandLog {
     }
 }
 
-/// The commands issued per physics step, of which only the last `delay_steps + 1` (and the very
-/// first) are kept.
+/// The commands issued per physics step, of which only the last `delay_steps + 2` (and the very
+/// first) are kept. A delay of `delay_steps + fraction` steps is exact: over each step the
+/// actuators receive the command issued `delay_steps + 1` steps ago for its first `fraction`,
+/// and the one issued `delay_steps` ago for the rest.
 struct CommandQueue {
     delay_steps: usize,
+    fraction: f64,
     first: Option<[f64; 4]>,
     recent: VecDeque<[f64; 4]>,
 }
 
 impl CommandQueue {
-    fn new(delay_steps: usize) -> Self {
+    /// A queue for a delay of `steps` physics steps (any non-negative number).
+    fn new(steps: f64) -> Self {
+        // Within rounding of a whole number of steps, the delay is that number.
+        let nearest = steps.round();
+        let (whole, fraction) = if (steps - nearest).abs() < 1e-9 {
+            (nearest, 0.0)
+        } else {
+            (steps.floor(), steps - steps.floor())
+        };
+        let delay_steps = whole as usize;
         Self {
             delay_steps,
+            fraction,
             first: None,
-            recent: VecDeque::with_capacity(delay_steps + 1),
+            recent: VecDeque::with_capacity(delay_steps + 2),
         }
     }
 
-    /// Records a command and returns the one the actuators receive now: the one issued
-    /// `delay_steps` physics steps ago (the first command before that).
-    fn push(&mut self, command: [f64; 4]) -> [f64; 4] {
+    /// Records a command and returns the two the actuators receive over this step: the one
+    /// issued `delay_steps + 1` physics steps ago (for the first `fraction` of it) and the one
+    /// issued `delay_steps` ago (the first command before those).
+    fn push(&mut self, command: [f64; 4]) -> ([f64; 4], [f64; 4]) {
         let first = *self.first.get_or_insert(command);
         self.recent.push_back(command);
-        if self.recent.len() > self.delay_steps + 1 {
+        if self.recent.len() > self.delay_steps + 2 {
             self.recent.pop_front();
         }
-        if self.recent.len() == self.delay_steps + 1 {
-            self.recent[0]
-        } else {
-            first
-        }
+        let issued_ago = |steps: usize| {
+            let len = self.recent.len();
+            if len > steps {
+                self.recent[len - 1 - steps]
+            } else {
+                first
+            }
+        };
+        (
+            issued_ago(self.delay_steps + 1),
+            issued_ago(self.delay_steps),
+        )
     }
 }
 
@@ -956,20 +990,52 @@ mod tests {
     #[test]
     fn the_command_queue_delays_like_the_full_history() {
         for delay_steps in [0, 1, 3, 17] {
-            let mut queue = CommandQueue::new(delay_steps);
+            let mut queue = CommandQueue::new(delay_steps as f64);
+            assert_eq!(queue.fraction, 0.0);
             let mut history: Vec<[f64; 4]> = Vec::new();
             for k in 0..60 {
                 let command = [k as f64, 0.5 * k as f64, 1.0, -(k as f64)];
                 history.push(command);
                 let index = history.len() - 1;
-                let expected = if index >= delay_steps {
-                    history[index - delay_steps]
-                } else {
-                    history[0]
-                };
-                assert_eq!(queue.push(command), expected);
+                let issued_ago = |steps: usize| history[index.saturating_sub(steps)];
+                assert_eq!(
+                    queue.push(command),
+                    (issued_ago(delay_steps + 1), issued_ago(delay_steps))
+                );
             }
-            assert!(queue.recent.len() <= delay_steps + 1);
+            assert!(queue.recent.len() <= delay_steps + 2);
         }
+        let queue = CommandQueue::new(12.5);
+        assert_eq!((queue.delay_steps, queue.fraction), (12, 0.5));
+    }
+
+    /// A delay that is not a whole number of physics steps is applied as configured, not rounded
+    /// to the step: 25 ms at 500 Hz (12.5 steps) flies as 25 ms at 2000 Hz does, far closer than
+    /// the 26 ms that rounding gave.
+    #[test]
+    fn a_delay_between_physics_steps_is_exact() {
+        let flight = |physics_rate_hz: f64, delay_s: f64| {
+            let mut s = scenario();
+            s.physics_rate_hz = physics_rate_hz;
+            s.effects.delay = Some(crate::effects::Delay { delay_s });
+            s.validate(Path::new("s.json")).unwrap();
+            simulate(&model(), &s, "delay").unwrap()
+        };
+        let distance = |a: &FlightLog, b: &FlightLog| {
+            a.body_rate
+                .iter()
+                .zip(&b.body_rate)
+                .map(|(x, y)| (0..3).map(|i| (x[i] - y[i]).powi(2)).sum::<f64>())
+                .sum::<f64>()
+                .sqrt()
+        };
+        let reference = flight(2000.0, 0.025);
+        let coarse = flight(500.0, 0.025);
+        let one_ms_later = flight(2000.0, 0.026);
+        let (error, scale) = (
+            distance(&coarse, &reference),
+            distance(&one_ms_later, &reference),
+        );
+        assert!(error < 0.2 * scale, "{error} vs {scale}");
     }
 }

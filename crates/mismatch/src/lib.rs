@@ -39,6 +39,7 @@ mod fit;
 pub mod fleet;
 pub mod forward;
 mod library;
+pub mod noise_reaction;
 mod output;
 mod problem;
 mod recording;

@@ -8,6 +8,7 @@ use physics::vector::{Mat3, Vec3, mat_t_vec};
 use physics::{CommandLogging, NominalModel};
 
 use crate::error::{MismatchError, Result};
+use crate::noise_reaction::{self, NoiseReaction};
 use crate::weak_form::white_noise_sigma;
 
 /// The recorded signals, per row.
@@ -34,6 +35,9 @@ pub struct Recording {
     pub command_spread: [f64; 4],
     /// The rate of the commands a row averages, Hz (when known).
     pub command_rate_hz: Option<f64>,
+    /// What was removed from sampled commands of a faster controller: their reaction to the
+    /// logged attitude and position noise that the vehicle did not feel ([`crate::noise_reaction`]).
+    pub noise_reaction: Option<NoiseReaction>,
 }
 
 impl Recording {
@@ -96,7 +100,7 @@ impl Recording {
                 command_spread[i] = (per_row - 1.0) * white_noise_sigma(&series).powi(2);
             }
         }
-        Ok(Self {
+        let mut recording = Self {
             path: log.path.clone(),
             dt,
             time: log.time.clone(),
@@ -109,7 +113,11 @@ impl Recording {
             commands,
             command_spread,
             command_rate_hz,
-        })
+            noise_reaction: None,
+        };
+        recording.noise_reaction =
+            noise_reaction::remove(&mut recording, &model.logger, model.actuator_count());
+        Ok(recording)
     }
 
     /// Number of rows.

@@ -1,0 +1,279 @@
+//! The part of a sampled command that reacts to the logged measurement noise and that the vehicle
+//! did not feel.
+//!
+//! A controller `N` times faster than the log reacts, at every control step, to the noise of that
+//! step's measurement. A logger that samples the command together with the state logs the command
+//! with its reaction to the very noise the row's state carries, but the vehicle held that command
+//! for one control step of the `N` in the row: `1 − 1/N` of that reaction is in the log and was
+//! never felt. The comparison would read it as command content and attenuate every factor it
+//! estimates through the commands.
+//!
+//! The reaction is identified from the log (a robust regression of the commands' fourth differences
+//! on those of the logged rate, attitude, velocity and position); each row's attitude and position
+//! noise is estimated by a fixed-interval smoother against the kinematics the log itself holds (the
+//! attitude against the integrated rates, the position against the integrated velocities), which no
+//! effect of the library changes. The reaction to the rate and velocity noise stays: no kinematic
+//! relation separates it from the motion.
+
+use faer::Mat;
+use faer::linalg::solvers::Solve;
+use physics::vector::{Mat3, Vec3, mat_mul, transpose, vee};
+use physics::{CommandLogging, Logger};
+
+use crate::recording::Recording;
+use crate::weak_form::white_noise_sigma;
+
+/// Fourth-difference weights; white noise of variance σ² has fourth differences of variance 70 σ².
+const FOURTH_DIFFERENCE: [f64; 5] = [1.0, -4.0, 6.0, -4.0, 1.0];
+/// Rows beyond this many robust standard deviations are left out of the regression (command
+/// transients).
+const TRIM_SIGMAS: f64 = 4.0;
+/// Fewer rows than this and the reaction is not identified.
+const MIN_ROWS: usize = 200;
+/// State channels the commands are regressed on: rate, attitude, velocity, position (3 each).
+const STATES: usize = 12;
+
+/// What was removed from the commands.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NoiseReaction {
+    /// Control steps per row, `N`.
+    pub steps_per_row: f64,
+    /// The unfelt share of the logged reaction, `1 − 1/N`.
+    pub unfelt_fraction: f64,
+    /// RMS of the removed part, per actuator command (in the commands' units).
+    pub removed_rms: [f64; 4],
+}
+
+/// Control steps per row when the commands are samples of a faster controller taken with the
+/// state; `None` otherwise (the vehicle then felt what the log holds, or the log holds no reaction
+/// to its own noise).
+pub fn steps_per_row(logger: &Logger, dt: f64) -> Option<f64> {
+    let rate = logger.controller_rate_hz?;
+    let steps = rate * dt;
+    let with_the_state = logger.command_time_offset_s.abs() < 0.5 / rate;
+    (logger.command == CommandLogging::Sample && with_the_state && steps >= 2.0).then_some(steps)
+}
+
+/// Removes the unfelt reaction to the logged attitude and position noise from the commands.
+pub fn remove(
+    recording: &mut Recording,
+    logger: &Logger,
+    actuators: usize,
+) -> Option<NoiseReaction> {
+    let steps = steps_per_row(logger, recording.dt)?;
+    if recording.len() < MIN_ROWS {
+        return None;
+    }
+    let gains = reaction_gains(recording, actuators)?;
+    let attitude_noise = attitude_noise(recording);
+    let position_noise = position_noise(recording);
+    let unfelt = 1.0 - 1.0 / steps;
+    let mut squares = [0.0; 4];
+    for (k, command) in recording.commands.iter_mut().enumerate() {
+        for i in 0..actuators {
+            let reaction: f64 = (0..3)
+                .map(|a| {
+                    gains[i][3 + a] * attitude_noise[k][a] + gains[i][9 + a] * position_noise[k][a]
+                })
+                .sum();
+            command[i] -= unfelt * reaction;
+            squares[i] += (unfelt * reaction).powi(2);
+        }
+    }
+    let rows = recording.len() as f64;
+    Some(NoiseReaction {
+        steps_per_row: steps,
+        unfelt_fraction: unfelt,
+        removed_rms: squares.map(|s| (s / rows).sqrt()),
+    })
+}
+
+/// The rotation vector from the attitude of row `a` to that of row `b`, in the body frame of `a`
+/// (small angles).
+fn relative_rotation(a: &Mat3, b: &Mat3) -> Vec3 {
+    vee(&mat_mul(&transpose(a), b))
+}
+
+/// Fourth differences of the twelve logged state channels, centred on rows `2..n−2`.
+fn state_fourth_differences(recording: &Recording) -> Vec<[f64; STATES]> {
+    let fourth = |series: &[Vec3], k: usize, a: usize| -> f64 {
+        (0..5)
+            .map(|j| FOURTH_DIFFERENCE[j] * series[k + j - 2][a])
+            .sum()
+    };
+    (2..recording.len() - 2)
+        .map(|k| {
+            let mut row = [0.0; STATES];
+            for j in 0..5 {
+                let turn =
+                    relative_rotation(&recording.rotation[k], &recording.rotation[k + j - 2]);
+                for a in 0..3 {
+                    row[3 + a] += FOURTH_DIFFERENCE[j] * turn[a];
+                }
+            }
+            for a in 0..3 {
+                row[a] = fourth(&recording.body_rate, k, a);
+                row[6 + a] = fourth(&recording.velocity, k, a);
+                row[9 + a] = fourth(&recording.position, k, a);
+            }
+            row
+        })
+        .collect()
+}
+
+/// The commands' linear reaction to each state channel (`gains[actuator][state]`), from a
+/// regression of fourth differences with the transients trimmed.
+fn reaction_gains(recording: &Recording, actuators: usize) -> Option<Vec<[f64; STATES]>> {
+    let states = state_fourth_differences(recording);
+    let commands: Vec<[f64; 4]> = (2..recording.len() - 2)
+        .map(|k| {
+            std::array::from_fn(|i| {
+                (0..5)
+                    .map(|j| FOURTH_DIFFERENCE[j] * recording.commands[k + j - 2][i])
+                    .sum()
+            })
+        })
+        .collect();
+    let mut keep = vec![true; states.len()];
+    let mut gains = vec![[0.0; STATES]; actuators];
+    for _ in 0..4 {
+        gains = least_squares(&states, &commands, &keep, actuators)?;
+        let residual = |r: usize, i: usize| -> f64 {
+            commands[r][i] - (0..STATES).map(|s| gains[i][s] * states[r][s]).sum::<f64>()
+        };
+        let scales: Vec<f64> = (0..actuators)
+            .map(|i| 1.4826 * median((0..states.len()).map(|r| residual(r, i).abs()).collect()))
+            .collect();
+        for (r, kept) in keep.iter_mut().enumerate() {
+            *kept = (0..actuators).all(|i| residual(r, i).abs() <= TRIM_SIGMAS * scales[i]);
+        }
+    }
+    Some(gains)
+}
+
+fn least_squares(
+    states: &[[f64; STATES]],
+    commands: &[[f64; 4]],
+    keep: &[bool],
+    actuators: usize,
+) -> Option<Vec<[f64; STATES]>> {
+    let mut gram = Mat::<f64>::zeros(STATES, STATES);
+    let mut cross = Mat::<f64>::zeros(STATES, actuators);
+    for ((x, y), _) in states.iter().zip(commands).zip(keep).filter(|(_, k)| **k) {
+        for a in 0..STATES {
+            for b in 0..STATES {
+                gram[(a, b)] += x[a] * x[b];
+            }
+            for i in 0..actuators {
+                cross[(a, i)] += x[a] * y[i];
+            }
+        }
+    }
+    let trace: f64 = (0..STATES).map(|a| gram[(a, a)]).sum();
+    if !(trace > 0.0 && trace.is_finite()) {
+        return None;
+    }
+    for a in 0..STATES {
+        gram[(a, a)] += 1e-12 * trace;
+    }
+    let solution = gram.full_piv_lu().solve(&cross);
+    let gains: Vec<[f64; STATES]> = (0..actuators)
+        .map(|i| std::array::from_fn(|a| solution[(a, i)]))
+        .collect();
+    gains
+        .iter()
+        .all(|g| g.iter().all(|v| v.is_finite()))
+        .then_some(gains)
+}
+
+fn median(mut values: Vec<f64>) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let middle = values.len() / 2;
+    *values.select_nth_unstable_by(middle, f64::total_cmp).1
+}
+
+/// Each row's attitude noise (body frame): the logged turn between rows minus the trapezoid of the
+/// logged rates is the change of the noise, up to the rates' own noise.
+fn attitude_noise(recording: &Recording) -> Vec<Vec3> {
+    let rows = recording.len();
+    let increments: Vec<Vec3> = (0..rows - 1)
+        .map(|k| {
+            let h = recording.time[k + 1] - recording.time[k];
+            let turn = relative_rotation(&recording.rotation[k], &recording.rotation[k + 1]);
+            std::array::from_fn(|a| {
+                turn[a] - 0.5 * h * (recording.body_rate[k][a] + recording.body_rate[k + 1][a])
+            })
+        })
+        .collect();
+    let states = state_fourth_differences(recording);
+    per_axis(|a| {
+        let fourth: Vec<f64> = states.iter().map(|s| s[3 + a]).collect();
+        let sigma = (median(fourth.iter().map(|v| v * v).collect()) / (70.0 * 0.4549)).sqrt();
+        let rate: Vec<f64> = recording.body_rate.iter().map(|w| w[a]).collect();
+        let step = recording.dt * white_noise_sigma(&rate);
+        let series: Vec<f64> = increments.iter().map(|e| e[a]).collect();
+        smooth_noise(&series, sigma, step)
+    })
+}
+
+/// Each row's position noise: the logged step minus the trapezoid of the logged velocities.
+fn position_noise(recording: &Recording) -> Vec<Vec3> {
+    let (p, v) = (&recording.position, &recording.velocity);
+    per_axis(|a| {
+        let series: Vec<f64> = (0..recording.len() - 1)
+            .map(|k| {
+                let h = recording.time[k + 1] - recording.time[k];
+                p[k + 1][a] - p[k][a] - 0.5 * h * (v[k][a] + v[k + 1][a])
+            })
+            .collect();
+        let position: Vec<f64> = p.iter().map(|x| x[a]).collect();
+        let velocity: Vec<f64> = v.iter().map(|x| x[a]).collect();
+        let step = recording.dt * white_noise_sigma(&velocity);
+        smooth_noise(&series, white_noise_sigma(&position), step)
+    })
+}
+
+fn per_axis(mut axis: impl FnMut(usize) -> Vec<f64>) -> Vec<Vec3> {
+    let [x, y, z] = [axis(0), axis(1), axis(2)];
+    (0..x.len()).map(|k| [x[k], y[k], z[k]]).collect()
+}
+
+/// The white noise `n` (standard deviation `sigma`) whose increments the series `e` measures with
+/// errors of standard deviation `step`: minimises `Σ n_k²/σ² + Σ (e_k − (n_{k+1} − n_k))²/step²`
+/// (a tridiagonal system, solved directly). Zero when there is no noise to find.
+pub(crate) fn smooth_noise(increments: &[f64], sigma: f64, step: f64) -> Vec<f64> {
+    let rows = increments.len() + 1;
+    if !(sigma > 0.0 && sigma.is_finite()) {
+        return vec![0.0; rows];
+    }
+    let step = step.max(1e-6 * sigma);
+    let (prior, link) = (1.0 / (sigma * sigma), 1.0 / (step * step));
+    let mut diagonal = vec![prior; rows];
+    let mut rhs = vec![0.0; rows];
+    for (k, e) in increments.iter().enumerate() {
+        diagonal[k] += link;
+        diagonal[k + 1] += link;
+        rhs[k] -= link * e;
+        rhs[k + 1] += link * e;
+    }
+    // Thomas algorithm; every off-diagonal entry is −link.
+    let mut upper = vec![0.0; rows];
+    let mut solution = rhs;
+    let mut pivot = diagonal[0];
+    upper[0] = -link / pivot;
+    solution[0] /= pivot;
+    for k in 1..rows {
+        pivot = diagonal[k] + link * upper[k - 1];
+        upper[k] = -link / pivot;
+        solution[k] = (solution[k] + link * solution[k - 1]) / pivot;
+    }
+    for k in (0..rows - 1).rev() {
+        solution[k] -= upper[k] * solution[k + 1];
+    }
+    solution
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,176 @@
+use std::path::PathBuf;
+
+use data::RateFrame;
+use physics::vector::{mat_mul, rotation_from_rotation_vector};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::*;
+
+const DT: f64 = 0.02;
+const ROWS: usize = 2000;
+
+fn gaussian(rng: &mut ChaCha8Rng, sigma: f64) -> f64 {
+    let u: f64 = rng.random_range(f64::EPSILON..1.0);
+    let v: f64 = rng.random_range(0.0..1.0);
+    sigma * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+}
+
+fn noise(rng: &mut ChaCha8Rng, sigma: f64) -> Vec3 {
+    std::array::from_fn(|_| gaussian(rng, sigma))
+}
+
+/// A flight whose smooth motion is consistent (rates and velocities are the derivatives of the
+/// attitude and position), logged with white noise; the commands react to every logged noise, as a
+/// controller's sampled command does. Returns the recording and, per row, the reaction to the
+/// attitude and position noise alone.
+fn flight(seed: u64) -> (Recording, Vec<[f64; 4]>) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let axis = {
+        let u: Vec3 = [0.3, 0.8, 0.5];
+        let n = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+        u.map(|v| v / n)
+    };
+    let mixing = [
+        [-1.0, 1.0, 1.0],
+        [1.0, -1.0, 1.0],
+        [1.0, 1.0, -1.0],
+        [-1.0, -1.0, -1.0],
+    ];
+    let mut recording = Recording {
+        path: PathBuf::from("synthetic.csv"),
+        dt: DT,
+        time: Vec::new(),
+        rotation: Vec::new(),
+        velocity: Vec::new(),
+        position: Vec::new(),
+        body_rate: Vec::new(),
+        rate_frame: RateFrame::Body,
+        rate_frame_errors: (0.0, 0.0),
+        commands: Vec::new(),
+        command_spread: [0.0; 4],
+        command_rate_hz: None,
+        noise_reaction: None,
+    };
+    let mut attitude_position_reaction = Vec::new();
+    for k in 0..ROWS {
+        let t = k as f64 * DT;
+        let angle = 0.3 * (1.3 * t).sin() + 0.1 * (0.4 * t).sin();
+        let angle_rate = 0.39 * (1.3 * t).cos() + 0.04 * (0.4 * t).cos();
+        let position = [(0.5 * t).sin(), (0.3 * t).cos(), 0.2 * (0.7 * t).sin()];
+        let velocity = [
+            0.5 * (0.5 * t).cos(),
+            -0.3 * (0.3 * t).sin(),
+            0.14 * (0.7 * t).cos(),
+        ];
+        let (rate_noise, attitude_noise) = (noise(&mut rng, 0.008), noise(&mut rng, 0.002));
+        let (velocity_noise, position_noise) = (noise(&mut rng, 0.005), noise(&mut rng, 0.002));
+        let truth = rotation_from_rotation_vector(axis.map(|u| u * angle));
+        recording.time.push(t);
+        recording.rotation.push(mat_mul(
+            &truth,
+            &rotation_from_rotation_vector(attitude_noise),
+        ));
+        recording.body_rate.push(std::array::from_fn(|a| {
+            axis[a] * angle_rate + rate_noise[a]
+        }));
+        recording
+            .velocity
+            .push(std::array::from_fn(|a| velocity[a] + velocity_noise[a]));
+        recording
+            .position
+            .push(std::array::from_fn(|a| position[a] + position_noise[a]));
+        let mut command = [0.0; 4];
+        let mut reaction = [0.0; 4];
+        for i in 0..4 {
+            let react = |gain: f64, n: Vec3| -> f64 {
+                (0..3).map(|a| 0.01 * mixing[i][a] * gain * n[a]).sum()
+            };
+            reaction[i] = react(-100.0, attitude_noise) + react(-55.0, position_noise);
+            command[i] = 0.6
+                + 0.05 * (2.0 * t + i as f64).sin()
+                + reaction[i]
+                + react(-18.0, rate_noise)
+                + react(40.0, velocity_noise);
+        }
+        recording.commands.push(command);
+        attitude_position_reaction.push(reaction);
+    }
+    (recording, attitude_position_reaction)
+}
+
+fn sampling_logger(controller_rate_hz: f64) -> Logger {
+    Logger {
+        command: CommandLogging::Sample,
+        controller_rate_hz: Some(controller_rate_hz),
+        ..Logger::default()
+    }
+}
+
+/// With a controller ten times the log rate, nine tenths of the reaction to the logged attitude and
+/// position noise is removed: the commands come out as the vehicle felt them, to a fifth of what
+/// the log held in excess.
+#[test]
+fn the_unfelt_reaction_to_attitude_and_position_noise_is_removed() {
+    for seed in [3, 4] {
+        let (mut recording, reaction) = flight(seed);
+        let logged = recording.commands.clone();
+        let removed = remove(&mut recording, &sampling_logger(500.0), 4).expect("removed");
+        assert!((removed.steps_per_row - 10.0).abs() < 1e-9);
+        let (mut excess, mut error) = (0.0, 0.0);
+        for k in 0..ROWS {
+            for i in 0..4 {
+                let felt = logged[k][i] - 0.9 * reaction[k][i];
+                excess += (logged[k][i] - felt).powi(2);
+                error += (recording.commands[k][i] - felt).powi(2);
+            }
+        }
+        let ratio = (error / excess).sqrt();
+        assert!(ratio < 0.2, "seed {seed}: error / excess {ratio:.3}");
+    }
+}
+
+/// Nothing is removed when the vehicle felt what the log holds (held commands, a controller at the
+/// log rate, period means) or when the logged command did not see the row's measurement.
+#[test]
+fn only_samples_of_a_faster_controller_taken_with_the_state_are_corrected() {
+    assert_eq!(steps_per_row(&sampling_logger(500.0), DT), Some(10.0));
+    assert_eq!(steps_per_row(&sampling_logger(50.0), DT), None);
+    assert_eq!(steps_per_row(&Logger::default(), DT), None);
+    let held = Logger {
+        command: CommandLogging::Held,
+        ..sampling_logger(500.0)
+    };
+    let mean = Logger {
+        command: CommandLogging::PeriodMean,
+        ..sampling_logger(500.0)
+    };
+    let late = Logger {
+        command_time_offset_s: 0.002,
+        ..sampling_logger(500.0)
+    };
+    for logger in [held, mean, late] {
+        assert_eq!(steps_per_row(&logger, DT), None, "{logger:?}");
+        let (mut recording, _) = flight(5);
+        let logged = recording.commands.clone();
+        assert!(remove(&mut recording, &logger, 4).is_none());
+        assert_eq!(recording.commands, logged);
+    }
+}
+
+/// The smoother finds white noise from its increments measured with small errors.
+#[test]
+fn the_smoother_recovers_white_noise_from_its_increments() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let truth: Vec<f64> = (0..1000).map(|_| gaussian(&mut rng, 0.002)).collect();
+    let increments: Vec<f64> = truth
+        .windows(2)
+        .map(|w| w[1] - w[0] + gaussian(&mut rng, 1e-4))
+        .collect();
+    let found = smooth_noise(&increments, 0.002, 1e-4);
+    let error: f64 = truth.iter().zip(&found).map(|(a, b)| (a - b).powi(2)).sum();
+    let total: f64 = truth.iter().map(|a| a * a).sum();
+    // The level is fixed only over about σ/step rows: an error of about a fifth is the limit.
+    assert!((error / total).sqrt() < 0.25, "{}", (error / total).sqrt());
+    assert_eq!(smooth_noise(&increments, 0.0, 1e-4), vec![0.0; 1000]);
+}

@@ -4,6 +4,7 @@
 use std::collections::BTreeMap;
 
 use data::FlightLog;
+use physics::vector::Vec3;
 use physics::{EffectId, EffectParameters, Effects, Logger, NominalModel, ParameterValue};
 pub use report::mismatch::recording::{ChannelReport, Fit, Heldout, Mse, RateFrameReport, Window};
 use serde::Serialize;
@@ -17,7 +18,8 @@ use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
 use crate::refine::effects_from;
 use crate::selection::{Design, Selection, SelectionSettings, stability_selection};
-use crate::weak_form::TestFunction;
+use crate::weak_form::{TestFunction, white_noise_sigma};
+use crate::{forward, noise_reaction};
 
 /// Settings of an analysis (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -133,6 +135,68 @@ pub fn analyze(
     settings: &AnalysisSettings,
 ) -> Result<Analysis> {
     let recording = Recording::new(log, model, 40)?;
+    let first = analyze_recording(recording, log, model, model_name, settings)?;
+    if first.problem.recording.noise_reaction.is_none() {
+        return Ok(first);
+    }
+    // Sampled commands of a faster controller: with the effects identified, the model predicts the
+    // velocity well enough to separate its noise, and the commands' unfelt reaction to it goes too.
+    let mut recording = first.problem.recording.clone();
+    let predicted = predicted_velocity_changes(&recording, model, &first.fitted);
+    let prediction_noise = prediction_noise(&recording, model, &first.fitted);
+    if !noise_reaction::remove_velocity(&mut recording, &predicted, prediction_noise) {
+        return Ok(first);
+    }
+    analyze_recording(recording, log, model, model_name, settings)
+}
+
+/// The model's velocity change over every row interval.
+fn predicted_velocity_changes(
+    recording: &Recording,
+    model: &NominalModel,
+    effects: &Effects,
+) -> Vec<Vec3> {
+    let prediction = forward::predict_substeps(recording, model, effects);
+    prediction
+        .translational
+        .chunks(forward::SUBSTEPS)
+        .enumerate()
+        .map(|(k, accelerations)| {
+            let h = (recording.time[k + 1] - recording.time[k]) / forward::SUBSTEPS as f64;
+            std::array::from_fn(|a| h * accelerations.iter().map(|x| x[a]).sum::<f64>())
+        })
+        .collect()
+}
+
+/// The row-to-row noise of the model's velocity change: the white noise of the acceleration at
+/// each row's logged attitude and command (which carry their own noise), times the interval.
+fn prediction_noise(recording: &Recording, model: &NominalModel, effects: &Effects) -> Vec3 {
+    let accelerations: Vec<Vec3> = (0..recording.len())
+        .map(|k| {
+            let thrust = model.wrench(&recording.commands[k]).thrust;
+            let (rotation, velocity) = (&recording.rotation[k], recording.velocity[k]);
+            effects.translational_acceleration(
+                model,
+                rotation,
+                velocity,
+                recording.position[k],
+                thrust,
+            )
+        })
+        .collect();
+    std::array::from_fn(|a| {
+        let series: Vec<f64> = accelerations.iter().map(|x| x[a]).collect();
+        recording.dt * white_noise_sigma(&series)
+    })
+}
+
+fn analyze_recording(
+    recording: Recording,
+    log: &FlightLog,
+    model: &NominalModel,
+    model_name: &str,
+    settings: &AnalysisSettings,
+) -> Result<Analysis> {
     let problem = Problem::new(
         recording,
         model.clone(),

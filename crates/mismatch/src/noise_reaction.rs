@@ -31,7 +31,9 @@ const TRIM_SIGMAS: f64 = 4.0;
 /// Fewer rows than this and the reaction is not identified.
 const MIN_ROWS: usize = 200;
 /// State channels the commands are regressed on: rate, attitude, velocity, position (3 each).
-const STATES: usize = 12;
+pub const STATES: usize = 12;
+/// The smallest error allowed to a predicted velocity change, relative to the velocity's noise.
+const VELOCITY_STEP_FLOOR: f64 = 0.02;
 
 /// What was removed from the commands.
 #[derive(Clone, Debug, PartialEq)]
@@ -40,7 +42,13 @@ pub struct NoiseReaction {
     pub steps_per_row: f64,
     /// The unfelt share of the logged reaction, `1 − 1/N`.
     pub unfelt_fraction: f64,
-    /// RMS of the removed part, per actuator command (in the commands' units).
+    /// The commands' reaction to each logged state channel, `gains[actuator][state]` (states: rate,
+    /// attitude, velocity, position, three axes each).
+    pub gains: Vec<[f64; STATES]>,
+    /// Whether the reaction to the velocity noise was removed too ([`remove_velocity`]).
+    pub velocity: bool,
+    /// RMS of the removed part, per actuator command (in the commands' units; the parts come from
+    /// independent noises and add in quadrature).
     pub removed_rms: [f64; 4],
 }
 
@@ -54,38 +62,87 @@ pub fn steps_per_row(logger: &Logger, dt: f64) -> Option<f64> {
     (logger.command == CommandLogging::Sample && with_the_state && steps >= 2.0).then_some(steps)
 }
 
-/// Removes the unfelt reaction to the logged attitude and position noise from the commands.
-pub fn remove(
-    recording: &mut Recording,
-    logger: &Logger,
-    actuators: usize,
-) -> Option<NoiseReaction> {
-    let steps = steps_per_row(logger, recording.dt)?;
+/// Removes the unfelt reaction to the logged attitude and position noise from the commands, and
+/// records it in `recording.noise_reaction`; returns whether it did.
+pub fn remove(recording: &mut Recording, logger: &Logger, actuators: usize) -> bool {
+    let Some(steps) = steps_per_row(logger, recording.dt) else {
+        return false;
+    };
     if recording.len() < MIN_ROWS {
-        return None;
+        return false;
     }
-    let gains = reaction_gains(recording, actuators)?;
-    let attitude_noise = attitude_noise(recording);
-    let position_noise = position_noise(recording);
-    let unfelt = 1.0 - 1.0 / steps;
-    let mut squares = [0.0; 4];
+    let Some(gains) = reaction_gains(recording, actuators) else {
+        return false;
+    };
+    let mut reaction = NoiseReaction {
+        steps_per_row: steps,
+        unfelt_fraction: 1.0 - 1.0 / steps,
+        gains,
+        velocity: false,
+        removed_rms: [0.0; 4],
+    };
+    let attitude = attitude_noise(recording);
+    let position = position_noise(recording);
+    subtract(recording, &mut reaction, &[(3, &attitude), (9, &position)]);
+    recording.noise_reaction = Some(reaction);
+    true
+}
+
+/// Removes the unfelt reaction to the logged velocity noise as well, once a model predicts the
+/// velocity: `predicted_change[k]` is the model's velocity change from row `k` to row `k + 1`.
+/// The logged change minus the predicted one measures the change of the noise (up to the model's
+/// own error, which is why this waits for the identified effects; `prediction_noise` is the standard
+/// deviation of the prediction's row-to-row error, per axis). Returns whether it did.
+pub fn remove_velocity(
+    recording: &mut Recording,
+    predicted_change: &[Vec3],
+    prediction_noise: Vec3,
+) -> bool {
+    let Some(mut reaction) = recording.noise_reaction.take() else {
+        return false;
+    };
+    if reaction.velocity || predicted_change.len() + 1 != recording.len() {
+        recording.noise_reaction = Some(reaction);
+        return false;
+    }
+    let velocity = &recording.velocity;
+    let noise = per_axis(|a| {
+        let increments: Vec<f64> = (0..recording.len() - 1)
+            .map(|k| velocity[k + 1][a] - velocity[k][a] - predicted_change[k][a])
+            .collect();
+        let logged: Vec<f64> = velocity.iter().map(|v| v[a]).collect();
+        let sigma = white_noise_sigma(&logged);
+        let step = prediction_noise[a].max(VELOCITY_STEP_FLOOR * sigma);
+        smooth_noise(&increments, sigma, step)
+    });
+    subtract(recording, &mut reaction, &[(6, &noise)]);
+    reaction.velocity = true;
+    recording.noise_reaction = Some(reaction);
+    true
+}
+
+/// Subtracts the unfelt share of the reaction to the given noise (each with the index of its first
+/// state channel) from the commands, and adds its RMS to the record.
+fn subtract(recording: &mut Recording, reaction: &mut NoiseReaction, noises: &[(usize, &[Vec3])]) {
+    let actuators = reaction.gains.len();
+    let rows = recording.len() as f64;
+    let mut squares = reaction.removed_rms.map(|r| r * r * rows);
     for (k, command) in recording.commands.iter_mut().enumerate() {
         for i in 0..actuators {
-            let reaction: f64 = (0..3)
-                .map(|a| {
-                    gains[i][3 + a] * attitude_noise[k][a] + gains[i][9 + a] * position_noise[k][a]
+            let removed: f64 = noises
+                .iter()
+                .map(|(first, noise)| {
+                    (0..3)
+                        .map(|a| reaction.gains[i][first + a] * noise[k][a])
+                        .sum::<f64>()
                 })
-                .sum();
-            command[i] -= unfelt * reaction;
-            squares[i] += (unfelt * reaction).powi(2);
+                .sum::<f64>()
+                * reaction.unfelt_fraction;
+            command[i] -= removed;
+            squares[i] += removed * removed;
         }
     }
-    let rows = recording.len() as f64;
-    Some(NoiseReaction {
-        steps_per_row: steps,
-        unfelt_fraction: unfelt,
-        removed_rms: squares.map(|s| (s / rows).sqrt()),
-    })
+    reaction.removed_rms = squares.map(|s| (s / rows).sqrt());
 }
 
 /// The rotation vector from the attitude of row `a` to that of row `b`, in the body frame of `a`

@@ -115,8 +115,7 @@ impl Recording {
             command_rate_hz,
             noise_reaction: None,
         };
-        recording.noise_reaction =
-            noise_reaction::remove(&mut recording, &model.logger, model.actuator_count());
+        noise_reaction::remove(&mut recording, &model.logger, model.actuator_count());
         Ok(recording)
     }
 

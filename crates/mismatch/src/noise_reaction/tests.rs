@@ -10,6 +10,8 @@ use super::*;
 const DT: f64 = 0.02;
 const ROWS: usize = 2000;
 
+type Commands = Vec<[f64; 4]>;
+
 fn gaussian(rng: &mut ChaCha8Rng, sigma: f64) -> f64 {
     let u: f64 = rng.random_range(f64::EPSILON..1.0);
     let v: f64 = rng.random_range(0.0..1.0);
@@ -22,9 +24,9 @@ fn noise(rng: &mut ChaCha8Rng, sigma: f64) -> Vec3 {
 
 /// A flight whose smooth motion is consistent (rates and velocities are the derivatives of the
 /// attitude and position), logged with white noise; the commands react to every logged noise, as a
-/// controller's sampled command does. Returns the recording and, per row, the reaction to the
-/// attitude and position noise alone.
-fn flight(seed: u64) -> (Recording, Vec<[f64; 4]>) {
+/// controller's sampled command does. Returns the recording, per row the reaction to the attitude
+/// and position noise and the reaction to the velocity noise, and the true velocity changes.
+fn flight(seed: u64) -> (Recording, Commands, Commands, Vec<Vec3>) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let axis = {
         let u: Vec3 = [0.3, 0.8, 0.5];
@@ -53,6 +55,8 @@ fn flight(seed: u64) -> (Recording, Vec<[f64; 4]>) {
         noise_reaction: None,
     };
     let mut attitude_position_reaction = Vec::new();
+    let mut velocity_reaction = Vec::new();
+    let mut true_velocity = Vec::new();
     for k in 0..ROWS {
         let t = k as f64 * DT;
         let angle = 0.3 * (1.3 * t).sin() + 0.1 * (0.4 * t).sin();
@@ -80,23 +84,50 @@ fn flight(seed: u64) -> (Recording, Vec<[f64; 4]>) {
         recording
             .position
             .push(std::array::from_fn(|a| position[a] + position_noise[a]));
+        true_velocity.push(velocity);
         let mut command = [0.0; 4];
         let mut reaction = [0.0; 4];
+        let mut to_velocity = [0.0; 4];
         for i in 0..4 {
             let react = |gain: f64, n: Vec3| -> f64 {
                 (0..3).map(|a| 0.01 * mixing[i][a] * gain * n[a]).sum()
             };
             reaction[i] = react(-100.0, attitude_noise) + react(-55.0, position_noise);
+            to_velocity[i] = react(40.0, velocity_noise);
             command[i] = 0.6
                 + 0.05 * (2.0 * t + i as f64).sin()
                 + reaction[i]
                 + react(-18.0, rate_noise)
-                + react(40.0, velocity_noise);
+                + to_velocity[i];
         }
         recording.commands.push(command);
         attitude_position_reaction.push(reaction);
+        velocity_reaction.push(to_velocity);
     }
-    (recording, attitude_position_reaction)
+    let changes = true_velocity
+        .windows(2)
+        .map(|w| std::array::from_fn(|a| w[1][a] - w[0][a]))
+        .collect();
+    (
+        recording,
+        attitude_position_reaction,
+        velocity_reaction,
+        changes,
+    )
+}
+
+/// The RMS of `corrected − (logged − 0.9 reaction)` over the RMS of `0.9 reaction`: 1 when nothing
+/// was removed, 0 when exactly the unfelt share was.
+fn removal_error(logged: &[[f64; 4]], corrected: &[[f64; 4]], reaction: &[[f64; 4]]) -> f64 {
+    let (mut excess, mut error) = (0.0, 0.0);
+    for k in 0..logged.len() {
+        for i in 0..4 {
+            let felt = logged[k][i] - 0.9 * reaction[k][i];
+            excess += (logged[k][i] - felt).powi(2);
+            error += (corrected[k][i] - felt).powi(2);
+        }
+    }
+    (error / excess).sqrt()
 }
 
 fn sampling_logger(controller_rate_hz: f64) -> Logger {
@@ -113,20 +144,30 @@ fn sampling_logger(controller_rate_hz: f64) -> Logger {
 #[test]
 fn the_unfelt_reaction_to_attitude_and_position_noise_is_removed() {
     for seed in [3, 4] {
-        let (mut recording, reaction) = flight(seed);
+        let (mut recording, reaction, _, _) = flight(seed);
         let logged = recording.commands.clone();
-        let removed = remove(&mut recording, &sampling_logger(500.0), 4).expect("removed");
+        assert!(remove(&mut recording, &sampling_logger(500.0), 4));
+        let removed = recording.noise_reaction.as_ref().expect("recorded");
         assert!((removed.steps_per_row - 10.0).abs() < 1e-9);
-        let (mut excess, mut error) = (0.0, 0.0);
-        for k in 0..ROWS {
-            for i in 0..4 {
-                let felt = logged[k][i] - 0.9 * reaction[k][i];
-                excess += (logged[k][i] - felt).powi(2);
-                error += (recording.commands[k][i] - felt).powi(2);
-            }
-        }
-        let ratio = (error / excess).sqrt();
+        let ratio = removal_error(&logged, &recording.commands, &reaction);
         assert!(ratio < 0.2, "seed {seed}: error / excess {ratio:.3}");
+    }
+}
+
+/// Given the velocity changes a model predicts, the unfelt reaction to the velocity noise goes too
+/// (once: a second call changes nothing).
+#[test]
+fn with_a_predicted_velocity_the_reaction_to_its_noise_is_removed() {
+    for seed in [6, 7] {
+        let (mut recording, _, reaction, changes) = flight(seed);
+        assert!(remove(&mut recording, &sampling_logger(500.0), 4));
+        let before = recording.commands.clone();
+        assert!(remove_velocity(&mut recording, &changes, [1e-5; 3]));
+        let ratio = removal_error(&before, &recording.commands, &reaction);
+        assert!(ratio < 0.2, "seed {seed}: error / excess {ratio:.3}");
+        let after = recording.commands.clone();
+        assert!(!remove_velocity(&mut recording, &changes, [1e-5; 3]));
+        assert_eq!(recording.commands, after);
     }
 }
 
@@ -151,10 +192,11 @@ fn only_samples_of_a_faster_controller_taken_with_the_state_are_corrected() {
     };
     for logger in [held, mean, late] {
         assert_eq!(steps_per_row(&logger, DT), None, "{logger:?}");
-        let (mut recording, _) = flight(5);
+        let (mut recording, ..) = flight(5);
         let logged = recording.commands.clone();
-        assert!(remove(&mut recording, &logger, 4).is_none());
+        assert!(!remove(&mut recording, &logger, 4));
         assert_eq!(recording.commands, logged);
+        assert!(recording.noise_reaction.is_none());
     }
 }
 

@@ -13,13 +13,14 @@ use crate::describe::describe;
 use crate::error::{MismatchError, Result};
 use crate::evidence::{self, Evidence, EvidenceSettings, explained_fractions};
 use crate::fit::{FitAlternatives, Screened, fit_parameters, profile_nonlinear};
+use crate::forward;
 use crate::library::{Candidate, build_library};
+use crate::noise_reaction::{self, NoiseReaction};
 use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
 use crate::refine::effects_from;
 use crate::selection::{Design, Selection, SelectionSettings, stability_selection};
 use crate::weak_form::{TestFunction, white_noise_sigma};
-use crate::{forward, noise_reaction};
 
 /// Settings of an analysis (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -113,6 +114,10 @@ pub struct Report {
     pub rate_frame: RateFrameReport,
     /// How the recording's commands and rates were logged (from the model file).
     pub logger: Logger,
+    /// What was taken out of sampled commands of a faster controller: their unfelt reaction to the
+    /// logged noise (absent when nothing was).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_reaction: Option<NoiseReaction>,
     pub selection: SelectionReport,
     pub settings: AnalysisSettings,
 }
@@ -506,6 +511,7 @@ fn build_report(
             world_rms: problem.recording.rate_frame_errors.1,
         },
         logger: problem.model.logger,
+        noise_reaction: problem.recording.noise_reaction.clone(),
         selection: SelectionReport {
             method: "forward stepwise selection of candidate groups scored by time-blocked cross-validation on the noise-normalised residual, kept when chosen in enough block-bootstrap resamples (stability selection); the kept effects fitted jointly with the exact model; each then kept only when the evidence rule holds for it".to_string(),
             settings: settings.selection,

@@ -19,6 +19,7 @@ use faer::Mat;
 use faer::linalg::solvers::Solve;
 use physics::vector::{Mat3, Vec3, mat_mul, transpose, vee};
 use physics::{CommandLogging, Logger};
+use serde::Serialize;
 
 use crate::recording::Recording;
 use crate::weak_form::white_noise_sigma;
@@ -36,7 +37,7 @@ pub const STATES: usize = 12;
 const VELOCITY_STEP_FLOOR: f64 = 0.02;
 
 /// What was removed from the commands.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct NoiseReaction {
     /// Control steps per row, `N`.
     pub steps_per_row: f64,
@@ -50,6 +51,9 @@ pub struct NoiseReaction {
     /// RMS of the removed part, per actuator command (in the commands' units; the parts come from
     /// independent noises and add in quadrature).
     pub removed_rms: [f64; 4],
+    /// The commands as logged.
+    #[serde(skip)]
+    pub logged_commands: Vec<[f64; 4]>,
 }
 
 /// Control steps per row when the commands are samples of a faster controller taken with the
@@ -80,6 +84,7 @@ pub fn remove(recording: &mut Recording, logger: &Logger, actuators: usize) -> b
         gains,
         velocity: false,
         removed_rms: [0.0; 4],
+        logged_commands: recording.commands.clone(),
     };
     let attitude = attitude_noise(recording);
     let position = position_noise(recording);

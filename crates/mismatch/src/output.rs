@@ -176,7 +176,15 @@ impl Analysis {
         match (logger.command, steps_per_row) {
             (CommandLogging::Sample, None) => CommandSampling::RateUnknown,
             (CommandLogging::Sample, Some(steps_per_row)) if steps_per_row >= 2.0 => {
-                CommandSampling::FasterController { steps_per_row }
+                let removed = match &self.problem.recording.noise_reaction {
+                    Some(reaction) if reaction.velocity => "attitude, position and velocity",
+                    Some(_) => "attitude and position",
+                    None => "",
+                };
+                CommandSampling::FasterController {
+                    steps_per_row,
+                    removed,
+                }
             }
             _ => CommandSampling::NotSampled,
         }

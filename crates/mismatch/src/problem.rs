@@ -79,6 +79,18 @@ impl Problem {
         } else {
             None
         };
+        // With the commands' unfelt reaction to the logged noise removed, the residual keeps the
+        // reaction to the rate noise and the reaction, felt, to the noise of the control steps the
+        // log did not sample; the logged commands' step-to-step noise bounds both, as it bounded
+        // the whole before (the floor), while the corrected commands' noise is what remains in the
+        // model's inputs (the share that attenuates a factor).
+        let logged = recording.noise_reaction.as_ref().map(|reaction| {
+            let logged = Recording {
+                commands: reaction.logged_commands.clone(),
+                ..recording.clone()
+            };
+            predict_at_rows(&logged, &model)
+        });
         let mut noise_floor = [0.0; 6];
         let mut model_noise = [0.0; 6];
         for c in 0..channels {
@@ -93,7 +105,14 @@ impl Problem {
             let measured = white_noise_sigma(&signal) * weak_form.target_noise_gain();
             model_noise[c] = model_side_noise(&recording, &model, nominal.as_ref(), c)
                 * weak_form.model_noise_gain();
-            noise_floor[c] = measured.hypot(model_noise[c]).max(1e-12);
+            let floor_side = match &logged {
+                Some(logged) => {
+                    model_side_noise(&recording, &model, Some(logged), c)
+                        * weak_form.model_noise_gain()
+                }
+                None => model_noise[c],
+            };
+            noise_floor[c] = measured.hypot(floor_side).max(1e-12);
         }
         let rows = target.len();
         let split = ((1.0 - heldout_fraction) * rows as f64).round() as usize;

@@ -190,8 +190,12 @@ pub enum CommandSampling {
     NotSampled,
     /// Instantaneous samples; the controller's rate is not declared.
     RateUnknown,
-    /// Instantaneous samples of a controller this many times faster than the log.
-    FasterController { steps_per_row: f64 },
+    /// Instantaneous samples of a controller this many times faster than the log; `removed` names
+    /// the logged noises whose unfelt reaction was taken out of the commands (empty: none).
+    FasterController {
+        steps_per_row: f64,
+        removed: &'static str,
+    },
 }
 
 /// A channel whose model-side noise is at least this share of its signal gets a note.
@@ -298,10 +302,22 @@ impl RecordingView<'_> {
                 md,
                 " If the rows hold instantaneous samples of a faster controller's commands (the model's logger does not say its rate), they carry its step-to-step reaction to its sensors' noise, which the vehicle averaged. {remedy}"
             ),
-            CommandSampling::FasterController { steps_per_row } => write!(
-                md,
-                " Here the rows hold instantaneous samples of a controller {steps_per_row:.0} times faster than the log: each carries the controller's step-to-step reaction to its sensors' noise, which the vehicle averaged. {remedy}"
-            ),
+            CommandSampling::FasterController {
+                steps_per_row,
+                removed,
+            } => {
+                let removed = if removed.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        " The share of its reaction to the logged {removed} noise that the vehicle did not feel was taken out of the commands before the comparison; the reaction to the rate noise stays."
+                    )
+                };
+                write!(
+                    md,
+                    " Here the rows hold instantaneous samples of a controller {steps_per_row:.0} times faster than the log: each carries the controller's step-to-step reaction to its sensors' noise, which the vehicle averaged.{removed} {remedy}"
+                )
+            }
         };
         let _ = writeln!(md);
     }
@@ -567,6 +583,7 @@ mod tests {
             fit: &fit,
             command_sampling: CommandSampling::FasterController {
                 steps_per_row: 10.0,
+                removed: "attitude, position and velocity",
             },
         };
         let md = view.markdown();

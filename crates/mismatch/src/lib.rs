@@ -17,7 +17,8 @@
 //! Method in one paragraph (the long version: `docs/mismatch.md`): the recording and the model are
 //! compared in the weak form ([`weak_form`]: the recorded velocity and body rate against the model's
 //! acceleration through the same smooth test function), the model's commands reconstructed as its
-//! logger says ([`forward`]). Candidates are screened by forward stepwise selection with blocked
+//! logger says ([`forward`]); sampled commands of a faster controller first lose their unfelt reaction
+//! to the logged noise ([`noise_reaction`]). Candidates are screened by forward stepwise selection with blocked
 //! cross-validation and kept by stability selection over block-bootstrap resamples; their parameters
 //! are fitted jointly with the exact model on the first part of the recording; each effect is then
 //! named only when the evidence rule holds for it ([`evidence`]). Several flights of one vehicle are

@@ -176,19 +176,8 @@ fn predicted_velocity_changes(
 /// The row-to-row noise of the model's velocity change: the white noise of the acceleration at
 /// each row's logged attitude and command (which carry their own noise), times the interval.
 fn prediction_noise(recording: &Recording, model: &NominalModel, effects: &Effects) -> Vec3 {
-    let accelerations: Vec<Vec3> = (0..recording.len())
-        .map(|k| {
-            let thrust = model.wrench(&recording.commands[k]).thrust;
-            let (rotation, velocity) = (&recording.rotation[k], recording.velocity[k]);
-            effects.translational_acceleration(
-                model,
-                rotation,
-                velocity,
-                recording.position[k],
-                thrust,
-            )
-        })
-        .collect();
+    let (accelerations, _) =
+        forward::accelerations_at_rows(recording, &recording.commands, model, effects);
     std::array::from_fn(|a| {
         let series: Vec<f64> = accelerations.iter().map(|x| x[a]).collect();
         recording.dt * white_noise_sigma(&series)

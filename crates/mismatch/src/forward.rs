@@ -123,11 +123,21 @@ pub type RowPrediction = (Vec<Vec3>, Option<Vec<Vec3>>);
 /// The nominal model's accelerations at the rows themselves, from each row's logged command and
 /// measured state (translational, and angular when the model predicts torques).
 pub fn predict_at_rows(recording: &Recording, model: &NominalModel) -> RowPrediction {
-    let effects = Effects::default();
+    accelerations_at_rows(recording, &recording.commands, model, &Effects::default())
+}
+
+/// The model's accelerations with `effects` at the rows themselves, from each row's command in
+/// `commands` and the row's measured state.
+pub fn accelerations_at_rows(
+    recording: &Recording,
+    commands: &[[f64; 4]],
+    model: &NominalModel,
+    effects: &Effects,
+) -> RowPrediction {
     let mut translational = Vec::with_capacity(recording.len());
     let mut angular = Vec::with_capacity(recording.len());
     for k in 0..recording.len() {
-        let wrench = model.wrench(&recording.commands[k]);
+        let wrench = model.wrench(&commands[k]);
         translational.push(effects.translational_acceleration(
             model,
             &recording.rotation[k],

@@ -22,13 +22,15 @@ use physics::{CommandLogging, Logger};
 use serde::Serialize;
 
 use crate::recording::Recording;
-use crate::weak_form::white_noise_sigma;
+use crate::weak_form::{white_noise_sigma, white_noise_sigma_of_fourth_differences};
 
 /// Fourth-difference weights; white noise of variance σ² has fourth differences of variance 70 σ².
 const FOURTH_DIFFERENCE: [f64; 5] = [1.0, -4.0, 6.0, -4.0, 1.0];
 /// Rows beyond this many robust standard deviations are left out of the regression (command
 /// transients).
 const TRIM_SIGMAS: f64 = 4.0;
+/// A controller at least this many times faster than the log counts as faster than it.
+pub const MIN_STEPS_PER_ROW: f64 = 2.0;
 /// Fewer rows than this and the reaction is not identified.
 const MIN_ROWS: usize = 200;
 /// State channels the commands are regressed on: rate, attitude, velocity, position (3 each).
@@ -63,7 +65,8 @@ pub fn steps_per_row(logger: &Logger, dt: f64) -> Option<f64> {
     let rate = logger.controller_rate_hz?;
     let steps = rate * dt;
     let with_the_state = logger.command_time_offset_s.abs() < 0.5 / rate;
-    (logger.command == CommandLogging::Sample && with_the_state && steps >= 2.0).then_some(steps)
+    let faster = steps >= MIN_STEPS_PER_ROW;
+    (logger.command == CommandLogging::Sample && with_the_state && faster).then_some(steps)
 }
 
 /// Removes the unfelt reaction to the logged attitude and position noise from the commands, and
@@ -75,7 +78,8 @@ pub fn remove(recording: &mut Recording, logger: &Logger, actuators: usize) -> b
     if recording.len() < MIN_ROWS {
         return false;
     }
-    let Some(gains) = reaction_gains(recording, actuators) else {
+    let states = state_fourth_differences(recording);
+    let Some(gains) = reaction_gains(recording, &states, actuators) else {
         return false;
     };
     let mut reaction = NoiseReaction {
@@ -86,7 +90,7 @@ pub fn remove(recording: &mut Recording, logger: &Logger, actuators: usize) -> b
         removed_rms: [0.0; 4],
         logged_commands: recording.commands.clone(),
     };
-    let attitude = attitude_noise(recording);
+    let attitude = attitude_noise(recording, &states);
     let position = position_noise(recording);
     subtract(recording, &mut reaction, &[(3, &attitude), (9, &position)]);
     recording.noise_reaction = Some(reaction);
@@ -185,8 +189,11 @@ fn state_fourth_differences(recording: &Recording) -> Vec<[f64; STATES]> {
 
 /// The commands' linear reaction to each state channel (`gains[actuator][state]`), from a
 /// regression of fourth differences with the transients trimmed.
-fn reaction_gains(recording: &Recording, actuators: usize) -> Option<Vec<[f64; STATES]>> {
-    let states = state_fourth_differences(recording);
+fn reaction_gains(
+    recording: &Recording,
+    states: &[[f64; STATES]],
+    actuators: usize,
+) -> Option<Vec<[f64; STATES]>> {
     let commands: Vec<[f64; 4]> = (2..recording.len() - 2)
         .map(|k| {
             std::array::from_fn(|i| {
@@ -199,7 +206,7 @@ fn reaction_gains(recording: &Recording, actuators: usize) -> Option<Vec<[f64; S
     let mut keep = vec![true; states.len()];
     let mut gains = vec![[0.0; STATES]; actuators];
     for _ in 0..4 {
-        gains = least_squares(&states, &commands, &keep, actuators)?;
+        gains = least_squares(states, &commands, &keep, actuators)?;
         let residual = |r: usize, i: usize| -> f64 {
             commands[r][i] - (0..STATES).map(|s| gains[i][s] * states[r][s]).sum::<f64>()
         };
@@ -257,8 +264,9 @@ fn median(mut values: Vec<f64>) -> f64 {
 }
 
 /// Each row's attitude noise (body frame): the logged turn between rows minus the trapezoid of the
-/// logged rates is the change of the noise, up to the rates' own noise.
-fn attitude_noise(recording: &Recording) -> Vec<Vec3> {
+/// logged rates is the change of the noise, up to the rates' own noise. `states`: the fourth
+/// differences of the state channels ([`state_fourth_differences`]).
+fn attitude_noise(recording: &Recording, states: &[[f64; STATES]]) -> Vec<Vec3> {
     let rows = recording.len();
     let increments: Vec<Vec3> = (0..rows - 1)
         .map(|k| {
@@ -269,10 +277,9 @@ fn attitude_noise(recording: &Recording) -> Vec<Vec3> {
             })
         })
         .collect();
-    let states = state_fourth_differences(recording);
     per_axis(|a| {
         let fourth: Vec<f64> = states.iter().map(|s| s[3 + a]).collect();
-        let sigma = (median(fourth.iter().map(|v| v * v).collect()) / (70.0 * 0.4549)).sqrt();
+        let sigma = white_noise_sigma_of_fourth_differences(&fourth);
         let rate: Vec<f64> = recording.body_rate.iter().map(|w| w[a]).collect();
         let step = recording.dt * white_noise_sigma(&rate);
         let series: Vec<f64> = increments.iter().map(|e| e[a]).collect();

@@ -14,6 +14,7 @@ use report::mismatch::recording::{
 use crate::analysis::{Analysis, check_finite};
 use crate::error::{MismatchError, Result, io_error};
 use crate::evidence::Evidence;
+use crate::noise_reaction;
 use crate::problem::CHANNEL_NAMES;
 
 /// The three files of an analysis in `dir`.
@@ -175,7 +176,9 @@ impl Analysis {
             .map(|rate| rate * self.problem.recording.dt);
         match (logger.command, steps_per_row) {
             (CommandLogging::Sample, None) => CommandSampling::RateUnknown,
-            (CommandLogging::Sample, Some(steps_per_row)) if steps_per_row >= 2.0 => {
+            (CommandLogging::Sample, Some(steps_per_row))
+                if steps_per_row >= noise_reaction::MIN_STEPS_PER_ROW =>
+            {
                 let removed = match &self.problem.recording.noise_reaction {
                     Some(reaction) if reaction.velocity => "attitude, position and velocity",
                     Some(_) => "attitude and position",

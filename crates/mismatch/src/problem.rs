@@ -5,7 +5,9 @@
 use physics::{CommandLogging, Effects, NominalModel};
 
 use crate::error::{MismatchError, Result};
-use crate::forward::{RowPrediction, SUBSTEPS, predict_at_rows, predict_substeps};
+use crate::forward::{
+    RowPrediction, SUBSTEPS, accelerations_at_rows, predict_at_rows, predict_substeps,
+};
 use crate::recording::Recording;
 use crate::weak_form::{TestFunction, WeakForm, white_noise_sigma};
 
@@ -85,11 +87,12 @@ impl Problem {
         // the whole before (the floor), while the corrected commands' noise is what remains in the
         // model's inputs (the share that attenuates a factor).
         let logged = recording.noise_reaction.as_ref().map(|reaction| {
-            let logged = Recording {
-                commands: reaction.logged_commands.clone(),
-                ..recording.clone()
-            };
-            predict_at_rows(&logged, &model)
+            accelerations_at_rows(
+                &recording,
+                &reaction.logged_commands,
+                &model,
+                &Effects::default(),
+            )
         });
         let mut noise_floor = [0.0; 6];
         let mut model_noise = [0.0; 6];

@@ -36,7 +36,8 @@ pub struct Recording {
     /// The rate of the commands a row averages, Hz (when known).
     pub command_rate_hz: Option<f64>,
     /// What was removed from sampled commands of a faster controller: their reaction to the
-    /// logged attitude and position noise that the vehicle did not feel ([`crate::noise_reaction`]).
+    /// logged attitude and position noise (and, after the analysis's first pass, velocity noise)
+    /// that the vehicle did not feel ([`crate::noise_reaction`]).
     pub noise_reaction: Option<NoiseReaction>,
 }
 

@@ -216,10 +216,20 @@ pub fn white_noise_sigma(x: &[f64]) -> f64 {
     if x.len() < 5 {
         return 0.0;
     }
-    let mut squares: Vec<f64> = x
+    let fourth: Vec<f64> = x
         .windows(5)
-        .map(|w| (w[0] - 4.0 * w[1] + 6.0 * w[2] - 4.0 * w[3] + w[4]).powi(2))
+        .map(|w| w[0] - 4.0 * w[1] + 6.0 * w[2] - 4.0 * w[3] + w[4])
         .collect();
+    white_noise_sigma_of_fourth_differences(&fourth)
+}
+
+/// [`white_noise_sigma`] from fourth differences already taken (of a signal that is not a plain
+/// series, such as the attitude).
+pub fn white_noise_sigma_of_fourth_differences(fourth: &[f64]) -> f64 {
+    if fourth.is_empty() {
+        return 0.0;
+    }
+    let mut squares: Vec<f64> = fourth.iter().map(|d| d * d).collect();
     let middle = squares.len() / 2;
     let (_, median, _) = squares.select_nth_unstable_by(middle, f64::total_cmp);
     (*median / (70.0 * 0.4549)).sqrt()

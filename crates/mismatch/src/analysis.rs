@@ -9,8 +9,10 @@ use physics::{EffectId, EffectParameters, Effects, Logger, NominalModel, Paramet
 pub use report::mismatch::recording::{ChannelReport, Fit, Heldout, Mse, RateFrameReport, Window};
 use serde::Serialize;
 
+use crate::command_samples::ActuatorLimits;
 use crate::describe::describe;
 use crate::error::{MismatchError, Result};
+use crate::estimate::{self, Estimate, EstimateSettings};
 use crate::evidence::{self, Evidence, EvidenceSettings, explained_fractions};
 use crate::fit::{FitAlternatives, Screened, fit_parameters, profile_nonlinear};
 use crate::forward;
@@ -33,6 +35,8 @@ pub struct AnalysisSettings {
     pub block_s: f64,
     pub selection: SelectionSettings,
     pub evidence: EvidenceSettings,
+    /// The final estimate of the named effects' parameters ([`crate::estimate`]).
+    pub estimate: EstimateSettings,
     /// A channel is significant when its residual RMS exceeds this multiple of its noise floor.
     pub significance_factor: f64,
     /// A window is located where the moving RMS of the residual exceeds this multiple of the floor.
@@ -52,6 +56,7 @@ impl Default for AnalysisSettings {
             block_s: 1.0,
             selection: SelectionSettings::default(),
             evidence: EvidenceSettings::default(),
+            estimate: EstimateSettings::default(),
             significance_factor: 2.0,
             window_factor: 2.5,
             window_s: 1.0,
@@ -65,12 +70,16 @@ impl Default for AnalysisSettings {
 #[derive(Clone, Debug, Serialize)]
 pub struct EffectReport {
     pub id: EffectId,
+    /// The final estimate: all rows, robust weights ([`crate::estimate`]).
     pub parameters: EffectParameters,
-    /// The standard error of each parameter, by name, in the parameters' shape (from the fit's
-    /// Jacobian, the residual's variance and its autocorrelation); absent where the fit does not
-    /// determine it.
+    /// The standard error of each parameter, by name, in the parameters' shape (from the final
+    /// estimate's Jacobian, the residual's variance and its autocorrelation); absent where the fit
+    /// does not determine it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub standard_errors: Option<BTreeMap<&'static str, ParameterValue>>,
+    /// The parameters fitted on the fit part only, with which the evidence rule judged the effect
+    /// and the held-out part checked it.
+    pub fit_part_parameters: EffectParameters,
     pub description: String,
     /// This effect's share of the nominal model's noise-normalised residual sum of squares (fit
     /// part) that the fitted effects remove, in [0, 1]; the shares sum to the total removed.
@@ -111,6 +120,12 @@ pub struct Report {
     /// Where a significant residual remains that the effects found do not explain.
     pub unexplained: Vec<Window>,
     pub fit: Fit,
+    /// Share of the (row, channel) residuals the final estimate downweighted.
+    pub estimate_downweighted_fraction: f64,
+    /// The limits the logged commands sat at, when any did (instantaneous samples are reconstructed
+    /// through them: [`crate::command_samples`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub command_limits: Option<[ActuatorLimits; 4]>,
     pub rate_frame: RateFrameReport,
     /// How the recording's commands and rates were logged (from the model file).
     pub logger: Logger,
@@ -224,8 +239,16 @@ fn analyze_recording(
         settings.iterations / 2,
         block_rows,
     );
-    let effects = judgement.set.effects();
-    let after = problem.residual(&effects);
+    // The model the evidence rule judged (fitted on the fit part) is the one the residuals and the
+    // held-out check describe; the parameters reported are estimated again on all rows.
+    let after = problem.residual(&judgement.set.effects());
+    let estimate = estimate::estimate(
+        &problem,
+        &judgement.set,
+        &settings.estimate,
+        settings.iterations,
+    );
+    let effects = estimate.set.effects();
     let report = build_report(
         &problem,
         log,
@@ -235,7 +258,10 @@ fn analyze_recording(
             before: &before,
             after: &after,
         },
-        &judgement,
+        Named {
+            judgement: &judgement,
+            estimate: &estimate,
+        },
         Screen {
             candidates: &candidates,
             selection: &selection,
@@ -381,6 +407,12 @@ struct Residuals<'a> {
     after: &'a [Channels],
 }
 
+/// The effects named: as the evidence rule judged them (fit part) and as finally estimated.
+struct Named<'a> {
+    judgement: &'a evidence::Judgement,
+    estimate: &'a Estimate,
+}
+
 /// What the screen and the fit stage chose and tried.
 struct Screen<'a> {
     candidates: &'a [Candidate],
@@ -438,16 +470,21 @@ fn build_report(
     model_name: &str,
     settings: &AnalysisSettings,
     residuals: Residuals,
-    judgement: &evidence::Judgement,
+    named: Named,
     screen: Screen,
 ) -> Report {
+    let Named {
+        judgement,
+        estimate,
+    } = named;
     let fit_rows = 0..problem.split;
     let heldout_rows = problem.split..problem.rows();
-    let effects = judgement.set.effects();
+    let effects = estimate.set.effects();
+    let fit_part = judgement.set.effects();
     let nominal_sse = problem.whitened_sse(residuals.before, fit_rows.clone());
     let fitted_sse = problem.whitened_sse(residuals.after, fit_rows.clone());
     let shares = explained_fractions(&judgement.evidence, nominal_sse, fitted_sse);
-    let errors = effects_from(&judgement.set.parameters, &judgement.standard_errors);
+    let errors = effects_from(&estimate.set.parameters, &estimate.standard_errors);
     let effect_reports = judgement
         .evidence
         .iter()
@@ -464,6 +501,9 @@ fn build_report(
                     .all(|(_, v)| v.numbers().iter().all(|x| x.is_finite()));
                 finite.then(|| values.into_iter().collect())
             }),
+            fit_part_parameters: fit_part
+                .parameters(evidence.id)
+                .expect("a named effect is in the judged set"),
             description: describe(evidence.id, &effects),
             explained_fraction: share,
             evidence: evidence.clone(),
@@ -494,6 +534,9 @@ fn build_report(
             t_start: t(0),
             t_end: t(fit_rows.end - 1),
         },
+        estimate_downweighted_fraction: estimate.downweighted_fraction,
+        command_limits: (problem.recording.samples.rows_held() > 0)
+            .then_some(problem.recording.command_limits),
         rate_frame: RateFrameReport {
             used: problem.recording.rate_frame,
             body_rms: problem.recording.rate_frame_errors.0,

@@ -26,7 +26,7 @@ use serde::Serialize;
 
 use crate::fit::FittedSet;
 use crate::problem::{Channels, Problem};
-use crate::refine::standard_errors;
+use crate::refine::{FitRows, standard_errors};
 use crate::selection::trimmed_gain;
 
 /// The thresholds of the rule (recorded in the output).
@@ -99,7 +99,7 @@ fn scores(problem: &Problem, set: &FittedSet, block_rows: usize) -> Scores {
 
 /// The integrated autocorrelation of a residual over lags up to `lags`, averaged over channels
 /// (at least 1).
-fn autocorrelation_factor(problem: &Problem, residual: &[Channels], lags: usize) -> f64 {
+pub(crate) fn autocorrelation_factor(problem: &Problem, residual: &[Channels], lags: usize) -> f64 {
     let mut total = 0.0;
     for c in 0..problem.channels {
         let r: Vec<f64> = residual.iter().map(|x| x[c]).collect();
@@ -323,7 +323,7 @@ pub fn apply(
                     problem,
                     &set.parameters,
                     &set.values,
-                    0..problem.split,
+                    &FitRows::plain(0..problem.split),
                     judge.noise.autocorrelation * judge.noise.variance,
                 );
                 return Judgement {

@@ -10,8 +10,8 @@ use serde::Serialize;
 use crate::library::{Candidate, CandidateId};
 use crate::problem::{Channels, Problem};
 use crate::refine::{
-    Parameter, effect_column, effects_from, levenberg_marquardt, profile_search, profile_wind,
-    unit_drag_in_wind,
+    FitRows, Parameter, effect_column, effects_from, levenberg_marquardt, profile_search,
+    profile_wind, unit_drag_in_wind,
 };
 use crate::selection::{Design, Selection};
 
@@ -60,7 +60,7 @@ impl FittedSet {
             problem,
             &self.parameters,
             &self.values,
-            0..problem.split,
+            &FitRows::plain(0..problem.split),
             iterations,
         );
         self.values = values;

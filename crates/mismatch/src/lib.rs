@@ -32,9 +32,11 @@
 #![allow(clippy::needless_range_loop)]
 
 mod analysis;
+pub mod command_samples;
 pub mod demo;
 mod describe;
 mod error;
+pub mod estimate;
 pub mod evidence;
 mod fit;
 pub mod fleet;
@@ -61,7 +63,7 @@ pub use output::{
 };
 pub use problem::{CHANNEL_NAMES, Channels, Problem};
 pub use recording::Recording;
-pub use refine::{Parameter, effects_from, levenberg_marquardt};
+pub use refine::{FitRows, Parameter, effects_from, levenberg_marquardt};
 pub use selection::{
     Design, Selection, SelectionSettings, stability_selection, stepwise, trimmed_gain,
 };

@@ -136,7 +136,8 @@ fn subtract(recording: &mut Recording, reaction: &mut NoiseReaction, noises: &[(
     let actuators = reaction.gains.len();
     let rows = recording.len() as f64;
     let mut squares = reaction.removed_rms.map(|r| r * r * rows);
-    for (k, command) in recording.commands.iter_mut().enumerate() {
+    let mut commands = recording.commands.clone();
+    for (k, command) in commands.iter_mut().enumerate() {
         for i in 0..actuators {
             let removed: f64 = noises
                 .iter()
@@ -151,6 +152,7 @@ fn subtract(recording: &mut Recording, reaction: &mut NoiseReaction, noises: &[(
             squares[i] += removed * removed;
         }
     }
+    recording.set_commands(commands);
     reaction.removed_rms = squares.map(|s| (s / rows).sqrt());
 }
 

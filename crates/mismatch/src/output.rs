@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use physics::CommandLogging;
 use report::mismatch::recording::{
-    CandidateLine, CommandSampling, EvidenceLine, EvidenceRule, NamedEffect, RecordingView,
-    ResidualFigure, TermLine,
+    CandidateLine, CommandSampling, EstimateLine, EvidenceLine, EvidenceRule, NamedEffect,
+    RecordingView, ResidualFigure, TermLine,
 };
 
 use crate::analysis::{Analysis, check_finite};
@@ -164,6 +164,11 @@ impl Analysis {
             timing: report.selection.alternatives.timing.as_ref(),
             fit: &report.fit,
             command_sampling: self.command_sampling(),
+            rows_at_limit: self.problem.recording.samples.rows_held(),
+            estimate: EstimateLine {
+                huber_threshold: settings.estimate.huber_threshold,
+                downweighted_fraction: report.estimate_downweighted_fraction,
+            },
         }
     }
 

@@ -7,6 +7,7 @@ use data::{FlightLog, RateFrame};
 use physics::vector::{Mat3, Vec3, mat_t_vec};
 use physics::{CommandLogging, NominalModel};
 
+use crate::command_samples::{ActuatorLimits, CommandSamples, SampleDomain, detect_limits};
 use crate::error::{MismatchError, Result};
 use crate::noise_reaction::{self, NoiseReaction};
 use crate::weak_form::white_noise_sigma;
@@ -35,6 +36,12 @@ pub struct Recording {
     pub command_spread: [f64; 4],
     /// The rate of the commands a row averages, Hz (when known).
     pub command_rate_hz: Option<f64>,
+    /// The limits the logged commands sit at ([`crate::command_samples`]).
+    pub command_limits: [ActuatorLimits; 4],
+    /// What the model's command is reconstructed through: for instantaneous samples, per-rotor
+    /// thrusts with the runs at a limit continued; otherwise the commands as they are. Kept in step
+    /// with `commands` by [`Recording::set_commands`].
+    pub samples: CommandSamples,
     /// What was removed from sampled commands of a faster controller: their reaction to the
     /// logged attitude and position noise (and, after the analysis's first pass, velocity noise)
     /// that the vehicle did not feel ([`crate::noise_reaction`]).
@@ -101,6 +108,14 @@ impl Recording {
                 command_spread[i] = (per_row - 1.0) * white_noise_sigma(&series).powi(2);
             }
         }
+        let count = model.actuator_count();
+        let command_limits = detect_limits(&commands, count);
+        let samples = match model.logger.command {
+            CommandLogging::Sample => {
+                CommandSamples::new(&commands, count, SampleDomain::of(model), &command_limits)
+            }
+            _ => CommandSamples::plain(&commands, count),
+        };
         let mut recording = Self {
             path: log.path.clone(),
             dt,
@@ -114,10 +129,18 @@ impl Recording {
             commands,
             command_spread,
             command_rate_hz,
+            command_limits,
+            samples,
             noise_reaction: None,
         };
         noise_reaction::remove(&mut recording, &model.logger, model.actuator_count());
         Ok(recording)
+    }
+
+    /// Replaces the commands (corrected ones) and the samples reconstructed through them.
+    pub fn set_commands(&mut self, commands: Vec<[f64; 4]>) {
+        self.samples = self.samples.with_commands(&commands);
+        self.commands = commands;
     }
 
     /// Number of rows.

@@ -104,25 +104,49 @@ pub fn effects_from(parameters: &[Parameter], values: &[f64]) -> Effects {
     e
 }
 
-/// Whitened residual over rows `range`, flattened.
-fn whitened(problem: &Problem, residual: &[Channels], range: std::ops::Range<usize>) -> Vec<f64> {
-    residual[range]
-        .iter()
-        .flat_map(|r| (0..problem.channels).map(move |c| r[c] / problem.noise_floor[c]))
+/// The rows a fit uses, each channel of each row with a weight (all 1 without weights).
+#[derive(Clone, Debug)]
+pub struct FitRows<'a> {
+    pub range: std::ops::Range<usize>,
+    /// Per analysed row (indexed as the problem's rows, not from the range's start).
+    pub weights: Option<&'a [Channels]>,
+}
+
+impl FitRows<'_> {
+    /// Rows `range`, unweighted.
+    pub fn plain(range: std::ops::Range<usize>) -> FitRows<'static> {
+        FitRows {
+            range,
+            weights: None,
+        }
+    }
+}
+
+/// Whitened residual over the fit's rows, each element times the square root of its weight,
+/// flattened.
+fn whitened(problem: &Problem, residual: &[Channels], rows: &FitRows) -> Vec<f64> {
+    rows.range
+        .clone()
+        .flat_map(|k| {
+            (0..problem.channels).map(move |c| {
+                let scale = rows.weights.map_or(1.0, |w| w[k][c].sqrt());
+                scale * residual[k][c] / problem.noise_floor[c]
+            })
+        })
         .collect()
 }
 
-/// The whitened residual on rows `range` of the effects `parameters` take at `values`.
+/// The whitened residual on the fit's rows of the effects `parameters` take at `values`.
 fn whitened_residual(
     problem: &Problem,
     parameters: &[Parameter],
     values: &[f64],
-    range: std::ops::Range<usize>,
+    rows: &FitRows,
 ) -> Vec<f64> {
     whitened(
         problem,
         &problem.residual(&effects_from(parameters, values)),
-        range,
+        rows,
     )
 }
 
@@ -166,17 +190,17 @@ fn normal_matrix(jacobian: &[Vec<f64>]) -> Mat<f64> {
 }
 
 /// Standard errors of fitted `values`: `√diag(scale · (JᵀJ)⁻¹)` with `J` the Jacobian of the
-/// whitened residual on rows `range`, and `scale` the variance of a whitened residual element
-/// times the residual's integrated autocorrelation (neighbouring rows share samples). NaN where
-/// `JᵀJ` is singular.
+/// (weighted) whitened residual on the fit's rows, and `scale` the variance of a whitened residual
+/// element times the residual's integrated autocorrelation (neighbouring rows share samples). NaN
+/// where `JᵀJ` is singular.
 pub fn standard_errors(
     problem: &Problem,
     parameters: &[Parameter],
     values: &[f64],
-    range: std::ops::Range<usize>,
+    rows: &FitRows,
     scale: f64,
 ) -> Vec<f64> {
-    let evaluate = |values: &[f64]| whitened_residual(problem, parameters, values, range.clone());
+    let evaluate = |values: &[f64]| whitened_residual(problem, parameters, values, rows);
     let residual = evaluate(values);
     let jacobian = forward_jacobian(parameters, values, &residual, &evaluate);
     let k = parameters.len();
@@ -195,12 +219,13 @@ pub fn standard_errors(
         .collect()
 }
 
-/// Levenberg–Marquardt with a forward-difference Jacobian and bounds by projection.
+/// Levenberg–Marquardt with a forward-difference Jacobian and bounds by projection, on the
+/// (weighted) whitened residual of the fit's rows.
 pub fn levenberg_marquardt(
     problem: &Problem,
     parameters: &[Parameter],
     initial: &[f64],
-    range: std::ops::Range<usize>,
+    rows: &FitRows,
     iterations: usize,
 ) -> (Vec<f64>, f64) {
     let project = |values: &mut [f64]| {
@@ -210,7 +235,7 @@ pub fn levenberg_marquardt(
     };
     let mut values = initial.to_vec();
     project(&mut values);
-    let evaluate = |values: &[f64]| whitened_residual(problem, parameters, values, range.clone());
+    let evaluate = |values: &[f64]| whitened_residual(problem, parameters, values, rows);
     let mut residual = evaluate(&values);
     let mut sse: f64 = residual.iter().map(|r| r * r).sum();
     let k = parameters.len();

@@ -6,6 +6,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
+use crate::command_samples::CommandSamples;
 
 const DT: f64 = 0.02;
 const ROWS: usize = 2000;
@@ -52,6 +53,8 @@ fn flight(seed: u64) -> (Recording, Commands, Commands, Vec<Vec3>) {
         commands: Vec::new(),
         command_spread: [0.0; 4],
         command_rate_hz: None,
+        command_limits: Default::default(),
+        samples: CommandSamples::plain(&[], 4),
         noise_reaction: None,
     };
     let mut attitude_position_reaction = Vec::new();
@@ -104,6 +107,7 @@ fn flight(seed: u64) -> (Recording, Commands, Commands, Vec<Vec3>) {
         attitude_position_reaction.push(reaction);
         velocity_reaction.push(to_velocity);
     }
+    recording.samples = CommandSamples::plain(&recording.commands, 4);
     let changes = true_velocity
         .windows(2)
         .map(|w| std::array::from_fn(|a| w[1][a] - w[0][a]))

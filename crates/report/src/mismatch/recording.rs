@@ -181,6 +181,18 @@ pub struct RecordingView<'a> {
     pub fit: &'a Fit,
     /// How the commands were logged, as far as it bears on the model side's noise.
     pub command_sampling: CommandSampling,
+    /// Rows whose instantaneous command sample sits at an actuator limit.
+    pub rows_at_limit: usize,
+    /// The final estimate's Huber threshold (robust standard deviations) and the share of the
+    /// residuals it downweighted.
+    pub estimate: EstimateLine,
+}
+
+/// How the reported parameters were estimated after the evidence rule.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EstimateLine {
+    pub huber_threshold: f64,
+    pub downweighted_fraction: f64,
 }
 
 /// Whether each row's command is an instantaneous sample, and of how fast a controller.
@@ -208,6 +220,7 @@ impl RecordingView<'_> {
         self.header_markdown(&mut md);
         self.disagreement_markdown(&mut md);
         self.model_noise_markdown(&mut md);
+        self.limits_markdown(&mut md);
         self.effects_markdown(&mut md);
         self.candidates_markdown(&mut md);
         self.fit_markdown(&mut md);
@@ -320,6 +333,18 @@ impl RecordingView<'_> {
             }
         };
         let _ = writeln!(md);
+    }
+
+    /// A note when instantaneous command samples sit at an actuator limit.
+    fn limits_markdown(&self, md: &mut String) {
+        if self.rows_at_limit == 0 {
+            return;
+        }
+        let _ = writeln!(
+            md,
+            "\n**Actuators at a limit.** On {} rows a motor command sits at a limit of its range. Between the samples the model's command follows each rotor's thrust (the quantity the mixer is linear in), the demand beyond the limit continued from the neighbouring samples and clipped, as the rotor clipped it.",
+            self.rows_at_limit
+        );
     }
 
     /// The evidence rule, the effects named and those not named, what remains unexplained.
@@ -442,8 +467,13 @@ impl RecordingView<'_> {
         let _ = writeln!(md, "\n## Does the fit improve?\n");
         let _ = writeln!(
             md,
-            "The parameters were fitted on {:.1}–{:.1} s and checked on the held-out {:.1}–{:.1} s.\n",
-            fit.t_start, fit.t_end, fit.heldout.t_start, fit.heldout.t_end
+            "The effects were chosen with parameters fitted on {:.1}–{:.1} s and checked on the held-out {:.1}–{:.1} s (the table). The parameters reported above were then estimated on the whole recording, residuals beyond {} robust standard deviations counting linearly (Huber's loss; {:.1}% of the residuals were downweighted).\n",
+            fit.t_start,
+            fit.t_end,
+            fit.heldout.t_start,
+            fit.heldout.t_end,
+            self.estimate.huber_threshold,
+            100.0 * self.estimate.downweighted_fraction
         );
         let _ = writeln!(
             md,
@@ -585,6 +615,11 @@ mod tests {
                 steps_per_row: 10.0,
                 removed: "attitude, position and velocity",
             },
+            rows_at_limit: 12,
+            estimate: EstimateLine {
+                huber_threshold: 2.5,
+                downweighted_fraction: 0.0625,
+            },
         };
         let md = view.markdown();
         for line in [
@@ -598,7 +633,8 @@ mod tests {
             "- unexplained residual on vdot_x, 2.0–2.8 s\n",
             "- linear_drag (`drag_x` = −v_x [m/s]): 88%, kept\n",
             "noise-normalised fit errors: {\"both\":1.25,\"delay\":1.5,\"motor_lag\":2.0}. The smallest",
-            "The parameters were fitted on 0.2–14.0 s and checked on the held-out 14.0–20.0 s.\n",
+            "The effects were chosen with parameters fitted on 0.2–14.0 s and checked on the held-out 14.0–20.0 s (the table). The parameters reported above were then estimated on the whole recording, residuals beyond 2.5 robust standard deviations counting linearly (Huber's loss; 6.2% of the residuals were downweighted).\n",
+            "\n**Actuators at a limit.** On 12 rows a motor command sits at a limit of its range.",
             "| fit | 0.50000 | 0.12500 | 75.0% |\n| held out | 0.40000 | 0.20000 | 50.0% |\n",
             "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is 12% on vdot_y.",
             "samples of a controller 10 times faster than the log",
@@ -640,6 +676,11 @@ mod tests {
             timing: None,
             fit: &fit,
             command_sampling: CommandSampling::NotSampled,
+            rows_at_limit: 0,
+            estimate: EstimateLine {
+                huber_threshold: 2.5,
+                downweighted_fraction: 0.0,
+            },
         };
         let md = view.markdown();
         assert!(md.contains("The `w` column was read in the body frame: "));
@@ -653,5 +694,6 @@ mod tests {
         assert!(md.contains("\nWith the effects named, no stretch of the flight disagrees by more than 2.5 times the noise floor.\n"));
         assert!(!md.contains("command-rate"));
         assert!(!md.contains("Noise on the model's side"));
+        assert!(!md.contains("Actuators at a limit"));
     }
 }

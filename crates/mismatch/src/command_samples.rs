@@ -1,0 +1,332 @@
+//! The samples a sampled command is reconstructed through, and the actuator limits the log shows.
+//!
+//! A mixer turns the controller's wrench into per-rotor thrusts, linear in the wrench and smooth
+//! when it is; the speeds it commands are their square roots, which bend sharply where a thrust
+//! nears zero. A rotor at a limit holds one command while the demand behind it goes beyond. So a
+//! logged speed is reconstructed through its per-rotor thrust, the squared speed the model's mixer
+//! is linear in ([`SampleDomain::SquaredSpeed`]), and a run of samples held at a limit is first
+//! replaced by the smoothest continuation of its neighbours (least third differences) beyond the
+//! limit; the curve through the samples is then clipped to the limits, as the rotor clipped the
+//! demand. Commands held or averaged over the log period are used as logged
+//! ([`crate::forward`]).
+
+use faer::Mat;
+use faer::linalg::solvers::Solve;
+use physics::{NominalModel, ThrustSource};
+use serde::Serialize;
+
+/// A value held on at least this many rows, at the extreme of its column, is an actuator limit
+/// (a smooth signal does not repeat its extreme exactly).
+pub const MIN_ROWS_AT_LIMIT: usize = 3;
+/// Known samples on each side of a run at a limit that its continuation is fitted to.
+const PAD: usize = 4;
+/// The longest run solved as one; a longer run is continued from each end over this many samples.
+const MAX_RUN: usize = 64;
+
+/// The quantity a sampled command is interpolated in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SampleDomain {
+    /// The logged command itself (a collective-thrust setpoint).
+    Command,
+    /// The square of a normalised motor speed: the per-rotor thrust a mixer is linear in.
+    SquaredSpeed,
+}
+
+impl SampleDomain {
+    /// The domain of a model's actuator commands.
+    pub fn of(model: &NominalModel) -> Self {
+        match model.thrust_source {
+            ThrustSource::Mixer => Self::SquaredSpeed,
+            ThrustSource::ThrustSetpoint => Self::Command,
+        }
+    }
+
+    fn to_domain(self, command: f64) -> f64 {
+        match self {
+            Self::Command => command,
+            Self::SquaredSpeed => command.max(0.0).powi(2),
+        }
+    }
+
+    fn to_command(self, value: f64) -> f64 {
+        match self {
+            Self::Command => value,
+            Self::SquaredSpeed => value.max(0.0).sqrt(),
+        }
+    }
+}
+
+/// The limits one actuator's logged command sits at (in the command's units), with how many rows
+/// sit there.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ActuatorLimits {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lower: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub upper: Option<f64>,
+    pub rows_at_limit: usize,
+}
+
+/// Where a logged sample sits: inside the range, or held at a limit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Held {
+    Inside,
+    Lower,
+    Upper,
+}
+
+/// The limits of the first `count` actuators: an extreme of a column held on at least
+/// [`MIN_ROWS_AT_LIMIT`] rows (none for a constant column).
+pub fn detect_limits(commands: &[[f64; 4]], count: usize) -> [ActuatorLimits; 4] {
+    let mut limits = [ActuatorLimits::default(); 4];
+    for (i, limit) in limits.iter_mut().enumerate().take(count) {
+        let column = || commands.iter().map(|c| c[i]);
+        let low = column().fold(f64::INFINITY, f64::min);
+        let high = column().fold(f64::NEG_INFINITY, f64::max);
+        if !(low.is_finite() && high.is_finite() && high > low) {
+            continue;
+        }
+        let at = |value: f64| column().filter(|&c| c == value).count();
+        let (at_low, at_high) = (at(low), at(high));
+        if at_low >= MIN_ROWS_AT_LIMIT {
+            limit.lower = Some(low);
+            limit.rows_at_limit += at_low;
+        }
+        if at_high >= MIN_ROWS_AT_LIMIT {
+            limit.upper = Some(high);
+            limit.rows_at_limit += at_high;
+        }
+    }
+    limits
+}
+
+/// The samples of a recording's commands in the domain they are interpolated in, runs at a limit
+/// continued beyond it, and the limits in that domain.
+#[derive(Clone, Debug)]
+pub struct CommandSamples {
+    pub values: Vec<[f64; 4]>,
+    pub count: usize,
+    pub domain: SampleDomain,
+    /// Per actuator, the range the reconstruction is clipped to (in the domain).
+    pub range: [(f64, f64); 4],
+    /// Per row and actuator, whether the logged sample was held at a limit.
+    held: Vec<[Held; 4]>,
+}
+
+impl CommandSamples {
+    /// The commands as they are, without limits (commands held or averaged over the log period).
+    pub fn plain(commands: &[[f64; 4]], count: usize) -> Self {
+        Self {
+            values: commands.to_vec(),
+            count,
+            domain: SampleDomain::Command,
+            range: [(f64::NEG_INFINITY, f64::INFINITY); 4],
+            held: vec![[Held::Inside; 4]; commands.len()],
+        }
+    }
+
+    /// The samples of the logged commands in `domain`, those held at a limit continued beyond it.
+    pub fn new(
+        logged: &[[f64; 4]],
+        count: usize,
+        domain: SampleDomain,
+        limits: &[ActuatorLimits; 4],
+    ) -> Self {
+        let mut range = [(f64::NEG_INFINITY, f64::INFINITY); 4];
+        for i in 0..count {
+            let floor = if domain == SampleDomain::SquaredSpeed {
+                0.0
+            } else {
+                f64::NEG_INFINITY
+            };
+            range[i] = (
+                limits[i].lower.map_or(floor, |l| domain.to_domain(l)),
+                limits[i]
+                    .upper
+                    .map_or(f64::INFINITY, |u| domain.to_domain(u)),
+            );
+        }
+        let held = logged
+            .iter()
+            .map(|c| {
+                std::array::from_fn(|i| match (limits[i].lower, limits[i].upper) {
+                    _ if i >= count => Held::Inside,
+                    (Some(l), _) if c[i] == l => Held::Lower,
+                    (_, Some(u)) if c[i] == u => Held::Upper,
+                    _ => Held::Inside,
+                })
+            })
+            .collect();
+        let samples = Self {
+            values: Vec::new(),
+            count,
+            domain,
+            range,
+            held,
+        };
+        samples.with_commands(logged)
+    }
+
+    /// The same limits and held samples with other values of the commands (corrected ones): the
+    /// samples held at a limit are continued from the new values around them.
+    pub fn with_commands(&self, commands: &[[f64; 4]]) -> Self {
+        let mut values: Vec<[f64; 4]> = commands
+            .iter()
+            .map(|c| c.map(|v| self.domain.to_domain(v)))
+            .collect();
+        for i in 0..self.count {
+            let held: Vec<Held> = self.held.iter().map(|h| h[i]).collect();
+            if held.iter().all(|h| *h == Held::Inside) {
+                continue;
+            }
+            let mut column: Vec<f64> = values.iter().map(|v| v[i]).collect();
+            continue_runs(&mut column, &held, self.range[i]);
+            for (v, c) in values.iter_mut().zip(column) {
+                v[i] = c;
+            }
+        }
+        Self {
+            values,
+            count: self.count,
+            domain: self.domain,
+            range: self.range,
+            held: self.held.clone(),
+        }
+    }
+
+    /// The rows whose logged command was held at a limit by some actuator.
+    pub fn rows_held(&self) -> usize {
+        self.held
+            .iter()
+            .filter(|h| h.iter().any(|&x| x != Held::Inside))
+            .count()
+    }
+
+    /// A value interpolated between samples, back in the command's units: clipped to the range
+    /// first, as the actuator clipped the demand.
+    pub fn command(&self, actuator: usize, value: f64) -> f64 {
+        let (low, high) = self.range[actuator];
+        self.domain.to_command(value.max(low).min(high))
+    }
+}
+
+/// Replaces each run of samples held at a limit by the continuation of its neighbours that
+/// minimises the sum of squared third differences, kept beyond the limit.
+fn continue_runs(column: &mut [f64], held: &[Held], (low, high): (f64, f64)) {
+    let n = column.len();
+    let mut k = 0;
+    while k < n {
+        if held[k] == Held::Inside {
+            k += 1;
+            continue;
+        }
+        let side = held[k];
+        let start = k;
+        while k < n && held[k] == side {
+            k += 1;
+        }
+        let beyond = |v: f64| match side {
+            Held::Lower => v.min(low),
+            _ => v.max(high),
+        };
+        if k - start <= MAX_RUN {
+            continue_segment(column, start, k, beyond);
+        } else {
+            continue_segment(column, start, start + MAX_RUN / 2, beyond);
+            continue_segment(column, k - MAX_RUN / 2, k, beyond);
+            // The middle is far from any sample inside the range: as extreme as its ends.
+            let fill = match side {
+                Held::Lower => column[start + MAX_RUN / 2 - 1].min(column[k - MAX_RUN / 2]),
+                _ => column[start + MAX_RUN / 2 - 1].max(column[k - MAX_RUN / 2]),
+            };
+            column[start + MAX_RUN / 2..k - MAX_RUN / 2].fill(fill);
+        }
+    }
+}
+
+/// Third-difference weights.
+const THIRD_DIFFERENCE: [f64; 4] = [-1.0, 3.0, -3.0, 1.0];
+
+/// The unknowns `[start, end)` of `column` that minimise the squared third differences over the
+/// segment with [`PAD`] samples on each side, mapped by `beyond`; left as they are when the segment
+/// is too short to determine them.
+fn continue_segment(column: &mut [f64], start: usize, end: usize, beyond: impl Fn(f64) -> f64) {
+    let first = start.saturating_sub(PAD);
+    let last = (end + PAD).min(column.len());
+    let unknowns = end - start;
+    let order = THIRD_DIFFERENCE.len() - 1;
+    if last - first < unknowns + order || unknowns == 0 {
+        return;
+    }
+    let mut normal = Mat::<f64>::zeros(unknowns, unknowns);
+    let mut right = Mat::<f64>::zeros(unknowns, 1);
+    for row in first..last - order {
+        let mut known = 0.0;
+        let mut terms = [(0usize, 0.0f64); 4];
+        let mut count = 0;
+        for (m, weight) in THIRD_DIFFERENCE.iter().enumerate() {
+            let index = row + m;
+            if (start..end).contains(&index) {
+                terms[count] = (index - start, *weight);
+                count += 1;
+            } else {
+                known += weight * column[index];
+            }
+        }
+        for &(p, wp) in &terms[..count] {
+            right[(p, 0)] -= wp * known;
+            for &(q, wq) in &terms[..count] {
+                normal[(p, q)] += wp * wq;
+            }
+        }
+    }
+    let solution = normal.full_piv_lu().solve(&right);
+    for u in 0..unknowns {
+        let value = solution[(u, 0)];
+        if value.is_finite() {
+            column[start + u] = beyond(value);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_repeated_extreme_is_a_limit_and_a_smooth_extreme_is_not() {
+        let smooth: Vec<[f64; 4]> = (0..200)
+            .map(|k| [(k as f64 * 0.1).sin(), 0.5, 0.0, 0.0])
+            .collect();
+        let limits = detect_limits(&smooth, 2);
+        assert_eq!(limits[0], ActuatorLimits::default());
+        assert_eq!(limits[1], ActuatorLimits::default(), "a constant column");
+        let clipped: Vec<[f64; 4]> = smooth
+            .iter()
+            .map(|c| [c[0].clamp(-0.8, 0.9), 0.0, 0.0, 0.0])
+            .collect();
+        let limits = detect_limits(&clipped, 1);
+        assert_eq!((limits[0].lower, limits[0].upper), (Some(-0.8), Some(0.9)));
+        assert!(limits[0].rows_at_limit > 20);
+    }
+
+    /// A demand that dips below zero, logged as speeds clipped at zero: continued through its
+    /// squares, the dip is recovered beyond the limit (the squared speeds are a parabola here, which
+    /// least third differences continue exactly).
+    #[test]
+    fn a_run_at_a_limit_is_continued_beyond_it() {
+        let demand = |k: usize| 0.04 * (k as f64 - 20.0).powi(2) - 1.0;
+        let logged: Vec<[f64; 4]> = (0..40)
+            .map(|k| [demand(k).max(0.0).sqrt(), 0.0, 0.0, 0.0])
+            .collect();
+        let limits = detect_limits(&logged, 1);
+        assert_eq!(limits[0].lower, Some(0.0));
+        let samples = CommandSamples::new(&logged, 1, SampleDomain::SquaredSpeed, &limits);
+        for k in 16..25 {
+            assert!((samples.values[k][0] - demand(k)).abs() < 1e-9, "row {k}");
+        }
+        assert_eq!(samples.command(0, -0.3), 0.0);
+        assert!((samples.command(0, 0.25) - 0.5).abs() < 1e-12);
+    }
+}

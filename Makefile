@@ -71,7 +71,7 @@ bench: data build
 # every simulator/logger configuration of experiments/mismatch/demo.json: the matrix), then every
 # real flight analysed together (one vehicle, one air velocity per flight; the known wind speeds only
 # checked). Writes results/mismatch/{summary.md,summary.json,neural-fly.json,neural-fly.md,neural-fly.svg}.
-# Takes about 15 minutes on 2 cores (the matrix about 8, the joint analysis about 6).
+# Takes about 10 minutes on 2 cores (the matrix about 6, the joint analysis about 4).
 mismatch-demo: data build
 	$(LEARN) mismatch --demo experiments/mismatch/demo.json --work target/mismatch-demo --out results/mismatch --force
 	$(LEARN) mismatch --flights experiments/conditions.json --model experiments/mismatch/neural-fly.json --out results/mismatch --force

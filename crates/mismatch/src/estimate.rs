@@ -15,6 +15,7 @@ use serde::Serialize;
 
 use crate::evidence::autocorrelation_factor;
 use crate::fit::FittedSet;
+use crate::noise_reaction::median;
 use crate::problem::{Channels, Problem};
 use crate::refine::{FitRows, levenberg_marquardt, standard_errors};
 
@@ -113,7 +114,7 @@ fn huber_weights(
             .iter()
             .map(|r| (r[c] / problem.noise_floor[c]).abs())
             .collect();
-        let sigma = median(&scaled) / 0.6745;
+        let sigma = median(scaled.clone()) / 0.6745;
         if !(sigma.is_finite() && sigma > 0.0) {
             continue;
         }
@@ -127,31 +128,4 @@ fn huber_weights(
         }
     }
     weights
-}
-
-/// The median of finite values (0 for none).
-fn median(values: &[f64]) -> f64 {
-    let mut sorted: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
-    if sorted.is_empty() {
-        return 0.0;
-    }
-    sorted.sort_by(f64::total_cmp);
-    let mid = sorted.len() / 2;
-    if sorted.len() % 2 == 1 {
-        sorted[mid]
-    } else {
-        0.5 * (sorted[mid - 1] + sorted[mid])
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn medians_of_odd_and_even_counts() {
-        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
-        assert_eq!(median(&[f64::NAN]), 0.0);
-    }
 }

@@ -257,7 +257,8 @@ fn least_squares(
         .then_some(gains)
 }
 
-fn median(mut values: Vec<f64>) -> f64 {
+/// The median (the upper one of an even count; 0 for none).
+pub(crate) fn median(mut values: Vec<f64>) -> f64 {
     if values.is_empty() {
         return 0.0;
     }

@@ -17,12 +17,14 @@
 //! Method in one paragraph (the long version: `docs/mismatch.md`): the recording and the model are
 //! compared in the weak form ([`weak_form`]: the recorded velocity and body rate against the model's
 //! acceleration through the same smooth test function), the model's commands reconstructed as its
-//! logger says ([`forward`]); sampled commands of a faster controller first lose their unfelt reaction
-//! to the logged noise ([`noise_reaction`]). Candidates are screened by forward stepwise selection with blocked
-//! cross-validation and kept by stability selection over block-bootstrap resamples; their parameters
-//! are fitted jointly with the exact model on the first part of the recording; each effect is then
-//! named only when the evidence rule holds for it ([`evidence`]). Several flights of one vehicle are
-//! analysed together by [`fleet`].
+//! logger says ([`forward`]; instantaneous samples of a mixer's speeds through the per-rotor thrust,
+//! runs at an actuator limit continued beyond it: [`command_samples`]); sampled commands of a faster
+//! controller first lose their unfelt reaction to the logged noise ([`noise_reaction`]). Candidates are
+//! screened by forward stepwise selection with blocked cross-validation and kept by stability
+//! selection over block-bootstrap resamples; their parameters are fitted jointly with the exact model
+//! on the first part of the recording; each effect is then named only when the evidence rule holds
+//! for it ([`evidence`]), and the named effects' parameters are estimated again on all rows with
+//! robust weights ([`estimate`]). Several flights of one vehicle are analysed together by [`fleet`].
 //!
 //! Names: every effect is named by a [`physics::EffectId`] (its spelling, `linear_drag` …, is what
 //! the outputs print); the candidates of the library by a [`CandidateId`] (an effect, or the timing

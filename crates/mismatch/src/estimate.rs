@@ -8,7 +8,7 @@
 //! log cannot reconstruct (a command that steps between two samples, so that no sample says when)
 //! then stop pulling the parameters, and on the rows that fit the estimate stays least squares.
 //!
-//! The standard errors have the form of the fit part's ([`crate::refine::standard_errors`]) with
+//! The standard errors have the form of the fit part's (`refine::standard_errors`) with
 //! the weighted residual and Jacobian on all rows: `√diag(κ s² (JᵀWJ)⁻¹)`.
 
 use serde::Serialize;

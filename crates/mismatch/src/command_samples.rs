@@ -209,6 +209,14 @@ impl CommandSamples {
         let (low, high) = self.range[actuator];
         self.domain.to_command(value.max(low).min(high))
     }
+
+    /// [`CommandSamples::command`] of every actuator of an interpolated value (the others kept).
+    pub fn commands(&self, mut values: [f64; 4]) -> [f64; 4] {
+        for (i, value) in values.iter_mut().enumerate().take(self.count) {
+            *value = self.command(i, *value);
+        }
+        values
+    }
 }
 
 /// Replaces each run of samples held at a limit by the continuation of its neighbours that

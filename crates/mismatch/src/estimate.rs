@@ -62,7 +62,8 @@ pub fn estimate(
             downweighted_fraction: 0.0,
         };
     }
-    let mut weights = huber_weights(problem, &problem.residual(&set.effects()), settings);
+    let mut residual = problem.residual(&set.effects());
+    let mut weights = huber_weights(problem, &residual, settings);
     for _ in 0..settings.passes {
         let rows = FitRows {
             range: all.clone(),
@@ -70,9 +71,9 @@ pub fn estimate(
         };
         set.values =
             levenberg_marquardt(problem, &set.parameters, &set.values, &rows, iterations).0;
-        weights = huber_weights(problem, &problem.residual(&set.effects()), settings);
+        residual = problem.residual(&set.effects());
+        weights = huber_weights(problem, &residual, settings);
     }
-    let residual = problem.residual(&set.effects());
     let weighted: Vec<Channels> = residual
         .iter()
         .zip(&weights)

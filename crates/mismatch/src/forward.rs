@@ -312,10 +312,7 @@ pub fn actuator_trace(
         _ => 0.0,
     };
     let shift = logger.command_time_offset_s + hold + delay;
-    let mut state = reconstruction.mean(-shift, h - shift);
-    for i in 0..count {
-        state[i] = samples.command(i, state[i]);
-    }
+    let mut state = samples.commands(reconstruction.mean(-shift, h - shift));
     let decay_full = if lag > 0.0 { (-h / lag).exp() } else { 0.0 };
     let decay_half = if lag > 0.0 {
         (-h / (2.0 * lag)).exp()
@@ -337,10 +334,7 @@ pub fn actuator_trace(
                         value[i] += w * p[i];
                     }
                 }
-                for i in 0..count {
-                    value[i] = samples.command(i, value[i]);
-                }
-                value
+                samples.commands(value)
             }
             None => reconstruction.mean(start, start + h),
         };

@@ -133,7 +133,7 @@ impl Recording {
             samples,
             noise_reaction: None,
         };
-        noise_reaction::remove(&mut recording, &model.logger, model.actuator_count());
+        noise_reaction::remove(&mut recording, &model.logger, count);
         Ok(recording)
     }
 

@@ -80,6 +80,10 @@ pub struct EffectReport {
     /// The parameters fitted on the fit part only, with which the evidence rule judged the effect
     /// and the held-out part checked it.
     pub fit_part_parameters: EffectParameters,
+    /// The bias the unfelt reaction to the gyro noise left, measured and subtracted from
+    /// `parameters` ([`crate::simex`]); absent when the commands carry no such reaction.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rate_noise_bias: Option<EffectParameters>,
     pub description: String,
     /// This effect's share of the nominal model's noise-normalised residual sum of squares (fit
     /// part) that the fitted effects remove, in [0, 1]; the shares sum to the total removed.
@@ -122,6 +126,8 @@ pub struct Report {
     pub fit: Fit,
     /// Share of the (row, channel) residuals the final estimate downweighted.
     pub estimate_downweighted_fraction: f64,
+    /// Times (s) of the command steps between samples whose place the final estimate left free.
+    pub estimate_step_times: Vec<f64>,
     /// The limits the logged commands sat at, when any did (instantaneous samples are reconstructed
     /// through them: [`crate::command_samples`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -485,6 +491,10 @@ fn build_report(
     let fitted_sse = problem.whitened_sse(residuals.after, fit_rows.clone());
     let shares = explained_fractions(&judgement.evidence, nominal_sse, fitted_sse);
     let errors = effects_from(&estimate.set.parameters, &estimate.standard_errors);
+    let biases = estimate
+        .rate_noise_bias
+        .as_ref()
+        .map(|b| effects_from(&estimate.set.parameters, &b.bias));
     let effect_reports = judgement
         .evidence
         .iter()
@@ -504,6 +514,7 @@ fn build_report(
             fit_part_parameters: fit_part
                 .parameters(evidence.id)
                 .expect("a named effect is in the judged set"),
+            rate_noise_bias: biases.as_ref().and_then(|b| b.parameters(evidence.id)),
             description: describe(evidence.id, &effects),
             explained_fraction: share,
             evidence: evidence.clone(),
@@ -535,6 +546,7 @@ fn build_report(
             t_end: t(fit_rows.end - 1),
         },
         estimate_downweighted_fraction: estimate.downweighted_fraction,
+        estimate_step_times: estimate.step_times.clone(),
         command_limits: (problem.recording.samples.rows_held() > 0)
             .then_some(problem.recording.command_limits),
         rate_frame: RateFrameReport {

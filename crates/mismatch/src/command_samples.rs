@@ -101,6 +101,10 @@ pub fn detect_limits(commands: &[[f64; 4]], count: usize) -> [ActuatorLimits; 4]
     limits
 }
 
+/// A command step stands out of the sample-to-sample changes by more than this many robust
+/// standard deviations ([`CommandSamples::unplaced_steps`]).
+pub const STEP_SIGMAS: f64 = 5.0;
+
 /// The samples of a recording's commands in the domain they are interpolated in, runs at a limit
 /// continued beyond it, and the limits in that domain.
 #[derive(Clone, Debug)]
@@ -112,6 +116,8 @@ pub struct CommandSamples {
     pub range: [(f64, f64); 4],
     /// Per row and actuator, whether the logged sample was held at a limit.
     held: Vec<[Held; 4]>,
+    /// Whether the values are instantaneous samples (so a step between two says nothing of when).
+    sampled: bool,
 }
 
 impl CommandSamples {
@@ -123,6 +129,7 @@ impl CommandSamples {
             domain: SampleDomain::Command,
             range: [(f64::NEG_INFINITY, f64::INFINITY); 4],
             held: vec![[Held::Inside; 4]; commands.len()],
+            sampled: false,
         }
     }
 
@@ -164,6 +171,7 @@ impl CommandSamples {
             domain,
             range,
             held,
+            sampled: true,
         };
         samples.with_commands(logged)
     }
@@ -192,7 +200,45 @@ impl CommandSamples {
             domain: self.domain,
             range: self.range,
             held: self.held.clone(),
+            sampled: self.sampled,
         }
+    }
+
+    /// The intervals `k` (between rows `k` and `k + 1`) in which an instantaneous sample's command
+    /// steps: some actuator's change over the interval departs from the mean of its neighbours'
+    /// changes by more than [`STEP_SIGMAS`] robust standard deviations of that departure. No
+    /// sample says when within the interval the step came, so the curve through the samples
+    /// misplaces it by up to half a row. Empty for commands held or averaged over the log period.
+    pub fn unplaced_steps(&self) -> Vec<usize> {
+        let n = self.values.len();
+        if !self.sampled || n < 4 {
+            return Vec::new();
+        }
+        let mut steps = vec![false; n - 1];
+        for i in 0..self.count {
+            let departure: Vec<f64> = (1..n - 2)
+                .map(|k| {
+                    let change = |j: usize| self.values[j + 1][i] - self.values[j][i];
+                    change(k) - 0.5 * (change(k - 1) + change(k + 1))
+                })
+                .collect();
+            let magnitude = self.values.iter().map(|v| v[i].abs()).fold(0.0, f64::max);
+            let scale = (1.4826
+                * crate::noise_reaction::median(departure.iter().map(|d| d.abs()).collect()))
+            .max(1e-9 * magnitude);
+            for (k, d) in departure.iter().enumerate() {
+                let inside = (k..k + 4).all(|j| self.held[j][i] == Held::Inside);
+                if inside && d.abs() > STEP_SIGMAS * scale {
+                    steps[k + 1] = true;
+                }
+            }
+        }
+        steps
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| **s)
+            .map(|(k, _)| k)
+            .collect()
     }
 
     /// The rows whose logged command was held at a limit by some actuator.
@@ -336,5 +382,36 @@ mod tests {
         }
         assert_eq!(samples.command(0, -0.3), 0.0);
         assert!((samples.command(0, 0.25) - 0.5).abs() < 1e-12);
+    }
+
+    /// A smooth command with white noise and one step between rows 120 and 121: the step's
+    /// interval is found, nothing else is, and commands held or averaged over the log period have
+    /// no unplaced step.
+    #[test]
+    fn a_command_step_between_samples_is_found() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut noise = || {
+            let u: f64 = rng.random_range(f64::EPSILON..1.0);
+            let v: f64 = rng.random_range(0.0..1.0);
+            0.01 * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+        };
+        let logged: Vec<[f64; 4]> = (0..300)
+            .map(|k| {
+                let step = if k > 120 { 0.3 } else { 0.0 };
+                let smooth = 0.5 + 0.2 * (k as f64 * 0.05).sin();
+                [smooth + step + noise(), 0.5, 0.0, 0.0]
+            })
+            .collect();
+        let limits = detect_limits(&logged, 2);
+        let samples = CommandSamples::new(&logged, 2, SampleDomain::Command, &limits);
+        let steps = samples.unplaced_steps();
+        assert!(steps.contains(&120), "{steps:?}");
+        assert!(steps.iter().all(|k| (119..=121).contains(k)), "{steps:?}");
+        assert!(
+            CommandSamples::plain(&logged, 2)
+                .unplaced_steps()
+                .is_empty()
+        );
     }
 }

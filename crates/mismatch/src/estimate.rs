@@ -8,6 +8,17 @@
 //! log cannot reconstruct (a command that steps between two samples, so that no sample says when)
 //! then stop pulling the parameters, and on the rows that fit the estimate stays least squares.
 //!
+//! A sampled command that steps between two samples says nothing of when within the interval it
+//! stepped, and the curve through the samples misplaces the step by up to half a row. Such steps
+//! are found in the commands alone ([`crate::command_samples::CommandSamples::unplaced_steps`]);
+//! each step's time is a nuisance parameter, profiled out: per channel, the weighted residual's
+//! component along the test functions' value at the step (what moving the step changes) is left
+//! out of the fit. Unlike a robust weight, this does not depend on the noise level: with more
+//! noise, Huber's threshold grows and the rows around a step pulled the parameters more.
+//!
+//! When the commands carry the controller's unfelt reaction to the gyro noise, the bias it leaves
+//! is measured and subtracted ([`crate::simex`]).
+//!
 //! The standard errors have the form of the fit part's (`refine::standard_errors`) with
 //! the weighted residual and Jacobian on all rows: `√diag(κ s² (JᵀWJ)⁻¹)`.
 
@@ -18,6 +29,7 @@ use crate::fit::FittedSet;
 use crate::noise_reaction::median;
 use crate::problem::{Channels, Problem};
 use crate::refine::{FitRows, levenberg_marquardt, standard_errors};
+use crate::simex::{RateNoiseBias, SimexSettings, rate_noise_bias};
 
 /// Settings of the final estimate (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -26,6 +38,8 @@ pub struct EstimateSettings {
     pub huber_threshold: f64,
     /// Reweighting passes.
     pub passes: usize,
+    /// The correction of the bias the unfelt reaction to the rate noise leaves ([`crate::simex`]).
+    pub rate_noise: SimexSettings,
 }
 
 impl Default for EstimateSettings {
@@ -33,6 +47,7 @@ impl Default for EstimateSettings {
         Self {
             huber_threshold: 2.5,
             passes: 4,
+            rate_noise: SimexSettings::default(),
         }
     }
 }
@@ -44,6 +59,11 @@ pub struct Estimate {
     pub standard_errors: Vec<f64>,
     /// Share of the (row, channel) residuals that carry a weight below 1 at the end.
     pub downweighted_fraction: f64,
+    /// The bias removed from the values, when the commands carry an unfelt reaction to the rate
+    /// noise.
+    pub rate_noise_bias: Option<RateNoiseBias>,
+    /// Times of the command steps between samples whose place within their interval was left free.
+    pub step_times: Vec<f64>,
 }
 
 /// Estimates the parameters of `judged` (the evidence rule's set) on all rows with Huber weights.
@@ -60,14 +80,18 @@ pub fn estimate(
             set,
             standard_errors: Vec::new(),
             downweighted_fraction: 0.0,
+            rate_noise_bias: None,
+            step_times: Vec::new(),
         };
     }
     let mut residual = problem.residual(&set.effects());
+    let step_times = step_times(problem);
     let mut weights = huber_weights(problem, &residual, settings);
     for _ in 0..settings.passes {
         let rows = FitRows {
             range: all.clone(),
             weights: Some(&weights),
+            step_times: &step_times,
         };
         set.values =
             levenberg_marquardt(problem, &set.parameters, &set.values, &rows, iterations).0;
@@ -89,8 +113,18 @@ pub fn estimate(
     let rows = FitRows {
         range: all,
         weights: Some(&weights),
+        step_times: &step_times,
     };
-    let standard_errors = standard_errors(problem, &set.parameters, &set.values, &rows, scale);
+    let mut standard_errors = standard_errors(problem, &set.parameters, &set.values, &rows, scale);
+    let rate_noise_bias = rate_noise_bias(problem, &set, &rows, &settings.rate_noise, iterations);
+    if let Some(bias) = &rate_noise_bias {
+        for (j, parameter) in set.parameters.iter().enumerate() {
+            set.values[j] = parameter.clamp(set.values[j] - bias.bias[j]);
+            if bias.standard_error[j].is_finite() {
+                standard_errors[j] = standard_errors[j].hypot(bias.standard_error[j]);
+            }
+        }
+    }
     let downweighted = weights
         .iter()
         .map(|w| w[..problem.channels].iter().filter(|&&v| v < 1.0).count())
@@ -99,6 +133,8 @@ pub fn estimate(
         set,
         standard_errors,
         downweighted_fraction: downweighted as f64 / count,
+        rate_noise_bias,
+        step_times,
     }
 }
 
@@ -129,4 +165,27 @@ fn huber_weights(
         }
     }
     weights
+}
+
+/// The times of the command steps the samples cannot place
+/// ([`crate::command_samples::CommandSamples::unplaced_steps`]): adjacent flagged intervals count
+/// as one step, at the middle of their span.
+fn step_times(problem: &Problem) -> Vec<f64> {
+    let time = &problem.recording.time;
+    let mut times = Vec::new();
+    let mut run: Option<(usize, usize)> = None;
+    for k in problem.recording.samples.unplaced_steps() {
+        run = match run {
+            Some((first, last)) if k == last + 1 => Some((first, k)),
+            Some((first, last)) => {
+                times.push(0.5 * (time[first] + time[last + 1]));
+                Some((k, k))
+            }
+            None => Some((k, k)),
+        };
+    }
+    if let Some((first, last)) = run {
+        times.push(0.5 * (time[first] + time[last + 1]));
+    }
+    times
 }

@@ -130,6 +130,39 @@ pub fn remove_velocity(
     true
 }
 
+/// The change of the corrected commands when `noise` is added to the logged body rate: the unfelt
+/// reaction to it, less the change of the removed reaction to the attitude noise (whose estimate
+/// reads the rates).
+pub fn rate_noise_response(
+    recording: &Recording,
+    reaction: &NoiseReaction,
+    noise: &[Vec3],
+) -> Vec<[f64; 4]> {
+    let states = state_fourth_differences(recording);
+    let before = attitude_noise(recording, &states);
+    let mut perturbed = recording.clone();
+    for (rate, n) in perturbed.body_rate.iter_mut().zip(noise) {
+        for a in 0..3 {
+            rate[a] += n[a];
+        }
+    }
+    let after = attitude_noise(&perturbed, &states);
+    (0..recording.len())
+        .map(|k| {
+            std::array::from_fn(|i| {
+                if i >= reaction.gains.len() {
+                    return 0.0;
+                }
+                let gains = &reaction.gains[i];
+                let response: f64 = (0..3)
+                    .map(|a| gains[a] * noise[k][a] - gains[3 + a] * (after[k][a] - before[k][a]))
+                    .sum();
+                reaction.unfelt_fraction * response
+            })
+        })
+        .collect()
+}
+
 /// Subtracts the unfelt share of the reaction to the given noise (each with the index of its first
 /// state channel) from the commands, and adds its RMS to the record.
 fn subtract(recording: &mut Recording, reaction: &mut NoiseReaction, noises: &[(usize, &[Vec3])]) {

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use physics::CommandLogging;
 use report::mismatch::recording::{
     CandidateLine, CommandSampling, EstimateLine, EvidenceLine, EvidenceRule, NamedEffect,
-    RecordingView, ResidualFigure, TermLine,
+    RateNoiseLine, RecordingView, ResidualFigure, TermLine,
 };
 
 use crate::analysis::{Analysis, check_finite};
@@ -168,6 +168,15 @@ impl Analysis {
             estimate: EstimateLine {
                 huber_threshold: settings.estimate.huber_threshold,
                 downweighted_fraction: report.estimate_downweighted_fraction,
+                steps: report.estimate_step_times.len(),
+                rate_noise: report
+                    .effects
+                    .iter()
+                    .any(|e| e.rate_noise_bias.is_some())
+                    .then_some(RateNoiseLine {
+                        pairs: settings.estimate.rate_noise.pairs,
+                        seed: settings.estimate.rate_noise.seed,
+                    }),
             },
         }
     }

@@ -75,7 +75,7 @@ impl Problem {
             )));
         }
         let channels = if model.predicts_torque() { 6 } else { 3 };
-        let mut target = vec![[0.0; 6]; n - 2 * half];
+        let target = targets(&recording, &weak_form, channels);
         let nominal = if model.logger.command == CommandLogging::Sample {
             Some(predict_at_rows(&recording, &model))
         } else {
@@ -102,9 +102,6 @@ impl Problem {
             } else {
                 recording.body_rate.iter().map(|w| w[c - 3]).collect()
             };
-            for (row, value) in target.iter_mut().zip(weak_form.target(&signal)) {
-                row[c] = value;
-            }
             let measured = white_noise_sigma(&signal) * weak_form.target_noise_gain();
             model_noise[c] = model_side_noise(&recording, &model, nominal.as_ref(), c)
                 * weak_form.model_noise_gain();
@@ -135,6 +132,19 @@ impl Problem {
             model_noise,
             split,
         })
+    }
+
+    /// The same comparison of another recording of the same rows (the target recomputed, the noise
+    /// floor and the split kept).
+    pub fn with_recording(&self, recording: Recording) -> Self {
+        Self {
+            target: targets(&recording, &self.weak_form, self.channels),
+            recording,
+            model: self.model.clone(),
+            weak_form: self.weak_form.clone(),
+            time: self.time.clone(),
+            ..*self
+        }
     }
 
     /// Number of analysed rows.
@@ -205,6 +215,23 @@ impl Problem {
             })
             .sum()
     }
+}
+
+/// The weak-form target of the recorded velocity (translational channels) and body rate.
+fn targets(recording: &Recording, weak_form: &WeakForm, channels: usize) -> Vec<Channels> {
+    let rows = recording.len() - 2 * weak_form.half;
+    let mut target = vec![[0.0; 6]; rows];
+    for c in 0..channels {
+        let signal: Vec<f64> = if c < 3 {
+            recording.velocity.iter().map(|v| v[c]).collect()
+        } else {
+            recording.body_rate.iter().map(|w| w[c - 3]).collect()
+        };
+        for (row, value) in target.iter_mut().zip(weak_form.target(&signal)) {
+            row[c] = value;
+        }
+    }
+    target
 }
 
 /// The noise per sample of the model's acceleration on channel `c`: the measured attitude tilting

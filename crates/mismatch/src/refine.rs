@@ -51,6 +51,11 @@ impl Parameter {
         }
     }
 
+    /// `value` within the admissible range.
+    pub fn clamp(self, value: f64) -> f64 {
+        value.clamp(self.lower_bound(), self.upper_bound())
+    }
+
     /// A typical magnitude, for finite-difference steps.
     fn typical(self) -> f64 {
         match self {
@@ -110,6 +115,10 @@ pub struct FitRows<'a> {
     pub range: std::ops::Range<usize>,
     /// Per analysed row (indexed as the problem's rows, not from the range's start).
     pub weights: Option<&'a [Channels]>,
+    /// Times of command steps whose place within their log interval is unknown: per step and
+    /// channel, the residual's component along the test functions' value at the step is left out
+    /// of the fit (a nuisance parameter, the step's time, profiled out).
+    pub step_times: &'a [f64],
 }
 
 impl FitRows<'_> {
@@ -118,6 +127,7 @@ impl FitRows<'_> {
         FitRows {
             range,
             weights: None,
+            step_times: &[],
         }
     }
 }
@@ -125,7 +135,8 @@ impl FitRows<'_> {
 /// Whitened residual over the fit's rows, each element times the square root of its weight,
 /// flattened.
 fn whitened(problem: &Problem, residual: &[Channels], rows: &FitRows) -> Vec<f64> {
-    rows.range
+    let mut whitened: Vec<f64> = rows
+        .range
         .clone()
         .flat_map(|k| {
             (0..problem.channels).map(move |c| {
@@ -133,7 +144,47 @@ fn whitened(problem: &Problem, residual: &[Channels], rows: &FitRows) -> Vec<f64
                 scale * residual[k][c] / problem.noise_floor[c]
             })
         })
-        .collect()
+        .collect();
+    if !rows.step_times.is_empty() {
+        project_out_steps(problem, rows, &mut whitened);
+    }
+    whitened
+}
+
+/// Removes from a whitened residual, per channel, its components along the (weighted) test
+/// functions' values at each step time: what misplacing a step within its interval changes.
+fn project_out_steps(problem: &Problem, rows: &FitRows, whitened: &mut [f64]) {
+    let channels = problem.channels;
+    for c in 0..channels {
+        let mut basis: Vec<Vec<f64>> = Vec::new();
+        for &t in rows.step_times {
+            let mut column: Vec<f64> = rows
+                .range
+                .clone()
+                .map(|k| {
+                    let weight = rows.weights.map_or(1.0, |w| w[k][c].sqrt());
+                    weight * problem.weak_form.weight(t - problem.time[k])
+                })
+                .collect();
+            for b in &basis {
+                let along: f64 = column.iter().zip(b).map(|(x, y)| x * y).sum();
+                column.iter_mut().zip(b).for_each(|(x, y)| *x -= along * y);
+            }
+            let norm = column.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norm > 1e-12 {
+                column.iter_mut().for_each(|x| *x /= norm);
+                basis.push(column);
+            }
+        }
+        for b in &basis {
+            let along: f64 = (0..b.len())
+                .map(|i| b[i] * whitened[i * channels + c])
+                .sum();
+            for (i, x) in b.iter().enumerate() {
+                whitened[i * channels + c] -= along * x;
+            }
+        }
+    }
 }
 
 /// The whitened residual on the fit's rows of the effects `parameters` take at `values`.
@@ -230,7 +281,7 @@ pub fn levenberg_marquardt(
 ) -> (Vec<f64>, f64) {
     let project = |values: &mut [f64]| {
         for (v, p) in values.iter_mut().zip(parameters) {
-            *v = v.clamp(p.lower_bound(), p.upper_bound());
+            *v = p.clamp(*v);
         }
     };
     let mut values = initial.to_vec();

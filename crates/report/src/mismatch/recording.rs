@@ -193,6 +193,18 @@ pub struct RecordingView<'a> {
 pub struct EstimateLine {
     pub huber_threshold: f64,
     pub downweighted_fraction: f64,
+    /// Command steps between samples whose time within their interval was left free.
+    pub steps: usize,
+    /// When the bias the unfelt reaction to the gyro noise leaves was removed: the pairs of draws
+    /// that measured it and their seed.
+    pub rate_noise: Option<RateNoiseLine>,
+}
+
+/// How the rate-noise bias was measured (SIMEX).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RateNoiseLine {
+    pub pairs: usize,
+    pub seed: u64,
 }
 
 /// Whether each row's command is an instantaneous sample, and of how fast a controller.
@@ -475,6 +487,19 @@ impl RecordingView<'_> {
             self.estimate.huber_threshold,
             100.0 * self.estimate.downweighted_fraction
         );
+        if self.estimate.steps > 0 {
+            let _ = writeln!(
+                md,
+                "The commands step between two samples {} time(s); no sample says when within the interval, so each step's time was left free (`estimate_step_times` in `mismatch.json`).\n",
+                self.estimate.steps
+            );
+        }
+        if let Some(RateNoiseLine { pairs, seed }) = self.estimate.rate_noise {
+            let _ = writeln!(
+                md,
+                "The commands carry the controller's reaction to the gyro noise, which the vehicle felt for one control step in a row, and it biases the parameters. Adding that noise once more with its reaction ({pairs} pairs of draws, seed {seed}) measured the bias, and it was subtracted (simulation and extrapolation; `rate_noise_bias` in `mismatch.json`).\n"
+            );
+        }
         let _ = writeln!(
             md,
             "| part | MSE nominal | MSE with effects | reduction |\n|---|---|---|---|"
@@ -619,6 +644,8 @@ mod tests {
             estimate: EstimateLine {
                 huber_threshold: 2.5,
                 downweighted_fraction: 0.0625,
+                steps: 3,
+                rate_noise: Some(RateNoiseLine { pairs: 4, seed: 7 }),
             },
         };
         let md = view.markdown();
@@ -634,6 +661,8 @@ mod tests {
             "- linear_drag (`drag_x` = −v_x [m/s]): 88%, kept\n",
             "noise-normalised fit errors: {\"both\":1.25,\"delay\":1.5,\"motor_lag\":2.0}. The smallest",
             "The effects were chosen with parameters fitted on 0.2–14.0 s and checked on the held-out 14.0–20.0 s (the table). The parameters reported above were then estimated on the whole recording, residuals beyond 2.5 robust standard deviations counting linearly (Huber's loss; 6.2% of the residuals were downweighted).\n",
+            "Adding that noise once more with its reaction (4 pairs of draws, seed 7) measured the bias",
+            "The commands step between two samples 3 time(s)",
             "\n**Actuators at a limit.** On 12 rows a motor command sits at a limit of its range.",
             "| fit | 0.50000 | 0.12500 | 75.0% |\n| held out | 0.40000 | 0.20000 | 50.0% |\n",
             "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is 12% on vdot_y.",
@@ -680,6 +709,8 @@ mod tests {
             estimate: EstimateLine {
                 huber_threshold: 2.5,
                 downweighted_fraction: 0.0,
+                steps: 0,
+                rate_noise: None,
             },
         };
         let md = view.markdown();

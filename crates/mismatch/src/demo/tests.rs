@@ -119,7 +119,7 @@ fn the_committed_summary_prints_one_line_per_cell_and_the_total() {
     );
     assert_eq!(
         lines[17],
-        "A          linear_drag+inertia_scale          MISS found [linear_drag, inertia_scale] held-out MSE ×0.066 (inertia_scale.k off by 15% (3.2 standard errors; model-side noise 3% on wdot_z))"
+        "A          linear_drag+inertia_scale          MISS found [linear_drag, inertia_scale] held-out MSE ×0.066 (inertia_scale.k off by 11% (2.3 standard errors; model-side noise 3% on wdot_z))"
     );
     assert_eq!(lines[184], "183 of 184 cells meet every target");
 }

@@ -389,13 +389,9 @@ mod tests {
     /// no unplaced step.
     #[test]
     fn a_command_step_between_samples_is_found() {
-        use rand::{RngExt, SeedableRng};
+        use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
-        let mut noise = || {
-            let u: f64 = rng.random_range(f64::EPSILON..1.0);
-            let v: f64 = rng.random_range(0.0..1.0);
-            0.01 * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-        };
+        let mut noise = || crate::simex::gaussian(&mut rng, 0.01);
         let logged: Vec<[f64; 4]> = (0..300)
             .map(|k| {
                 let step = if k > 120 { 0.3 } else { 0.0 };

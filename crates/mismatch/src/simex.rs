@@ -119,7 +119,7 @@ pub fn rate_noise_bias(
 /// commands.
 fn with_rate_noise(
     problem: &Problem,
-    reaction: &crate::noise_reaction::NoiseReaction,
+    reaction: &noise_reaction::NoiseReaction,
     noise: &[Vec3],
     sign: f64,
 ) -> Problem {
@@ -145,7 +145,7 @@ fn with_rate_noise(
 }
 
 /// A standard normal draw times `sigma` (Box–Muller).
-fn gaussian(rng: &mut ChaCha8Rng, sigma: f64) -> f64 {
+pub(crate) fn gaussian(rng: &mut ChaCha8Rng, sigma: f64) -> f64 {
     let u: f64 = rng.random_range(f64::EPSILON..1.0);
     let v: f64 = rng.random_range(0.0..1.0);
     sigma * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()

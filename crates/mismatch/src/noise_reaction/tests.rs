@@ -2,7 +2,7 @@ use std::path::PathBuf;
 
 use data::RateFrame;
 use physics::vector::{mat_mul, rotation_from_rotation_vector};
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
@@ -13,11 +13,7 @@ const ROWS: usize = 2000;
 
 type Commands = Vec<[f64; 4]>;
 
-fn gaussian(rng: &mut ChaCha8Rng, sigma: f64) -> f64 {
-    let u: f64 = rng.random_range(f64::EPSILON..1.0);
-    let v: f64 = rng.random_range(0.0..1.0);
-    sigma * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-}
+use crate::simex::gaussian;
 
 fn noise(rng: &mut ChaCha8Rng, sigma: f64) -> Vec3 {
     std::array::from_fn(|_| gaussian(rng, sigma))

@@ -254,7 +254,7 @@ pub struct Judgement {
     pub evidence: Vec<Evidence>,
     /// The evidence of each effect dropped, when it was dropped (in order).
     pub dropped: Vec<Evidence>,
-    /// The standard error of each value of `set` ([`crate::refine::standard_errors`], with the
+    /// The standard error of each value of `set` (`refine::standard_errors`, with the
     /// final set's residual variance and autocorrelation).
     pub standard_errors: Vec<f64>,
 }

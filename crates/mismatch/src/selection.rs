@@ -198,7 +198,7 @@ impl Design {
 pub const TRIMMED_BLOCKS: f64 = 2.0;
 
 /// The mean of per-block gains (each with a weight: a block drawn `w` times counts `w` times) once
-/// the [`TRIMMED_BLOCKS`] largest are left out: what remains of a gain when the one or two blocks
+/// the `TRIMMED_BLOCKS` largest are left out: what remains of a gain when the one or two blocks
 /// that carry most of it are ignored. Near zero for a term that only fits a transient; most of the
 /// mean for an effect present, however unevenly, through much of the flight.
 pub fn trimmed_gain(gains: &[(f64, f64)]) -> f64 {

@@ -3,7 +3,7 @@
 //! command is logged, jitter, gyro filter, noise, trajectory). The closed loop keeps the position on
 //! the reference, so an effect shows only in the dynamics and the control effort. The analysis runs
 //! blind on each written CSV with only the configuration's nominal model (and its logger), and each
-//! cell is judged against fixed targets ([`summary`]).
+//! cell is judged against fixed targets (`summary.rs`).
 
 mod summary;
 #[cfg(test)]

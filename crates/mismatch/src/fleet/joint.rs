@@ -123,7 +123,7 @@ impl Vehicle {
     }
 
     /// Adds effect `id` at its neutral values, or `start` (nothing if present, or if `id` has no
-    /// vehicle parameters: see [`parameters_of`]).
+    /// vehicle parameters: see `parameters_of`).
     pub fn with(&self, id: EffectId, start: Option<&[f64]>) -> Self {
         let mut out = self.clone();
         if self.ids().contains(&id) {

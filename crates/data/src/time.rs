@@ -98,9 +98,9 @@ pub(crate) fn check_interval_range(
 /// Gaps from which [`StreamedTimeAxis`] takes its reference step.
 const REFERENCE_GAPS: usize = 4096;
 
-/// The checks of [`check_time_column`] on a time column read in blocks, in constant memory:
+/// The checks of `check_time_column` on a time column read in blocks, in constant memory:
 /// strictly increasing, and every gap within `tolerance` of a reference step, the median of the
-/// first [`REFERENCE_GAPS`] gaps (the whole column's median would need every gap at once). Errors
+/// first `REFERENCE_GAPS` gaps (the whole column's median would need every gap at once). Errors
 /// name the line (one line per row).
 pub struct StreamedTimeAxis {
     path: std::path::PathBuf,

@@ -28,7 +28,7 @@ pub struct PublishedTables {
 impl PublishedTables {
     /// Reads `published.json` and checks it: at least one table, every table with at least one
     /// condition, every value a plausible mean squared error (finite, non-negative, at most
-    /// [`MAX_PUBLISHED_MSE`]). Errors name the file and the field.
+    /// `MAX_PUBLISHED_MSE`). Errors name the file and the field.
     pub fn load(path: &Path) -> Result<Self> {
         let published: Self = read_json(path)?;
         let published = Self {

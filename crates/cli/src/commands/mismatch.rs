@@ -2,11 +2,11 @@
 //!
 //! - `--recording REAL.csv --model NOMINAL.json --out DIR`: one recording → DIR/mismatch.{json,svg,md}.
 //! - `--demo MANIFEST --out DIR [--work WORK]`: simulate every case of the manifest with a concealed
-//!   effect (WORK/<case>/recording.csv), run the analysis blind on each (WORK/<case>/mismatch.*),
+//!   effect (`WORK/<case>/recording.csv`), run the analysis blind on each (`WORK/<case>/mismatch.*`),
 //!   and write DIR/summary.{md,json}.
 //! - `--flights CONDITIONS.json --model NOMINAL.json --out DIR`: every flight of every condition of
 //!   the data directory analysed together (one vehicle, one air velocity per flight) →
-//!   DIR/<model stem>.{json,md,svg}.
+//!   `DIR/<model stem>.{json,md,svg}`.
 //!
 //! Every mode plans every file it will write in an output set (the `outputs` crate) and checks
 //! them all before any work: none may be one of the files the run reads (even with `--force`),
@@ -40,7 +40,7 @@ pub struct Args {
     #[arg(long, conflicts_with = "flights")]
     pub demo: Option<PathBuf>,
     /// With --demo: where it writes each case's simulated recording and analysis
-    /// (WORK/<case>/recording.csv, mismatch.{json,svg,md}; default: target/mismatch-demo);
+    /// (WORK/CASE/recording.csv, mismatch.{json,svg,md}; default: target/mismatch-demo);
     /// existing ones are replaced only with --force.
     #[arg(long, conflicts_with_all = ["recording", "flights"])]
     pub work: Option<PathBuf>,

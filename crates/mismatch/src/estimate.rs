@@ -4,9 +4,8 @@
 //! held-out part can test them ([`crate::evidence`]). Once the effects are named, their parameters
 //! are estimated again on every analysed row, with robust weights: per channel, a residual beyond
 //! `huber_threshold` robust standard deviations counts linearly instead of quadratically (Huber's
-//! loss, by iteratively reweighted least squares from the judged values). Rows whose model side the
-//! log cannot reconstruct (a command that steps between two samples, so that no sample says when)
-//! then stop pulling the parameters, and on the rows that fit the estimate stays least squares.
+//! loss, by iteratively reweighted least squares from the judged values): rows far off stop pulling
+//! the parameters, and on the rows that fit the estimate stays least squares.
 //!
 //! A sampled command that steps between two samples says nothing of when within the interval it
 //! stepped, and the curve through the samples misplaces the step by up to half a row. Such steps
@@ -19,8 +18,9 @@
 //! When the commands carry the controller's unfelt reaction to the gyro noise, the bias it leaves
 //! is measured and subtracted ([`crate::simex`]).
 //!
-//! The standard errors have the form of the fit part's (`refine::standard_errors`) with
-//! the weighted residual and Jacobian on all rows: `√diag(κ s² (JᵀWJ)⁻¹)`.
+//! The standard errors have the form of the fit part's (`refine::standard_errors`) with the
+//! weighted residual (steps' components left out) and Jacobian on all rows: `√diag(κ s² (JᵀWJ)⁻¹)`,
+//! with the Monte Carlo error of the subtracted bias added in quadrature.
 
 use serde::Serialize;
 

@@ -28,7 +28,7 @@ use crate::evidence::autocorrelation_factor;
 use crate::fit::FittedSet;
 use crate::noise_reaction::median;
 use crate::problem::{Channels, Problem};
-use crate::refine::{FitRows, levenberg_marquardt, standard_errors, weighted_residual};
+use crate::refine::{FitRows, levenberg_marquardt, standard_errors};
 use crate::simex::{RateNoiseBias, SimexSettings, rate_noise_bias};
 
 /// Settings of the final estimate (recorded in the output).
@@ -98,22 +98,23 @@ pub fn estimate(
         residual = problem.residual(&set.effects());
         weights = huber_weights(problem, &residual, settings);
     }
+    let weighted: Vec<Channels> = residual
+        .iter()
+        .zip(&weights)
+        .map(|(r, w)| std::array::from_fn(|c| w[c].sqrt() * r[c] / problem.noise_floor[c]))
+        .collect();
+    let count = (weighted.len() * problem.channels).max(1) as f64;
+    let variance = weighted
+        .iter()
+        .map(|r| r[..problem.channels].iter().map(|v| v * v).sum::<f64>())
+        .sum::<f64>()
+        / count;
+    let scale = autocorrelation_factor(problem, &weighted, 2 * problem.weak_form.half) * variance;
     let rows = FitRows {
         range: all,
         weights: Some(&weights),
         step_times: &step_times,
     };
-    // The residual as the fit saw it (weighted, steps' components left out), and its degrees of
-    // freedom (one fewer per step and channel).
-    let weighted = weighted_residual(problem, &residual, &rows);
-    let count = (weighted.len() * problem.channels).max(1) as f64;
-    let free = (count - (step_times.len() * problem.channels) as f64).max(1.0);
-    let variance = weighted
-        .iter()
-        .map(|r| r[..problem.channels].iter().map(|v| v * v).sum::<f64>())
-        .sum::<f64>()
-        / free;
-    let scale = autocorrelation_factor(problem, &weighted, 2 * problem.weak_form.half) * variance;
     let mut standard_errors = standard_errors(problem, &set.parameters, &set.values, &rows, scale);
     let rate_noise_bias = rate_noise_bias(problem, &set, &rows, &settings.rate_noise, iterations);
     if let Some(bias) = &rate_noise_bias {

@@ -151,19 +151,6 @@ fn whitened(problem: &Problem, residual: &[Channels], rows: &FitRows) -> Vec<f64
     whitened
 }
 
-/// [`whitened`], per row: the residual the fit minimises, each channel in units of its noise floor.
-pub fn weighted_residual(
-    problem: &Problem,
-    residual: &[Channels],
-    rows: &FitRows,
-) -> Vec<Channels> {
-    let channels = problem.channels;
-    whitened(problem, residual, rows)
-        .chunks(channels)
-        .map(|row| std::array::from_fn(|c| if c < channels { row[c] } else { 0.0 }))
-        .collect()
-}
-
 /// Removes from a whitened residual, per channel, its components along the (weighted) test
 /// functions' values at each step time: what misplacing a step within its interval changes.
 fn project_out_steps(problem: &Problem, rows: &FitRows, whitened: &mut [f64]) {

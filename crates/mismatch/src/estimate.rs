@@ -30,7 +30,7 @@ use crate::evidence::autocorrelation_factor;
 use crate::fit::FittedSet;
 use crate::noise_reaction::median;
 use crate::problem::{Channels, Problem};
-use crate::refine::{FitRows, levenberg_marquardt, standard_errors};
+use crate::refine::{FitRows, StepBasis, levenberg_marquardt, standard_errors};
 use crate::simex::{RateNoiseBias, SimexSettings, rate_noise_bias};
 
 /// Settings of the final estimate (recorded in the output).
@@ -90,10 +90,15 @@ pub fn estimate(
     let step_times = step_times(problem);
     let mut weights = huber_weights(problem, &residual, settings);
     for _ in 0..settings.passes {
-        let rows = FitRows {
+        let weighted = FitRows {
             range: all.clone(),
             weights: Some(&weights),
-            step_times: &step_times,
+            steps: None,
+        };
+        let steps = StepBasis::new(problem, &weighted, &step_times);
+        let rows = FitRows {
+            steps: Some(&steps),
+            ..weighted
         };
         set.values =
             levenberg_marquardt(problem, &set.parameters, &set.values, &rows, iterations).0;
@@ -112,10 +117,15 @@ pub fn estimate(
         .sum::<f64>()
         / count;
     let scale = autocorrelation_factor(problem, &weighted, 2 * problem.weak_form.half) * variance;
-    let rows = FitRows {
+    let weighted_rows = FitRows {
         range: all,
         weights: Some(&weights),
-        step_times: &step_times,
+        steps: None,
+    };
+    let steps = StepBasis::new(problem, &weighted_rows, &step_times);
+    let rows = FitRows {
+        steps: Some(&steps),
+        ..weighted_rows
     };
     let mut standard_errors = standard_errors(problem, &set.parameters, &set.values, &rows, scale);
     let rate_noise_bias = rate_noise_bias(problem, &set, &rows, &settings.rate_noise, iterations);

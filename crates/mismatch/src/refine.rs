@@ -115,10 +115,10 @@ pub struct FitRows<'a> {
     pub range: std::ops::Range<usize>,
     /// Per analysed row (indexed as the problem's rows, not from the range's start).
     pub weights: Option<&'a [Channels]>,
-    /// Times of command steps whose place within their log interval is unknown: per step and
-    /// channel, the residual's component along the test functions' value at the step is left out
-    /// of the fit (a nuisance parameter, the step's time, profiled out).
-    pub step_times: &'a [f64],
+    /// Command steps whose place within their log interval is unknown: per step and channel, the
+    /// residual's component along the test functions' value at the step is left out of the fit (a
+    /// nuisance parameter, the step's time, profiled out). Built for these rows and weights.
+    pub steps: Option<&'a StepBasis>,
 }
 
 impl FitRows<'_> {
@@ -127,7 +127,7 @@ impl FitRows<'_> {
         FitRows {
             range,
             weights: None,
-            step_times: &[],
+            steps: None,
         }
     }
 }
@@ -145,43 +145,63 @@ fn whitened(problem: &Problem, residual: &[Channels], rows: &FitRows) -> Vec<f64
             })
         })
         .collect();
-    if !rows.step_times.is_empty() {
-        project_out_steps(problem, rows, &mut whitened);
+    if let Some(steps) = rows.steps {
+        steps.project_out(&mut whitened);
     }
     whitened
 }
 
-/// Removes from a whitened residual, per channel, its components along the (weighted) test
-/// functions' values at each step time: what misplacing a step within its interval changes.
-fn project_out_steps(problem: &Problem, rows: &FitRows, whitened: &mut [f64]) {
-    let channels = problem.channels;
-    for c in 0..channels {
-        let mut basis: Vec<Vec<f64>> = Vec::new();
-        for &t in rows.step_times {
-            let mut column: Vec<f64> = rows
-                .range
-                .clone()
-                .map(|k| {
-                    let weight = rows.weights.map_or(1.0, |w| w[k][c].sqrt());
-                    weight * problem.weak_form.weight(t - problem.time[k])
-                })
-                .collect();
-            for b in &basis {
-                let along: f64 = column.iter().zip(b).map(|(x, y)| x * y).sum();
-                column.iter_mut().zip(b).for_each(|(x, y)| *x -= along * y);
-            }
-            let norm = column.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if norm > 1e-12 {
-                column.iter_mut().for_each(|x| *x /= norm);
-                basis.push(column);
-            }
-        }
-        for b in &basis {
-            let along: f64 = (0..b.len())
-                .map(|i| b[i] * whitened[i * channels + c])
-                .sum();
-            for (i, x) in b.iter().enumerate() {
-                whitened[i * channels + c] -= along * x;
+/// Per channel, an orthonormal basis of the (weighted) test functions' values at each step time
+/// over a fit's rows: what misplacing a step within its interval changes. Built once per set of
+/// rows and weights; [`FitRows::steps`] leaves these components out of the fit.
+#[derive(Clone, Debug)]
+pub struct StepBasis {
+    channels: Vec<Vec<Vec<f64>>>,
+}
+
+impl StepBasis {
+    /// The basis for `rows` (its weights) and the given step times (s).
+    pub fn new(problem: &Problem, rows: &FitRows, step_times: &[f64]) -> Self {
+        let channels = (0..problem.channels)
+            .map(|c| {
+                let mut basis: Vec<Vec<f64>> = Vec::new();
+                for &t in step_times {
+                    let mut column: Vec<f64> = rows
+                        .range
+                        .clone()
+                        .map(|k| {
+                            let weight = rows.weights.map_or(1.0, |w| w[k][c].sqrt());
+                            weight * problem.weak_form.weight(t - problem.time[k])
+                        })
+                        .collect();
+                    for b in &basis {
+                        let along: f64 = column.iter().zip(b).map(|(x, y)| x * y).sum();
+                        column.iter_mut().zip(b).for_each(|(x, y)| *x -= along * y);
+                    }
+                    let norm = column.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    if norm > 1e-12 {
+                        column.iter_mut().for_each(|x| *x /= norm);
+                        basis.push(column);
+                    }
+                }
+                basis
+            })
+            .collect();
+        Self { channels }
+    }
+
+    /// Removes the basis' components from a flattened whitened residual (row-major, `channels`
+    /// values a row).
+    fn project_out(&self, whitened: &mut [f64]) {
+        let channels = self.channels.len();
+        for (c, basis) in self.channels.iter().enumerate() {
+            for b in basis {
+                let along: f64 = (0..b.len())
+                    .map(|i| b[i] * whitened[i * channels + c])
+                    .sum();
+                for (i, x) in b.iter().enumerate() {
+                    whitened[i * channels + c] -= along * x;
+                }
             }
         }
     }

@@ -249,6 +249,26 @@ fn a_delay_behind_sampled_commands_is_measured() {
     assert!(shares.iter().all(|s| (0.0..=1.0).contains(s)), "{shares:?}");
 }
 
+/// The inertia scale the configuration-A inertia tests conceal.
+const INERTIA_TRUTH: [f64; 3] = [1.25, 0.85, 1.15];
+
+/// A plant with [`INERTIA_TRUTH`] as its inertia scale.
+fn wrong_inertia() -> Effects {
+    Effects {
+        inertia_scale: Some(physics::InertiaScale { k: INERTIA_TRUTH }),
+        ..Effects::default()
+    }
+}
+
+/// The fitted inertia scale and its error relative to |k − 1| (norms over the three axes).
+fn inertia_error(analysis: &mismatch::Analysis) -> ([f64; 3], f64) {
+    let k = analysis.fitted.inertia_scale.unwrap().k;
+    let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let error = norm(std::array::from_fn(|i| k[i] - INERTIA_TRUTH[i]))
+        / norm(INERTIA_TRUTH.map(|t| t - 1.0));
+    (k, error)
+}
+
 /// The low passes of configuration A start and end on the log grid, so the command steps right at
 /// a sample and no sample says when within its interval: the reconstruction misplaces each step by
 /// up to half a row. Estimated with robust weights on all rows, a flight without noise gives the
@@ -256,16 +276,9 @@ fn a_delay_behind_sampled_commands_is_measured() {
 /// 6 %).
 #[test]
 fn a_command_step_between_samples_does_not_pull_the_parameters() {
-    let truth = [1.25, 0.85, 1.15];
-    let effects = Effects {
-        inertia_scale: Some(physics::InertiaScale { k: truth }),
-        ..Effects::default()
-    };
-    let analysis = analysed_on_configuration_a(effects, true);
+    let analysis = analysed_on_configuration_a(wrong_inertia(), true);
     assert_eq!(analysis.fitted.ids(), [EffectId::InertiaScale]);
-    let k = analysis.fitted.inertia_scale.unwrap().k;
-    let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let error = norm(std::array::from_fn(|i| k[i] - truth[i])) / norm(truth.map(|t| t - 1.0));
+    let (k, error) = inertia_error(&analysis);
     assert!(error < 0.01, "{k:?}: {error}");
     assert!(analysis.report.estimate_downweighted_fraction > 0.0);
 }
@@ -275,16 +288,9 @@ fn a_command_step_between_samples_does_not_pull_the_parameters() {
 /// (5.3 % off); with each step's time left free, 1.9 %.
 #[test]
 fn command_steps_between_samples_do_not_pull_a_noisy_estimate() {
-    let truth = [1.25, 0.85, 1.15];
-    let effects = Effects {
-        inertia_scale: Some(physics::InertiaScale { k: truth }),
-        ..Effects::default()
-    };
-    let analysis = analysed_on_configuration_a(effects, false);
+    let analysis = analysed_on_configuration_a(wrong_inertia(), false);
     assert!(!analysis.report.estimate_step_times.is_empty());
-    let k = analysis.fitted.inertia_scale.unwrap().k;
-    let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let error = norm(std::array::from_fn(|i| k[i] - truth[i])) / norm(truth.map(|t| t - 1.0));
+    let (k, error) = inertia_error(&analysis);
     assert!(error < 0.04, "{k:?}: {error}");
 }
 
@@ -294,17 +300,11 @@ fn command_steps_between_samples_do_not_pull_a_noisy_estimate() {
 /// than without the correction, and the report says so.
 #[test]
 fn the_bias_of_the_reaction_to_the_gyro_noise_is_measured_and_removed() {
-    let effects = Effects {
-        inertia_scale: Some(physics::InertiaScale {
-            k: [1.25, 0.85, 1.15],
-        }),
-        ..Effects::default()
-    };
-    let corrected = analysed_on_configuration_a(effects, false);
+    let corrected = analysed_on_configuration_a(wrong_inertia(), false);
     let mut settings = AnalysisSettings::default();
     settings.estimate.rate_noise.pairs = 0;
-    let plain = analysed_on_configuration_a_with(effects, false, &settings);
-    let k = |analysis: &mismatch::Analysis| analysis.fitted.inertia_scale.unwrap().k;
+    let plain = analysed_on_configuration_a_with(wrong_inertia(), false, &settings);
+    let k = |analysis: &mismatch::Analysis| inertia_error(analysis).0;
     let report = &corrected.report.effects[0];
     let Some(physics::EffectParameters::InertiaScale(bias)) = &report.rate_noise_bias else {
         panic!("no rate-noise bias: {:?}", report.rate_noise_bias);

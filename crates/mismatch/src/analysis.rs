@@ -20,7 +20,7 @@ use crate::library::{Candidate, build_library};
 use crate::noise_reaction::{self, NoiseReaction};
 use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
-use crate::refine::effects_from;
+use crate::refine::{FitRows, StepBasis, effects_from};
 use crate::selection::{Design, Selection, SelectionSettings, stability_selection};
 use crate::weak_form::{TestFunction, white_noise_sigma};
 
@@ -340,6 +340,15 @@ fn first_null(value: &serde_json::Value, path: String) -> Option<String> {
     }
 }
 
+/// `residual` (all rows) without its components along the test functions' values at the command
+/// steps the samples cannot place: a step misplaced within its interval is not a missing effect.
+fn without_steps(problem: &Problem, residual: &[Channels], step_times: &[f64]) -> Vec<Channels> {
+    let mut remaining = residual.to_vec();
+    StepBasis::new(problem, &FitRows::plain(0..problem.rows()), step_times)
+        .remove_from(&mut remaining);
+    remaining
+}
+
 /// Windows where the centred moving RMS of a channel's residual exceeds `factor` × floor.
 fn locate_windows(
     problem: &Problem,
@@ -528,7 +537,11 @@ fn build_report(
         channels: channel_reports(problem, settings, &residuals),
         windows: locate_windows(problem, residuals.before, settings),
         effects: effect_reports,
-        unexplained: locate_windows(problem, residuals.after, settings),
+        unexplained: locate_windows(
+            problem,
+            &without_steps(problem, residuals.after, &estimate.step_times),
+            settings,
+        ),
         fit: Fit {
             before: Mse { mse: problem.mse(residuals.before, fit_rows.clone()) },
             after: Mse { mse: problem.mse(residuals.after, fit_rows.clone()) },

@@ -77,17 +77,17 @@ pub fn estimate(
 ) -> Estimate {
     let all = 0..problem.rows();
     let mut set = judged.clone();
+    let step_times = step_times(problem);
     if set.parameters.is_empty() {
         return Estimate {
             set,
             standard_errors: Vec::new(),
             downweighted_fraction: 0.0,
             rate_noise_bias: None,
-            step_times: Vec::new(),
+            step_times,
         };
     }
     let mut residual = problem.residual(&set.effects());
-    let step_times = step_times(problem);
     let mut weights = huber_weights(problem, &residual, settings);
     for _ in 0..settings.passes {
         let weighted = FitRows {
@@ -182,7 +182,7 @@ fn huber_weights(
 /// The times of the command steps the samples cannot place
 /// ([`crate::command_samples::CommandSamples::unplaced_steps`]): adjacent flagged intervals count
 /// as one step, at the middle of their span.
-fn step_times(problem: &Problem) -> Vec<f64> {
+pub(crate) fn step_times(problem: &Problem) -> Vec<f64> {
     let time = &problem.recording.time;
     let mut times = Vec::new();
     let mut run: Option<(usize, usize)> = None;

@@ -205,6 +205,19 @@ impl StepBasis {
             }
         }
     }
+
+    /// Removes the basis' components from a residual on the rows the basis was built for (whose
+    /// first row is `residual[0]`; built unweighted): what remains once each step's place is free.
+    pub fn remove_from(&self, residual: &mut [Channels]) {
+        for (c, basis) in self.channels.iter().enumerate() {
+            for b in basis {
+                let along: f64 = b.iter().zip(residual.iter()).map(|(x, r)| x * r[c]).sum();
+                for (x, r) in b.iter().zip(residual.iter_mut()) {
+                    r[c] -= along * x;
+                }
+            }
+        }
+    }
 }
 
 /// The whitened residual on the fit's rows of the effects `parameters` take at `values`.

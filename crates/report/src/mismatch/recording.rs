@@ -420,16 +420,22 @@ impl RecordingView<'_> {
 
     /// What remains unexplained with the effects named.
     fn unexplained_markdown(&self, md: &mut String) {
+        let steps = match self.estimate.steps {
+            0 => String::new(),
+            n => format!(
+                " (the residual that placing each of the {n} command steps between samples within its interval explains is left out)"
+            ),
+        };
         if self.unexplained.is_empty() {
             let _ = writeln!(
                 md,
-                "\nWith the effects named, no stretch of the flight disagrees by more than {:.1} times the noise floor.",
+                "\nWith the effects named, no stretch of the flight disagrees by more than {:.1} times the noise floor{steps}.",
                 self.window_factor
             );
         } else {
             let _ = writeln!(
                 md,
-                "\nA significant residual remains that no effect of the vocabulary explains:\n"
+                "\nA significant residual remains that no effect of the vocabulary explains{steps}:\n"
             );
             for w in self.unexplained {
                 let _ = writeln!(

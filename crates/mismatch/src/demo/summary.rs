@@ -57,6 +57,9 @@ pub struct CellOutcome {
     pub passed: bool,
     /// Why not, in a few words.
     pub failures: Vec<String>,
+    /// The stretches the analysis reports as a residual no effect explains (`wdot_x 30.5–31.5 s`).
+    /// Every simulated effect is in the vocabulary, so each is a false alarm; not a target.
+    pub unexplained: Vec<String>,
 }
 
 impl CellOutcome {
@@ -131,6 +134,11 @@ impl CellOutcome {
             heldout_target: None,
             passed: failures.is_empty(),
             failures,
+            unexplained: report
+                .unexplained
+                .iter()
+                .map(|w| format!("{} {:.1}–{:.1} s", w.channel, w.t_start, w.t_end))
+                .collect(),
         }
     }
 
@@ -437,5 +445,6 @@ fn cell_line(c: &CellOutcome) -> CellLine<'_> {
         heldout_ratio: c.heldout_ratio,
         passed: c.passed,
         failures: &c.failures,
+        unexplained: &c.unexplained,
     }
 }

@@ -65,6 +65,7 @@ fn cell(c: &Value) -> CellOutcome {
         heldout_target: from(&c["heldout_target"]),
         passed: from(&c["passed"]),
         failures: from(&c["failures"]),
+        unexplained: from(&c["unexplained"]),
     }
 }
 

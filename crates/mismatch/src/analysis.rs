@@ -22,6 +22,7 @@ use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
 use crate::refine::{FitRows, StepBasis, effects_from};
 use crate::selection::{Design, Selection, SelectionSettings, stability_selection};
+use crate::simex::NoiseSources;
 use crate::weak_form::{TestFunction, white_noise_sigma};
 
 /// Settings of an analysis (recorded in the output).
@@ -80,10 +81,10 @@ pub struct EffectReport {
     /// The parameters fitted on the fit part only, with which the evidence rule judged the effect
     /// and the held-out part checked it.
     pub fit_part_parameters: EffectParameters,
-    /// The bias the unfelt reaction to the gyro noise left, measured and subtracted from
-    /// `parameters` ([`crate::simex`]); absent when the commands carry no such reaction.
+    /// The bias the noise on the model's inputs left, measured and subtracted from `parameters`
+    /// ([`crate::simex`]); absent when the commands are not samples of a faster controller.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub rate_noise_bias: Option<EffectParameters>,
+    pub noise_bias: Option<EffectParameters>,
     pub description: String,
     /// This effect's share of the nominal model's noise-normalised residual sum of squares (fit
     /// part) that the fitted effects remove, in [0, 1]; the shares sum to the total removed.
@@ -128,6 +129,9 @@ pub struct Report {
     pub estimate_downweighted_fraction: f64,
     /// Times (s) of the command steps between samples whose place the final estimate left free.
     pub estimate_step_times: Vec<f64>,
+    /// The noises whose bias the final estimate measured and removed ([`crate::simex`]), when it did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimate_noise_bias: Option<NoiseSources>,
     /// The limits the logged commands sat at, when any did (instantaneous samples are reconstructed
     /// through them: [`crate::command_samples`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -501,7 +505,7 @@ fn build_report(
     let shares = explained_fractions(&judgement.evidence, nominal_sse, fitted_sse);
     let errors = effects_from(&estimate.set.parameters, &estimate.standard_errors);
     let biases = estimate
-        .rate_noise_bias
+        .noise_bias
         .as_ref()
         .map(|b| effects_from(&estimate.set.parameters, &b.bias));
     let effect_reports = judgement
@@ -523,7 +527,7 @@ fn build_report(
             fit_part_parameters: fit_part
                 .parameters(evidence.id)
                 .expect("a named effect is in the judged set"),
-            rate_noise_bias: biases.as_ref().and_then(|b| b.parameters(evidence.id)),
+            noise_bias: biases.as_ref().and_then(|b| b.parameters(evidence.id)),
             description: describe(evidence.id, &effects),
             explained_fraction: share,
             evidence: evidence.clone(),
@@ -560,6 +564,7 @@ fn build_report(
         },
         estimate_downweighted_fraction: estimate.downweighted_fraction,
         estimate_step_times: estimate.step_times.clone(),
+        estimate_noise_bias: estimate.noise_bias.as_ref().map(|b| b.sources),
         command_limits: (problem.recording.samples.rows_held() > 0)
             .then_some(problem.recording.command_limits),
         rate_frame: RateFrameReport {

@@ -42,14 +42,16 @@ impl SampleDomain {
         }
     }
 
-    fn to_domain(self, command: f64) -> f64 {
+    /// A command's value in the domain.
+    pub fn to_domain(self, command: f64) -> f64 {
         match self {
             Self::Command => command,
             Self::SquaredSpeed => command.max(0.0).powi(2),
         }
     }
 
-    fn to_command(self, value: f64) -> f64 {
+    /// A value in the domain as a command.
+    pub fn to_command(self, value: f64) -> f64 {
         match self {
             Self::Command => value,
             Self::SquaredSpeed => value.max(0.0).sqrt(),

@@ -15,8 +15,8 @@
 //! out of the fit. Unlike a robust weight, this does not depend on the noise level: with more
 //! noise, Huber's threshold grows and the rows around a step pulled the parameters more.
 //!
-//! When the commands carry the controller's unfelt reaction to the gyro noise, the bias it leaves
-//! is measured and subtracted ([`crate::simex`]).
+//! When the commands are instantaneous samples of a faster controller, the bias their noise (and
+//! its correlation with the recorded rate's) leaves is measured and subtracted ([`crate::simex`]).
 //!
 //! The standard errors have the form of the fit part's (`refine::standard_errors`) with the
 //! weighted residual and Jacobian on all rows: `√diag(κ s² (JᵀWJ)⁻¹)`, with the Monte Carlo error
@@ -31,7 +31,7 @@ use crate::fit::FittedSet;
 use crate::noise_reaction::median;
 use crate::problem::{Channels, Problem};
 use crate::refine::{FitRows, StepBasis, levenberg_marquardt, standard_errors};
-use crate::simex::{RateNoiseBias, SimexSettings, rate_noise_bias};
+use crate::simex::{NoiseBias, SimexSettings, noise_bias};
 
 /// Settings of the final estimate (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -40,8 +40,8 @@ pub struct EstimateSettings {
     pub huber_threshold: f64,
     /// Reweighting passes.
     pub passes: usize,
-    /// The correction of the bias the unfelt reaction to the rate noise leaves ([`crate::simex`]).
-    pub rate_noise: SimexSettings,
+    /// The correction of the bias the noise on sampled commands leaves ([`crate::simex`]).
+    pub noise_bias: SimexSettings,
 }
 
 impl Default for EstimateSettings {
@@ -49,7 +49,7 @@ impl Default for EstimateSettings {
         Self {
             huber_threshold: 2.5,
             passes: 4,
-            rate_noise: SimexSettings::default(),
+            noise_bias: SimexSettings::default(),
         }
     }
 }
@@ -63,7 +63,7 @@ pub struct Estimate {
     pub downweighted_fraction: f64,
     /// The bias removed from the values, when the commands carry an unfelt reaction to the rate
     /// noise.
-    pub rate_noise_bias: Option<RateNoiseBias>,
+    pub noise_bias: Option<NoiseBias>,
     /// Times of the command steps between samples whose place within their interval was left free.
     pub step_times: Vec<f64>,
 }
@@ -83,7 +83,7 @@ pub fn estimate(
             set,
             standard_errors: Vec::new(),
             downweighted_fraction: 0.0,
-            rate_noise_bias: None,
+            noise_bias: None,
             step_times,
         };
     }
@@ -128,8 +128,8 @@ pub fn estimate(
         ..weighted_rows
     };
     let mut standard_errors = standard_errors(problem, &set.parameters, &set.values, &rows, scale);
-    let rate_noise_bias = rate_noise_bias(problem, &set, &rows, &settings.rate_noise, iterations);
-    if let Some(bias) = &rate_noise_bias {
+    let noise_bias = noise_bias(problem, &set, &rows, &settings.noise_bias, iterations);
+    if let Some(bias) = &noise_bias {
         for (j, parameter) in set.parameters.iter().enumerate() {
             set.values[j] = parameter.clamp(set.values[j] - bias.bias[j]);
             if bias.standard_error[j].is_finite() {
@@ -145,7 +145,7 @@ pub fn estimate(
         set,
         standard_errors,
         downweighted_fraction: downweighted as f64 / count,
-        rate_noise_bias,
+        noise_bias,
         step_times,
     }
 }

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use physics::CommandLogging;
 use report::mismatch::recording::{
     CandidateLine, CommandSampling, EstimateLine, EvidenceLine, EvidenceRule, NamedEffect,
-    RateNoiseLine, RecordingView, ResidualFigure, TermLine,
+    NoiseBiasLine, RecordingView, ResidualFigure, TermLine,
 };
 
 use crate::analysis::{Analysis, check_finite};
@@ -169,14 +169,12 @@ impl Analysis {
                 huber_threshold: settings.estimate.huber_threshold,
                 downweighted_fraction: report.estimate_downweighted_fraction,
                 steps: report.estimate_step_times.len(),
-                rate_noise: report
-                    .effects
-                    .iter()
-                    .any(|e| e.rate_noise_bias.is_some())
-                    .then_some(RateNoiseLine {
-                        pairs: settings.estimate.rate_noise.pairs,
-                        seed: settings.estimate.rate_noise.seed,
-                    }),
+                noise_bias: report.estimate_noise_bias.map(|sources| NoiseBiasLine {
+                    pairs: settings.estimate.noise_bias.pairs,
+                    seed: settings.estimate.noise_bias.seed,
+                    rate: sources.rate,
+                    command_samples: sources.command_samples,
+                }),
             },
         }
     }

@@ -1,19 +1,28 @@
-//! The bias the unfelt reaction to the gyro noise leaves in the final estimate, measured by
-//! simulation and removed by extrapolation (SIMEX: Cook and Stefanski, 1994).
+//! The bias the noise on the model's inputs leaves in the final estimate, measured by simulation
+//! and removed by extrapolation (SIMEX: Cook and Stefanski, 1994).
 //!
-//! A sampled command of a faster controller carries the controller's reaction to the noise of the
-//! logged body rate, which the vehicle felt for one control step of the row's `N`
-//! ([`crate::noise_reaction`]). No kinematic relation separates that noise from the motion, so the
-//! reaction stays in the model's inputs while the same noise sits in the recorded rate the model is
-//! compared with. The two are correlated, and a factor estimated through the commands (an inertia
-//! scale above all) comes out biased, in either direction.
+//! Instantaneous samples of a faster controller's commands carry its step-to-step reaction to its
+//! sensors' noise, which the vehicle averaged over the row ([`crate::noise_reaction`]). Two biases
+//! follow:
 //!
-//! The bias is of second order in the noise: adding the same noise once more, with its unfelt
-//! reaction (the identified gains times `1 − 1/N`), moves the estimate by the same amount again.
-//! Each draw adds white noise of the logged rate's standard deviation to the recorded rate and its
-//! reaction to the commands, and estimates again from the final values with the final weights; a
-//! draw and its negative form a pair, so that the first-order change cancels. The estimate minus
-//! the mean change is the estimate at no noise (linear extrapolation in the noise variance).
+//! - **Correlation with the recorded rate.** Sampled with the state, the commands' reaction to the
+//!   logged rate's noise is correlated with the same noise in the rate the model is compared with;
+//!   no kinematic relation separates that noise from the motion. (The reaction to the logged
+//!   attitude, position and velocity noise is removed before the analysis.)
+//! - **Attenuation.** Sampled at another time than the state (configuration C: one control step
+//!   late), the samples' white noise is an error of the model's inputs, uncorrelated with the
+//!   recording: a factor estimated through them (an inertia scale, a motor lag) comes out too far
+//!   from the data, by about the noise's share of the model's signal (1–2 % of `k` on C).
+//!
+//! Both are of second order in the noise: adding the same noise once more moves the estimate by
+//! the same amount again. Each draw adds, in the first case, white noise of the logged rate's
+//! standard deviation to the recorded rate and its unfelt reaction (the identified gains times
+//! `1 − 1/N`) to the commands; in the second, white noise to the commands with `1 − 1/N` of the
+//! samples' own white-noise covariance, in the domain the mixer is linear in (where the reaction
+//! adds: added to the speeds, it would give their squares a mean they do not have). The estimate
+//! is fitted again from the final values with the final weights; a draw and its negative form a
+//! pair, so that the first-order change cancels. The estimate minus the mean change is the
+//! estimate at no noise (linear extrapolation in the noise variance).
 
 use physics::vector::Vec3;
 use rand::{RngExt, SeedableRng};
@@ -45,42 +54,75 @@ impl Default for SimexSettings {
     }
 }
 
+/// The noises added to measure the bias.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct NoiseSources {
+    /// The logged rate's noise with its unfelt reaction (commands sampled with the state).
+    pub rate: bool,
+    /// The command samples' unfelt white noise (beyond the rate's reaction).
+    pub command_samples: bool,
+}
+
 /// The measured bias, per parameter of the set.
 #[derive(Clone, Debug, PartialEq)]
-pub struct RateNoiseBias {
-    /// The mean change of the estimate when the rate noise and its reaction are added once more.
+pub struct NoiseBias {
+    /// What was added.
+    pub sources: NoiseSources,
+    /// The mean change of the estimate when the noise is added once more.
     pub bias: Vec<f64>,
     /// The Monte Carlo standard error of `bias` (from the spread between pairs).
     pub standard_error: Vec<f64>,
 }
 
-/// The bias of `set` (estimated on `rows`) from the unfelt reaction to the rate noise, when the
-/// recording's commands carry one (`None` otherwise).
-pub fn rate_noise_bias(
+/// The bias of `set` (estimated on `rows`) from the noise on the model's inputs, when the
+/// recording's commands are instantaneous samples of a faster controller (`None` otherwise).
+pub fn noise_bias(
     problem: &Problem,
     set: &FittedSet,
     rows: &FitRows,
     settings: &SimexSettings,
     iterations: usize,
-) -> Option<RateNoiseBias> {
-    let reaction = problem.recording.noise_reaction.as_ref()?;
-    if set.parameters.is_empty() || settings.pairs == 0 {
+) -> Option<NoiseBias> {
+    let reaction = problem.recording.noise_reaction.as_ref();
+    let command_noise = command_sample_noise(problem);
+    if (reaction.is_none() && command_noise.is_none())
+        || set.parameters.is_empty()
+        || settings.pairs == 0
+    {
         return None;
     }
     let sigma: Vec3 = std::array::from_fn(|a| {
         let series: Vec<f64> = problem.recording.body_rate.iter().map(|w| w[a]).collect();
         white_noise_sigma(&series)
     });
+    let length = problem.recording.len();
+    let draw_rate = |rng: &mut ChaCha8Rng| -> Vec<Vec3> {
+        (0..length)
+            .map(|_| std::array::from_fn(|a| gaussian(rng, sigma[a])))
+            .collect()
+    };
+    let command_factor = command_noise.map(|covariance| square_root(&covariance));
     let changes: Vec<Vec<f64>> = (0..settings.pairs)
         .into_par_iter()
         .map(|pair| {
             let mut rng = ChaCha8Rng::seed_from_u64(settings.seed.wrapping_add(pair as u64));
-            let noise: Vec<Vec3> = (0..problem.recording.len())
-                .map(|_| std::array::from_fn(|a| gaussian(&mut rng, sigma[a])))
-                .collect();
+            let noise = reaction.map(|_| draw_rate(&mut rng));
+            let extra: Option<Vec<[f64; 4]>> = command_factor.map(|factor| {
+                (0..length)
+                    .map(|_| {
+                        let z: [f64; 4] = std::array::from_fn(|_| gaussian(&mut rng, 1.0));
+                        std::array::from_fn(|i| (0..4).map(|j| factor[i][j] * z[j]).sum())
+                    })
+                    .collect()
+            });
             let mut mean = vec![0.0; set.parameters.len()];
             for sign in [1.0, -1.0] {
-                let perturbed = with_rate_noise(problem, reaction, &noise, sign);
+                let perturbed = with_noise(
+                    problem,
+                    reaction.zip(noise.as_deref()),
+                    extra.as_deref(),
+                    sign,
+                );
                 let values =
                     levenberg_marquardt(&perturbed, &set.parameters, &set.values, rows, iterations)
                         .0;
@@ -109,39 +151,117 @@ pub fn rate_noise_bias(
             (spread / pairs).sqrt()
         })
         .collect();
-    Some(RateNoiseBias {
+    Some(NoiseBias {
+        sources: NoiseSources {
+            rate: reaction.is_some(),
+            command_samples: command_factor.is_some(),
+        },
         bias,
         standard_error,
     })
 }
 
 /// The problem with `sign · noise` added to the recorded body rate and its unfelt reaction to the
-/// commands.
-fn with_rate_noise(
+/// commands, and `sign · extra` to the commands.
+fn with_noise(
     problem: &Problem,
-    reaction: &noise_reaction::NoiseReaction,
-    noise: &[Vec3],
+    rate: Option<(&noise_reaction::NoiseReaction, &[Vec3])>,
+    extra: Option<&[[f64; 4]]>,
     sign: f64,
 ) -> Problem {
     let mut recording = problem.recording.clone();
-    let signed: Vec<Vec3> = noise.iter().map(|n| n.map(|v| sign * v)).collect();
-    let response = noise_reaction::rate_noise_response(&recording, reaction, &signed);
     let mut commands = recording.commands.clone();
-    for ((rate, command), (n, change)) in recording
-        .body_rate
-        .iter_mut()
-        .zip(commands.iter_mut())
-        .zip(signed.iter().zip(&response))
-    {
-        for a in 0..3 {
-            rate[a] += n[a];
+    if let Some((reaction, noise)) = rate {
+        let signed: Vec<Vec3> = noise.iter().map(|n| n.map(|v| sign * v)).collect();
+        let response = noise_reaction::rate_noise_response(&recording, reaction, &signed);
+        for ((rate, command), (n, change)) in recording
+            .body_rate
+            .iter_mut()
+            .zip(commands.iter_mut())
+            .zip(signed.iter().zip(&response))
+        {
+            for a in 0..3 {
+                rate[a] += n[a];
+            }
+            for (c, d) in command.iter_mut().zip(change) {
+                *c += d;
+            }
         }
-        for (c, d) in command.iter_mut().zip(change) {
-            *c += d;
+    }
+    if let Some(extra) = extra {
+        let domain = recording.samples.domain;
+        for (command, e) in commands.iter_mut().zip(extra) {
+            for (c, d) in command.iter_mut().zip(e) {
+                *c = domain.to_command(domain.to_domain(*c) + sign * d);
+            }
         }
     }
     recording.set_commands(commands);
     problem.with_recording(recording)
+}
+
+/// For instantaneous samples of a faster controller from which no reaction to the logged noise was
+/// removed ([`crate::noise_reaction`]), the covariance of their unfelt white noise in the domain
+/// the mixer is linear in (where the controller's reaction adds): `1 − 1/N` of the samples' own
+/// (`N` control steps per row); `None` otherwise. Where the reaction was removed, what remains of
+/// the samples' white noise is mostly the reaction to the row's other steps' noise, which the
+/// vehicle felt: not an error of the inputs.
+fn command_sample_noise(problem: &Problem) -> Option<[[f64; 4]; 4]> {
+    let logger = &problem.model.logger;
+    let steps = logger.controller_rate_hz? * problem.recording.dt;
+    let sampled = logger.command == physics::CommandLogging::Sample;
+    if !sampled
+        || steps < noise_reaction::MIN_STEPS_PER_ROW
+        || problem.recording.noise_reaction.is_some()
+    {
+        return None;
+    }
+    let samples = &problem.recording.samples;
+    let in_domain: Vec<[f64; 4]> = problem
+        .recording
+        .commands
+        .iter()
+        .map(|c| c.map(|v| samples.domain.to_domain(v)))
+        .collect();
+    let covariance = white_covariance(&in_domain);
+    let unfelt = 1.0 - 1.0 / steps;
+    Some(std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            if i < samples.count && j < samples.count {
+                unfelt * covariance[i][j]
+            } else {
+                0.0
+            }
+        })
+    }))
+}
+
+/// The covariance of the white noise on four smooth series, by polarisation of
+/// [`white_noise_sigma`]: `cov(a, b) = (σ(a + b)² − σ(a − b)²) / 4`.
+fn white_covariance(series: &[[f64; 4]]) -> [[f64; 4]; 4] {
+    let sigma2 = |f: &dyn Fn(&[f64; 4]) -> f64| {
+        let values: Vec<f64> = series.iter().map(f).collect();
+        white_noise_sigma(&values).powi(2)
+    };
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            if i == j {
+                sigma2(&|x| x[i])
+            } else {
+                0.25 * (sigma2(&|x| x[i] + x[j]) - sigma2(&|x| x[i] - x[j]))
+            }
+        })
+    })
+}
+
+/// A square root `L` (`L Lᵀ = C`) of a symmetric matrix with its negative eigenvalues set to zero.
+fn square_root(matrix: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
+    let m = faer::Mat::from_fn(4, 4, |i, j| 0.5 * (matrix[i][j] + matrix[j][i]));
+    let Ok(eigen) = m.self_adjoint_eigen(faer::Side::Lower) else {
+        return [[0.0; 4]; 4];
+    };
+    let (u, s) = (eigen.U(), eigen.S());
+    std::array::from_fn(|i| std::array::from_fn(|j| u[(i, j)] * s[j].max(0.0).sqrt()))
 }
 
 /// A standard normal draw times `sigma` (Box–Muller).

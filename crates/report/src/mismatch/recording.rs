@@ -195,16 +195,19 @@ pub struct EstimateLine {
     pub downweighted_fraction: f64,
     /// Command steps between samples whose time within their interval was left free.
     pub steps: usize,
-    /// When the bias the unfelt reaction to the gyro noise leaves was removed: the pairs of draws
-    /// that measured it and their seed.
-    pub rate_noise: Option<RateNoiseLine>,
+    /// When the bias the noise on the model's inputs leaves was removed: how it was measured.
+    pub noise_bias: Option<NoiseBiasLine>,
 }
 
-/// How the rate-noise bias was measured (SIMEX).
+/// How the noise bias was measured (SIMEX): the pairs of draws, their seed and what was added.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RateNoiseLine {
+pub struct NoiseBiasLine {
     pub pairs: usize,
     pub seed: u64,
+    /// The logged rate's noise with its unfelt reaction to the commands.
+    pub rate: bool,
+    /// The command samples' unfelt white noise.
+    pub command_samples: bool,
 }
 
 /// Whether each row's command is an instantaneous sample, and of how fast a controller.
@@ -500,10 +503,16 @@ impl RecordingView<'_> {
                 self.estimate.steps
             );
         }
-        if let Some(RateNoiseLine { pairs, seed }) = self.estimate.rate_noise {
+        if let Some(line) = self.estimate.noise_bias {
+            let NoiseBiasLine { pairs, seed, .. } = line;
+            let noises = if line.rate {
+                "the controller's reaction to the gyro noise, which the vehicle felt for one control step in a row"
+            } else {
+                "white noise (the controller's reaction to its sensors' noise, which the vehicle averaged over the row)"
+            };
             let _ = writeln!(
                 md,
-                "The commands carry the controller's reaction to the gyro noise, which the vehicle felt for one control step in a row, and it biases the parameters. Adding that noise once more with its reaction ({pairs} pairs of draws, seed {seed}) measured the bias, and it was subtracted (simulation and extrapolation; `rate_noise_bias` in `mismatch.json`).\n"
+                "The command samples carry {noises}. Such noise biases the parameters: adding it once more ({pairs} pairs of draws, seed {seed}) measured the bias, and it was subtracted (simulation and extrapolation; `noise_bias` in `mismatch.json`).\n"
             );
         }
         let _ = writeln!(
@@ -651,7 +660,12 @@ mod tests {
                 huber_threshold: 2.5,
                 downweighted_fraction: 0.0625,
                 steps: 3,
-                rate_noise: Some(RateNoiseLine { pairs: 4, seed: 7 }),
+                noise_bias: Some(NoiseBiasLine {
+                    pairs: 4,
+                    seed: 7,
+                    rate: true,
+                    command_samples: false,
+                }),
             },
         };
         let md = view.markdown();
@@ -667,7 +681,7 @@ mod tests {
             "- linear_drag (`drag_x` = −v_x [m/s]): 88%, kept\n",
             "noise-normalised fit errors: {\"both\":1.25,\"delay\":1.5,\"motor_lag\":2.0}. The smallest",
             "The effects were chosen with parameters fitted on 0.2–14.0 s and checked on the held-out 14.0–20.0 s (the table). The parameters reported above were then estimated on the whole recording, residuals beyond 2.5 robust standard deviations counting linearly (Huber's loss; 6.2% of the residuals were downweighted).\n",
-            "Adding that noise once more with its reaction (4 pairs of draws, seed 7) measured the bias",
+            "The command samples carry the controller's reaction to the gyro noise, which the vehicle felt for one control step in a row. Such noise biases the parameters: adding it once more (4 pairs of draws, seed 7) measured the bias",
             "The commands step between two samples 3 time(s)",
             "\n**Actuators at a limit.** On 12 rows a motor command sits at a limit of its range.",
             "| fit | 0.50000 | 0.12500 | 75.0% |\n| held out | 0.40000 | 0.20000 | 50.0% |\n",
@@ -716,7 +730,7 @@ mod tests {
                 huber_threshold: 2.5,
                 downweighted_fraction: 0.0,
                 steps: 0,
-                rate_noise: None,
+                noise_bias: None,
             },
         };
         let md = view.markdown();

@@ -61,8 +61,8 @@ pub struct Estimate {
     pub standard_errors: Vec<f64>,
     /// Share of the (row, channel) residuals that carry a weight below 1 at the end.
     pub downweighted_fraction: f64,
-    /// The bias removed from the values, when the commands carry an unfelt reaction to the rate
-    /// noise.
+    /// The bias removed from the values, when the commands are instantaneous samples of a faster
+    /// controller ([`crate::simex`]).
     pub noise_bias: Option<NoiseBias>,
     /// Times of the command steps between samples whose place within their interval was left free.
     pub step_times: Vec<f64>,

@@ -24,8 +24,8 @@
 //! selection over block-bootstrap resamples; their parameters are fitted jointly with the exact model
 //! on the first part of the recording; each effect is then named only when the evidence rule holds
 //! for it ([`evidence`]), and the named effects' parameters are estimated again on all rows with
-//! robust weights, each command step between samples with its time left free, and the bias of the
-//! commands' reaction to the gyro noise measured and removed ([`estimate`], [`simex`]). Several
+//! robust weights, each command step between samples with its time left free, and the bias the
+//! sampled commands' noise leaves measured and removed ([`estimate`], [`simex`]). Several
 //! flights of one vehicle are analysed together by [`fleet`].
 //!
 //! Names: every effect is named by a [`physics::EffectId`] (its spelling, `linear_drag` …, is what

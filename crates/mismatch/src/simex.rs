@@ -59,7 +59,7 @@ impl Default for SimexSettings {
 pub struct NoiseSources {
     /// The logged rate's noise with its unfelt reaction (commands sampled with the state).
     pub rate: bool,
-    /// The command samples' unfelt white noise (beyond the rate's reaction).
+    /// The command samples' unfelt white noise (samples from which no reaction was removed).
     pub command_samples: bool,
 }
 
@@ -133,8 +133,21 @@ pub fn noise_bias(
             mean
         })
         .collect();
+    let (bias, standard_error) = mean_and_standard_error(&changes, set.parameters.len());
+    Some(NoiseBias {
+        sources: NoiseSources {
+            rate: reaction.is_some(),
+            command_samples: command_factor.is_some(),
+        },
+        bias,
+        standard_error,
+    })
+}
+
+/// Per parameter, the mean of the pairs' changes and its Monte Carlo standard error (from their
+/// spread; NaN with fewer than two pairs).
+fn mean_and_standard_error(changes: &[Vec<f64>], parameters: usize) -> (Vec<f64>, Vec<f64>) {
     let pairs = changes.len() as f64;
-    let parameters = set.parameters.len();
     let bias: Vec<f64> = (0..parameters)
         .map(|j| changes.iter().map(|c| c[j]).sum::<f64>() / pairs)
         .collect();
@@ -151,14 +164,7 @@ pub fn noise_bias(
             (spread / pairs).sqrt()
         })
         .collect();
-    Some(NoiseBias {
-        sources: NoiseSources {
-            rate: reaction.is_some(),
-            command_samples: command_factor.is_some(),
-        },
-        bias,
-        standard_error,
-    })
+    (bias, standard_error)
 }
 
 /// The problem with `sign · noise` added to the recorded body rate and its unfelt reaction to the

@@ -1,6 +1,7 @@
 //! Properties of the optimizers on random problems.
 
 use proptest::prelude::*;
+use proptest::test_runner::{FileFailurePersistence, RngSeed};
 use sindy::{Lasso, Mat, Stlsq, kkt_violation, least_squares};
 
 /// A deterministic pseudo-random n × p matrix with entries in [−1, 1] (SplitMix64 of `seed`).
@@ -21,7 +22,13 @@ fn column(m: &Mat<f64>, j: usize) -> Vec<f64> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(48))]
+    // A fixed seed: the same 48 cases on every run, so CI cannot pass or fail by the draw.
+    #![proptest_config(ProptestConfig {
+        cases: 48,
+        rng_seed: RngSeed::Fixed(2026),
+        failure_persistence: Some(Box::new(FileFailurePersistence::Off)),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn stlsq_recovers_sparse_coefficients_from_exact_data(
@@ -75,18 +82,40 @@ proptest! {
         seed in any::<u64>(),
         fraction in 0.01f64..0.9,
     ) {
-        let theta = random_matrix(60, 5, seed);
-        let y = random_matrix(60, 1, seed.wrapping_mul(3) ^ 17);
-        let correlations = theta.transpose() * &y;
-        let critical = (0..5).map(|j| correlations[(j, 0)].abs()).fold(0.0, f64::max);
-        let names = vec!["y".to_string()];
-        let lambda = fraction * critical;
-        let xi = Lasso::new(lambda).unwrap().fit(theta.as_ref(), y.as_ref(), &names).unwrap();
-        let row: Vec<f64> = (0..5).map(|j| xi[(0, j)]).collect();
-        let violation = kkt_violation(theta.as_ref(), &column(&y, 0), &row, lambda);
-        prop_assert!(violation < 1e-7 * critical, "KKT violation {violation}");
-
-        let zero = Lasso::new(1.01 * critical).unwrap().fit(theta.as_ref(), y.as_ref(), &names).unwrap();
-        prop_assert!((0..5).all(|j| zero[(0, j)].abs() < 1e-9 * critical));
+        lasso_is_optimal(seed, fraction)?;
     }
+}
+
+/// A case a random draw found in CI: the interior point left a 4·10⁻⁸ coefficient whose exact
+/// value is zero, so the polish on that support flipped its sign and was refused.
+#[test]
+fn lasso_polish_drops_a_coefficient_the_interior_point_left_near_zero() {
+    lasso_is_optimal(9360318926050116435, 0.32889343323934095).unwrap();
+}
+
+/// At `fraction` of the critical λ the LASSO satisfies its optimality conditions; just above the
+/// critical λ every coefficient is zero.
+fn lasso_is_optimal(seed: u64, fraction: f64) -> Result<(), TestCaseError> {
+    let theta = random_matrix(60, 5, seed);
+    let y = random_matrix(60, 1, seed.wrapping_mul(3) ^ 17);
+    let correlations = theta.transpose() * &y;
+    let critical = (0..5)
+        .map(|j| correlations[(j, 0)].abs())
+        .fold(0.0, f64::max);
+    let names = vec!["y".to_string()];
+    let lambda = fraction * critical;
+    let xi = Lasso::new(lambda)
+        .unwrap()
+        .fit(theta.as_ref(), y.as_ref(), &names)
+        .unwrap();
+    let row: Vec<f64> = (0..5).map(|j| xi[(0, j)]).collect();
+    let violation = kkt_violation(theta.as_ref(), &column(&y, 0), &row, lambda);
+    prop_assert!(violation < 1e-7 * critical, "KKT violation {violation}");
+
+    let zero = Lasso::new(1.01 * critical)
+        .unwrap()
+        .fit(theta.as_ref(), y.as_ref(), &names)
+        .unwrap();
+    prop_assert!((0..5).all(|j| zero[(0, j)].abs() < 1e-9 * critical));
+    Ok(())
 }

@@ -7,9 +7,10 @@
 //! QP in the Gram form (the library is tall, n ≫ p): variables `[ξ; t]` (2p),
 //! `P = blockdiag(ΘᵀΘ, 0)`, `q = [−Θᵀy; λ·1]`, subject to `ξ − t ≤ 0` and `−ξ − t ≤ 0`
 //! (a non-negative cone of dimension 2p); at the optimum `t = |ξ|`. The interior-point solution is
-//! then polished: on the support S with signs s, the optimum solves `Θ_SᵀΘ_S ξ_S = Θ_Sᵀy − λs`; the
-//! polished point is kept when it has the same signs and satisfies the KKT conditions at least as
-//! well. [`kkt_violation`] measures how far any ξ is from optimal.
+//! then polished by an active set started from its support S and signs s: the optimum solves
+//! `Θ_SᵀΘ_S ξ_S = Θ_Sᵀy − λs`, coefficients whose sign flips leave S, violating zeros enter it; the
+//! polished point is kept when it satisfies the KKT conditions at least as well.
+//! [`kkt_violation`] measures how far any ξ is from optimal.
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -109,39 +110,91 @@ impl Lasso {
         Ok(self.polish(problem, target, solution))
     }
 
-    /// The exact optimum on the support and signs of the interior-point `solution`, if it keeps
-    /// those signs and satisfies the KKT conditions at least as well.
+    /// The exact optimum by an active set started from the interior-point `solution`'s support and
+    /// signs: coefficients whose sign flips on re-solving are dropped, the zero coefficient that
+    /// violates its condition most enters with its gradient's sign. The best point seen (the
+    /// interior-point one included) by the KKT conditions is returned.
     fn polish(&self, problem: &Problem<'_>, target: usize, solution: Vec<f64>) -> Vec<f64> {
         let (gram, moments) = (problem.gram(), problem.moments().col(target).as_mat());
+        let p = solution.len();
         let scale = solution
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs()))
             .max(1e-300);
-        let support: Vec<usize> = (0..solution.len())
-            .filter(|&j| solution[j].abs() > 1e-7 * scale)
+        let mut signs: Vec<f64> = solution
+            .iter()
+            .map(|v| {
+                if v.abs() > 1e-7 * scale {
+                    v.signum()
+                } else {
+                    0.0
+                }
+            })
             .collect();
-        let mut polished = vec![0.0; solution.len()];
+        let mut best_violation = gram_kkt_violation(gram, moments, &solution, self.lambda);
+        let mut best = solution;
+        for _ in 0..2 * p + 2 {
+            let candidate = self.optimum_on_signs(problem, target, &signs);
+            let flipped: Vec<usize> = (0..p)
+                .filter(|&j| {
+                    signs[j] != 0.0
+                        && !(candidate[j].signum() == signs[j] && candidate[j].is_finite())
+                })
+                .collect();
+            if !flipped.is_empty() {
+                flipped.iter().for_each(|&j| signs[j] = 0.0);
+                continue;
+            }
+            let violation = gram_kkt_violation(gram, moments, &candidate, self.lambda);
+            if violation <= best_violation {
+                (best, best_violation) = (candidate.clone(), violation);
+            }
+            match most_violating_zero(gram, moments, &candidate, self.lambda) {
+                Some((j, gradient)) => signs[j] = gradient.signum(),
+                None => break,
+            }
+        }
+        best
+    }
+
+    /// The stationary point of the objective with the coefficients' signs fixed (zero where the
+    /// sign is zero): `Θ_SᵀΘ_S ξ_S = Θ_Sᵀy − λs` on the support S.
+    fn optimum_on_signs(&self, problem: &Problem<'_>, target: usize, signs: &[f64]) -> Vec<f64> {
+        let moments = problem.moments().col(target).as_mat();
+        let support: Vec<usize> = (0..signs.len()).filter(|&j| signs[j] != 0.0).collect();
+        let mut optimum = vec![0.0; signs.len()];
         if !support.is_empty() {
             let rhs = Mat::from_fn(support.len(), 1, |a, _| {
-                moments[(support[a], 0)] - self.lambda * solution[support[a]].signum()
+                moments[(support[a], 0)] - self.lambda * signs[support[a]]
             });
             let exact = problem.ridge_on(&support, rhs.as_ref(), 0.0);
             for (a, &j) in support.iter().enumerate() {
-                polished[j] = exact[(a, 0)];
+                optimum[j] = exact[(a, 0)];
             }
         }
-        let same_signs = support
-            .iter()
-            .all(|&j| polished[j].signum() == solution[j].signum() && polished[j].is_finite());
-        if same_signs
-            && gram_kkt_violation(gram, moments, &polished, self.lambda)
-                <= gram_kkt_violation(gram, moments, &solution, self.lambda)
-        {
-            polished
-        } else {
-            solution
-        }
+        optimum
     }
+}
+
+/// The zero coefficient whose gradient `g_j = (Θᵀ(y − Θξ))_j` exceeds λ the most, with `g_j`.
+fn most_violating_zero(
+    gram: MatRef<'_, f64>,
+    moments: MatRef<'_, f64>,
+    coefficients: &[f64],
+    lambda: f64,
+) -> Option<(usize, f64)> {
+    let tolerance = 1e-12
+        * (lambda + (0..coefficients.len()).fold(0.0f64, |m, j| m.max(moments[(j, 0)].abs())));
+    (0..coefficients.len())
+        .filter(|&j| coefficients[j] == 0.0)
+        .map(|j| {
+            let fitted: f64 = (0..coefficients.len())
+                .map(|k| gram[(j, k)] * coefficients[k])
+                .sum();
+            (j, moments[(j, 0)] - fitted)
+        })
+        .filter(|&(_, gradient)| gradient.abs() - lambda > tolerance)
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
 }
 
 /// Largest violation of the LASSO optimality conditions by ξ for one target, with

@@ -323,6 +323,35 @@ fn attitude_noise(recording: &Recording, states: &[[f64; STATES]]) -> Vec<Vec3> 
     })
 }
 
+/// A draw of the error of each row's attitude-noise estimate ([`attitude_noise`]), from the
+/// smoother's posterior, pushed through the unfelt attitude gains to the commands.
+pub fn attitude_estimate_error_response(
+    recording: &Recording,
+    reaction: &NoiseReaction,
+    normal: &mut dyn FnMut() -> f64,
+) -> Vec<[f64; 4]> {
+    let states = state_fourth_differences(recording);
+    let rows = recording.len();
+    let error = per_axis(|a| {
+        let fourth: Vec<f64> = states.iter().map(|s| s[3 + a]).collect();
+        let sigma = white_noise_sigma_of_fourth_differences(&fourth);
+        let rate: Vec<f64> = recording.body_rate.iter().map(|w| w[a]).collect();
+        let step = recording.dt * white_noise_sigma(&rate);
+        smoothing_error_draw(rows, sigma, step, normal)
+    });
+    (0..rows)
+        .map(|k| {
+            std::array::from_fn(|i| {
+                if i >= reaction.gains.len() {
+                    return 0.0;
+                }
+                let gains = &reaction.gains[i];
+                reaction.unfelt_fraction * (0..3).map(|a| gains[3 + a] * error[k][a]).sum::<f64>()
+            })
+        })
+        .collect()
+}
+
 /// Each row's position noise: the logged step minus the trapezoid of the logged velocities.
 fn position_noise(recording: &Recording) -> Vec<Vec3> {
     let (p, v) = (&recording.position, &recording.velocity);
@@ -378,6 +407,47 @@ pub(crate) fn smooth_noise(increments: &[f64], sigma: f64, step: f64) -> Vec<f64
         solution[k] -= upper[k] * solution[k + 1];
     }
     solution
+}
+
+/// A draw of the error of [`smooth_noise`]'s estimate over `rows` rows: Gaussian with the
+/// posterior covariance, the inverse of the system's tridiagonal matrix `P` (drawn as `L⁻ᵀ z` with
+/// `P = L Lᵀ`). Zero when there is no noise to find.
+pub(crate) fn smoothing_error_draw(
+    rows: usize,
+    sigma: f64,
+    step: f64,
+    normal: &mut dyn FnMut() -> f64,
+) -> Vec<f64> {
+    if !(sigma > 0.0 && sigma.is_finite()) || rows == 0 {
+        return vec![0.0; rows];
+    }
+    let step = step.max(1e-6 * sigma);
+    let (prior, link) = (1.0 / (sigma * sigma), 1.0 / (step * step));
+    let mut diagonal = vec![0.0; rows];
+    let mut lower = vec![0.0; rows];
+    for k in 0..rows {
+        let links = [k > 0, k + 1 < rows].iter().filter(|&&x| x).count() as f64;
+        let previous = if k > 0 {
+            lower[k - 1] * lower[k - 1]
+        } else {
+            0.0
+        };
+        diagonal[k] = (prior + link * links - previous).sqrt();
+        if k + 1 < rows {
+            lower[k] = -link / diagonal[k];
+        }
+    }
+    let z: Vec<f64> = (0..rows).map(|_| normal()).collect();
+    let mut draw = vec![0.0; rows];
+    for k in (0..rows).rev() {
+        let next = if k + 1 < rows {
+            lower[k] * draw[k + 1]
+        } else {
+            0.0
+        };
+        draw[k] = (z[k] - next) / diagonal[k];
+    }
+    draw
 }
 
 #[cfg(test)]

@@ -173,6 +173,7 @@ impl Analysis {
                     pairs: settings.estimate.noise_bias.pairs,
                     seed: settings.estimate.noise_bias.seed,
                     rate: sources.rate,
+                    attitude_estimate: sources.attitude_estimate,
                     command_samples: sources.command_samples,
                 }),
             },

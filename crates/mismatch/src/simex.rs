@@ -21,8 +21,11 @@
 //! samples' own white-noise covariance, in the domain the mixer is linear in (where the reaction
 //! adds: added to the speeds, it would give their squares a mean they do not have). The estimate
 //! is fitted again from the final values with the final weights; a draw and its negative form a
-//! pair, so that the first-order change cancels. The estimate minus the mean change is the
-//! estimate at no noise (linear extrapolation in the noise variance).
+//! pair, so that the first-order change cancels. Where the reaction to the logged attitude noise
+//! was removed, each draw also adds the unfelt reaction to a draw of that noise's estimation error
+//! (the smoother's posterior): what the removal left in the commands is an error of the inputs.
+//! The estimate minus the mean change is the estimate at no noise (linear extrapolation in the
+//! noise variance).
 
 use physics::vector::Vec3;
 use rand::{RngExt, SeedableRng};
@@ -59,6 +62,9 @@ impl Default for SimexSettings {
 pub struct NoiseSources {
     /// The logged rate's noise with its unfelt reaction (commands sampled with the state).
     pub rate: bool,
+    /// The error of the attitude noise's estimate, through the unfelt reaction the analysis
+    /// removed with it (commands sampled with the state).
+    pub attitude_estimate: bool,
     /// The command samples' unfelt white noise (samples from which no reaction was removed).
     pub command_samples: bool,
 }
@@ -115,14 +121,29 @@ pub fn noise_bias(
                     })
                     .collect()
             });
+            let attitude: Option<Vec<[f64; 4]>> = reaction.map(|r| {
+                let mut normal = || gaussian(&mut rng, 1.0);
+                noise_reaction::attitude_estimate_error_response(&problem.recording, r, &mut normal)
+            });
             let mut mean = vec![0.0; set.parameters.len()];
             for sign in [1.0, -1.0] {
-                let perturbed = with_noise(
+                let mut perturbed = with_noise(
                     problem,
                     reaction.zip(noise.as_deref()),
                     extra.as_deref(),
                     sign,
                 );
+                if let Some(extra) = &attitude {
+                    let mut recording = perturbed.recording.clone();
+                    let mut commands = recording.commands.clone();
+                    for (c, e) in commands.iter_mut().zip(extra) {
+                        for (x, d) in c.iter_mut().zip(e) {
+                            *x += sign * d;
+                        }
+                    }
+                    recording.set_commands(commands);
+                    perturbed = perturbed.with_recording(recording);
+                }
                 let values =
                     levenberg_marquardt(&perturbed, &set.parameters, &set.values, rows, iterations)
                         .0;
@@ -137,6 +158,7 @@ pub fn noise_bias(
     Some(NoiseBias {
         sources: NoiseSources {
             rate: reaction.is_some(),
+            attitude_estimate: reaction.is_some(),
             command_samples: command_factor.is_some(),
         },
         bias,

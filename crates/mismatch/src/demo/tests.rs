@@ -120,7 +120,22 @@ fn the_committed_summary_prints_one_line_per_cell_and_the_total() {
     );
     assert_eq!(
         lines[17],
-        "A          linear_drag+inertia_scale          MISS found [linear_drag, inertia_scale] held-out MSE ×0.066 (inertia_scale.k off by 11% (2.3 standard errors; model-side noise 3% on wdot_z))"
+        "A          linear_drag+inertia_scale          OK   found [linear_drag, inertia_scale] held-out MSE ×0.066"
+    );
+    assert_eq!(lines[184], "184 of 184 cells meet every target");
+}
+
+#[test]
+fn a_cell_that_misses_prints_why_and_counts_against_the_total() {
+    let mut summary = committed_summary();
+    let cell = &mut summary.cells[17];
+    cell.passed = false;
+    cell.failures = vec!["inertia_scale.k off by 11% (2.3 standard errors)".to_string()];
+    let text = summary.view().table_text();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(
+        lines[17],
+        "A          linear_drag+inertia_scale          MISS found [linear_drag, inertia_scale] held-out MSE ×0.066 (inertia_scale.k off by 11% (2.3 standard errors))"
     );
     assert_eq!(lines[184], "183 of 184 cells meet every target");
 }

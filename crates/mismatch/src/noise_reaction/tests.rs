@@ -216,3 +216,40 @@ fn the_smoother_recovers_white_noise_from_its_increments() {
     assert!((error / total).sqrt() < 0.25, "{}", (error / total).sqrt());
     assert_eq!(smooth_noise(&increments, 0.0, 1e-4), vec![0.0; 1000]);
 }
+
+/// The smoother's error, drawn from its posterior, has the variance and the correlation between
+/// neighbouring rows of the actual error of [`smooth_noise`] on white noise measured through its
+/// increments (A's attitude: σ = 0.002 rad, increments to 1.6·10⁻⁴ rad).
+#[test]
+fn the_smoothing_error_draw_matches_the_smoothers_error() {
+    let (rows, sigma, step) = (20_000, 0.002, 1.6e-4);
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let truth: Vec<f64> = (0..rows).map(|_| gaussian(&mut rng, sigma)).collect();
+    let increments: Vec<f64> = truth
+        .windows(2)
+        .map(|w| w[1] - w[0] + gaussian(&mut rng, step))
+        .collect();
+    let estimate = smooth_noise(&increments, sigma, step);
+    let error: Vec<f64> = estimate.iter().zip(&truth).map(|(e, t)| e - t).collect();
+    let draw = smoothing_error_draw(rows, sigma, step, &mut || gaussian(&mut rng, 1.0));
+    let moments = |x: &[f64]| {
+        let variance = x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64;
+        let lag: f64 = x.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / (x.len() - 1) as f64;
+        (variance, lag / variance)
+    };
+    let ((actual, actual_lag), (drawn, drawn_lag)) = (moments(&error), moments(&draw));
+    // Stationary posterior variance of the interior rows: 1 / √(p (p + 4 l)).
+    let (p, l) = (sigma.powi(-2), step.powi(-2));
+    let theory = 1.0 / (p * (p + 4.0 * l)).sqrt();
+    for value in [actual, drawn] {
+        assert!(
+            (value / theory - 1.0).abs() < 0.1,
+            "{actual} {drawn} {theory}"
+        );
+    }
+    assert!(
+        (actual_lag - drawn_lag).abs() < 0.03,
+        "{actual_lag} {drawn_lag}"
+    );
+    assert!(actual_lag > 0.8, "the error is smooth: {actual_lag}");
+}

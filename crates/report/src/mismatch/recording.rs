@@ -206,6 +206,8 @@ pub struct NoiseBiasLine {
     pub seed: u64,
     /// The logged rate's noise with its unfelt reaction to the commands.
     pub rate: bool,
+    /// The error of the attitude noise's estimate, through the unfelt reaction removed with it.
+    pub attitude_estimate: bool,
     /// The command samples' unfelt white noise.
     pub command_samples: bool,
 }
@@ -505,7 +507,9 @@ impl RecordingView<'_> {
         }
         if let Some(line) = self.estimate.noise_bias {
             let NoiseBiasLine { pairs, seed, .. } = line;
-            let noises = if line.rate {
+            let noises = if line.rate && line.attitude_estimate {
+                "the controller's reaction to the gyro noise, which the vehicle felt for one control step in a row, and the error of the removed reaction to the attitude noise (whose estimate is uncertain)"
+            } else if line.rate {
                 "the controller's reaction to the gyro noise, which the vehicle felt for one control step in a row"
             } else {
                 "white noise (the controller's reaction to its sensors' noise, which the vehicle averaged over the row)"
@@ -664,6 +668,7 @@ mod tests {
                     pairs: 4,
                     seed: 7,
                     rate: true,
+                    attitude_estimate: false,
                     command_samples: false,
                 }),
             },

@@ -147,15 +147,29 @@ pub fn rate_noise_response(
         }
     }
     let after = attitude_noise(&perturbed, &states);
-    (0..recording.len())
+    unfelt_response(reaction, recording.len(), |k, a| {
+        (noise[k][a], before[k][a] - after[k][a])
+    })
+}
+
+/// Per row, the unfelt share of the reaction to a rate and an attitude change, `change(row, axis)`
+/// giving both: `(1 − 1/N) Σ_a (g_rate,a · rate_a + g_attitude,a · attitude_a)` per actuator.
+fn unfelt_response(
+    reaction: &NoiseReaction,
+    rows: usize,
+    change: impl Fn(usize, usize) -> (f64, f64),
+) -> Vec<[f64; 4]> {
+    (0..rows)
         .map(|k| {
             std::array::from_fn(|i| {
-                if i >= reaction.gains.len() {
+                let Some(gains) = reaction.gains.get(i) else {
                     return 0.0;
-                }
-                let gains = &reaction.gains[i];
+                };
                 let response: f64 = (0..3)
-                    .map(|a| gains[a] * noise[k][a] - gains[3 + a] * (after[k][a] - before[k][a]))
+                    .map(|a| {
+                        let (rate, attitude) = change(k, a);
+                        gains[a] * rate + gains[3 + a] * attitude
+                    })
                     .sum();
                 reaction.unfelt_fraction * response
             })
@@ -314,13 +328,26 @@ fn attitude_noise(recording: &Recording, states: &[[f64; STATES]]) -> Vec<Vec3> 
         })
         .collect();
     per_axis(|a| {
-        let fourth: Vec<f64> = states.iter().map(|s| s[3 + a]).collect();
-        let sigma = white_noise_sigma_of_fourth_differences(&fourth);
-        let rate: Vec<f64> = recording.body_rate.iter().map(|w| w[a]).collect();
-        let step = recording.dt * white_noise_sigma(&rate);
+        let (sigma, step) = attitude_smoothing_scales(recording, states, a);
         let series: Vec<f64> = increments.iter().map(|e| e[a]).collect();
         smooth_noise(&series, sigma, step)
     })
+}
+
+/// For axis `a`, the attitude's white noise (from the fourth differences in `states`) and the error
+/// of the turn between rows that the rates' trapezoid leaves (`dt` times the rate's white noise):
+/// the scales of the attitude-noise smoother ([`smooth_noise`]).
+fn attitude_smoothing_scales(
+    recording: &Recording,
+    states: &[[f64; STATES]],
+    a: usize,
+) -> (f64, f64) {
+    let fourth: Vec<f64> = states.iter().map(|s| s[3 + a]).collect();
+    let rate: Vec<f64> = recording.body_rate.iter().map(|w| w[a]).collect();
+    (
+        white_noise_sigma_of_fourth_differences(&fourth),
+        recording.dt * white_noise_sigma(&rate),
+    )
 }
 
 /// A draw of the error of each row's attitude-noise estimate ([`attitude_noise`]), from the
@@ -333,23 +360,10 @@ pub fn attitude_estimate_error_response(
     let states = state_fourth_differences(recording);
     let rows = recording.len();
     let error = per_axis(|a| {
-        let fourth: Vec<f64> = states.iter().map(|s| s[3 + a]).collect();
-        let sigma = white_noise_sigma_of_fourth_differences(&fourth);
-        let rate: Vec<f64> = recording.body_rate.iter().map(|w| w[a]).collect();
-        let step = recording.dt * white_noise_sigma(&rate);
+        let (sigma, step) = attitude_smoothing_scales(recording, &states, a);
         smoothing_error_draw(rows, sigma, step, normal)
     });
-    (0..rows)
-        .map(|k| {
-            std::array::from_fn(|i| {
-                if i >= reaction.gains.len() {
-                    return 0.0;
-                }
-                let gains = &reaction.gains[i];
-                reaction.unfelt_fraction * (0..3).map(|a| gains[3 + a] * error[k][a]).sum::<f64>()
-            })
-        })
-        .collect()
+    unfelt_response(reaction, rows, |k, a| (0.0, error[k][a]))
 }
 
 /// Each row's position noise: the logged step minus the trapezoid of the logged velocities.
@@ -382,8 +396,7 @@ pub(crate) fn smooth_noise(increments: &[f64], sigma: f64, step: f64) -> Vec<f64
     if !(sigma > 0.0 && sigma.is_finite()) {
         return vec![0.0; rows];
     }
-    let step = step.max(1e-6 * sigma);
-    let (prior, link) = (1.0 / (sigma * sigma), 1.0 / (step * step));
+    let (prior, link) = smoother_precisions(sigma, step);
     let mut diagonal = vec![prior; rows];
     let mut rhs = vec![0.0; rows];
     for (k, e) in increments.iter().enumerate() {
@@ -409,6 +422,13 @@ pub(crate) fn smooth_noise(increments: &[f64], sigma: f64, step: f64) -> Vec<f64
     solution
 }
 
+/// The smoother's precisions: of the noise's prior (`1/σ²`) and of each increment's link
+/// (`1/step²`, the step kept above `10⁻⁶ σ`).
+fn smoother_precisions(sigma: f64, step: f64) -> (f64, f64) {
+    let step = step.max(1e-6 * sigma);
+    (1.0 / (sigma * sigma), 1.0 / (step * step))
+}
+
 /// A draw of the error of [`smooth_noise`]'s estimate over `rows` rows: Gaussian with the
 /// posterior covariance, the inverse of the system's tridiagonal matrix `P` (drawn as `L⁻ᵀ z` with
 /// `P = L Lᵀ`). Zero when there is no noise to find.
@@ -421,8 +441,7 @@ pub(crate) fn smoothing_error_draw(
     if !(sigma > 0.0 && sigma.is_finite()) || rows == 0 {
         return vec![0.0; rows];
     }
-    let step = step.max(1e-6 * sigma);
-    let (prior, link) = (1.0 / (sigma * sigma), 1.0 / (step * step));
+    let (prior, link) = smoother_precisions(sigma, step);
     let mut diagonal = vec![0.0; rows];
     let mut lower = vec![0.0; rows];
     for k in 0..rows {

@@ -127,23 +127,13 @@ pub fn noise_bias(
             });
             let mut mean = vec![0.0; set.parameters.len()];
             for sign in [1.0, -1.0] {
-                let mut perturbed = with_noise(
+                let perturbed = with_noise(
                     problem,
                     reaction.zip(noise.as_deref()),
+                    attitude.as_deref(),
                     extra.as_deref(),
                     sign,
                 );
-                if let Some(extra) = &attitude {
-                    let mut recording = perturbed.recording.clone();
-                    let mut commands = recording.commands.clone();
-                    for (c, e) in commands.iter_mut().zip(extra) {
-                        for (x, d) in c.iter_mut().zip(e) {
-                            *x += sign * d;
-                        }
-                    }
-                    recording.set_commands(commands);
-                    perturbed = perturbed.with_recording(recording);
-                }
                 let values =
                     levenberg_marquardt(&perturbed, &set.parameters, &set.values, rows, iterations)
                         .0;
@@ -190,10 +180,12 @@ fn mean_and_standard_error(changes: &[Vec<f64>], parameters: usize) -> (Vec<f64>
 }
 
 /// The problem with `sign · noise` added to the recorded body rate and its unfelt reaction to the
-/// commands, and `sign · extra` to the commands.
+/// commands, `sign · attitude` to the commands (in their units) and `sign · extra` to the commands
+/// (in the domain the mixer is linear in).
 fn with_noise(
     problem: &Problem,
     rate: Option<(&noise_reaction::NoiseReaction, &[Vec3])>,
+    attitude: Option<&[[f64; 4]]>,
     extra: Option<&[[f64; 4]]>,
     sign: f64,
 ) -> Problem {
@@ -213,6 +205,13 @@ fn with_noise(
             }
             for (c, d) in command.iter_mut().zip(change) {
                 *c += d;
+            }
+        }
+    }
+    if let Some(attitude) = attitude {
+        for (command, change) in commands.iter_mut().zip(attitude) {
+            for (c, d) in command.iter_mut().zip(change) {
+                *c += sign * d;
             }
         }
     }

@@ -1,5 +1,7 @@
 # The two commands of the README: `make reproduce` (the main job) and `make test` (every test).
-# One build profile (dev, with the numeric crates optimised: see Cargo.toml) serves both.
+# Each does its own set-up (the flight data linked or fetched, the build), so either can be the first
+# command on a fresh clone; crates/cli/tests/repository.rs checks the graph. One build profile
+# (dev, with the numeric crates optimised: see Cargo.toml) serves both.
 
 CARGO ?= cargo
 LEARN := target/debug/learn
@@ -24,14 +26,14 @@ test: data build
 
 # The paper's tables and figures from one command (experiments/reproduce.json): results/,
 # paper/tables/ and the README's tables block. Stage times are printed; see results/timings.json.
-reproduce: build
+reproduce: data build
 	$(LEARN) $(QUIET) reproduce --config experiments/reproduce.json --out results --latex-dir paper/tables --readme README.md --force
 
 # Variants beyond the paper (experiments/variants.json): every variant on every cell over 5 seeds,
 # model selection inside the support segment only; results/ablations/ablations.{md,json} and figures
 # with the ensemble band. Takes about 6 minutes on 2 cores (LeARN meta-training for the learned-basis
 # variants: three models per cell and seed for learn-ensemble3).
-ablations: build
+ablations: data build
 	$(LEARN) $(QUIET) ablations --config experiments/variants.json --out results/ablations --force
 
 # The regression against the paper: the same protocol and LeARN budget without the variant columns
@@ -40,7 +42,7 @@ ablations: build
 # The scratch is emptied first: files left there by an older tool have no output manifest, and a
 # command never replaces files it did not write.
 CI_RESULTS := results/.scratch/ci
-check-paper: build
+check-paper: data build
 	rm -rf $(CI_RESULTS)
 	$(LEARN) $(QUIET) reproduce --config experiments/ci.json --out $(CI_RESULTS) --latex-dir $(CI_RESULTS)/latex --force
 	$(LEARN) check-paper --results $(CI_RESULTS)/tables
@@ -48,8 +50,8 @@ check-paper: build
 # LeARN on your own data, the worked example (experiments/own-data/example.json): a simulated family
 # of forced, damped Duffing oscillators written as CSV tasks to target/own-data-example (try the
 # three commands of docs/own-data.md on them), meta-trained with the default settings, and the
-# learning curve against SINDy and ridge: results/own-data/learning-curve.{svg,md,json}. About 10 s
-# after the build; not part of `make test`.
+# learning curve against SINDy and ridge: results/own-data/learning-curve.{svg,md,json}. About 25 s
+# of processor time after the build (docs/own-data.md); not part of `make test`.
 own-data-example: build
 	$(LEARN) $(QUIET) own-data-example --config experiments/own-data/example.json --work target/own-data-example --out results/own-data --force
 

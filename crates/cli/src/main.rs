@@ -27,6 +27,8 @@ macro_rules! note {
 }
 
 mod commands;
+#[cfg(test)]
+mod help_agreement;
 
 use std::process::ExitCode;
 

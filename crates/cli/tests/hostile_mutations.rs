@@ -150,7 +150,7 @@ fn mutated_flights_are_read_or_refused_in_one_line() {
             };
             read_or_refuse(&path, &read).map_err(TestCaseError::fail)?;
             case.set(case.get() + 1);
-            if case.get() % THROUGH_THE_BINARY == 0 {
+            if case.get().is_multiple_of(THROUGH_THE_BINARY) {
                 through_the_binary(&path).map_err(TestCaseError::fail)?;
             }
             Ok(())

@@ -50,6 +50,7 @@ pub use stream::{NumericBlock, NumericStream};
 pub use table::ColumnRef;
 pub use tasks::{MAX_TASKS, TaskTable, interval_text, read_column_tasks, read_file_tasks};
 pub use time::{DEFAULT_UNIFORM_TOLERANCE, StreamedTimeAxis, check_time_axis};
+pub use write::write_numeric_csv;
 
 /// Re-exported so that downstream crates name the same matrix type.
 pub use faer::Mat;

@@ -68,6 +68,22 @@ impl NumericTable {
         Ok((time_values, table))
     }
 
+    /// Reads the named columns and checks that `time` is strictly increasing, with at least two
+    /// samples; its steps may vary (for estimators that use the true time stamps).
+    pub fn read_with_increasing_time(
+        path: &Path,
+        time: &str,
+        columns: &[&str],
+    ) -> Result<(Vec<f64>, Self)> {
+        let mut names = vec![time];
+        names.extend_from_slice(columns);
+        let mut table = Self::read(path, &names)?;
+        let time_values = table.columns.remove(0);
+        table.names.remove(0);
+        check_time_axis_at(path, time, &time_values, f64::INFINITY, &|k| table.line(k))?;
+        Ok((time_values, table))
+    }
+
     /// Number of rows.
     pub fn rows(&self) -> usize {
         self.columns.first().map_or(0, Vec::len)

@@ -1,5 +1,5 @@
 //! Writing flight logs in the Neural-Fly CSV layout (used by the simulator and by tests that make
-//! their own small data).
+//! their own small data), and plain numeric tables (a model's predictions).
 
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -88,4 +88,31 @@ impl FlightLog {
         let mut file = std::fs::File::create(path).map_err(io)?;
         file.write_all(text.as_bytes()).map_err(io)
     }
+}
+
+/// Writes named numeric columns of equal length as a CSV with a header (names quoted where they
+/// need it); numbers with full precision, so reading the file back is lossless.
+pub fn write_numeric_csv(path: &Path, names: &[String], columns: &[Vec<f64>]) -> Result<()> {
+    let io = |source| DataError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let quoted = |name: &String| {
+        if name.contains([',', '"', '\n', '\r']) {
+            format!("\"{}\"", name.replace('"', "\"\""))
+        } else {
+            name.clone()
+        }
+    };
+    let mut text = names.iter().map(quoted).collect::<Vec<_>>().join(",");
+    text.push('\n');
+    let rows = columns.first().map_or(0, Vec::len);
+    for row in 0..rows {
+        let cells: Vec<String> = columns.iter().map(|c| format!("{:?}", c[row])).collect();
+        text.push_str(&cells.join(","));
+        text.push('\n');
+    }
+    let mut file = std::fs::File::create(path).map_err(io)?;
+    file.write_all(text.as_bytes()).map_err(io)?;
+    Ok(())
 }

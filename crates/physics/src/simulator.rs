@@ -229,7 +229,10 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
             .update(&measured, &reference, flight.control_dt);
         let speeds = flight.speeds_for(&output, t);
         commands.issue(step, speeds, mixer.wrench(&speeds)[0]);
-        if step >= warmup_steps && (step - warmup_steps) % per_row == 0 && step <= last_row_step {
+        if step >= warmup_steps
+            && (step - warmup_steps).is_multiple_of(per_row)
+            && step <= last_row_step
+        {
             record_row(&mut log, &measured, &reference, &output, t);
             commands.add_row(step - warmup_steps);
         }

@@ -1,4 +1,4 @@
-//! Differentiation: derivative estimators for uniformly sampled signals (PySINDy's
+//! Differentiation: derivative estimators on sampled signals (PySINDy's
 //! `differentiation` module), the targets ẋ that SINDy regresses on.
 //!
 //! - forward difference: `(x[k+1] − x[k]) / dt`, the last sample backward `(x[n−1] − x[n−2]) / dt`;
@@ -23,6 +23,18 @@ pub enum DifferentiationError {
          order {order}"
     )]
     BadWindow { window: usize, order: usize },
+    /// Samples whose spacing is not uniform, given to an estimator that needs a uniform grid.
+    #[error(
+        "derivative: sample {sample} is {step} s after the one before, the mean step is {mean} s: \
+         the {estimator} estimator needs uniform samples (forward and central differences use \
+         the true time stamps)"
+    )]
+    NonUniformTime {
+        sample: usize,
+        step: f64,
+        mean: f64,
+        estimator: Derivative,
+    },
     /// A signal shorter than the estimator's stencil.
     #[error("derivative: {samples} samples, the {estimator} estimator needs at least {needed}")]
     TooFewSamples {
@@ -139,6 +151,78 @@ impl Derivative {
         })
     }
 
+    /// Estimates the derivative of `x` sampled at the strictly increasing times `time`.
+    ///
+    /// Forward differences divide by each sample's own step, and central differences are the
+    /// second-order three-point formulas of a non-uniform grid (NumPy's `gradient` with
+    /// `edge_order=2`); on a grid uniform to rounding ([`UNIFORM_STEP_TOLERANCE`]) both are
+    /// [`Derivative::apply`] with the mean step. Savitzky–Golay weights assume a uniform grid: it
+    /// uses the mean step when every step is within [`SAVITZKY_GOLAY_STEP_TOLERANCE`] of it and
+    /// is refused beyond, naming the first sample off the grid ([`Derivative::check_times`]).
+    ///
+    /// ```
+    /// use sindy::Derivative;
+    /// let time = [0.0, 0.1, 0.25, 0.3, 0.5, 0.55];
+    /// let x: Vec<f64> = time.iter().map(|t| t * t).collect();
+    /// let dx = Derivative::Central.apply_at_times(&x, &time)?;
+    /// assert!(dx.iter().zip(&time).all(|(d, t)| (d - 2.0 * t).abs() < 1e-12)); // exact on t²
+    /// # Ok::<(), sindy::DifferentiationError>(())
+    /// ```
+    pub fn apply_at_times(&self, x: &[f64], time: &[f64]) -> Result<Vec<f64>> {
+        let n = x.len().min(time.len());
+        let (x, time) = (&x[..n], &time[..n]);
+        self.check_times(time)?;
+        let mean = (time[n - 1] - time[0]) / (n - 1) as f64;
+        if first_off_grid(time, UNIFORM_STEP_TOLERANCE).is_none() {
+            return self.apply(x, mean);
+        }
+        Ok(match *self {
+            Self::Forward => forward_at_times(x, time),
+            Self::Central => central_at_times(x, time),
+            Self::SavitzkyGolay { .. } => self.apply(x, mean)?,
+        })
+    }
+
+    /// Whether the estimator can be applied at the times `time`: enough samples and, for
+    /// Savitzky–Golay, every step within [`SAVITZKY_GOLAY_STEP_TOLERANCE`] of the mean step.
+    pub fn check_times(&self, time: &[f64]) -> Result<()> {
+        let n = time.len();
+        if n < self.min_samples() {
+            return Err(DifferentiationError::TooFewSamples {
+                samples: n,
+                estimator: *self,
+                needed: self.min_samples(),
+            });
+        }
+        if let Self::SavitzkyGolay { .. } = self
+            && let Some(sample) = first_off_grid(time, SAVITZKY_GOLAY_STEP_TOLERANCE)
+        {
+            return Err(DifferentiationError::NonUniformTime {
+                sample,
+                step: time[sample] - time[sample - 1],
+                mean: (time[n - 1] - time[0]) / (n - 1) as f64,
+                estimator: *self,
+            });
+        }
+        Ok(())
+    }
+
+    /// [`Derivative::apply_at_times`] to each column of `x` (one row per sample).
+    pub fn apply_columns_at_times(
+        &self,
+        x: faer::MatRef<'_, f64>,
+        time: &[f64],
+    ) -> Result<faer::Mat<f64>> {
+        let mut derivatives = faer::Mat::zeros(x.nrows(), x.ncols());
+        for j in 0..x.ncols() {
+            let column: Vec<f64> = x.col(j).iter().copied().collect();
+            for (i, value) in self.apply_at_times(&column, time)?.into_iter().enumerate() {
+                derivatives[(i, j)] = value;
+            }
+        }
+        Ok(derivatives)
+    }
+
     /// [`Derivative::apply`] to each column of `x` (one row per sample, sampled every `dt`).
     pub fn apply_columns(&self, x: faer::MatRef<'_, f64>, dt: f64) -> Result<faer::Mat<f64>> {
         let mut derivatives = faer::Mat::zeros(x.nrows(), x.ncols());
@@ -168,6 +252,55 @@ fn forward(x: &[f64], dt: f64) -> Vec<f64> {
     let mut d: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]) / dt).collect();
     d.push((x[n - 1] - x[n - 2]) / dt);
     d
+}
+
+/// Largest relative deviation of a step from the mean step for which forward and central
+/// differences use the mean step in [`Derivative::apply_at_times`]: rounding of the time stamps,
+/// not jitter (the results are then those of [`Derivative::apply`] bit for bit).
+pub const UNIFORM_STEP_TOLERANCE: f64 = 1e-6;
+
+/// Largest relative deviation of a step from the mean step that Savitzky–Golay accepts (and
+/// ignores, using the mean step): time stamps printed with a few digits, not a jittering logger.
+pub const SAVITZKY_GOLAY_STEP_TOLERANCE: f64 = 0.01;
+
+/// The first sample whose step from the one before deviates from the mean step by more than
+/// `tolerance` of it.
+fn first_off_grid(time: &[f64], tolerance: f64) -> Option<usize> {
+    let n = time.len();
+    let mean = (time[n - 1] - time[0]) / (n - 1) as f64;
+    (1..n).find(|&k| ((time[k] - time[k - 1]) - mean).abs() > tolerance * mean.abs())
+}
+
+fn forward_at_times(x: &[f64], time: &[f64]) -> Vec<f64> {
+    let n = x.len();
+    let slope = |k: usize| (x[k + 1] - x[k]) / (time[k + 1] - time[k]);
+    let mut d: Vec<f64> = (0..n - 1).map(slope).collect();
+    d.push(slope(n - 2));
+    d
+}
+
+/// The derivative at `time[at]` of the parabola through the samples `points` (three indices).
+fn parabola_slope(x: &[f64], time: &[f64], points: [usize; 3], at: usize) -> f64 {
+    // Lagrange form: the derivative of each basis polynomial at `time[at]`.
+    let t = time[at];
+    (0..3)
+        .map(|i| {
+            let (a, b, c) = (points[i], points[(i + 1) % 3], points[(i + 2) % 3]);
+            let weight =
+                ((t - time[b]) + (t - time[c])) / ((time[a] - time[b]) * (time[a] - time[c]));
+            weight * x[a]
+        })
+        .sum()
+}
+
+fn central_at_times(x: &[f64], time: &[f64]) -> Vec<f64> {
+    let n = x.len();
+    (0..n)
+        .map(|k| {
+            let centre = k.clamp(1, n - 2);
+            parabola_slope(x, time, [centre - 1, centre, centre + 1], k)
+        })
+        .collect()
 }
 
 fn central(x: &[f64], dt: f64) -> Vec<f64> {

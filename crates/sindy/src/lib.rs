@@ -76,7 +76,9 @@ mod persist;
 mod regression;
 mod stream;
 
-pub use differentiation::{Derivative, DifferentiationError};
+pub use differentiation::{
+    Derivative, DifferentiationError, SAVITZKY_GOLAY_STEP_TOLERANCE, UNIFORM_STEP_TOLERANCE,
+};
 pub use error::{Result, SindyError, field, shape};
 pub use library::{CustomFunction, FeatureLibrary, LibrarySpec, MAX_FEATURES};
 pub use linalg::least_squares;

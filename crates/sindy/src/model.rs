@@ -10,7 +10,9 @@ use crate::optimizers::tsqr::{BLOCK_ROWS, reduce_row_blocks};
 use crate::optimizers::{Optimizer, OptimizerSpec, Problem};
 
 /// One recorded trajectory: states x(t), optional controls u(t), optional derivatives ẋ(t).
-/// Samples must be uniformly spaced in time when derivatives are estimated from the states.
+/// Derivatives estimated from the states use the true time stamps
+/// ([`Derivative::apply_at_times`]): the samples need not be evenly spaced, except for
+/// Savitzky–Golay.
 #[derive(Clone, Debug)]
 pub struct Trajectory {
     /// Time of each sample, s, strictly increasing.
@@ -88,17 +90,16 @@ impl Trajectory {
         concatenate_columns(self.states.as_ref(), self.controls.as_ref())
     }
 
-    /// ẋ: the given derivatives, or the estimate of `derivative` on each state column.
+    /// ẋ: the given derivatives, or the estimate of `derivative` on each state column at the
+    /// trajectory's time stamps.
     fn targets(&self, derivative: Derivative) -> Result<Mat<f64>> {
         if let Some(d) = &self.derivatives {
             return Ok(d.clone());
         }
-        let n = self.len();
-        if n < 2 {
+        if self.len() < 2 {
             return Err(shape("trajectory", "needs at least two samples"));
         }
-        let dt = (self.time[n - 1] - self.time[0]) / (n - 1) as f64;
-        Ok(derivative.apply_columns(self.states.as_ref(), dt)?)
+        Ok(derivative.apply_columns_at_times(self.states.as_ref(), &self.time)?)
     }
 }
 
@@ -520,8 +521,22 @@ impl SindyModel {
     /// MSE and R² of the predicted ẋ against the trajectory's derivatives (estimated with the
     /// model's derivative estimator when the trajectory has none).
     pub fn score(&self, trajectory: &Trajectory) -> Result<Score> {
-        let predicted = self.predict(trajectory.states.as_ref(), trajectory.controls.as_ref())?;
-        let actual = trajectory.targets(self.derivative)?;
+        self.score_all(std::slice::from_ref(trajectory))
+    }
+
+    /// [`SindyModel::score`] over several trajectories, their samples stacked (PySINDy's score
+    /// with multiple trajectories); each trajectory's derivatives are estimated on its own.
+    pub fn score_all(&self, trajectories: &[Trajectory]) -> Result<Score> {
+        if trajectories.is_empty() {
+            return Err(invalid("trajectories", "at least one is needed"));
+        }
+        let mut predicted = Vec::with_capacity(trajectories.len());
+        let mut actual = Vec::with_capacity(trajectories.len());
+        for trajectory in trajectories {
+            predicted.push(self.predict(trajectory.states.as_ref(), trajectory.controls.as_ref())?);
+            actual.push(trajectory.targets(self.derivative)?);
+        }
+        let (predicted, actual) = (stack_rows(&predicted), stack_rows(&actual));
         let constant_states = constant_columns(actual.as_ref());
         let varying: Vec<usize> = (0..actual.ncols())
             .filter(|j| !constant_states.contains(j))
@@ -766,10 +781,10 @@ pub(crate) fn check_finite(
     for j in 0..matrix.ncols() {
         let column = matrix.col(j);
         // The common case first: a contiguous column checked in one vectorised pass.
-        if let Some(slice) = column.try_as_col_major() {
-            if slice.as_slice().iter().all(|v| v.is_finite()) {
-                continue;
-            }
+        if let Some(slice) = column.try_as_col_major()
+            && slice.as_slice().iter().all(|v| v.is_finite())
+        {
+            continue;
         }
         if let Some(i) = column.iter().position(|v| !v.is_finite()) {
             return Err(SindyError::NonFinite {

@@ -17,7 +17,7 @@ pub struct Args {
     pub checkpoint: PathBuf,
     /// The flight to explain over (default: the evaluation flight of the checkpoint's held-out
     /// condition); for a model of CSV tasks, the recording (a CSV with its columns; required).
-    #[arg(long, alias = "csv")]
+    #[arg(long, visible_alias = "csv")]
     pub flight: Option<PathBuf>,
     /// For a model of CSV tasks: the rows it adapts on before the explanation, A:B (data rows
     /// from 0, B excluded) [default: the first half of the recording].

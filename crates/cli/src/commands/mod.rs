@@ -17,6 +17,7 @@ mod seed_spread;
 mod shard;
 mod simulate;
 mod sindy;
+mod sindy_apply;
 
 use std::path::{Path, PathBuf};
 
@@ -25,9 +26,16 @@ use clap::{Parser, Subcommand};
 /// Whether two paths name the same file whatever their spelling (see [`data::paths::same_file`]).
 pub use data::paths::same_file;
 
-/// Learned-library system identification: SINDy and LeARN on quadrotor flights.
+/// Learned-library system identification: reproduces the LeARN paper against SINDy on the
+/// Neural-Fly quadrotor flights, fits SINDy and LeARN on your own recordings, and names the
+/// physics a nominal model leaves out of real flights.
 #[derive(Parser, Debug)]
-#[command(name = "learn", version, about)]
+#[command(
+    name = "learn",
+    version,
+    after_help = "Start in the repository root with `make reproduce` (the paper's tables and \
+                  figures) or `make test`; the README says what each command writes."
+)]
 pub struct Cli {
     /// Flight data directory (default: $NEURAL_FLY_DIR, then data/neural-fly).
     #[arg(long, global = true)]
@@ -48,7 +56,8 @@ pub enum Command {
     },
     /// List the wind conditions of the experiment and which flight files are present.
     Conditions(conditions::Args),
-    /// Fit a SINDy model on any numeric CSV: print its equations, optionally save it as JSON.
+    /// Fit a SINDy model on numeric CSV recordings: print its equations, optionally save it as
+    /// JSON; `learn sindy predict|simulate` apply a saved model to new data.
     Sindy(sindy::Args),
     /// Run SINDy and LeARN on every formulation and condition: tables, figures, summary.
     Reproduce(reproduce::Args),

@@ -1,11 +1,13 @@
-//! `learn sindy --csv FILE --time t --state x,y [--control u] --library poly:2+fourier:1 ...`:
-//! fits a SINDy model on any numeric CSV, prints its equations, optionally writes the model JSON.
+//! `learn sindy --csv FILE [--csv FILE ...] --time t --state x,y [--control u] --library ...`:
+//! fits a SINDy model on numeric CSV recordings (one trajectory per file), prints its equations,
+//! optionally writes the model JSON; `learn sindy predict|simulate` apply a saved model
+//! ([`super::sindy_apply`]).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow, bail};
 use data::{DEFAULT_UNIFORM_TOLERANCE, NumericStream, NumericTable, StreamedTimeAxis};
-use sindy::Derivative;
+use sindy::{Derivative, DifferentiationError};
 use sindy::{
     FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, RowBlock, Score, SindyError, SindyModel,
     SindyParams, Trajectory,
@@ -14,6 +16,7 @@ use sindy::{
 use outputs::{Existing, OutputSet};
 
 use super::Global;
+use super::sindy_apply::{self, ApplyCommand};
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum OptimizerKind {
@@ -24,11 +27,16 @@ pub enum OptimizerKind {
 }
 
 #[derive(clap::Args, Debug)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct Args {
-    /// A numeric CSV file with a header row.
-    #[arg(long)]
-    pub csv: PathBuf,
-    /// The time column (uniformly sampled, strictly increasing).
+    #[command(subcommand)]
+    pub command: Option<ApplyCommand>,
+    /// A numeric CSV file with a header row; give --csv once per recording to fit several
+    /// trajectories together (derivatives are estimated within each).
+    #[arg(long, required = true)]
+    pub csv: Vec<PathBuf>,
+    /// The time column (strictly increasing; forward and central differences use the true time
+    /// stamps, savgol needs uniform steps).
     #[arg(long, default_value = "t")]
     pub time: String,
     /// State columns, comma-separated (x in ẋ = f(x, u)).
@@ -52,7 +60,7 @@ pub struct Args {
     #[arg(long)]
     pub force: bool,
     /// Read the CSV in blocks of rows and fit as it is read, in memory that does not grow with
-    /// the file (the default for files over 8 MiB; the file must be a regular file).
+    /// the file (the default for one file over 8 MiB; one regular file with uniform time steps).
     #[arg(long)]
     pub stream: bool,
 }
@@ -151,25 +159,117 @@ pub const STREAM_ABOVE_BYTES: u64 = 8 << 20;
 /// Rows per block read from a streamed CSV.
 const STREAM_BLOCK_ROWS: usize = 1 << 14;
 
-/// The fit of a file read whole; its model, score on all rows and number of rows.
+/// One recording read whole: its trajectory and the line of the file each row starts on.
+pub(super) struct Recording {
+    pub(super) path: PathBuf,
+    pub(super) trajectory: Trajectory,
+    pub(super) table: NumericTable,
+}
+
+/// Reads the time column and `columns` (states, then controls) of `path` as a trajectory whose
+/// derivatives `derivative` can be estimated (a savgol derivative needs uniform steps).
+pub(super) fn read_recording(
+    path: &Path,
+    time_column: &str,
+    state_count: usize,
+    columns: &[&str],
+    derivative: Derivative,
+) -> anyhow::Result<Recording> {
+    let (time, table) = NumericTable::read_with_increasing_time(path, time_column, columns)?;
+    check_sampling(path, time_column, derivative, &time, |row| table.line(row))?;
+    let n = table.rows();
+    let states = Mat::from_fn(n, state_count, |i, j| table.columns[j][i]);
+    let controls = Mat::from_fn(n, columns.len() - state_count, |i, j| {
+        table.columns[state_count + j][i]
+    });
+    let trajectory = Trajectory::new(time, states)?.with_controls(controls)?;
+    Ok(Recording {
+        path: path.to_path_buf(),
+        trajectory,
+        table,
+    })
+}
+
+/// Refuses a time axis the derivative cannot use, naming the file's line.
+fn check_sampling(
+    path: &Path,
+    time_column: &str,
+    derivative: Derivative,
+    time: &[f64],
+    line: impl Fn(usize) -> usize,
+) -> anyhow::Result<()> {
+    derivative.check_times(time).map_err(|error| match error {
+        DifferentiationError::NonUniformTime {
+            sample, step, mean, ..
+        } => anyhow!(
+            "{}:{}:{time_column}: a step of {step} s against a mean of {mean} s: the \
+             {derivative} derivative needs uniform samples (--derivative forward or central use \
+             the true time stamps)",
+            path.display(),
+            line(sample),
+        ),
+        other => anyhow!("{}: {other}", path.display()),
+    })
+}
+
+/// The fit of the files read whole, one trajectory each; its model, score on all rows and number
+/// of rows.
 fn fit_whole(
     args: &Args,
     params: &SindyParams,
     columns: &[&str],
     feature_count: usize,
 ) -> anyhow::Result<(SindyModel, Score, usize)> {
-    let (time, table) = NumericTable::read_with_time(&args.csv, &args.time, columns)?;
-    let n = table.rows();
+    let derivative = Derivative::parse(&args.derivative)?;
+    let recordings = args
+        .csv
+        .iter()
+        .map(|path| read_recording(path, &args.time, args.state.len(), columns, derivative))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let n = recordings.iter().map(|r| r.table.rows()).sum();
     check_rows(args, n, feature_count, columns)?;
-    let dim_x = args.state.len();
-    let states = Mat::from_fn(n, dim_x, |i, j| table.columns[j][i]);
-    let controls = Mat::from_fn(n, args.control.len(), |i, j| table.columns[dim_x + j][i]);
-    let trajectory = Trajectory::new(time, states)?.with_controls(controls)?;
+    let trajectories: Vec<Trajectory> = recordings.iter().map(|r| r.trajectory.clone()).collect();
     let model = params
-        .fit(std::slice::from_ref(&trajectory))
-        .map_err(|error| fit_error(args, error, |row| table.line(row)))?;
-    let score = model.score(&trajectory)?;
+        .fit(&trajectories)
+        .map_err(|error| whole_fit_error(args, &recordings, error))?;
+    let score = model.score_all(&trajectories)?;
     Ok((model, score, n))
+}
+
+/// A fit's error over stacked recordings: a non-finite value named by its file and line.
+fn whole_fit_error(args: &Args, recordings: &[Recording], error: SindyError) -> anyhow::Error {
+    let SindyError::NonFinite {
+        what,
+        row,
+        column,
+        value,
+    } = error
+    else {
+        return fit_error(args, &args.csv[0], error, |row| row);
+    };
+    let mut first = 0;
+    for recording in recordings {
+        let rows = recording.table.rows();
+        if row < first + rows {
+            let local = SindyError::NonFinite {
+                what,
+                row: row - first,
+                column,
+                value,
+            };
+            return fit_error(args, &recording.path, local, |row| {
+                recording.table.line(row)
+            });
+        }
+        first += rows;
+    }
+    let error = SindyError::NonFinite {
+        what,
+        row,
+        column,
+        value,
+    };
+    fit_error(args, &args.csv[0], error, |row| row)
 }
 
 /// The fit of a file read in two passes of blocks: the time column (checked as a uniform axis),
@@ -180,14 +280,22 @@ fn fit_streamed(
     columns: &[&str],
     feature_count: usize,
 ) -> anyhow::Result<(SindyModel, Score, usize)> {
-    let mut stream = NumericStream::open(&args.csv, &[args.time.as_str()])?;
-    let mut axis = StreamedTimeAxis::new(&args.csv, &args.time, DEFAULT_UNIFORM_TOLERANCE);
+    let [csv] = args.csv.as_slice() else {
+        bail!(
+            "--stream reads one --csv file; {} were given (several recordings are read whole)",
+            args.csv.len()
+        );
+    };
+    let mut stream = NumericStream::open(csv, &[args.time.as_str()])?;
+    let mut axis = StreamedTimeAxis::new(csv, &args.time, DEFAULT_UNIFORM_TOLERANCE);
     while let Some(block) = stream.next_block(STREAM_BLOCK_ROWS)? {
-        axis.push(&block.columns[0])?;
+        axis.push(&block.columns[0]).context(
+            "a file read in blocks (--stream, or one file over 8 MiB) needs uniform time steps",
+        )?;
     }
     let (n, dt) = axis.finish()?;
     check_rows(args, n, feature_count, columns)?;
-    let mut stream = NumericStream::open(&args.csv, columns)?;
+    let mut stream = NumericStream::open(csv, columns)?;
     let fit = params
         .fit_streamed(n, dt, || {
             let block = stream
@@ -197,7 +305,7 @@ fn fit_streamed(
                 columns: block.columns,
             }))
         })
-        .map_err(|error| fit_error(args, error, |row| row + 2))?;
+        .map_err(|error| fit_error(args, csv, error, |row| row + 2))?;
     Ok((fit.model, fit.score, n))
 }
 
@@ -206,7 +314,7 @@ fn check_rows(args: &Args, n: usize, feature_count: usize, columns: &[&str]) -> 
         bail!(
             "{}: {n} data rows, fewer than the {feature_count} features of library {} on {}: \
              the fit needs at least one row per feature",
-            args.csv.display(),
+            files(&args.csv),
             args.fit.library,
             columns.join(", ")
         );
@@ -214,8 +322,22 @@ fn check_rows(args: &Args, n: usize, feature_count: usize, columns: &[&str]) -> 
     Ok(())
 }
 
-/// A fit's error, a non-finite value named by the line of its row.
-fn fit_error(args: &Args, error: SindyError, line: impl Fn(usize) -> usize) -> anyhow::Error {
+/// The files named in a message: one path, or the paths joined by ", ".
+fn files(paths: &[PathBuf]) -> String {
+    paths
+        .iter()
+        .map(|path| path.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A fit's error, a non-finite value named by the line of its row in `path`.
+fn fit_error(
+    args: &Args,
+    path: &Path,
+    error: SindyError,
+    line: impl Fn(usize) -> usize,
+) -> anyhow::Error {
     match error {
         SindyError::NonFinite {
             what,
@@ -230,15 +352,18 @@ fn fit_error(args: &Args, error: SindyError, line: impl Fn(usize) -> usize) -> a
             };
             anyhow!(
                 "{}:{}: {column} is not finite ({value}) on this row{hint}",
-                args.csv.display(),
+                path.display(),
                 line(row),
             )
         }
-        other => anyhow::Error::new(other).context(format!("fitting {}", args.csv.display())),
+        other => anyhow::Error::new(other).context(format!("fitting {}", files(&args.csv))),
     }
 }
 
-pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
+pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
+    if let Some(command) = args.command {
+        return sindy_apply::run(global, command);
+    }
     // Everything that can be checked without reading the file is checked first.
     let library = args.fit.library()?;
     let optimizer = args.fit.optimizer()?;
@@ -267,7 +392,9 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     let output = match &args.out {
         Some(out) => {
             let mut set = OutputSet::new("sindy");
-            set.input("the --csv input", &args.csv);
+            for csv in &args.csv {
+                set.input("the --csv input", csv);
+            }
             let file = set.file(out, "--out", Existing::from_force(args.force));
             Some((set.prepare()?, file))
         }
@@ -281,8 +408,9 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         .optimizer(optimizer)
         .derivative(derivative);
     let streamed = args.stream
-        || std::fs::metadata(&args.csv)
-            .is_ok_and(|metadata| metadata.is_file() && metadata.len() > STREAM_ABOVE_BYTES);
+        || (args.csv.len() == 1
+            && std::fs::metadata(&args.csv[0])
+                .is_ok_and(|metadata| metadata.is_file() && metadata.len() > STREAM_ABOVE_BYTES));
     let (model, score, n) = if streamed {
         fit_streamed(&args, &params, &columns, feature_count)?
     } else {
@@ -294,7 +422,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         bail!(
             "{}: the fit is not finite (MSE {}, R² {}): are the time steps of column '{}' in \
              seconds?",
-            args.csv.display(),
+            files(&args.csv),
             score.mse,
             score.r2,
             args.time
@@ -308,15 +436,32 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     for line in model.equations(usize::from(args.precision)) {
         say!("{line}");
     }
-    // R² divides by the variance of the target: on a constant one it is rounding noise, so such
-    // states are left out of it and named.
+    let trajectories = match args.csv.len() {
+        1 => String::new(),
+        count => format!(" in {count} trajectories"),
+    };
+    note!(
+        "{n} samples{trajectories}, {} features; MSE {:.6}, {}",
+        model.feature_names().len(),
+        score.mse,
+        r2_text(&model, &score),
+    );
+    if let Some(out) = &args.out {
+        note!("model written to {}", out.display());
+    }
+    Ok(())
+}
+
+/// R² as printed: R² divides by the variance of the target, so on a constant one it is rounding
+/// noise; such states are left out of it and named.
+pub(super) fn r2_text(model: &SindyModel, score: &Score) -> String {
     let states = model.state_names();
     let constant: Vec<String> = score
         .constant_states
         .iter()
         .map(|&j| format!("{}'", states[j]))
         .collect();
-    let r2 = match score.r2_varying {
+    match score.r2_varying {
         _ if constant.is_empty() => format!("R² {:.6}", score.r2),
         Some(r2) => format!(
             "R² {r2:.6} over the {} of {} states whose target varies ({} constant: no R²)",
@@ -325,15 +470,5 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
             constant.join(", ")
         ),
         None => "R² n/a (constant target)".to_string(),
-    };
-    note!(
-        "{} samples, {} features; MSE {:.6}, {r2}",
-        n,
-        model.feature_names().len(),
-        score.mse,
-    );
-    if let Some(out) = &args.out {
-        note!("model written to {}", out.display());
     }
-    Ok(())
 }

@@ -289,7 +289,10 @@ fn the_command_log_reads_what_the_logger_describes() {
         let warmup_steps = s.warmup_rows() * 10;
         for step in 0..warmup_steps + 40 {
             commands.issue(step, [step as f64; 4], 2.0 * step as f64);
-            if step >= warmup_steps && (step - warmup_steps) % 10 == 0 && step < warmup_steps + 30 {
+            if step >= warmup_steps
+                && (step - warmup_steps).is_multiple_of(10)
+                && step < warmup_steps + 30
+            {
                 commands.add_row(step - warmup_steps);
             }
             commands.fill_ready(step);

@@ -98,7 +98,12 @@ fn every_subcommand_is_in_the_readme_and_has_a_summary() {
             "`learn {name}` is not in the README"
         );
     }
-    let flatten = |text: &str| text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let flatten = |text: &str| {
+        text.split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ")
+            .to_lowercase()
+    };
     let summary = flatten(&command.get_about().expect("a summary").to_string());
     assert!(
         flatten(&readme).contains(&summary),

@@ -26,9 +26,8 @@ use clap::{Parser, Subcommand};
 /// Whether two paths name the same file whatever their spelling (see [`data::paths::same_file`]).
 pub use data::paths::same_file;
 
-/// Learned-library system identification: reproduces the LeARN paper against SINDy on the
-/// Neural-Fly quadrotor flights, fits SINDy and LeARN on your own recordings, and names the
-/// physics a nominal model leaves out of real flights.
+/// Reproduces the LeARN paper against SINDy on the Neural-Fly quadrotor flights, fits SINDy and
+/// LeARN on your own recordings, and names the physics a nominal model leaves out of real flights.
 #[derive(Parser, Debug)]
 #[command(
     name = "learn",
@@ -49,7 +48,8 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Work with flight logs.
+    /// Flight logs: `learn data inspect FLIGHT.csv` shows a log's duration, rate, columns, ranges
+    /// and problems.
     Data {
         #[command(subcommand)]
         command: DataCommand,

@@ -213,27 +213,28 @@ impl Derivative {
         x: faer::MatRef<'_, f64>,
         time: &[f64],
     ) -> Result<faer::Mat<f64>> {
-        let mut derivatives = faer::Mat::zeros(x.nrows(), x.ncols());
-        for j in 0..x.ncols() {
-            let column: Vec<f64> = x.col(j).iter().copied().collect();
-            for (i, value) in self.apply_at_times(&column, time)?.into_iter().enumerate() {
-                derivatives[(i, j)] = value;
-            }
-        }
-        Ok(derivatives)
+        columnwise(x, |column| self.apply_at_times(column, time))
     }
 
     /// [`Derivative::apply`] to each column of `x` (one row per sample, sampled every `dt`).
     pub fn apply_columns(&self, x: faer::MatRef<'_, f64>, dt: f64) -> Result<faer::Mat<f64>> {
-        let mut derivatives = faer::Mat::zeros(x.nrows(), x.ncols());
-        for j in 0..x.ncols() {
-            let column: Vec<f64> = x.col(j).iter().copied().collect();
-            for (i, value) in self.apply(&column, dt)?.into_iter().enumerate() {
-                derivatives[(i, j)] = value;
-            }
-        }
-        Ok(derivatives)
+        columnwise(x, |column| self.apply(column, dt))
     }
+}
+
+/// `derivative` of each column of `x`, as the columns of a matrix of the same shape.
+fn columnwise(
+    x: faer::MatRef<'_, f64>,
+    derivative: impl Fn(&[f64]) -> Result<Vec<f64>>,
+) -> Result<faer::Mat<f64>> {
+    let mut derivatives = faer::Mat::zeros(x.nrows(), x.ncols());
+    for j in 0..x.ncols() {
+        let column: Vec<f64> = x.col(j).iter().copied().collect();
+        for (i, value) in derivative(&column)?.into_iter().enumerate() {
+            derivatives[(i, j)] = value;
+        }
+    }
+    Ok(derivatives)
 }
 
 impl std::fmt::Display for Derivative {

@@ -6,8 +6,7 @@
 //! [`read_column_tasks`]); support/query splits ([`SplitSpec`]); the experiment's wind conditions
 //! ([`ExperimentConditions`]); the noise floor of forward-difference targets
 //! ([`forward_difference_noise_floor`]); file hashes ([`file_sha256`]); finding the data directory
-//! ([`resolve_data_dir`]); telling whether two spellings name the same file
-//! ([`paths::same_file`]).
+//! ([`resolve_data_dir`]).
 //!
 //! What it is not for: fitting anything (models live in `sindy` and `learn`, tables in `report`),
 //! nor the paper's protocol: a formulation's segments of a flight, the experiment and its
@@ -28,10 +27,6 @@ mod table;
 mod tasks;
 mod time;
 mod write;
-
-/// Comparing paths of files to read or write (kept in the `outputs` crate, the home of output
-/// checks).
-pub use outputs::paths;
 
 pub use conditions::{Condition, ExperimentConditions, FlightFile, PaperTraining, Role};
 pub use error::{DataError, Result};

@@ -23,8 +23,8 @@ use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
 
-/// Whether two paths name the same file whatever their spelling (see [`data::paths::same_file`]).
-pub use data::paths::same_file;
+/// Whether two paths name the same file whatever their spelling (see [`outputs::paths::same_file`]).
+pub use outputs::paths::same_file;
 
 /// Reproduces the LeARN paper against SINDy on the Neural-Fly quadrotor flights, fits SINDy and
 /// LeARN on your own recordings, and names the physics a nominal model leaves out of real flights.

@@ -183,7 +183,7 @@ fn fit_streamed(
     let mut stream = NumericStream::open(&args.csv, &[args.time.as_str()])?;
     let mut axis = StreamedTimeAxis::new(&args.csv, &args.time, DEFAULT_UNIFORM_TOLERANCE);
     while let Some(block) = stream.next_block(STREAM_BLOCK_ROWS)? {
-        axis.push(&block.columns[0])?;
+        axis.push(&block.columns[0], &block.lines)?;
     }
     let (n, dt) = axis.finish()?;
     check_rows(args, n, feature_count, columns)?;
@@ -197,7 +197,11 @@ fn fit_streamed(
                 columns: block.columns,
             }))
         })
-        .map_err(|error| fit_error(args, error, |row| row + 2))?;
+        .map_err(|error| {
+            fit_error(args, error, |row| {
+                NumericStream::line_of_row(&args.csv, row).unwrap_or(row + 2)
+            })
+        })?;
     Ok((fit.model, fit.score, n))
 }
 
@@ -234,6 +238,9 @@ fn fit_error(args: &Args, error: SindyError, line: impl Fn(usize) -> usize) -> a
                 line(row),
             )
         }
+        // The file's own error (a bad line met while the rows were read), as the whole-file read
+        // gives it: it names the file already.
+        SindyError::Source(source) => anyhow::Error::from_boxed(source),
         other => anyhow::Error::new(other).context(format!("fitting {}", args.csv.display())),
     }
 }

@@ -16,7 +16,7 @@ data:
 
 # Binaries, tests and examples in one build: with dev-dependencies in the same feature resolution,
 # `cargo test` then reuses every artifact (building the binaries alone resolves features differently
-# and recompiles polars and faer, ~3 min on 2 cores).
+# and recompiles faer, minutes on 2 cores).
 build:
 	$(CARGO) build --workspace --bins --tests --examples
 

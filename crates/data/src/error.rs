@@ -13,8 +13,6 @@ pub enum DataError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{}: cannot parse as CSV: {message}", path.display())]
-    Csv { path: PathBuf, message: String },
     #[error("{}: the file is empty (no data rows)", path.display())]
     Empty { path: PathBuf },
     #[error("{}: is a directory, not a CSV file", path.display())]
@@ -36,11 +34,13 @@ pub enum DataError {
         first: usize,
         second: usize,
     },
-    #[error("{}:{row}: {message}", path.display())]
-    BadRow {
+    /// A fault of the CSV layout (a comment line, a blank line, an unpaired quote, a row of the
+    /// wrong width...) on line `row`.
+    #[error("{}:{row}: {fault}", path.display())]
+    Layout {
         path: PathBuf,
         row: usize,
-        message: String,
+        fault: crate::records::LayoutFault,
     },
     #[error("{}: missing column '{column}' (columns present: {present})", path.display())]
     MissingColumn {
@@ -48,11 +48,13 @@ pub enum DataError {
         column: String,
         present: String,
     },
-    #[error("{}:{row}:{column}: cannot parse {value:?}: {reason}", path.display())]
+    #[error("{}:{row}:{column}: cannot parse {value}: {reason}", path.display())]
     BadCell {
         path: PathBuf,
         row: usize,
         column: String,
+        /// The cell as a message shows it: quoted, at most [`inputs::EXCERPT_CHARACTERS`]
+        /// characters ([`inputs::Excerpt`]).
         value: String,
         reason: String,
     },

@@ -372,7 +372,7 @@ fn check_unit_quaternions(
                 path: table.path().to_path_buf(),
                 row: table.line(index),
                 column: "q".to_string(),
-                value: format!("{q:?}"),
+                value: format!("\"{q:?}\""),
                 reason: format!("not a unit quaternion (norm {norm:.6})"),
             });
         }
@@ -408,7 +408,7 @@ fn check_rotations(table: &TextTable, rotation: &[[[f64; 3]; 3]], recorded: bool
                 path: table.path().to_path_buf(),
                 row: table.line(index),
                 column: "R".to_string(),
-                value: format!("{r:?}"),
+                value: format!("\"{r:?}\""),
                 reason: format!(
                     "not a rotation matrix (largest |R Rᵀ − I| entry {deviation:.6}, determinant {determinant:.6})"
                 ),
@@ -432,7 +432,7 @@ fn check_agreement(
                 path: table.path().to_path_buf(),
                 row: table.line(index),
                 column: "R".to_string(),
-                value: format!("{r:?}"),
+                value: format!("\"{r:?}\""),
                 reason: format!(
                     "does not match the rotation of q {q:?} (largest entry difference {difference:.6})"
                 ),

@@ -15,11 +15,13 @@
 //! Every error is a [`DataError`] whose message is one line naming the file, and where it applies
 //! the row (line number in the file, header = line 1) and column: `file:row:column: message`.
 
+mod cells;
 mod conditions;
 mod error;
 mod flight_log;
 mod noise_floor;
 mod numeric;
+mod records;
 mod source;
 mod split;
 mod stream;
@@ -36,6 +38,7 @@ pub use flight_log::{
 };
 pub use noise_floor::{NoiseFloor, forward_difference_noise_floor};
 pub use numeric::NumericTable;
+pub use records::LayoutFault;
 pub use source::{
     DATA_DIR_VARIABLE, DEFAULT_DATA_DIR, bytes_sha256, file_sha256, find_data_dir,
     real_data_dir_for_tests, resolve_data_dir,

@@ -2,7 +2,12 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::error::Result;
+use std::io::BufReader;
+
+use crate::cells::NumericColumn;
+use crate::error::{DataError, Result};
+use crate::records::CsvRecords;
+use crate::stream::NumericRows;
 use crate::table::TextTable;
 use crate::time::check_time_axis_at;
 
@@ -19,18 +24,53 @@ pub struct NumericTable {
 impl NumericTable {
     /// Reads the named columns of `path`, in the order given. A name `v[k]` that is not a column
     /// of the file reads element k of the list cells of column `v` ([`crate::ColumnRef`]).
+    ///
+    /// The rows are read as [`crate::NumericStream`] reads them, by the same code from a source
+    /// read once (a file or a pipe, at most [`inputs::MAX_CSV_BYTES`]): the same values, or the
+    /// same first error in file order.
     pub fn read(path: &Path, columns: &[&str]) -> Result<Self> {
-        Self::from_text(&TextTable::read(path)?, columns)
+        let io = |source| DataError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        if std::fs::metadata(path).map_err(io)?.is_dir() {
+            return Err(DataError::IsDirectory {
+                path: path.to_path_buf(),
+            });
+        }
+        let file = inputs::open(path, inputs::InputKind::Csv).map_err(io)?;
+        let records = CsvRecords::new(path, BufReader::with_capacity(1 << 16, file));
+        let mut rows = NumericRows::new(path, records, columns)?;
+        let block = rows
+            .next_block(usize::MAX)?
+            .expect("a file without rows is an error");
+        Ok(Self {
+            path: path.to_path_buf(),
+            names: columns.iter().map(|s| s.to_string()).collect(),
+            columns: block.columns,
+            lines: block.lines,
+        })
     }
 
-    /// The named columns of a table already read.
+    /// The named columns of a table already read, parsed row by row (as [`crate::NumericStream`]
+    /// reads them, so that the first bad cell named is the same).
     pub(crate) fn from_text(table: &TextTable, columns: &[&str]) -> Result<Self> {
-        let parsed = columns
+        let path = table.path();
+        let selected = NumericColumn::resolve(path, table.names(), columns)?;
+        let mut cells: Vec<_> = selected
             .iter()
-            .map(|name| table.numbers(name))
-            .collect::<Result<Vec<_>>>()?;
+            .map(|column| table.field_cells(column.field))
+            .collect();
+        let mut parsed = vec![Vec::with_capacity(table.lines().len()); selected.len()];
+        let mut buffer = Vec::new();
+        for &line in table.lines() {
+            for ((column, cells), values) in selected.iter().zip(&mut cells).zip(&mut parsed) {
+                let cell = cells.next().expect("every column has a cell per row");
+                values.push(column.number(path, line, cell, &mut buffer)?);
+            }
+        }
         Ok(Self {
-            path: table.path().to_path_buf(),
+            path: path.to_path_buf(),
             names: columns.iter().map(|s| s.to_string()).collect(),
             columns: parsed,
             lines: table.lines().to_vec(),

@@ -7,6 +7,8 @@
 
 use std::path::{Path, PathBuf};
 
+use inputs::Excerpt;
+
 use crate::error::{DataError, Result};
 use crate::numeric::NumericTable;
 use crate::table::TextTable;
@@ -131,16 +133,18 @@ fn read_task_runs(
             Some((last, rows)) if last == label => rows.end = row + 1,
             _ => {
                 if runs.iter().any(|(seen, _)| seen == label) {
-                    return Err(DataError::BadCell {
-                        path: path.to_path_buf(),
-                        row: text.line(row),
-                        column: column.to_string(),
-                        value: label.clone(),
-                        reason: format!(
-                            "task '{label}' appears again after task '{}': a task's rows must be consecutive",
-                            runs.last().map_or("", |(name, _)| name.as_str())
+                    let previous = runs.last().map_or("", |(name, _)| name.as_str());
+                    return Err(crate::cells::bad_cell(
+                        path,
+                        text.line(row),
+                        column,
+                        label,
+                        format!(
+                            "task '{}' appears again after task '{}': a task's rows must be consecutive",
+                            Excerpt::of(label).unquoted(),
+                            Excerpt::of(previous).unquoted()
                         ),
-                    });
+                    ));
                 }
                 if runs.len() == MAX_TASKS {
                     return Err(DataError::Invalid {

@@ -101,7 +101,7 @@ const REFERENCE_GAPS: usize = 4096;
 /// The checks of `check_time_column` on a time column read in blocks, in constant memory:
 /// strictly increasing, and every gap within `tolerance` of a reference step, the median of the
 /// first `REFERENCE_GAPS` gaps (the whole column's median would need every gap at once). Errors
-/// name the line (one line per row).
+/// name the line of the row.
 pub struct StreamedTimeAxis {
     path: std::path::PathBuf,
     column: String,
@@ -110,7 +110,7 @@ pub struct StreamedTimeAxis {
     last: f64,
     rows: usize,
     reference: Option<f64>,
-    /// The first gaps, with the row each ends on, until the reference is known.
+    /// The first gaps, with the line of the row each ends on, until the reference is known.
     pending: Vec<(usize, f64)>,
 }
 
@@ -128,9 +128,9 @@ impl StreamedTimeAxis {
         }
     }
 
-    /// The next values of the column.
-    pub fn push(&mut self, values: &[f64]) -> Result<()> {
-        for &value in values {
+    /// The next values of the column, with the line of the file each row starts on.
+    pub fn push(&mut self, values: &[f64], lines: &[usize]) -> Result<()> {
+        for (&value, &line) in values.iter().zip(lines) {
             let row = self.rows;
             self.rows += 1;
             if row == 0 {
@@ -140,7 +140,7 @@ impl StreamedTimeAxis {
             if value <= self.last {
                 return Err(DataError::TimeNotIncreasing {
                     path: self.path.clone(),
-                    row: file_row(row),
+                    row: line,
                     column: self.column.clone(),
                     previous: self.last,
                     current: value,
@@ -149,9 +149,9 @@ impl StreamedTimeAxis {
             let gap = value - self.last;
             self.last = value;
             match self.reference {
-                Some(step) => self.check_gap(row, gap, step)?,
+                Some(step) => self.check_gap(line, gap, step)?,
                 None => {
-                    self.pending.push((row, gap));
+                    self.pending.push((line, gap));
                     if self.pending.len() == REFERENCE_GAPS {
                         self.settle()?;
                     }
@@ -181,17 +181,17 @@ impl StreamedTimeAxis {
         gaps.sort_by(f64::total_cmp);
         let step = gaps[gaps.len() / 2];
         self.reference = Some(step);
-        for (row, gap) in std::mem::take(&mut self.pending) {
-            self.check_gap(row, gap, step)?;
+        for (line, gap) in std::mem::take(&mut self.pending) {
+            self.check_gap(line, gap, step)?;
         }
         Ok(())
     }
 
-    fn check_gap(&self, row: usize, gap: f64, step: f64) -> Result<()> {
+    fn check_gap(&self, line: usize, gap: f64, step: f64) -> Result<()> {
         if (gap - step).abs() > self.tolerance * step {
             return Err(DataError::NonUniformSampling {
                 path: self.path.clone(),
-                row: file_row(row),
+                row: line,
                 column: self.column.clone(),
                 gap,
                 median: step,

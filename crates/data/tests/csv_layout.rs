@@ -309,3 +309,45 @@ fn a_pipe_is_read_to_its_end() {
     assert_eq!(time.len(), 20);
     assert_eq!(table.column("x").unwrap()[19], 19.0);
 }
+
+#[test]
+fn carriage_return_line_endings_are_refused_by_name() {
+    let mac = plain(5).replace('\n', "\r");
+    let message = numeric_error(&write("mac.csv", mac.as_bytes()), &["x"]);
+    assert!(
+        message.ends_with(
+            "mac.csv:1: line endings are CR only (classic Mac): convert the file to LF or CRLF line endings"
+        ),
+        "{message}"
+    );
+    // A lone CR after LF lines, outside quotes: named by its line.
+    let text = plain(5).replacen("0.2,2,4\n", "0.2,2,4\r0.25,2,4\n", 1);
+    let message = numeric_error(&write("lone-cr.csv", text.as_bytes()), &["x"]);
+    assert!(
+        message.contains("lone-cr.csv:4: a carriage return (CR) not followed by a line feed"),
+        "{message}"
+    );
+    // Inside a quoted cell a CR is text, and a last line ended by a CR alone is a line.
+    let text = "t,x,note\r\n0,1,\"a\rb\"\r\n0.1,2,c\r";
+    let (time, table) =
+        NumericTable::read_with_time(&write("cr-in-cell.csv", text.as_bytes()), "t", &["x"])
+            .unwrap();
+    assert_eq!(time, [0.0, 0.1]);
+    assert_eq!(table.column("x").unwrap(), &[1.0, 2.0]);
+}
+
+#[test]
+fn a_long_header_name_is_cut_in_messages() {
+    let name = "n".repeat(100_000);
+    let text = format!("t,{name},{name}\n0,1,2\n0.1,1,2\n");
+    let message = numeric_error(&write("long-name.csv", text.as_bytes()), &["x"]);
+    assert!(message.len() < 400, "{message}");
+    assert!(
+        message.contains("… (100000 characters)' appears twice in the header (fields 2 and 3)"),
+        "{message}"
+    );
+    let text = format!("t,x,{name}\n0,1\n");
+    let message = numeric_error(&write("long-missing.csv", text.as_bytes()), &["x"]);
+    assert!(message.len() < 400, "{message}");
+    assert!(message.contains("no value for 'nnn"), "{message}");
+}

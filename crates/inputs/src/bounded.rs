@@ -54,28 +54,50 @@ fn refused(message: String) -> std::io::Error {
 /// Reads the bytes of `path` as `kind`: refuses what is not a regular file (a pipe is accepted
 /// for a CSV) and anything larger than the kind's limit, before or while reading.
 pub fn read_bytes(path: &Path, kind: InputKind) -> std::io::Result<Vec<u8>> {
+    let capacity = std::fs::metadata(path)
+        .ok()
+        .filter(std::fs::Metadata::is_file)
+        .map_or(0, |metadata| metadata.len().min(kind.limit()) as usize);
+    let mut bytes = Vec::with_capacity(capacity);
+    open(path, kind)?.read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
+
+/// Opens `path` as `kind` to be read in pieces: refuses what is not a regular file (a pipe is
+/// accepted for a CSV) and a file larger than the kind's limit at once; reading past the limit
+/// (a pipe, a growing file) is an error of the read that passes it.
+pub fn open(path: &Path, kind: InputKind) -> std::io::Result<BoundedFile> {
     if path.as_os_str().is_empty() {
         return Err(refused("an empty path names no file".to_string()));
     }
     let metadata = std::fs::metadata(path)?;
-    let file_type = metadata.file_type();
-    check_file_type(&file_type, kind)?;
-    let limit = kind.limit();
-    if metadata.is_file() && metadata.len() > limit {
+    check_file_type(&metadata.file_type(), kind)?;
+    if metadata.is_file() && metadata.len() > kind.limit() {
         return Err(too_large(metadata.len(), kind));
     }
-    let file = std::fs::File::open(path)?;
-    let capacity = if metadata.is_file() {
-        metadata.len() as usize
-    } else {
-        0
-    };
-    let mut bytes = Vec::with_capacity(capacity);
-    file.take(limit + 1).read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > limit {
-        return Err(too_large(bytes.len() as u64, kind));
+    Ok(BoundedFile {
+        file: std::fs::File::open(path)?.take(kind.limit() + 1),
+        kind,
+        read: 0,
+    })
+}
+
+/// A file opened by [`open`]: its reads fail once more than its kind's limit has been read.
+pub struct BoundedFile {
+    file: std::io::Take<std::fs::File>,
+    kind: InputKind,
+    read: u64,
+}
+
+impl Read for BoundedFile {
+    fn read(&mut self, buffer: &mut [u8]) -> std::io::Result<usize> {
+        let count = self.file.read(buffer)?;
+        self.read += count as u64;
+        if self.read > self.kind.limit() {
+            return Err(too_large(self.read, self.kind));
+        }
+        Ok(count)
     }
-    Ok(bytes)
 }
 
 /// Reads `path` as UTF-8 text of `kind` (see [`read_bytes`]).

@@ -88,15 +88,20 @@ pub fn checked_text(text: &str) -> Result<&str, JsonError> {
     if let Some((path, key)) = duplicate.into_inner() {
         return Err(JsonError {
             field: format!("{} ({position})", display_path(&path)),
-            message: format!("key `{key}` is given twice (refused: which one is meant?)"),
+            message: format!(
+                "key `{}` is given twice (refused: which one is meant?)",
+                crate::Excerpt::of(&key).unquoted()
+            ),
         });
     }
     if error.is_syntax() && !text.trim_start().starts_with(['{', '[']) {
         let first = text.trim_start().lines().next().unwrap_or("");
-        let shown: String = first.chars().take(40).collect();
         return Err(JsonError {
             field: "the document (line 1 column 1)".to_string(),
-            message: format!("not JSON: it starts with {shown:?} (a CSV or other text?)"),
+            message: format!(
+                "not JSON: it starts with {} (a CSV or other text?)",
+                crate::Excerpt::of(first)
+            ),
         });
     }
     // Any other fault is reported by the reader that interprets the text, with its field.

@@ -289,9 +289,8 @@ fn fit_streamed(
     let mut stream = NumericStream::open(csv, &[args.time.as_str()])?;
     let mut axis = StreamedTimeAxis::new(csv, &args.time, DEFAULT_UNIFORM_TOLERANCE);
     while let Some(block) = stream.next_block(STREAM_BLOCK_ROWS)? {
-        axis.push(&block.columns[0]).context(
-            "a file read in blocks (--stream, or one file over 8 MiB) needs uniform time steps",
-        )?;
+        axis.push(&block.columns[0], &block.lines)
+            .map_err(streamed_time_error)?;
     }
     let (n, dt) = axis.finish()?;
     check_rows(args, n, feature_count, columns)?;
@@ -305,8 +304,23 @@ fn fit_streamed(
                 columns: block.columns,
             }))
         })
-        .map_err(|error| fit_error(args, csv, error, |row| row + 2))?;
+        .map_err(|error| {
+            fit_error(args, csv, error, |row| {
+                NumericStream::line_of_row(csv, row).unwrap_or(row + 2)
+            })
+        })?;
     Ok((fit.model, fit.score, n))
+}
+
+/// A time column a fit read in blocks cannot use; uneven steps are named as what the whole-file
+/// fit takes and this one does not.
+fn streamed_time_error(error: data::DataError) -> anyhow::Error {
+    match error {
+        data::DataError::NonUniformSampling { .. } => anyhow!(
+            "{error} (a file read in blocks, with --stream or over 8 MiB, needs even time steps)"
+        ),
+        other => other.into(),
+    }
 }
 
 fn check_rows(args: &Args, n: usize, feature_count: usize, columns: &[&str]) -> anyhow::Result<()> {
@@ -356,6 +370,9 @@ fn fit_error(
                 line(row),
             )
         }
+        // The file's own error (a bad line met while the rows were read), as the whole-file read
+        // gives it: it names the file already.
+        SindyError::Source(source) => anyhow::Error::from_boxed(source),
         other => anyhow::Error::new(other).context(format!("fitting {}", files(&args.csv))),
     }
 }

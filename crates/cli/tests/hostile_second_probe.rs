@@ -1,0 +1,7 @@
+//! The second hostile-input probe (issue 31): one module per part, each test through the built
+//! binary and named after the defect it guards.
+
+mod common;
+
+#[path = "hostile_second_probe/readers.rs"]
+mod readers;

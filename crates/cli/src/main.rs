@@ -44,7 +44,11 @@ fn main() -> ExitCode {
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            note!("error: {}", one_line(&error));
+            // An error caused by an interrupt's removal of the staging is not reported: the
+            // interrupt ends the process once the staging is gone.
+            outputs::wait_if_interrupted();
+            // Writers are given staging paths: every error names the final paths instead.
+            note!("error: {}", outputs::in_final_terms(&one_line(&error)));
             ExitCode::FAILURE
         }
     }

@@ -1,7 +1,10 @@
 //! The second hostile-input probe (issue 31): one module per part, each test through the built
-//! binary and named after the defect it guards.
+//! `learn` binary, asserting a property the documentation promises, named after the defect it
+//! guards.
 
 mod common;
 
+#[path = "hostile_second_probe/outputs.rs"]
+mod outputs;
 #[path = "hostile_second_probe/readers.rs"]
 mod readers;

@@ -3,6 +3,8 @@
 
 use std::path::PathBuf;
 
+use crate::paths::{FileKind, Leaf};
+
 /// An output set refused or failed.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
@@ -23,6 +25,43 @@ pub enum OutputError {
         parent: PathBuf,
         option: String,
     },
+    #[error(
+        "{}: is {kind}, not a regular file: a named output is only written into a regular file \
+         ({option}; refused even with --force)",
+        path.display()
+    )]
+    NotRegularFile {
+        path: PathBuf,
+        kind: FileKind,
+        option: String,
+    },
+    #[error(
+        "{}: is a symbolic link to {}, which does not exist ({option}); name the file itself",
+        path.display(), target.display()
+    )]
+    LinkToNothing {
+        path: PathBuf,
+        target: PathBuf,
+        option: String,
+    },
+    #[error(
+        "{}: is {kind}, not the {} learn made there ({option}): refusing to write through it, \
+         even with --force; move it away",
+        path.display(),
+        match expected { Leaf::File => "file", Leaf::Folder => "folder" }
+    )]
+    NotMadeByLearn {
+        path: PathBuf,
+        kind: FileKind,
+        expected: Leaf,
+        option: String,
+    },
+    #[error(
+        "{}: a commit interrupted here was shared with {}, whose journal is gone: learn cannot \
+         tell whether to finish or undo it; compare the folders, then move this journal away",
+        journal.display(), lead.display()
+    )]
+    UnresolvableCommit { journal: PathBuf, lead: PathBuf },
     #[error("{}: already exists (pass --force to overwrite)", path.display())]
     Exists { path: PathBuf },
     #[error("{}: already exists, written by an earlier `learn {producer}` (pass --force to replace it)", path.display())]

@@ -7,33 +7,41 @@
 //!    spelling of either path), each can be a file or folder, and an existing file is replaced only
 //!    when allowed: in a folder only a file `learn` wrote there itself (its manifest says so), and
 //!    then only with [`Existing::Replace`] (`--force`, or the tool's scratch); a named file only
-//!    with `--force`;
+//!    with `--force`, and only a regular file (a link is written through); below a folder, only
+//!    folders and regular files (never through a link);
 //! 3. **prepare** ([`OutputSet::prepare`]), before any work: each folder is created and locked (a
 //!    second run into it is refused), and a staging folder (`.learn-staging-<pid>-*`) is made in
 //!    it, which proves it writable; every subfolder of a planned file gets a probe file;
 //! 4. the work writes into the staging paths ([`Staged::dir`], [`Staged::path`]);
 //! 5. **commit** ([`Staged::commit`]): a journal in every folder of the set first (if one cannot be
-//!    written, the others are withdrawn and nothing moves), then per folder the renames into
-//!    place, stale own files removed, the manifest (`.learn-outputs.json`) rewritten. An interrupt (SIGINT, SIGTERM) or a
+//!    written, the others are withdrawn and nothing moves), the first folder's armed last, then
+//!    per folder the renames into place, stale own files removed, the manifest
+//!    (`.learn-outputs.json`) rewritten, then the named files. An interrupt (SIGINT, SIGTERM) or a
 //!    failure before the commit removes the staging and leaves the old set as it was; SIGKILL
-//!    leaves a hidden staging folder that the next run into the folder removes, and a journal that
-//!    it finishes.
+//!    leaves a hidden staging folder that the next run into the folder removes, and journals that
+//!    the next run into any folder of the set finishes or undoes in all of them
+//!    (the `journal` module).
 //!
 //! What it is not: a writer of formats (callers write their JSON, SVG or CSV into the staging
 //! paths), nor a checker of what is read (see the `inputs` crate). The protocol, and why, is in
 //! `docs/data-safety.md`.
 
 mod error;
+mod journal;
 pub mod manifest;
 pub mod paths;
 mod signals;
 mod stage;
+mod test_hooks;
 
 use std::path::{Path, PathBuf};
 
 pub use error::{OutputError, Result};
 pub use manifest::{MANIFEST, Manifest};
-pub use stage::Staged;
+pub use signals::wait_if_interrupted;
+pub use stage::{Staged, in_final_terms};
+
+use paths::FileKind;
 
 /// What may happen to an output file that already exists.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -255,6 +263,9 @@ fn check_folder(
     for relative in &folder.files {
         check_folder_file(folder, &manifest, relative)?;
     }
+    for relative in &folder.subfolders {
+        stage::refuse_foreign_folder(&folder.dir, relative, &option)?;
+    }
     let planned: Vec<String> = folder.files.iter().map(|r| manifest::key(r)).collect();
     let stale = if remove_stale {
         manifest.stale(producer, &planned)
@@ -287,6 +298,7 @@ fn check_folder_file(folder: &FolderPlan, manifest: &Manifest, relative: &Path) 
             option,
         });
     }
+    journal::refuse_foreign_component(&folder.dir, &manifest::key(relative), &option)?;
     if std::fs::symlink_metadata(&path).is_err() || folder.existing == Existing::Scratch {
         return Ok(());
     }
@@ -304,7 +316,8 @@ fn check_folder_file(folder: &FolderPlan, manifest: &Manifest, relative: &Path) 
     }
 }
 
-/// A named file's checks: it can be a file, and an existing one only with `--force`.
+/// A named file's checks: it can be a file; what is there (through links) is a regular file, and
+/// an existing one is replaced only with `--force`.
 fn check_named_file(file: &FilePlan) -> Result<()> {
     let option = file.option.clone();
     if file.path.as_os_str().is_empty() {
@@ -323,10 +336,46 @@ fn check_named_file(file: &FilePlan) -> Result<()> {
             option,
         });
     }
+    let target = named_target(file)?;
+    check_named_kind(&file.path, &target, &option)?;
     if file.existing == Existing::Refuse && std::fs::symlink_metadata(&file.path).is_ok() {
         return Err(OutputError::Exists {
             path: file.path.clone(),
         });
     }
     Ok(())
+}
+
+/// The file a named output writes: the path named, or, when it is a symbolic link, the file the
+/// link leads to (the link itself is never replaced). A link to nothing is refused.
+pub(crate) fn named_target(file: &FilePlan) -> Result<PathBuf> {
+    let is_link = std::fs::symlink_metadata(&file.path).is_ok_and(|m| m.file_type().is_symlink());
+    if !is_link {
+        return Ok(file.path.clone());
+    }
+    file.path
+        .canonicalize()
+        .map_err(|_| OutputError::LinkToNothing {
+            path: file.path.clone(),
+            target: std::fs::read_link(&file.path).unwrap_or_default(),
+            option: file.option.clone(),
+        })
+}
+
+/// An error when `target` (the file the named output `named` writes, links resolved) exists and
+/// is not a regular file: a FIFO, device or socket is never written to nor replaced, with or
+/// without `--force`.
+pub(crate) fn check_named_kind(named: &Path, target: &Path, option: &str) -> Result<()> {
+    match FileKind::of_path(target) {
+        None | Some(FileKind::Regular) => Ok(()),
+        Some(FileKind::Directory) => Err(OutputError::FileIsDirectory {
+            path: named.to_path_buf(),
+            option: option.to_string(),
+        }),
+        Some(kind) => Err(OutputError::NotRegularFile {
+            path: named.to_path_buf(),
+            kind,
+            option: option.to_string(),
+        }),
+    }
 }

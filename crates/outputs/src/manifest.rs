@@ -98,15 +98,22 @@ impl Manifest {
     }
 }
 
-/// Writes `text` to `path` through a temporary file in the same directory renamed over it.
+/// Writes `text` to `path` through a temporary file in the same directory renamed over it: a new
+/// file follows the umask, a replaced one keeps its mode.
 pub(crate) fn write_atomically(path: &Path, text: &str) -> Result<()> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut temp = tempfile::Builder::new()
         .prefix(&crate::stage::staging_prefix())
+        .permissions(crate::stage::new_file_mode())
         .tempfile_in(dir)
         .map_err(io(path))?;
     std::io::Write::write_all(&mut temp, text.as_bytes()).map_err(io(path))?;
     temp.as_file().sync_all().map_err(io(path))?;
+    if let Ok(existing) = std::fs::symlink_metadata(path)
+        && existing.is_file()
+    {
+        crate::journal::keep_mode_and_owner(temp.path(), &existing)?;
+    }
     temp.persist(path).map_err(|error| io(path)(error.error))?;
     Ok(())
 }

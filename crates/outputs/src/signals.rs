@@ -4,11 +4,29 @@
 //! same lock as the handler.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard, Once};
 
 /// Staging paths of this process that an interrupt removes.
 static STAGING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 static INSTALL: Once = Once::new();
+/// Set by the signal thread when an interrupt arrives, before it removes the staging.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Whether an interrupt arrived: the signal thread is removing the staging and then ends the
+/// process with 128 + the signal.
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::SeqCst)
+}
+
+/// After an interrupt, waits for the signal thread to end the process (so never returns then):
+/// an error that the removal of the staging caused (a writer finding its folder gone) must not
+/// end the process first, with its own message and exit code, cutting the removal short.
+pub fn wait_if_interrupted() {
+    while interrupted() {
+        std::thread::park();
+    }
+}
 
 /// The staging registry, held for the length of a commit (the handler waits for it).
 pub(crate) fn hold() -> MutexGuard<'static, Vec<PathBuf>> {
@@ -64,6 +82,7 @@ fn install() {
             .name("learn-signals".to_string())
             .spawn(move || {
                 if let Some(signal) = signals.forever().next() {
+                    INTERRUPTED.store(true, Ordering::SeqCst);
                     let staging = hold();
                     remove_until_gone(&staging);
                     std::process::exit(128 + signal);

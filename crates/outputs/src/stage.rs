@@ -1,25 +1,56 @@
-//! Preparing a checked [`OutputSet`] (lock, probe, stage) and committing it (journal, renames,
-//! manifest).
+//! Preparing a checked [`OutputSet`] (lock, recover, probe, stage) and committing it (journals,
+//! renames, manifests; see [`crate::journal`]).
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use fs4::FileExt;
-use serde::{Deserialize, Serialize};
 use tempfile::{TempDir, TempPath};
 
 use crate::error::{OutputError, Result, io};
-use crate::manifest::{self, Manifest, write_atomically};
-use crate::{Existing, FileId, FilePlan, FolderId, FolderPlan, OutputSet, signals};
+use crate::journal::{self, Journal, NamedMove};
+use crate::manifest::{self, Manifest};
+use crate::paths::{self, Leaf};
+use crate::{Existing, FileId, FilePlan, FolderId, FolderPlan, OutputSet, signals, test_hooks};
 
-/// The journal of a commit in progress, in the output folder.
-const JOURNAL: &str = ".learn-commit.json";
 /// Every staging name starts so (hidden; ignored by git; removed by the next run).
 const STAGING: &str = ".learn-staging-";
 
 /// The prefix of this process's staging names: `.learn-staging-<pid>-`.
 pub(crate) fn staging_prefix() -> String {
     format!("{STAGING}{}-", std::process::id())
+}
+
+/// Every staging path this process made, with the final path it stands for; kept for the
+/// process's life, so an error reported after its set is gone is still put in final terms.
+static FINAL_NAMES: Mutex<Vec<(String, String)>> = Mutex::new(Vec::new());
+
+fn record_final_name(staging: &Path, final_path: &Path) {
+    let mut names = FINAL_NAMES
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    names.push((
+        staging.display().to_string(),
+        final_path.display().to_string(),
+    ));
+}
+
+/// `message` (an error of a writer given staging paths) in terms of the final paths: every
+/// staging path this process made replaced by what it stands for (a named file's staging by the
+/// name given, a folder's staging by the folder).
+pub fn in_final_terms(message: &str) -> String {
+    let names = FINAL_NAMES
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    // Longer first: no staging path is then replaced inside a longer one.
+    let mut sorted: Vec<&(String, String)> = names.iter().collect();
+    sorted.sort_by_key(|(staging, _)| std::cmp::Reverse(staging.len()));
+    sorted
+        .into_iter()
+        .fold(message.to_string(), |text, (staging, final_path)| {
+            text.replace(staging.as_str(), final_path)
+        })
 }
 
 /// A prepared output set: folders locked, staging made. Dropping it without
@@ -39,6 +70,8 @@ pub struct Staged {
 #[derive(Debug)]
 struct StagedFolder {
     plan: FolderPlan,
+    /// The folder, absolute and resolved (as the journals name it).
+    resolved: PathBuf,
     /// The open folder, locked while the set lives.
     _lock: File,
     staging: TempDir,
@@ -47,17 +80,9 @@ struct StagedFolder {
 #[derive(Debug)]
 struct StagedFile {
     plan: FilePlan,
+    /// The file written: the path named, or the file a symbolic link there leads to.
+    target: PathBuf,
     staging: TempPath,
-}
-
-/// What a commit does in one folder, written before it starts so that a killed commit is finished
-/// by the next run into the folder.
-#[derive(Serialize, Deserialize)]
-struct Journal {
-    staging: String,
-    moves: Vec<String>,
-    removals: Vec<String>,
-    manifest: Manifest,
 }
 
 pub(crate) fn prepare(set: OutputSet) -> Result<Staged> {
@@ -70,8 +95,21 @@ pub(crate) fn prepare(set: OutputSet) -> Result<Staged> {
         files: Vec::new(),
     };
     // On an error below, dropping `staged` removes what was made so far.
+    let mut locked = Vec::new();
     for plan in &set.folders {
-        let folder = prepare_folder(plan, &mut staged.created)?;
+        locked.push(lock_folder(plan, &mut staged.created)?);
+    }
+    {
+        // Every folder is locked before a killed commit is finished or undone: it may span
+        // several of them. An interrupt waits for it, as for any commit.
+        let _registry = signals::hold_installed();
+        let held: Vec<PathBuf> = locked.iter().map(|(dir, _)| dir.clone()).collect();
+        for plan in &set.folders {
+            journal::recover(&plan.dir, &held)?;
+        }
+    }
+    for (plan, (resolved, lock)) in set.folders.iter().zip(locked) {
+        let folder = stage_folder(plan, resolved, lock, &mut staged.created)?;
         staged.folders.push(folder);
     }
     // Under the locks: what another run may have committed meanwhile is checked again.
@@ -80,6 +118,8 @@ pub(crate) fn prepare(set: OutputSet) -> Result<Staged> {
         let file = prepare_file(plan, &mut staged.created)?;
         staged.files.push(file);
     }
+    let staging: Vec<&Path> = staged.staging_paths().collect();
+    test_hooks::point(format_args!("prepared"), &staging);
     Ok(staged)
 }
 
@@ -105,9 +145,8 @@ fn not_writable(path: &Path, option: &str) -> impl FnOnce(std::io::Error) -> Out
     }
 }
 
-/// Creates and locks the folder, finishes a killed commit, removes dead staging, stages and
-/// probes every subfolder of a planned file.
-fn prepare_folder(plan: &FolderPlan, created: &mut Vec<PathBuf>) -> Result<StagedFolder> {
+/// Creates and locks the folder; returns it resolved (absolute) with its lock.
+fn lock_folder(plan: &FolderPlan, created: &mut Vec<PathBuf>) -> Result<(PathBuf, File)> {
     let dir = &plan.dir;
     create_dir(dir, &plan.option, created)?;
     let lock = File::open(dir).map_err(not_writable(dir, &plan.option))?;
@@ -117,11 +156,21 @@ fn prepare_folder(plan: &FolderPlan, created: &mut Vec<PathBuf>) -> Result<Stage
             option: plan.option.clone(),
         });
     }
-    {
-        // A killed commit is finished whole: an interrupt waits for it, as for any commit.
-        let _registry = signals::hold_installed();
-        finish_journal(dir)?;
-    }
+    let resolved = dir
+        .canonicalize()
+        .map_err(not_writable(dir, &plan.option))?;
+    Ok((resolved, lock))
+}
+
+/// Removes dead staging from the locked folder, stages it, and probes every subfolder of a
+/// planned file (each checked to be a folder `learn` made, not a link to another).
+fn stage_folder(
+    plan: &FolderPlan,
+    resolved: PathBuf,
+    lock: File,
+    created: &mut Vec<PathBuf>,
+) -> Result<StagedFolder> {
+    let dir = &plan.dir;
     remove_dead_staging(dir);
     let staging = signals::create_registered(
         || {
@@ -132,11 +181,14 @@ fn prepare_folder(plan: &FolderPlan, created: &mut Vec<PathBuf>) -> Result<Stage
         },
         |staging| staging.path().to_path_buf(),
     )?;
+    record_final_name(staging.path(), dir);
+    test_hooks::point(format_args!("{}: staged", plan.option), &[staging.path()]);
     let parents = plan.files.iter().filter_map(|r| r.parent());
     for parent in parents.chain(plan.subfolders.iter().map(PathBuf::as_path)) {
         if parent.as_os_str().is_empty() {
             continue;
         }
+        refuse_foreign_folder(dir, parent, &plan.option)?;
         let target = dir.join(parent);
         create_dir(&target, &plan.option, created)?;
         // A run killed while it probed this subfolder left its probe here.
@@ -146,9 +198,23 @@ fn prepare_folder(plan: &FolderPlan, created: &mut Vec<PathBuf>) -> Result<Stage
     }
     Ok(StagedFolder {
         plan: plan.clone(),
+        resolved,
         _lock: lock,
         staging,
     })
+}
+
+/// An error when a component of the subfolder `relative` of `dir` is not a folder `learn` made.
+pub(crate) fn refuse_foreign_folder(dir: &Path, relative: &Path, option: &str) -> Result<()> {
+    match paths::first_foreign_component(dir, relative, Leaf::Folder) {
+        Some((path, kind)) => Err(OutputError::NotMadeByLearn {
+            path,
+            kind,
+            expected: Leaf::Folder,
+            option: option.to_string(),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Creates the folders of `relative` inside `root`, never `root` itself: once an interrupt has
@@ -191,16 +257,18 @@ fn probe_observed(dir: &Path, option: &str, while_present: impl FnOnce(&Path)) -
     file.close().map_err(io(dir))
 }
 
-/// Stages a named file beside its target (which proves the folder writable).
+/// Stages a named file beside the file it writes (the named path, or the file a link there leads
+/// to: the rename must stay on its file system), which proves that folder writable. The staging
+/// file is created as any new file is (0666 less the umask).
 fn prepare_file(plan: &FilePlan, created: &mut Vec<PathBuf>) -> Result<StagedFile> {
-    let parent = match plan.path.parent() {
+    let target = crate::named_target(plan)?;
+    let parent = match target.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent.to_path_buf(),
         _ => PathBuf::from("."),
     };
     create_dir(&parent, &plan.option, created)?;
     remove_dead_staging(&parent);
-    let name = plan
-        .path
+    let name = target
         .file_name()
         .map(|n| format!("-{}", n.to_string_lossy()))
         .unwrap_or_default();
@@ -209,16 +277,25 @@ fn prepare_file(plan: &FilePlan, created: &mut Vec<PathBuf>) -> Result<StagedFil
             tempfile::Builder::new()
                 .prefix(&staging_prefix())
                 .suffix(&name)
+                .permissions(new_file_mode())
                 .tempfile_in(&parent)
                 .map(tempfile::NamedTempFile::into_temp_path)
                 .map_err(not_writable(&plan.path, &plan.option))
         },
         |staging| staging.to_path_buf(),
     )?;
+    record_final_name(&staging, &plan.path);
     Ok(StagedFile {
         plan: plan.clone(),
+        target,
         staging,
     })
+}
+
+/// The mode a new file is created with before the umask, as `std::fs::File::create` does.
+pub(crate) fn new_file_mode() -> std::fs::Permissions {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::Permissions::from_mode(0o666)
 }
 
 /// Removes the staging left in `dir` by processes that no longer run (killed with SIGKILL).
@@ -243,50 +320,6 @@ fn alive(pid: i32) -> bool {
     // SAFETY: kill with signal 0 only checks for the process; it has no other effect.
     let result = unsafe { libc::kill(pid, 0) };
     result == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
-}
-
-/// Finishes a commit that was killed in `dir` (its journal is still there): the remaining moves,
-/// the removals, the manifest.
-fn finish_journal(dir: &Path) -> Result<()> {
-    let path = dir.join(JOURNAL);
-    let Ok(text) = std::fs::read_to_string(&path) else {
-        return Ok(());
-    };
-    let journal: Journal = serde_json::from_str(&text).map_err(|error| OutputError::Manifest {
-        path: path.clone(),
-        message: format!("not a learn commit journal ({error}); move it away"),
-    })?;
-    apply(dir, &journal)
-}
-
-/// Carries out a journal: idempotent (a move whose source is gone was done).
-fn apply(dir: &Path, journal: &Journal) -> Result<()> {
-    let staging = dir.join(&journal.staging);
-    for key in &journal.moves {
-        let from = manifest::path_of(&staging, key);
-        let to = manifest::path_of(dir, key);
-        if std::fs::symlink_metadata(&from).is_err() {
-            continue;
-        }
-        if let Some(parent) = to.parent() {
-            std::fs::create_dir_all(parent).map_err(io(parent))?;
-        }
-        std::fs::rename(&from, &to).map_err(io(&to))?;
-    }
-    for key in &journal.removals {
-        let path = manifest::path_of(dir, key);
-        match std::fs::remove_file(&path) {
-            Err(error) if error.kind() != std::io::ErrorKind::NotFound => {
-                return Err(io(&path)(error));
-            }
-            _ => {}
-        }
-    }
-    journal.manifest.write(dir)?;
-    let journal_path = dir.join(JOURNAL);
-    std::fs::remove_file(&journal_path).map_err(io(&journal_path))?;
-    signals::remove(&staging);
-    Ok(())
 }
 
 /// The files under `root`, as manifest keys, sorted.
@@ -319,68 +352,96 @@ impl Staged {
         &self.files[file.0].staging
     }
 
-    /// `message` (an error of a writer given staging paths) in terms of the final paths: every
-    /// staging path replaced by what it stands for.
+    /// `message` (an error of a writer given staging paths) in terms of the final paths: see
+    /// [`in_final_terms`].
     pub fn in_final_terms(&self, message: &str) -> String {
-        let mut text = message.to_string();
-        for file in &self.files {
-            text = text.replace(
-                &file.staging.display().to_string(),
-                &file.plan.path.display().to_string(),
-            );
-        }
-        for folder in &self.folders {
-            text = text.replace(
-                &folder.staging.path().display().to_string(),
-                &folder.plan.dir.display().to_string(),
-            );
-        }
-        text
+        in_final_terms(message)
     }
 
-    /// Moves everything staged into place (see the crate documentation, step 5) and returns the
-    /// final paths written. Interrupts wait until it is done.
+    /// Every staging path of the set.
+    fn staging_paths(&self) -> impl Iterator<Item = &Path> {
+        let folders = self.folders.iter().map(|f| f.staging.path());
+        folders.chain(self.files.iter().map(|f| f.staging.as_ref()))
+    }
+
+    /// Moves everything staged into place (see the crate documentation, step 5, and
+    /// the `journal` module) and returns the final paths written. Interrupts wait until it is done.
     pub fn commit(mut self) -> Result<Vec<PathBuf>> {
-        self.committed = true;
         let mut registry = signals::hold();
-        // Every folder's journal first, then the moves: a run killed during the moves leaves a
-        // journal in every folder of the set, and the next run into them completes all of them.
-        let mut journals = Vec::with_capacity(self.folders.len());
-        for folder in &self.folders {
-            match write_journal(folder, &self.producer, self.remove_stale) {
-                Ok(journal) => journals.push(journal),
-                Err(error) => {
-                    // Nothing has moved yet: withdrawing the journals leaves every folder as it was.
-                    for done in &self.folders[..journals.len()] {
-                        let _ = std::fs::remove_file(done.plan.dir.join(JOURNAL));
-                    }
-                    self.committed = false;
-                    return Err(error);
-                }
-            }
+        if self.folders.is_empty() {
+            return self.commit_named_files_only();
         }
-        let mut written = Vec::new();
-        for (folder, journal) in self.folders.iter().zip(&journals) {
-            let dir = &folder.plan.dir;
-            apply(dir, journal)?;
-            written.extend(journal.moves.iter().map(|key| manifest::path_of(dir, key)));
+        // Checked and written before anything moves: an error here leaves every folder as it was
+        // (dropping the set removes the staging).
+        let journals = self.journals()?;
+        journal::write_all(&journals)?;
+        // Armed: the staging belongs to the journals now, for the next run to finish if this one
+        // cannot.
+        self.committed = true;
+        for folder in &mut self.folders {
+            folder.staging.disable_cleanup(true);
             signals::unregister(&mut registry, folder.staging.path());
         }
-        for file in std::mem::take(&mut self.files) {
-            let StagedFile { plan, staging } = file;
-            signals::unregister(&mut registry, &staging);
-            staging
-                .persist(&plan.path)
-                .map_err(|error| io(&plan.path)(error.error))?;
-            written.push(plan.path);
+        for file in &mut self.files {
+            file.staging.disable_cleanup(true);
+            signals::unregister(&mut registry, &file.staging);
         }
+        journal::finish(&journals)?;
+        let mut written = Vec::new();
+        for (folder, (_, journal)) in self.folders.iter().zip(&journals) {
+            let dir = &folder.plan.dir;
+            written.extend(journal.moves.iter().map(|key| manifest::path_of(dir, key)));
+        }
+        written.extend(self.files.iter().map(|file| file.plan.path.clone()));
         Ok(written)
+    }
+
+    /// A set of named files only: each moved into place on its own.
+    fn commit_named_files_only(&mut self) -> Result<Vec<PathBuf>> {
+        let mut written = Vec::new();
+        for file in &self.files {
+            journal::commit_named(&file.staging, &file.target, &file.plan.option)?;
+            written.push(file.plan.path.clone());
+        }
+        self.committed = true;
+        Ok(written)
+    }
+
+    /// Every folder's journal (the lead, the first folder, also lists the named files), checked:
+    /// nothing staged replaces a foreign file or goes through a link or special file.
+    fn journals(&self) -> Result<Vec<(PathBuf, Journal)>> {
+        let commit = format!(
+            "{}-{}",
+            std::process::id(),
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map(|since| since.as_nanos())
+                .unwrap_or_default()
+        );
+        let folders: Vec<PathBuf> = self.folders.iter().map(|f| f.resolved.clone()).collect();
+        let mut journals = Vec::with_capacity(self.folders.len());
+        for folder in &self.folders {
+            let mut journal = folder_journal(folder, &self.producer, self.remove_stale)?;
+            journal.commit.clone_from(&commit);
+            journal.folders.clone_from(&folders);
+            journals.push((folder.resolved.clone(), journal));
+        }
+        for file in &self.files {
+            crate::check_named_kind(&file.plan.path, &file.target, &file.plan.option)?;
+            let absolute = |path: &Path| std::path::absolute(path).map_err(io(path));
+            journals[0].1.files.push(NamedMove {
+                staging: absolute(&file.staging)?,
+                target: absolute(&file.target)?,
+                option: file.plan.option.clone(),
+            });
+        }
+        Ok(journals)
     }
 }
 
-/// One folder's commit journal, written: every staged file must be planned or at least not
-/// foreign.
-fn write_journal(folder: &StagedFolder, producer: &str, remove_stale: bool) -> Result<Journal> {
+/// One folder's part of the commit: every staged file must be planned or at least not foreign,
+/// and no path it moves to or removes may go through a link or special file.
+fn folder_journal(folder: &StagedFolder, producer: &str, remove_stale: bool) -> Result<Journal> {
     let dir = &folder.plan.dir;
     let moves = staged_files(folder.staging.path())?;
     let old = Manifest::read(dir)?;
@@ -395,27 +456,29 @@ fn write_journal(folder: &StagedFolder, producer: &str, remove_stale: bool) -> R
             });
         }
     }
-    let journal = Journal {
+    let removals = if remove_stale {
+        old.stale(producer, &moves)
+    } else {
+        Vec::new()
+    };
+    for key in moves.iter().chain(&removals) {
+        journal::refuse_foreign_component(dir, key, &folder.plan.option)?;
+    }
+    Ok(Journal {
+        commit: String::new(),
+        folders: Vec::new(),
+        armed: false,
         staging: folder
             .staging
             .path()
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default(),
-        removals: if remove_stale {
-            old.stale(producer, &moves)
-        } else {
-            Vec::new()
-        },
+        removals,
         manifest: old.updated(producer, &moves, remove_stale),
         moves,
-    };
-    let text = serde_json::to_string(&journal).map_err(|error| OutputError::Manifest {
-        path: dir.join(JOURNAL),
-        message: error.to_string(),
-    })?;
-    write_atomically(&dir.join(JOURNAL), &text)?;
-    Ok(journal)
+        files: Vec::new(),
+    })
 }
 
 impl Drop for Staged {

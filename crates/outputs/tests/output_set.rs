@@ -250,3 +250,231 @@ fn a_commit_that_fails_in_one_folder_changes_none() {
     );
     assert!(!first.join(".learn-commit.json").exists());
 }
+
+/// Runs `producer` with the named file `path` (`--out`) holding `content`.
+fn run_named(path: &Path, content: &str, existing: Existing) -> outputs::Result<()> {
+    let mut set = OutputSet::new("sindy");
+    let file = set.file(path, "--out", existing);
+    let staged = set.prepare()?;
+    std::fs::write(staged.path(file), content).unwrap();
+    staged.commit().map(drop)
+}
+
+/// Makes a FIFO at `path`.
+fn make_fifo(path: &Path) {
+    let name = std::ffi::CString::new(path.as_os_str().as_encoded_bytes()).unwrap();
+    // SAFETY: a valid NUL-terminated path inside the test's temporary folder.
+    assert_eq!(unsafe { libc::mkfifo(name.as_ptr(), 0o644) }, 0);
+}
+
+/// Makes a character device node with /dev/null's numbers at `path` (inside the test's own
+/// folder; nothing is ever written to it); `false` when not permitted (not root).
+fn make_character_device(path: &Path) -> bool {
+    let name = std::ffi::CString::new(path.as_os_str().as_encoded_bytes()).unwrap();
+    // SAFETY: a valid NUL-terminated path inside the test's temporary folder.
+    unsafe { libc::mknod(name.as_ptr(), libc::S_IFCHR | 0o666, libc::makedev(1, 3)) == 0 }
+}
+
+fn mode(path: &Path) -> u32 {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::metadata(path).unwrap().permissions().mode() & 0o7777
+}
+
+/// Issue 31, class 1: a named output is never a FIFO, device or socket (refused with or without
+/// --force, left as it was), is written through a symbolic link into the file it leads to (the
+/// link stays), and through the inode of a file with other hard links.
+#[test]
+fn named_outputs_never_replace_special_files_and_write_through_links() {
+    use std::os::unix::fs::{FileTypeExt, MetadataExt};
+    let tmp = scratch("special");
+    let dir = tmp.path();
+    let fifo = dir.join("model.fifo");
+    make_fifo(&fifo);
+    let socket = dir.join("model.sock");
+    let _listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
+    let device = dir.join("null");
+    let mut special = vec![(fifo.clone(), "a FIFO"), (socket, "a socket")];
+    if make_character_device(&device) {
+        special.push((device.clone(), "a character device"));
+    } else {
+        eprintln!("not root: the character device case is skipped");
+    }
+    let link_to_fifo = dir.join("link-to-fifo.json");
+    std::os::unix::fs::symlink(&fifo, &link_to_fifo).unwrap();
+    special.push((link_to_fifo.clone(), "a FIFO"));
+    for (path, kind) in &special {
+        for existing in [Existing::Refuse, Existing::Replace] {
+            let error = run_named(path, "{}", existing).unwrap_err();
+            assert!(
+                matches!(error, OutputError::NotRegularFile { .. }),
+                "{existing:?}: {error}"
+            );
+            let message = error.to_string();
+            assert!(message.contains(&path.display().to_string()), "{message}");
+            assert!(message.contains(kind), "{message}");
+        }
+    }
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    assert!(
+        std::fs::symlink_metadata(&link_to_fifo)
+            .unwrap()
+            .is_symlink()
+    );
+    if device.exists() {
+        assert!(
+            std::fs::metadata(&device)
+                .unwrap()
+                .file_type()
+                .is_char_device()
+        );
+    }
+    // A link to a README: the README is rewritten, the link stays a link.
+    let readme = dir.join("README.md");
+    std::fs::write(&readme, "old").unwrap();
+    let link = dir.join("README-link.md");
+    std::os::unix::fs::symlink("README.md", &link).unwrap();
+    run_named(&link, "new", Existing::Replace).unwrap();
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+    assert_eq!(std::fs::read_to_string(&readme).unwrap(), "new");
+    let dangling = dir.join("dangling.json");
+    std::os::unix::fs::symlink("missing/none.json", &dangling).unwrap();
+    let error = run_named(&dangling, "x", Existing::Replace).unwrap_err();
+    assert!(
+        matches!(error, OutputError::LinkToNothing { .. }),
+        "{error}"
+    );
+    // A file with a second hard link: written through its inode, both names see the new text.
+    let linked = dir.join("linked.json");
+    std::fs::write(&linked, "old").unwrap();
+    std::fs::hard_link(&linked, dir.join("other-name.json")).unwrap();
+    let inode = std::fs::metadata(&linked).unwrap().ino();
+    run_named(&linked, "new text", Existing::Replace).unwrap();
+    assert_eq!(std::fs::metadata(&linked).unwrap().ino(), inode);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("other-name.json")).unwrap(),
+        "new text"
+    );
+    assert!(
+        !listing(dir)
+            .iter()
+            .any(|name| name.contains(".learn-staging-")),
+        "{:?}",
+        listing(dir)
+    );
+}
+
+/// Issue 31, class 5: new files (named, in folders, the manifest) follow the umask; a replaced
+/// file (named or in a folder) keeps its mode.
+#[test]
+fn modes_follow_the_umask_and_replaced_files_keep_theirs() {
+    use std::os::unix::fs::PermissionsExt;
+    // SAFETY: umask only changes this process's file creation mask (restored below).
+    let previous = unsafe { libc::umask(0o002) };
+    let tmp = scratch("modes");
+    let dir = tmp.path();
+    let named = dir.join("model.json");
+    run_named(&named, "1", Existing::Refuse).unwrap();
+    assert_eq!(mode(&named), 0o664, "a new named file");
+    std::fs::set_permissions(&named, std::fs::Permissions::from_mode(0o640)).unwrap();
+    run_named(&named, "2", Existing::Replace).unwrap();
+    assert_eq!(mode(&named), 0o640, "a replaced named file");
+    let out = dir.join("out");
+    run(&out, "p", &[("t/a.json", "1")], Existing::Refuse).unwrap();
+    assert_eq!(mode(&out.join("t/a.json")), 0o664, "a new file in a folder");
+    assert_eq!(
+        mode(&out.join(".learn-outputs.json")),
+        0o664,
+        "a new manifest"
+    );
+    assert_eq!(mode(&out.join("t")), 0o775, "a new subfolder");
+    std::fs::set_permissions(out.join("t/a.json"), std::fs::Permissions::from_mode(0o600)).unwrap();
+    run(&out, "p", &[("t/a.json", "2")], Existing::Replace).unwrap();
+    assert_eq!(
+        mode(&out.join("t/a.json")),
+        0o600,
+        "a replaced file in a folder"
+    );
+    // SAFETY: as above.
+    unsafe { libc::umask(previous) };
+}
+
+/// Issue 31, class 2: a subfolder of an output folder that became a link to a foreign folder is
+/// refused (before the work, and at the commit if it changed after), never written through; a
+/// stale file is never removed through it.
+#[test]
+fn a_subfolder_that_became_a_link_is_refused_not_written_through() {
+    let tmp = scratch("linked-subfolder");
+    let out = tmp.path().join("out");
+    let foreign = tmp.path().join("foreign");
+    std::fs::create_dir(&foreign).unwrap();
+    std::fs::write(foreign.join("a.svg"), "foreign a").unwrap();
+    std::fs::write(foreign.join("old.svg"), "foreign old").unwrap();
+    let files = [("figures/a.svg", "1"), ("figures/old.svg", "1")];
+    run(&out, "p", &files, Existing::Refuse).unwrap();
+    std::fs::remove_dir_all(out.join("figures")).unwrap();
+    std::os::unix::fs::symlink(&foreign, out.join("figures")).unwrap();
+    let before = listing(&foreign);
+    // Through a planned file, and through a stale one (removed on commit).
+    for files in [&[("figures/a.svg", "2")][..], &[("b.json", "2")][..]] {
+        let error = run(&out, "p", files, Existing::Replace).unwrap_err();
+        assert!(
+            matches!(error, OutputError::NotMadeByLearn { .. }),
+            "{error}"
+        );
+        assert!(
+            error
+                .to_string()
+                .contains(&out.join("figures").display().to_string()),
+            "{error}"
+        );
+    }
+    // A link that appears after the checks is refused at the commit.
+    std::fs::remove_file(out.join("figures")).unwrap();
+    std::fs::create_dir(out.join("figures")).unwrap();
+    let mut set = OutputSet::new("p");
+    let folder = set.folder(&out, "--out", Existing::Replace);
+    set.subfolder_in(folder, "figures");
+    let staged = set.prepare().unwrap();
+    std::fs::write(staged.dir(folder).join("figures/a.svg"), "2").unwrap();
+    std::fs::remove_dir(out.join("figures")).unwrap();
+    std::os::unix::fs::symlink(&foreign, out.join("figures")).unwrap();
+    let error = staged.commit().unwrap_err();
+    assert!(
+        matches!(error, OutputError::NotMadeByLearn { .. }),
+        "{error}"
+    );
+    assert_eq!(listing(&foreign), before);
+    assert_eq!(
+        std::fs::read_to_string(foreign.join("a.svg")).unwrap(),
+        "foreign a"
+    );
+    assert_eq!(
+        std::fs::read_to_string(foreign.join("old.svg")).unwrap(),
+        "foreign old"
+    );
+    assert!(!out.join(".learn-commit.json").exists());
+}
+
+/// Issue 31, class 12: an error naming a staging path is put in final terms, also after its set
+/// is gone (the error reaches the user once the set has been dropped).
+#[test]
+fn errors_name_final_paths_after_the_set_is_gone() {
+    let tmp = scratch("final-terms");
+    let out = tmp.path().join("out");
+    let mut set = OutputSet::new("p");
+    let folder = set.folder(&out, "--out", Existing::Refuse);
+    set.subfolder_in(folder, "figures");
+    let staged = set.prepare().unwrap();
+    let message = format!(
+        "{}: No space left on device",
+        staged.dir(folder).join("figures/x.svg").display()
+    );
+    drop(staged);
+    assert_eq!(
+        outputs::in_final_terms(&message),
+        format!(
+            "{}: No space left on device",
+            out.join("figures/x.svg").display()
+        )
+    );
+}

@@ -7,8 +7,8 @@ use anyhow::{Context, anyhow, bail};
 use data::{DEFAULT_UNIFORM_TOLERANCE, NumericStream, NumericTable, StreamedTimeAxis};
 use sindy::Derivative;
 use sindy::{
-    FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, RowBlock, Score, SindyError, SindyModel,
-    SindyParams, Trajectory,
+    FeatureLibrary, FitShape, LibrarySpec, Mat, OptimizerSpec, RowBlock, RowSource, Score,
+    SindyError, SindyModel, SindyParams, Trajectory,
 };
 
 use outputs::{Existing, OutputSet};
@@ -40,8 +40,8 @@ pub struct Args {
     #[command(flatten)]
     pub fit: FitArgs,
     /// Derivative estimator: forward, central, savgol or savgol:WINDOW:ORDER.
-    #[arg(long, default_value = "central")]
-    pub derivative: String,
+    #[arg(long, default_value = "central", value_parser = parse_derivative)]
+    pub derivative: Derivative,
     /// Decimals printed in the equations (at most 17: an f64 has no more).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=17))]
     pub precision: u8,
@@ -83,6 +83,12 @@ pub struct FitArgs {
     /// LASSO weight λ (required with --optimizer lasso).
     #[arg(long, allow_hyphen_values = true)]
     pub lambda: Option<f64>,
+}
+
+/// `--derivative`: a clap value parser, so that a setting with no derivative (`savgol:5:0`) or an
+/// unbounded cost is a usage error before anything is read.
+pub fn parse_derivative(text: &str) -> Result<Derivative, String> {
+    Derivative::parse(text).map_err(|error| error.to_string())
 }
 
 /// The STLSQ threshold when --threshold is not given.
@@ -161,6 +167,7 @@ fn fit_whole(
     let (time, table) = NumericTable::read_with_time(&args.csv, &args.time, columns)?;
     let n = table.rows();
     check_rows(args, n, feature_count, columns)?;
+    check_memory(args, n, feature_count, RowSource::Whole)?;
     let dim_x = args.state.len();
     let states = Mat::from_fn(n, dim_x, |i, j| table.columns[j][i]);
     let controls = Mat::from_fn(n, args.control.len(), |i, j| table.columns[dim_x + j][i]);
@@ -187,6 +194,7 @@ fn fit_streamed(
     }
     let (n, dt) = axis.finish()?;
     check_rows(args, n, feature_count, columns)?;
+    check_memory(args, n, feature_count, RowSource::Streamed)?;
     let mut stream = NumericStream::open(&args.csv, columns)?;
     let fit = params
         .fit_streamed(n, dt, || {
@@ -202,6 +210,14 @@ fn fit_streamed(
 }
 
 fn check_rows(args: &Args, n: usize, feature_count: usize, columns: &[&str]) -> anyhow::Result<()> {
+    let needed = args.derivative.min_samples();
+    if n < needed {
+        bail!(
+            "{}: {n} data rows, too few: the {} estimator needs at least {needed} (its window)",
+            args.csv.display(),
+            args.derivative
+        );
+    }
     if n < feature_count {
         bail!(
             "{}: {n} data rows, fewer than the {feature_count} features of library {} on {}: \
@@ -209,6 +225,40 @@ fn check_rows(args: &Args, n: usize, feature_count: usize, columns: &[&str]) -> 
             args.csv.display(),
             args.fit.library,
             columns.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// Refuses a fit whose estimated peak memory ([`FitShape::peak_bytes`]) exceeds what the process
+/// may still allocate ([`super::memory::memory_bound`]), before any of it is allocated.
+fn check_memory(
+    args: &Args,
+    rows: usize,
+    feature_count: usize,
+    source: RowSource,
+) -> anyhow::Result<()> {
+    let threads = evaluation::worker_threads();
+    let shape = FitShape {
+        rows,
+        features: feature_count,
+        targets: args.state.len(),
+        source,
+        threads,
+    };
+    let needed = shape.peak_bytes(&args.fit.optimizer()?);
+    let Some(bound) = super::memory::memory_bound(threads) else {
+        return Ok(());
+    };
+    if needed > bound.bytes {
+        bail!(
+            "{}: a fit of {rows} rows on the {feature_count} features of library {} needs about \
+             {} of memory, more than {} ({}): use a smaller library or fewer states",
+            args.csv.display(),
+            args.fit.library,
+            super::memory::in_words(needed),
+            bound.source,
+            super::memory::in_words(bound.bytes),
         );
     }
     Ok(())
@@ -242,7 +292,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     // Everything that can be checked without reading the file is checked first.
     let library = args.fit.library()?;
     let optimizer = args.fit.optimizer()?;
-    let derivative = Derivative::parse(&args.derivative)?;
+    let derivative = args.derivative;
     let columns: Vec<&str> = args
         .state
         .iter()

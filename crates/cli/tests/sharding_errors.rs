@@ -275,7 +275,7 @@ fn merge_refuses_what_is_not_a_shard_of_the_same_command() {
     );
     std::fs::write(
         dir.join("results/shard.json"),
-        "{\"format\": \"learn-shard/1\", ",
+        "{\"format\": \"learn-shard/2\", ",
     )
     .unwrap();
     refused(

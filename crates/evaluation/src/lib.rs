@@ -91,7 +91,7 @@ pub use output::{
 pub use progress::{NoProgress, Progress, Stage, Units};
 pub use run::{
     GENERATED_PATHS, ReproduceShard, RunOutcome, git_commit, merged_run, run, run_shard,
-    shard_timings, uncommitted_inputs,
+    shard_timings, uncommitted_inputs, worker_threads,
 };
 pub use runner::{Fitted, Method, Models, Outcome, Runner, Train, Trial};
 pub use segment::{Segment, SegmentModel, Segmentation, flight_segments, segment_batch};

@@ -124,7 +124,7 @@ pub fn write_outputs(outcome: &RunOutcome, paths: &OutputPaths) -> Result<Vec<Pa
     let timings = Timings {
         run: outcome.summary.run.clone(),
         uncommitted_inputs: outcome.uncommitted_inputs,
-        threads: rayon::current_num_threads(),
+        threads: crate::worker_threads(),
         total_seconds: stages.iter().map(|s| s.seconds).sum(),
         stages,
     };

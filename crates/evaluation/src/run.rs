@@ -95,7 +95,7 @@ pub fn run_shard(
     let work = ReproduceWork::plan(config, data_dir, root, &mut stopwatch)?;
     let results = stopwatch.time(work.items_stage(shard), || work.run_items(shard, progress))?;
     let provenance = ShardProvenance::here(root, stopwatch.timings());
-    Ok(work.sweep.shard_file(shard, results, provenance))
+    work.sweep.shard_file(shard, results, provenance)
 }
 
 /// The outcome of merged reproduce shards: rendered as [`run`] renders; the timings are each
@@ -449,6 +449,12 @@ fn git(root: &Path, arguments: &[&str]) -> Option<String> {
         .ok()
         .filter(|output| output.status.success())
         .and_then(|output| String::from_utf8(output.stdout).ok())
+}
+
+/// The threads the run's parallel work uses: rayon's pool (`RAYON_NUM_THREADS` when set, else
+/// the processors available), as the banner, `timings.json` and shard provenance report it.
+pub fn worker_threads() -> usize {
+    rayon::current_num_threads()
 }
 
 /// The last commit that changed an input of the run (anything but [`GENERATED_PATHS`]), or

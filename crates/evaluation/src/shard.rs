@@ -7,8 +7,8 @@
 //! rendering needs besides the items' results (configuration, published numbers, file hashes).
 //! The unsharded run executes every item and renders; shard `K/N` ([`ShardSpec`]) executes the
 //! items whose position is ≡ K (mod N) and writes a [`ShardFile`] (`shard.json`) with the
-//! configuration's hash, the data files' hashes, the item list and each item's result;
-//! [`merge`] checks that shards belong together and cover every item once, and hands the
+//! configuration's hash, the data files' hashes, the item list, each item's result and the hash of
+//! all of it ([`ShardFile::content_sha256`]); [`merge`] checks that no shard was edited, and that shards belong together and cover every item once, and hands the
 //! results, in enumeration order, to the same rendering code. Each item depends on its own seed
 //! only, so a merged sweep is bit-identical to the unsharded one.
 
@@ -32,7 +32,10 @@ pub use merge::{MergedSweep, merge};
 /// The file a shard writes in its `--out` folder.
 pub const SHARD_FILE: &str = "shard.json";
 /// The format tag of [`SHARD_FILE`].
-pub const SHARD_FORMAT: &str = "learn-shard/1";
+pub const SHARD_FORMAT: &str = "learn-shard/2";
+/// Formats of earlier versions, refused with the reason: `learn-shard/1` had no hash of its
+/// results, so an edited result could not be told from a computed one.
+const EARLIER_FORMATS: [&str; 1] = ["learn-shard/1"];
 
 /// Shard `index` of `count` (`K/N` on the command line, K from 0): the items whose position in
 /// the sweep's enumeration is ≡ K (mod N).
@@ -144,7 +147,7 @@ impl ShardProvenance {
             git_commit: crate::git_commit(root),
             uncommitted_inputs: crate::uncommitted_inputs(root),
             host: host_name(),
-            threads: rayon::current_num_threads(),
+            threads: crate::worker_threads(),
             stages,
         }
     }
@@ -177,6 +180,46 @@ pub struct ShardFile<C, R> {
     /// This shard's items' results, by position.
     pub results: Vec<ItemResult<R>>,
     pub provenance: ShardProvenance,
+    /// The SHA-256 of every other field ([`content_sha256`]): the results, the provenance and
+    /// everything else a merge renders, so that a shard edited after it was written is refused.
+    pub content_sha256: String,
+}
+
+/// Every field of a [`ShardFile`] but its `content_sha256`, as it is written: what that hash
+/// covers.
+#[derive(Serialize)]
+struct ShardContent<'a, C, R> {
+    format: &'a str,
+    kind: SweepKind,
+    configuration_sha256: &'a str,
+    data_files: &'a [DataFile],
+    shard: ShardSpec,
+    items: &'a [WorkItem],
+    context: &'a C,
+    results: &'a [ItemResult<R>],
+    provenance: &'a ShardProvenance,
+}
+
+/// The SHA-256 of the compact JSON of every field of `file` but `content_sha256` (floats written
+/// as the shortest decimal that reads back to the same bits, so a shard read back hashes the
+/// same); an error if a value cannot be written as JSON.
+pub(crate) fn content_sha256<C: Serialize, R: Serialize>(
+    file: &ShardFile<C, R>,
+) -> std::result::Result<String, serde_json::Error> {
+    let content = ShardContent {
+        format: &file.format,
+        kind: file.kind,
+        configuration_sha256: &file.configuration_sha256,
+        data_files: &file.data_files,
+        shard: file.shard,
+        items: &file.items,
+        context: &file.context,
+        results: &file.results,
+        provenance: &file.provenance,
+    };
+    Ok(data::bytes_sha256(
+        serde_json::to_string(&content)?.as_bytes(),
+    ))
 }
 
 /// A run's work: its items in enumeration order and what rendering needs besides their results.
@@ -220,14 +263,15 @@ impl<C: Serialize> Sweep<C> {
             .collect()
     }
 
-    /// The shard file of `shard` with its `results`.
-    pub fn shard_file<R>(
+    /// The shard file of `shard` with its `results`, hashed; an error if a result cannot be
+    /// written as JSON.
+    pub fn shard_file<R: Serialize>(
         self,
         shard: ShardSpec,
         results: Vec<ItemResult<R>>,
         provenance: ShardProvenance,
-    ) -> ShardFile<C, R> {
-        ShardFile {
+    ) -> Result<ShardFile<C, R>> {
+        let mut file = ShardFile {
             format: SHARD_FORMAT.to_string(),
             kind: self.kind,
             configuration_sha256: self.configuration_sha256(),
@@ -237,7 +281,13 @@ impl<C: Serialize> Sweep<C> {
             context: self.context,
             results,
             provenance,
-        }
+            content_sha256: String::new(),
+        };
+        file.content_sha256 = content_sha256(&file).map_err(|error| EvaluationError::Mismatch {
+            what: format!("shard {shard}"),
+            message: format!("cannot be written as JSON: {error}"),
+        })?;
+        Ok(file)
     }
 }
 
@@ -299,6 +349,16 @@ pub fn read_shard(dir: &Path) -> Result<ShardDocument> {
     let value: serde_json::Value =
         inputs::json::from_str(&text).map_err(|error| EvaluationError::json(&path, error))?;
     let format = value.get("format").and_then(|f| f.as_str());
+    if let Some(earlier) = format.filter(|f| EARLIER_FORMATS.contains(f)) {
+        return Err(EvaluationError::Config {
+            path,
+            field: "format".to_string(),
+            message: format!(
+                "a shard of an earlier learn ('{earlier}', whose results no hash covers; this \
+                 learn reads '{SHARD_FORMAT}'): run the shard again"
+            ),
+        });
+    }
     if format != Some(SHARD_FORMAT) {
         let found = format.map_or("no format".to_string(), |f| format!("format '{f}'"));
         return Err(EvaluationError::Config {
@@ -395,7 +455,9 @@ mod tests {
         };
         let results = sweep.run(ShardSpec::WHOLE, |_| Ok(values.clone())).unwrap();
         let provenance = ShardProvenance::here(Path::new("."), Vec::new());
-        let file = sweep.shard_file(ShardSpec::WHOLE, results, provenance);
+        let file = sweep
+            .shard_file(ShardSpec::WHOLE, results, provenance)
+            .unwrap();
         let scratch = tempfile::tempdir().unwrap();
         let dir = scratch.path().join("shard");
         write_shard(&file, &dir).unwrap();
@@ -421,12 +483,21 @@ mod tests {
         std::fs::write(dir.join(SHARD_FILE), r#"{"format": "learn-results/1"}"#).unwrap();
         let message = read_shard(&dir).err().unwrap().to_string();
         assert!(
-            message.ends_with("shard.json: format: not a shard result (format 'learn-results/1'; a shard has 'learn-shard/1')"),
+            message.ends_with("shard.json: format: not a shard result (format 'learn-results/1'; a shard has 'learn-shard/2')"),
+            "{message}"
+        );
+        std::fs::write(dir.join(SHARD_FILE), r#"{"format": "learn-shard/1"}"#).unwrap();
+        let message = read_shard(&dir).err().unwrap().to_string();
+        assert!(
+            message.ends_with(
+                "shard.json: format: a shard of an earlier learn ('learn-shard/1', whose \
+                 results no hash covers; this learn reads 'learn-shard/2'): run the shard again"
+            ),
             "{message}"
         );
         std::fs::write(
             dir.join(SHARD_FILE),
-            r#"{"format": "learn-shard/1", "kind": "paper"}"#,
+            r#"{"format": "learn-shard/2", "kind": "paper"}"#,
         )
         .unwrap();
         let message = read_shard(&dir).err().unwrap().to_string();

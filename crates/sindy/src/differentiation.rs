@@ -7,7 +7,10 @@
 //!   second-order one-sided differences at both ends.
 //! - Savitzky–Golay: the derivative of a least-squares polynomial of degree `order` fitted over a
 //!   window of `window` (odd) samples centred on each point; near the ends the polynomial fitted to
-//!   the first (last) window is evaluated at the point itself (SciPy's `mode="interp"`).
+//!   the first (last) window is evaluated at the point itself (SciPy's `mode="interp"`). The
+//!   order is at least 1 (a constant has no derivative) and at most
+//!   [`MAX_SAVITZKY_GOLAY_ORDER`]; the window at most [`MAX_SAVITZKY_GOLAY_WINDOW`] samples (the
+//!   cost is samples × window) and at most the samples of the signal.
 
 use serde::{Deserialize, Serialize};
 
@@ -35,6 +38,24 @@ pub enum DifferentiationError {
         mean: f64,
         estimator: Derivative,
     },
+    /// A Savitzky–Golay order of 0: the polynomial is a constant, whose derivative is 0.
+    #[error(
+        "Savitzky-Golay derivative: order 0 fits a constant, whose derivative is 0 whatever the \
+         data: the order must be at least 1"
+    )]
+    ZeroOrder,
+    /// A Savitzky–Golay order whose polynomial the double-precision fit cannot resolve.
+    #[error(
+        "Savitzky-Golay derivative: order {order} is above {MAX_SAVITZKY_GOLAY_ORDER}, the highest \
+         whose weights double precision computes accurately"
+    )]
+    OrderTooHigh { order: usize },
+    /// A Savitzky–Golay window longer than the bound on its cost.
+    #[error(
+        "Savitzky-Golay derivative: window {window} is longer than {MAX_SAVITZKY_GOLAY_WINDOW} \
+         samples (the cost grows with samples × window)"
+    )]
+    WindowTooLong { window: usize },
     /// A signal shorter than the estimator's stencil.
     #[error("derivative: {samples} samples, the {estimator} estimator needs at least {needed}")]
     TooFewSamples {
@@ -45,6 +66,16 @@ pub enum DifferentiationError {
 }
 
 type Result<T> = std::result::Result<T, DifferentiationError>;
+
+/// The longest Savitzky–Golay window: its cost is samples × window per signal, plus window² ×
+/// order² for the end weights.
+pub const MAX_SAVITZKY_GOLAY_WINDOW: usize = 1001;
+
+/// The highest Savitzky–Golay order: up to it, the weights from the normal equations give the
+/// derivative of a line to 1e-8 (relative) in every window up to [`MAX_SAVITZKY_GOLAY_WINDOW`]
+/// (measured: 9e-9 at order 10, 1e-8 at 12, 3e-6 at 14, as the monomials' Gram matrix loses
+/// its conditioning).
+pub const MAX_SAVITZKY_GOLAY_ORDER: usize = 10;
 
 /// How a derivative is estimated from samples.
 ///
@@ -107,12 +138,23 @@ impl Derivative {
         }
     }
 
-    /// Checks the settings (window odd, larger than the order).
+    /// Checks the settings: a Savitzky–Golay order from 1 to [`MAX_SAVITZKY_GOLAY_ORDER`], its
+    /// window odd, larger than the order and at most [`MAX_SAVITZKY_GOLAY_WINDOW`].
     pub fn validate(&self) -> Result<()> {
-        if let Self::SavitzkyGolay { window, order } = *self
-            && (window % 2 == 0 || window <= order || window < 3)
-        {
+        let Self::SavitzkyGolay { window, order } = *self else {
+            return Ok(());
+        };
+        if order == 0 {
+            return Err(DifferentiationError::ZeroOrder);
+        }
+        if window % 2 == 0 || window <= order || window < 3 {
             return Err(DifferentiationError::BadWindow { window, order });
+        }
+        if order > MAX_SAVITZKY_GOLAY_ORDER {
+            return Err(DifferentiationError::OrderTooHigh { order });
+        }
+        if window > MAX_SAVITZKY_GOLAY_WINDOW {
+            return Err(DifferentiationError::WindowTooLong { window });
         }
         Ok(())
     }
@@ -528,5 +570,75 @@ mod tests {
         for text in ["forward", "central", "savgol:11:2"] {
             assert_eq!(Derivative::parse(text).unwrap().to_string(), text);
         }
+    }
+
+    /// Every setting `parse` accepts differentiates a line to its slope at every sample (the
+    /// ends included); every one it refuses is a one-line message.
+    #[test]
+    fn every_accepted_savitzky_golay_setting_differentiates_a_line() {
+        use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+        let config = Config {
+            cases: 96,
+            failure_persistence: None,
+            ..Config::default()
+        };
+        let mut runner =
+            TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &[10; 32]));
+        let settings = (0usize..1_200, 0usize..16);
+        runner
+            .run(&settings, |(window, order)| {
+                let text = format!("savgol:{window}:{order}");
+                match Derivative::parse(&text) {
+                    Ok(derivative) => {
+                        let dt = 0.01;
+                        let line: Vec<f64> =
+                            (0..window + 7).map(|k| 3.0 - 2.0 * k as f64 * dt).collect();
+                        let slope = derivative.apply(&line, dt).unwrap();
+                        let error = max_error(&slope, &vec![-2.0; slope.len()]);
+                        proptest::prop_assert!(error < 2e-8, "{text}: error {error}");
+                    }
+                    Err(error) => {
+                        let message = error.to_string();
+                        proptest::prop_assert!(
+                            order == 0
+                                || order > MAX_SAVITZKY_GOLAY_ORDER
+                                || window % 2 == 0
+                                || window <= order
+                                || window > MAX_SAVITZKY_GOLAY_WINDOW,
+                            "{text} refused: {message}"
+                        );
+                        proptest::prop_assert!(
+                            message.starts_with("Savitzky-Golay derivative: ")
+                                && !message.contains('\n'),
+                            "{message}"
+                        );
+                    }
+                }
+                Ok(())
+            })
+            .unwrap();
+    }
+
+    #[test]
+    fn order_zero_and_unbounded_windows_are_refused_by_name() {
+        let message = |text: &str| Derivative::parse(text).unwrap_err().to_string();
+        assert_eq!(
+            message("savgol:5:0"),
+            "Savitzky-Golay derivative: order 0 fits a constant, whose derivative is 0 whatever \
+             the data: the order must be at least 1"
+        );
+        assert_eq!(
+            message("savgol:99999:2"),
+            "Savitzky-Golay derivative: window 99999 is longer than 1001 samples (the cost grows \
+             with samples × window)"
+        );
+        assert_eq!(
+            message("savgol:31:11"),
+            "Savitzky-Golay derivative: order 11 is above 10, the highest whose weights double \
+             precision computes accurately"
+        );
+        let json = r#"{"kind": "savitzky_golay", "window": 5, "order": 0}"#;
+        let read: Derivative = inputs::json::from_str(json).unwrap();
+        assert_eq!(read.validate(), Err(DifferentiationError::ZeroOrder));
     }
 }

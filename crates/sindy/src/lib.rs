@@ -70,6 +70,7 @@ pub mod differentiation;
 mod error;
 mod library;
 mod linalg;
+mod memory;
 mod model;
 mod optimizers;
 mod persist;
@@ -82,6 +83,7 @@ pub use differentiation::{
 pub use error::{Result, SindyError, field, shape};
 pub use library::{CustomFunction, FeatureLibrary, LibrarySpec, MAX_FEATURES};
 pub use linalg::least_squares;
+pub use memory::{FitShape, RowSource};
 pub use model::{
     LARGE_LIBRARY_ENTRIES, Score, SindyModel, SindyParams, Trajectory, mean_squared_error,
 };

@@ -36,14 +36,14 @@ pub struct TaskArgs {
     #[arg(long, value_delimiter = ',', requires = "tasks")]
     pub control: Vec<String>,
     /// Derivative estimator of the targets: forward, central, savgol or savgol:WINDOW:ORDER.
-    #[arg(long, default_value = "central")]
-    pub derivative: String,
+    #[arg(long, default_value = "central", value_parser = super::sindy::parse_derivative)]
+    pub derivative: Derivative,
 }
 
 impl TaskArgs {
     /// Refuses the task options that only mean something with --tasks (those with defaults).
     pub fn refuse_without_tasks(&self) -> anyhow::Result<()> {
-        if self.time != "t" || self.derivative != "central" {
+        if self.time != "t" || self.derivative != Derivative::Central {
             bail!("--time and --derivative apply to --tasks only");
         }
         Ok(())
@@ -61,7 +61,7 @@ impl TaskArgs {
             time: self.time.clone(),
             state: self.state.clone(),
             control: self.control.clone(),
-            derivative: Derivative::parse(&self.derivative)?,
+            derivative: self.derivative,
         };
         spec.check()
             .map_err(|message| anyhow::anyhow!("--state/--control: {message}"))?;

@@ -6,6 +6,7 @@ mod conditions;
 mod evaluate;
 mod explain;
 mod inspect;
+mod memory;
 mod merge;
 mod meta_train;
 mod meta_train_tasks;

@@ -74,10 +74,10 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     let data_dir = global.data_dir()?;
     let staged = plan.set.prepare()?;
     note!(
-        "run '{}' on {} ({} threads)",
+        "run '{}' on {} ({})",
         config.raw.name,
         data_dir.display(),
-        available_threads()
+        worker_threads()
     );
     let progress = StageBars::new(global.show_progress());
     let outcome = evaluation::run(&config, &data_dir, &args.root, &progress)?;
@@ -96,10 +96,10 @@ fn run_shard(
     let data_dir = global.data_dir()?;
     let staged = outputs.prepare()?;
     note!(
-        "run '{}' shard {shard} on {} ({} threads)",
+        "run '{}' shard {shard} on {} ({})",
         config.raw.name,
         data_dir.display(),
-        available_threads()
+        worker_threads()
     );
     let progress = StageBars::new(global.show_progress());
     let file = evaluation::run_shard(config, &data_dir, &args.root, &progress, shard)?;
@@ -209,6 +209,10 @@ fn readme_in(set: &mut OutputSet, readme: &Path) -> anyhow::Result<FileId> {
     Ok(file)
 }
 
-fn available_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
+/// "1 thread", "4 threads": the pool the run's parallel work uses.
+fn worker_threads() -> String {
+    match evaluation::worker_threads() {
+        1 => "1 thread".to_string(),
+        count => format!("{count} threads"),
+    }
 }

@@ -101,7 +101,7 @@ pub fn run(global: &Global, args: &Args, inputs: &[(String, PathBuf)]) -> anyhow
                 stage("seed spread", started.elapsed().as_secs_f64() - loaded),
             ];
             let provenance = ShardProvenance::here(Path::new("."), stages);
-            staged.commit(&sweep.shard_file(shard, results, provenance))
+            staged.commit(&sweep.shard_file(shard, results, provenance)?)
         }
         Prepared::File(staged, file) => {
             let summaries: Vec<_> = results.into_iter().map(|r| r.result).collect();

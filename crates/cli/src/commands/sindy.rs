@@ -9,8 +9,8 @@ use anyhow::{Context, anyhow, bail};
 use data::{DEFAULT_UNIFORM_TOLERANCE, NumericStream, NumericTable, StreamedTimeAxis};
 use sindy::{Derivative, DifferentiationError};
 use sindy::{
-    FeatureLibrary, LibrarySpec, Mat, OptimizerSpec, RowBlock, Score, SindyError, SindyModel,
-    SindyParams, Trajectory,
+    FeatureLibrary, FitShape, LibrarySpec, Mat, OptimizerSpec, RowBlock, RowSource, Score,
+    SindyError, SindyModel, SindyParams, Trajectory,
 };
 
 use outputs::{Existing, OutputSet};
@@ -48,8 +48,8 @@ pub struct Args {
     #[command(flatten)]
     pub fit: FitArgs,
     /// Derivative estimator: forward, central, savgol or savgol:WINDOW:ORDER.
-    #[arg(long, default_value = "central")]
-    pub derivative: String,
+    #[arg(long, default_value = "central", value_parser = parse_derivative)]
+    pub derivative: Derivative,
     /// Decimals printed in the equations (at most 17: an f64 has no more).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=17))]
     pub precision: u8,
@@ -91,6 +91,12 @@ pub struct FitArgs {
     /// LASSO weight λ (required with --optimizer lasso).
     #[arg(long, allow_hyphen_values = true)]
     pub lambda: Option<f64>,
+}
+
+/// `--derivative`: a clap value parser, so that a setting with no derivative (`savgol:5:0`) or an
+/// unbounded cost is a usage error before anything is read.
+pub fn parse_derivative(text: &str) -> Result<Derivative, String> {
+    Derivative::parse(text).map_err(|error| error.to_string())
 }
 
 /// The STLSQ threshold when --threshold is not given.
@@ -208,8 +214,20 @@ fn check_sampling(
             path.display(),
             line(sample),
         ),
+        DifferentiationError::TooFewSamples { samples, .. } => {
+            too_few_rows(&path.display().to_string(), samples, derivative)
+        }
         other => anyhow!("{}: {other}", path.display()),
     })
+}
+
+/// A recording shorter than the derivative's stencil.
+fn too_few_rows(files: &str, rows: usize, derivative: Derivative) -> anyhow::Error {
+    anyhow!(
+        "{files}: {rows} data rows, too few: the {derivative} estimator needs at least {} (its \
+         window)",
+        derivative.min_samples()
+    )
 }
 
 /// The fit of the files read whole, one trajectory each; its model, score on all rows and number
@@ -220,7 +238,7 @@ fn fit_whole(
     columns: &[&str],
     feature_count: usize,
 ) -> anyhow::Result<(SindyModel, Score, usize)> {
-    let derivative = Derivative::parse(&args.derivative)?;
+    let derivative = args.derivative;
     let recordings = args
         .csv
         .iter()
@@ -228,6 +246,7 @@ fn fit_whole(
         .collect::<anyhow::Result<Vec<_>>>()?;
     let n = recordings.iter().map(|r| r.table.rows()).sum();
     check_rows(args, n, feature_count, columns)?;
+    check_memory(args, n, feature_count, RowSource::Whole)?;
     let trajectories: Vec<Trajectory> = recordings.iter().map(|r| r.trajectory.clone()).collect();
     let model = params
         .fit(&trajectories)
@@ -294,6 +313,7 @@ fn fit_streamed(
     }
     let (n, dt) = axis.finish()?;
     check_rows(args, n, feature_count, columns)?;
+    check_memory(args, n, feature_count, RowSource::Streamed)?;
     let mut stream = NumericStream::open(csv, columns)?;
     let fit = params
         .fit_streamed(n, dt, || {
@@ -324,6 +344,9 @@ fn streamed_time_error(error: data::DataError) -> anyhow::Error {
 }
 
 fn check_rows(args: &Args, n: usize, feature_count: usize, columns: &[&str]) -> anyhow::Result<()> {
+    if n < args.derivative.min_samples() {
+        return Err(too_few_rows(&files(&args.csv), n, args.derivative));
+    }
     if n < feature_count {
         bail!(
             "{}: {n} data rows, fewer than the {feature_count} features of library {} on {}: \
@@ -343,6 +366,40 @@ fn files(paths: &[PathBuf]) -> String {
         .map(|path| path.display().to_string())
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// Refuses a fit whose estimated peak memory ([`FitShape::peak_bytes`]) exceeds what the process
+/// may still allocate ([`super::memory::memory_bound`]), before any of it is allocated.
+fn check_memory(
+    args: &Args,
+    rows: usize,
+    feature_count: usize,
+    source: RowSource,
+) -> anyhow::Result<()> {
+    let threads = evaluation::worker_threads();
+    let shape = FitShape {
+        rows,
+        features: feature_count,
+        targets: args.state.len(),
+        source,
+        threads,
+    };
+    let needed = shape.peak_bytes(&args.fit.optimizer()?);
+    let Some(bound) = super::memory::memory_bound(threads) else {
+        return Ok(());
+    };
+    if needed > bound.bytes {
+        bail!(
+            "{}: a fit of {rows} rows on the {feature_count} features of library {} needs about \
+             {} of memory, more than {} ({}): use a smaller library or fewer states",
+            files(&args.csv),
+            args.fit.library,
+            super::memory::in_words(needed),
+            bound.source,
+            super::memory::in_words(bound.bytes),
+        );
+    }
+    Ok(())
 }
 
 /// A fit's error, a non-finite value named by the line of its row in `path`.
@@ -384,7 +441,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     // Everything that can be checked without reading the file is checked first.
     let library = args.fit.library()?;
     let optimizer = args.fit.optimizer()?;
-    let derivative = Derivative::parse(&args.derivative)?;
+    let derivative = args.derivative;
     let columns: Vec<&str> = args
         .state
         .iter()

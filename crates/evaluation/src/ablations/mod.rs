@@ -168,7 +168,7 @@ pub fn run_variants_shard(
 ) -> Result<AblationsShard> {
     let (work, results, stages) = plan_and_run(config, data_dir, progress, shard)?;
     let provenance = ShardProvenance::here(&config.root, stages);
-    Ok(work.sweep.shard_file(shard, results, provenance))
+    work.sweep.shard_file(shard, results, provenance)
 }
 
 /// The results of the items of `shard`, and the stages' times: "load flights, cut the cells", then

@@ -9,7 +9,9 @@ use crate::experiment::WorkItem;
 use learn::DataFile;
 use serde::Serialize;
 
-use super::{ShardFile, ShardProvenance, ShardSpec, SweepKind, configuration_sha256};
+use super::{
+    ShardFile, ShardProvenance, ShardSpec, SweepKind, configuration_sha256, content_sha256,
+};
 use crate::error::{EvaluationError, Result};
 
 /// Shards merged: one sweep's context and every item's result in enumeration order.
@@ -31,7 +33,7 @@ pub struct MergedSweep<C, R> {
 const LISTED_ITEMS: usize = 6;
 
 /// Checks `shards` (each with the file it was read from) and merges them.
-pub fn merge<C: Serialize, R>(
+pub fn merge<C: Serialize, R: Serialize>(
     shards: Vec<(PathBuf, ShardFile<C, R>)>,
 ) -> Result<MergedSweep<C, R>> {
     let Some((first_path, first)) = shards.first() else {
@@ -39,6 +41,7 @@ pub fn merge<C: Serialize, R>(
     };
     for (path, shard) in &shards {
         check_own_hash(path, shard)?;
+        check_content_hash(path, shard)?;
         check_same_sweep(first_path, first, path, shard)?;
         check_own_items(path, shard)?;
     }
@@ -93,6 +96,34 @@ fn check_own_hash<C: Serialize, R>(path: &Path, shard: &ShardFile<C, R>) -> Resu
                 "{} does not match the shard's context and items ({}): the file was changed \
                  after it was written",
                 short(&shard.configuration_sha256),
+                short(&computed)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The recorded content hash is that of every other field of the shard, its results and
+/// provenance included.
+fn check_content_hash<C: Serialize, R: Serialize>(
+    path: &Path,
+    shard: &ShardFile<C, R>,
+) -> Result<()> {
+    let computed = content_sha256(shard).map_err(|error| {
+        field_error(
+            path,
+            "results",
+            format!("cannot be hashed as JSON: {error}"),
+        )
+    })?;
+    if computed != shard.content_sha256 {
+        return Err(field_error(
+            path,
+            "content_sha256",
+            format!(
+                "{} does not match the shard's results and other fields ({}): the file was \
+                 changed after it was written",
+                short(&shard.content_sha256),
                 short(&computed)
             ),
         ));
@@ -369,7 +400,15 @@ mod tests {
             stages: Vec::new(),
         };
         let path = PathBuf::from(format!("s{index}/shard.json"));
-        (path, sweep.clone().shard_file(spec, results, provenance))
+        let file = sweep.clone().shard_file(spec, results, provenance).unwrap();
+        (path, file)
+    }
+
+    /// `file` with its content hash recomputed: edited consistently, so that the checks behind
+    /// the hash are reached.
+    fn rehashed(mut file: ShardFile<String, u64>) -> ShardFile<String, u64> {
+        file.content_sha256 = content_sha256(&file).unwrap();
+        file
     }
 
     fn error(shards: Vec<(PathBuf, ShardFile<String, u64>)>) -> String {
@@ -448,6 +487,7 @@ mod tests {
         );
         let mut later = shard(&ours, 1, 2);
         later.1.provenance.git_commit = "def".to_string();
+        let later = (later.0, rehashed(later.1));
         let message = error(vec![(path.clone(), first.clone()), later]);
         assert_eq!(
             message,
@@ -475,7 +515,7 @@ mod tests {
         );
         let (_, mut foreign) = shard(&sweep, 0, 2);
         foreign.results[1].position = 1;
-        let message = error(vec![(path.clone(), foreign)]);
+        let message = error(vec![(path.clone(), rehashed(foreign))]);
         assert_eq!(
             message,
             "s0/shard.json: results[1]: item 1 (attitude 35wind seed 1) is recorded as 'attitude 35wind seed 2'"
@@ -483,17 +523,38 @@ mod tests {
         let (_, mut stray) = shard(&sweep, 0, 2);
         stray.results[1].position = 1;
         stray.results[1].item = sweep.items[1].clone();
-        let message = error(vec![(path.clone(), stray)]);
+        let message = error(vec![(path.clone(), rehashed(stray))]);
         assert_eq!(
             message,
             "s0/shard.json: results[1]: item 1 (attitude 35wind seed 1) is not one of shard 0/2's"
         );
         let (_, mut past) = shard(&sweep, 0, 2);
         past.results[0].position = 9;
-        let message = error(vec![(path, past)]);
+        let message = error(vec![(path, rehashed(past))]);
         assert_eq!(
             message,
             "s0/shard.json: results[0]: position 9 is past the 5 items of the sweep"
         );
+    }
+
+    #[test]
+    fn an_edited_result_or_provenance_is_refused_by_its_hash() {
+        let sweep = sweep("c");
+        let (path, written) = shard(&sweep, 0, 1);
+        assert!(merge(vec![(path.clone(), written.clone())]).is_ok());
+        let mut result = written.clone();
+        result.results[2].result += 1;
+        let mut host = written.clone();
+        host.provenance.host = Some("elsewhere".to_string());
+        let mut threads = written;
+        threads.provenance.threads = 64;
+        for edited in [result, host, threads] {
+            let message = error(vec![(path.clone(), edited)]);
+            assert!(
+                message.starts_with("s0/shard.json: content_sha256: ")
+                    && message.ends_with("the file was changed after it was written"),
+                "{message}"
+            );
+        }
     }
 }

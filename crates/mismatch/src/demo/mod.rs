@@ -341,7 +341,10 @@ impl DemoPlan {
             .into_iter()
             .chain((0..self.configurations.len()).map(|i| self.configuration_dir(i)));
         for dir in dirs {
-            if let Some(summary) = summaries.iter().find(|s| outputs::paths::same_file(&dir, s)) {
+            if let Some(summary) = summaries
+                .iter()
+                .find(|s| outputs::paths::same_file(&dir, s))
+            {
                 return Err(MismatchError::CaseDirectoryIsSummary {
                     path: summary.clone(),
                 });

@@ -396,7 +396,9 @@ fn simulate_writes_only_logs_the_data_tools_read() {
     let dir = setup("sim-pwm-scale");
     let mut model: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("quad.json")).unwrap()).unwrap();
-    model["mixer"]["pwm_scale"] = json!(1e6);
+    // Each within its range, but the commands near hover exceed the pwm column's 1e5.
+    model["mixer"]["pwm_offset"] = json!(99_000.0);
+    model["mixer"]["pwm_scale"] = json!(10_000.0);
     std::fs::write(dir.join("big.json"), model.to_string()).unwrap();
     write_scenario(&dir, "s.json", |s| s["model"] = json!("big.json"));
     let run = learn_in(

@@ -178,6 +178,8 @@ pub struct Analysis {
 pub enum Stage {
     /// The weak-form comparison of the recording with the nominal model.
     Comparing,
+    /// The candidate effects' columns, the nonlinear ones profiled.
+    Candidates,
     /// Forward stepwise selection over block-bootstrap resamples (stability selection).
     Screening,
     /// The joint fit of the kept candidates.
@@ -193,6 +195,7 @@ impl Stage {
     pub fn describe(self) -> &'static str {
         match self {
             Self::Comparing => "comparing the recording with the model",
+            Self::Candidates => "computing the candidate effects",
             Self::Screening => "screening the candidate effects",
             Self::Fitting => "fitting the kept effects",
             Self::Judging => "judging the evidence for each effect",
@@ -298,6 +301,7 @@ fn analyze_recording(
     }
     let block_rows = ((settings.block_s / problem.recording.dt).round() as usize).max(1);
     let before = problem.residual(&Effects::default());
+    observe(Stage::Candidates);
     let (candidates, mut columns) = build_library(&problem);
     let wind_start = profile_nonlinear(&problem, &before, &candidates, &mut columns, block_rows);
     let groups: Vec<Vec<usize>> = candidates.iter().map(|c| c.columns.clone()).collect();

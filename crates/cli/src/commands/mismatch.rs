@@ -192,7 +192,7 @@ fn run_recording(
     let model = load_model(model_path)?;
     let staged = set.prepare()?;
     let log = read_recording(recording, args.rows.as_ref())?;
-    let spinner = super::progress::spinner(global.show_progress(), "reading");
+    let spinner = super::progress::spinner(global.show_progress(), "preparing the recording");
     let analysis = mismatch::analyze_observed(
         &log,
         &model,

@@ -6,6 +6,8 @@ mod common;
 
 #[path = "hostile_second_probe/bounds.rs"]
 mod bounds;
+#[path = "hostile_second_probe/degenerate.rs"]
+mod degenerate;
 #[path = "hostile_second_probe/outputs.rs"]
 mod outputs;
 #[path = "hostile_second_probe/readers.rs"]

@@ -396,7 +396,9 @@ fn simulate_writes_only_logs_the_data_tools_read() {
     let dir = setup("sim-pwm-scale");
     let mut model: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("quad.json")).unwrap()).unwrap();
-    model["mixer"]["pwm_scale"] = json!(1e6);
+    // Each within its range, but the commands near hover exceed the pwm column's 1e5.
+    model["mixer"]["pwm_offset"] = json!(99_000.0);
+    model["mixer"]["pwm_scale"] = json!(10_000.0);
     std::fs::write(dir.join("big.json"), model.to_string()).unwrap();
     write_scenario(&dir, "s.json", |s| s["model"] = json!("big.json"));
     let run = learn_in(
@@ -607,19 +609,21 @@ fn work_is_refused_outside_the_demo() {
     assert_eq!(run.code, Some(2), "{}", run.stderr);
 }
 
-/// A data directory for `--flights` in `dir/data` holding the baseline controller's flights of
+/// A data directory for `--flights` in `dir/data` holding every controller's flights of
 /// `conditions` (empty files: the checks under test come before any flight is read).
 fn flights_dir(dir: &Path, conditions: &[&str]) -> PathBuf {
     let data = dir.join("data");
     std::fs::create_dir_all(data.join("experiment")).unwrap();
     for condition in conditions {
-        std::fs::write(
-            data.join(format!(
-                "experiment/custom_figure8_baseline_{condition}.csv"
-            )),
-            "",
-        )
-        .unwrap();
+        for controller in ["baseline", "indi", "L1", "NF", "NF-C", "NF-T"] {
+            std::fs::write(
+                data.join(format!(
+                    "experiment/custom_figure8_{controller}_{condition}.csv"
+                )),
+                "",
+            )
+            .unwrap();
+        }
     }
     data
 }
@@ -706,16 +710,21 @@ fn flights_check_every_output_before_work() {
     run.one_line_error(&["o/quad.md", "conditions file", "even with --force"]);
 }
 
-/// No flight at all in the data directory is an error naming it; flights without a calm one to
-/// calibrate on are an error naming the calm condition.
+/// No flight at all in the data directory is an error naming it; a declared flight that is
+/// missing (the calm ones here) is an error naming its condition and file.
 #[test]
 fn flights_need_a_flight_and_a_calm_one() {
     let dir = setup("mm-flights-none");
     flights_dir(&dir, &[]);
     flights(&dir, &[]).one_line_error(&["data", "none of the 30 flights"]);
     assert!(!dir.join("o").exists());
-    flights_dir(&dir, &["35wind"]);
-    flights(&dir, &[]).one_line_error(&["conditions.json", "calm", "nowind"]);
+    flights_dir(&dir, &["35wind", "70p20sint", "70wind", "100wind"]);
+    flights(&dir, &[]).one_line_error(&[
+        "conditions.json",
+        "the baseline flight of condition 'nowind' is missing",
+        "custom_figure8_baseline_nowind.csv",
+        "6 of the 30",
+    ]);
     assert!(!dir.join("o").exists());
 }
 

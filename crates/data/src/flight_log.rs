@@ -311,6 +311,35 @@ impl FlightLog {
         self.time.is_empty()
     }
 
+    /// The data rows `rows` (counted from 0, the end excluded) as a log of their own, with the
+    /// same path and times; `None` unless `rows` is a non-empty range inside the log.
+    pub fn row_range(&self, rows: std::ops::Range<usize>) -> Option<Self> {
+        if rows.is_empty() || rows.end > self.len() {
+            return None;
+        }
+        let part = |values: &Option<Vec<_>>| values.as_ref().map(|v| v[rows.clone()].to_vec());
+        Some(Self {
+            path: self.path.clone(),
+            meta: self.meta.clone(),
+            time: self.time[rows.clone()].to_vec(),
+            position: self.position[rows.clone()].to_vec(),
+            velocity: self.velocity[rows.clone()].to_vec(),
+            quaternion: self.quaternion[rows.clone()].to_vec(),
+            rotation: self.rotation[rows.clone()].to_vec(),
+            body_rate: self.body_rate[rows.clone()].to_vec(),
+            thrust_setpoint: self.thrust_setpoint[rows.clone()].to_vec(),
+            hover_throttle: self.hover_throttle[rows.clone()].to_vec(),
+            motor_command: self.motor_command[rows.clone()].to_vec(),
+            position_desired: part(&self.position_desired),
+            velocity_desired: part(&self.velocity_desired),
+            attitude_setpoint: self
+                .attitude_setpoint
+                .as_ref()
+                .map(|v| v[rows.clone()].to_vec()),
+            residual_force: part(&self.residual_force),
+        })
+    }
+
     /// The mean sample interval, s.
     pub fn sample_interval(&self) -> f64 {
         (self.time[self.len() - 1] - self.time[0]) / (self.len() - 1) as f64

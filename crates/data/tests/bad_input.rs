@@ -413,3 +413,20 @@ fn a_numeric_time_axis_error_names_its_own_column() {
         "{message}"
     );
 }
+
+/// A part of a log (`learn mismatch --rows A:B`): the rows asked for, every column cut alike;
+/// nothing for an empty range or one past the end.
+#[test]
+fn a_row_range_cuts_every_column_alike() {
+    let log = common::synthetic_log(100);
+    let part = log.row_range(10..40).unwrap();
+    assert_eq!(part.len(), 30);
+    assert_eq!(part.time[0], log.time[10]);
+    assert_eq!(part.motor_command[29], log.motor_command[39]);
+    assert_eq!(part.residual_force.as_ref().unwrap().len(), 30);
+    assert_eq!(part.attitude_setpoint.as_ref().unwrap().len(), 30);
+    assert_eq!(part.path, log.path);
+    assert!(log.row_range(90..101).is_none());
+    assert!(log.row_range(5..5).is_none());
+    assert_eq!(log.row_range(0..100).unwrap().len(), 100);
+}

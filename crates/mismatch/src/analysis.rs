@@ -10,6 +10,7 @@ pub use report::mismatch::recording::{ChannelReport, Fit, Heldout, Mse, RateFram
 use serde::Serialize;
 
 use crate::command_samples::ActuatorLimits;
+use crate::degenerate;
 use crate::describe::describe;
 use crate::error::{MismatchError, Result};
 use crate::estimate::{self, Estimate, EstimateSettings};
@@ -47,6 +48,20 @@ pub struct AnalysisSettings {
     /// Shortest window reported, s.
     pub min_window_s: f64,
     pub iterations: usize,
+    /// What to do with a recording without measurement noise ([`degenerate::check_noise`]).
+    #[serde(skip)]
+    pub noise_free: NoiseFree,
+}
+
+/// What [`analyze`] does with a recording whose noise floor is below the comparison's accuracy.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NoiseFree {
+    /// Refuse it: the evidence rule measures residuals in units of the noise.
+    #[default]
+    Refuse,
+    /// Analyse it anyway, for development on noise-free simulations (the estimates are
+    /// meaningful; the evidence, the windows and the significance are not).
+    Analyse,
 }
 
 impl Default for AnalysisSettings {
@@ -63,6 +78,7 @@ impl Default for AnalysisSettings {
             window_s: 1.0,
             min_window_s: 0.5,
             iterations: 40,
+            noise_free: NoiseFree::Refuse,
         }
     }
 }
@@ -157,6 +173,37 @@ pub struct Analysis {
     pub fitted: Effects,
 }
 
+/// The stages of an analysis, in order (each pass goes through all of them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// The weak-form comparison of the recording with the nominal model.
+    Comparing,
+    /// The candidate effects' columns, the nonlinear ones profiled.
+    Candidates,
+    /// Forward stepwise selection over block-bootstrap resamples (stability selection).
+    Screening,
+    /// The joint fit of the kept candidates.
+    Fitting,
+    /// The evidence rule, each effect refitted without it.
+    Judging,
+    /// The final estimate on all rows (robust weights, the noise's bias).
+    Estimating,
+}
+
+impl Stage {
+    /// What the stage does, for a progress line.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Comparing => "comparing the recording with the model",
+            Self::Candidates => "computing the candidate effects",
+            Self::Screening => "screening the candidate effects",
+            Self::Fitting => "fitting the kept effects",
+            Self::Judging => "judging the evidence for each effect",
+            Self::Estimating => "estimating the named effects on all rows",
+        }
+    }
+}
+
 /// Analyses a recording against a nominal model. `model_name` only labels the output.
 pub fn analyze(
     log: &FlightLog,
@@ -164,8 +211,28 @@ pub fn analyze(
     model_name: &str,
     settings: &AnalysisSettings,
 ) -> Result<Analysis> {
+    analyze_observed(log, model, model_name, settings, &|_, _| {})
+}
+
+/// [`analyze`], telling `observe` the pass (1, or 2 when the commands' reaction to the velocity
+/// noise is removed) and the stage as each begins.
+pub fn analyze_observed(
+    log: &FlightLog,
+    model: &NominalModel,
+    model_name: &str,
+    settings: &AnalysisSettings,
+    observe: &dyn Fn(usize, Stage),
+) -> Result<Analysis> {
+    if log.len() > degenerate::MAX_ANALYSED_ROWS {
+        return Err(MismatchError::TooLong {
+            path: log.path.clone(),
+            rows: log.len(),
+        });
+    }
     let recording = Recording::new(log, model, 40)?;
-    let first = analyze_recording(recording, log, model, model_name, settings)?;
+    let first = analyze_recording(recording, log, model, model_name, settings, &|stage| {
+        observe(1, stage)
+    })?;
     if first.problem.recording.noise_reaction.is_none() {
         return Ok(first);
     }
@@ -177,7 +244,9 @@ pub fn analyze(
     if !noise_reaction::remove_velocity(&mut recording, &predicted, prediction_noise) {
         return Ok(first);
     }
-    analyze_recording(recording, log, model, model_name, settings)
+    analyze_recording(recording, log, model, model_name, settings, &|stage| {
+        observe(2, stage)
+    })
 }
 
 /// The model's velocity change over every row interval.
@@ -215,19 +284,29 @@ fn analyze_recording(
     model: &NominalModel,
     model_name: &str,
     settings: &AnalysisSettings,
+    observe: &dyn Fn(Stage),
 ) -> Result<Analysis> {
+    observe(Stage::Comparing);
     let problem = Problem::new(
         recording,
         model.clone(),
         settings.test_function,
         settings.heldout_fraction,
     )?;
+    if settings.noise_free == NoiseFree::Refuse {
+        degenerate::check_noise(&problem).map_err(|degeneracy| MismatchError::Degenerate {
+            path: problem.recording.path.clone(),
+            degeneracy,
+        })?;
+    }
     let block_rows = ((settings.block_s / problem.recording.dt).round() as usize).max(1);
     let before = problem.residual(&Effects::default());
+    observe(Stage::Candidates);
     let (candidates, mut columns) = build_library(&problem);
     let wind_start = profile_nonlinear(&problem, &before, &candidates, &mut columns, block_rows);
     let groups: Vec<Vec<usize>> = candidates.iter().map(|c| c.columns.clone()).collect();
     let design = Design::new(&problem, &before, &columns, 0..problem.split, block_rows);
+    observe(Stage::Screening);
     let selection = stability_selection(&design, &groups, &settings.selection);
     let screened = Screened {
         candidates: &candidates,
@@ -235,6 +314,7 @@ fn analyze_recording(
         design: &design,
         selection: &selection,
     };
+    observe(Stage::Fitting);
     let (set, alternatives) = fit_parameters(
         &problem,
         &screened,
@@ -242,6 +322,7 @@ fn analyze_recording(
         block_rows,
         wind_start,
     );
+    observe(Stage::Judging);
     let judgement = evidence::apply(
         &problem,
         set,
@@ -252,6 +333,7 @@ fn analyze_recording(
     // The model the evidence rule judged (fitted on the fit part) is the one the residuals and the
     // held-out check describe; the parameters reported are estimated again on all rows.
     let after = problem.residual(&judgement.set.effects());
+    observe(Stage::Estimating);
     let estimate = estimate::estimate(
         &problem,
         &judgement.set,

@@ -26,6 +26,20 @@ pub enum MismatchError {
     CaseDirectoryIsSummary { path: PathBuf },
     #[error("{}: {message}", path.display())]
     Recording { path: PathBuf, message: String },
+    /// More rows than one analysis accepts ([`crate::degenerate::MAX_ANALYSED_ROWS`]).
+    #[error(
+        "{}: {rows} rows, more than the {} one analysis accepts: its time grows faster than the rows ({}); analyse a part (learn mismatch --recording takes --rows A:B)",
+        path.display(),
+        crate::degenerate::MAX_ANALYSED_ROWS,
+        crate::degenerate::COST_MEASURED
+    )]
+    TooLong { path: PathBuf, rows: usize },
+    /// A recording that cannot be compared with a model ([`crate::degenerate`]).
+    #[error("{}: {degeneracy}", path.display())]
+    Degenerate {
+        path: PathBuf,
+        degeneracy: crate::degenerate::Degeneracy,
+    },
     #[error(
         "{}: the analysis of this recording gives a non-finite {what}: its values are outside the range the analysis can handle",
         path.display()
@@ -44,6 +58,19 @@ pub enum MismatchError {
         conditions: PathBuf,
         count: usize,
         example: Option<PathBuf>,
+    },
+    #[error(
+        "{}: the {controller} flight of condition '{condition}' is missing: {} ({missing} of the {declared} flights it declares are missing; a condition that lists \"files\" declares only those)",
+        conditions.display(),
+        path.display()
+    )]
+    MissingFlight {
+        conditions: PathBuf,
+        condition: String,
+        controller: String,
+        path: PathBuf,
+        missing: usize,
+        declared: usize,
     },
     #[error("{}: field '{field}': {message}", path.display())]
     Config {

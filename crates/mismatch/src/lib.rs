@@ -37,6 +37,7 @@
 
 mod analysis;
 pub mod command_samples;
+pub mod degenerate;
 pub mod demo;
 mod describe;
 mod error;
@@ -56,7 +57,8 @@ pub mod simex;
 pub mod weak_form;
 
 pub use analysis::{
-    Analysis, AnalysisSettings, ChannelReport, EffectReport, Fit, Report, Window, analyze,
+    Analysis, AnalysisSettings, ChannelReport, EffectReport, Fit, NoiseFree, Report, Stage, Window,
+    analyze, analyze_observed,
 };
 pub use describe::{describe, remove_effect};
 pub use error::{MismatchError, Result};

@@ -8,6 +8,7 @@ use physics::vector::{Mat3, Vec3, mat_t_vec};
 use physics::{CommandLogging, NominalModel};
 
 use crate::command_samples::{ActuatorLimits, CommandSamples, SampleDomain, detect_limits};
+use crate::degenerate;
 use crate::error::{MismatchError, Result};
 use crate::noise_reaction::{self, NoiseReaction};
 use crate::weak_form::white_noise_sigma;
@@ -76,6 +77,11 @@ impl Recording {
                 ),
             });
         }
+        let degenerate = |degeneracy| MismatchError::Degenerate {
+            path: log.path.clone(),
+            degeneracy,
+        };
+        degenerate::check_excitation(log, model).map_err(degenerate)?;
         let (frame, body_rms, world_rms) = log.rate_frame();
         let body_rate = match frame {
             RateFrame::Body => log.body_rate.clone(),
@@ -95,6 +101,7 @@ impl Recording {
                 )
             })
             .collect();
+        degenerate::check_thrust(&commands, model).map_err(degenerate)?;
         let dt = log.sample_interval();
         let command_rate_hz = match model.logger.command {
             CommandLogging::PeriodMean => model.logger.controller_rate_hz,

@@ -24,6 +24,7 @@ mod error;
 mod jitter;
 mod logger;
 mod model;
+pub mod ranges;
 mod residual;
 mod scenario;
 mod simulator;

@@ -91,15 +91,9 @@ impl Logger {
                     "a held command changes only at the rows: leave it out".into(),
                 ));
             }
-            if !(rate.is_finite() && rate > 0.0 && rate <= 1e6) {
-                return Err((
-                    "controller_rate_hz".into(),
-                    format!(
-                        "must be a positive rate up to 1e6 Hz, found {}",
-                        crate::error::readable(rate)
-                    ),
-                ));
-            }
+            crate::ranges::CONTROLLER_RATE_HZ
+                .check(rate)
+                .map_err(|message| ("controller_rate_hz".to_string(), message))?;
         }
         Ok(())
     }

@@ -13,6 +13,7 @@ use serde_json::{Map, Value};
 
 use crate::error::{PhysicsError, Result};
 use crate::logger::Logger;
+use crate::ranges::{self, PhysicalRange};
 use crate::vector::{E3, Vec3, add, cross, hadamard, mat_vec, scale};
 
 /// Where the collective thrust comes from.
@@ -116,7 +117,8 @@ impl NominalModel {
     }
 
     /// Parses and validates model JSON under the project's reading policy (a byte-order mark
-    /// accepted, a key given twice refused); `origin` names the file in errors.
+    /// accepted, a key given twice refused); every number must lie in its physical range
+    /// ([`crate::ranges`]); `origin` names the file in errors.
     pub fn from_json(text: &str, origin: &Path) -> Result<Self> {
         let text = inputs::json::checked_text(text).map_err(|error| PhysicsError::Json {
             path: origin.to_path_buf(),
@@ -133,14 +135,13 @@ impl NominalModel {
             .as_object()
             .ok_or_else(|| fields.error("(top level)", "expected a JSON object"))?;
         fields.known_keys(object, "", &MODEL_KEYS)?;
-        let mass_kg = fields.positive(object, "mass_kg")?;
-        let gravity_m_s2 = fields.positive(object, "gravity_m_s2")?;
+        let mass_kg = fields.in_range(object, &ranges::MASS_KG)?;
+        let gravity_m_s2 = fields.in_range(object, &ranges::GRAVITY_M_S2)?;
         let inertia = fields.numbers(object, "inertia_kg_m2", 3)?;
-        if let Some(bad) = inertia.iter().position(|v| *v <= 0.0) {
-            return Err(fields.error(
-                &format!("inertia_kg_m2[{bad}]"),
-                "must be a positive number",
-            ));
+        for (i, value) in inertia.iter().enumerate() {
+            ranges::INERTIA_KG_M2
+                .check(*value)
+                .map_err(|message| fields.error(&format!("inertia_kg_m2[{i}]"), &message))?;
         }
         let thrust_source = match object.get("thrust_source") {
             None => {
@@ -167,9 +168,12 @@ impl NominalModel {
         if thrust_source == ThrustSource::Mixer && mixer.is_none() {
             return Err(fields.error("mixer", "missing, but thrust_source is \"mixer\""));
         }
+        if let Some(mixer) = &mixer {
+            fields.check_lift(mixer, mass_kg * gravity_m_s2)?;
+        }
         let ground_height_m = match object.get("ground_height_m") {
             None => 0.0,
-            Some(_) => fields.finite(object, "ground_height_m")?,
+            Some(_) => fields.in_range(object, &ranges::GROUND_HEIGHT_M)?,
         };
         let logger = match object.get("logger") {
             None | Some(Value::Null) => Logger::default(),
@@ -350,19 +354,33 @@ impl FieldReader {
         }
     }
 
-    fn finite(&self, object: &Map<String, Value>, field: &str) -> Result<f64> {
-        self.finite_value(object.get(field), field)
+    /// A number of `object` named by `range.field`, within the range.
+    fn in_range(&self, object: &Map<String, Value>, range: &PhysicalRange) -> Result<f64> {
+        self.checked(object.get(range.field), range.field, range)
     }
 
-    fn positive(&self, object: &Map<String, Value>, field: &str) -> Result<f64> {
-        let value = self.finite(object, field)?;
-        if value <= 0.0 {
-            return Err(self.error(
-                field,
-                &format!("must be positive, found {}", crate::error::readable(value)),
-            ));
-        }
-        Ok(value)
+    /// The number `value` of `field`, within `range`.
+    fn checked(&self, value: Option<&Value>, field: &str, range: &PhysicalRange) -> Result<f64> {
+        let value = self.finite_value(value, field)?;
+        range
+            .check(value)
+            .map_err(|message| self.error(field, &message))
+    }
+
+    /// The rotors at full speed must lift `weight_n` (and no vehicle lifts a hundred times it).
+    fn check_lift(&self, mixer: &Mixer, weight_n: f64) -> Result<()> {
+        let full_thrust: f64 = mixer.b0[0].iter().sum();
+        ranges::THRUST_TO_WEIGHT
+            .check(full_thrust / weight_n)
+            .map(drop)
+            .map_err(|message| {
+                let detail = format!(
+                    "{message} (thrust {} N, weight {} N)",
+                    crate::error::readable(full_thrust),
+                    crate::error::readable(weight_n)
+                );
+                self.error("mixer.b0[0]", &detail)
+            })
     }
 
     fn numbers_of(&self, value: Option<&Value>, field: &str, count: usize) -> Result<Vec<f64>> {
@@ -407,8 +425,16 @@ impl FieldReader {
                 "controller_rate_hz",
             ],
         )?;
-        let logger: Logger = serde_json::from_value(value.clone())
-            .map_err(|error| self.error("logger", &error.to_string()))?;
+        // Read from its own text, the error's position is not the file's: only its field is kept.
+        let logger: Logger = inputs::json::from_str(&value.to_string()).map_err(|error| {
+            let field = error.field.split(" (").next().unwrap_or_default();
+            let field = if field.starts_with("the document") {
+                "logger".to_string()
+            } else {
+                format!("logger.{field}")
+            };
+            self.error(&field, &error.message)
+        })?;
         logger
             .validate()
             .map_err(|(field, message)| self.error(&format!("logger.{field}"), &message))?;
@@ -417,11 +443,16 @@ impl FieldReader {
 
     fn mixer(&self, mixer: &Map<String, Value>) -> Result<Mixer> {
         self.known_keys(mixer, "mixer.", &MIXER_KEYS)?;
-        let pwm_offset = self.finite_value(mixer.get("pwm_offset"), "mixer.pwm_offset")?;
-        let pwm_scale = self.finite_value(mixer.get("pwm_scale"), "mixer.pwm_scale")?;
-        if pwm_scale <= 0.0 {
-            return Err(self.error("mixer.pwm_scale", "must be positive"));
-        }
+        let pwm_offset = self.checked(
+            mixer.get("pwm_offset"),
+            ranges::PWM_OFFSET.field,
+            &ranges::PWM_OFFSET,
+        )?;
+        let pwm_scale = self.checked(
+            mixer.get("pwm_scale"),
+            ranges::PWM_SCALE.field,
+            &ranges::PWM_SCALE,
+        )?;
         let rows = match mixer.get("b0") {
             None => return Err(self.error("mixer.b0", "missing")),
             Some(Value::Array(rows)) if rows.len() == 4 => rows,
@@ -441,6 +472,18 @@ impl FieldReader {
                     b0[0][j]
                 ),
             ));
+        }
+        for (i, row) in b0.iter().enumerate() {
+            let range = if i == 0 {
+                &ranges::ROTOR_THRUST_N
+            } else {
+                &ranges::ROTOR_TORQUE_N_M
+            };
+            for (j, value) in row.iter().enumerate() {
+                range
+                    .check(*value)
+                    .map_err(|message| self.error(&format!("mixer.b0[{i}][{j}]"), &message))?;
+            }
         }
         Mixer::new(pwm_offset, pwm_scale, b0)
             .ok_or_else(|| self.error("mixer.b0", "the matrix is singular (cannot be inverted)"))

@@ -1,6 +1,7 @@
 //! `learn mismatch`: locate, name and fit the physics a nominal model leaves out.
 //!
-//! - `--recording REAL.csv --model NOMINAL.json --out DIR`: one recording → DIR/mismatch.{json,svg,md}.
+//! - `--recording REAL.csv --model NOMINAL.json --out DIR [--rows A:B]`: one recording (or its data
+//!   rows A:B) → DIR/mismatch.{json,svg,md}; the analysis's stages shown on a terminal.
 //! - `--demo MANIFEST --out DIR [--work WORK]`: simulate every case of the manifest with a concealed
 //!   effect (`WORK/<case>/recording.csv`), run the analysis blind on each (`WORK/<case>/mismatch.*`),
 //!   and write DIR/summary.{md,json}.
@@ -48,6 +49,10 @@ pub struct Args {
     /// together (one vehicle, one air velocity per flight; conditions marked calm calibrate).
     #[arg(long)]
     pub flights: Option<PathBuf>,
+    /// With --recording: analyse only data rows A:B (counted from 0, B excluded), e.g. a part of a
+    /// recording longer than one analysis accepts.
+    #[arg(long, value_parser = super::evaluate::parse_rows, requires = "recording")]
+    pub rows: Option<std::ops::Range<usize>>,
     /// Overwrite existing output files (never one of the run's inputs).
     #[arg(long)]
     pub force: bool,
@@ -61,7 +66,9 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         (None, None, Some(conditions), Some(model)) => {
             run_flights(global, conditions, model, &args)
         }
-        (Some(recording), None, None, Some(model)) => run_recording(recording, model, &args),
+        (Some(recording), None, None, Some(model)) => {
+            run_recording(global, recording, model, &args)
+        }
         _ => anyhow::bail!(
             "give one of --recording or --flights (each with --model), or --demo (without --model)"
         ),
@@ -148,7 +155,32 @@ fn run_flights(
     Ok(())
 }
 
-fn run_recording(recording: &Path, model_path: &Path, args: &Args) -> anyhow::Result<()> {
+/// The recording, or the rows of it that `--rows` asks for.
+fn read_recording(
+    recording: &Path,
+    rows: Option<&std::ops::Range<usize>>,
+) -> anyhow::Result<data::FlightLog> {
+    let log = data::FlightLog::read(recording)?;
+    let Some(rows) = rows else {
+        return Ok(log);
+    };
+    log.row_range(rows.clone()).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: --rows {}:{} reaches past its {} data rows",
+            recording.display(),
+            rows.start,
+            rows.end,
+            log.len()
+        )
+    })
+}
+
+fn run_recording(
+    global: &Global,
+    recording: &Path,
+    model_path: &Path,
+    args: &Args,
+) -> anyhow::Result<()> {
     let mut set = OutputSet::new("mismatch --recording");
     set.input("the --model file", model_path);
     set.input("the --recording", recording);
@@ -159,13 +191,17 @@ fn run_recording(recording: &Path, model_path: &Path, args: &Args) -> anyhow::Re
     set.check()?;
     let model = load_model(model_path)?;
     let staged = set.prepare()?;
-    let log = data::FlightLog::read(recording)?;
-    let analysis = mismatch::analyze(
+    let log = read_recording(recording, args.rows.as_ref())?;
+    let spinner = super::progress::spinner(global.show_progress(), "preparing the recording");
+    let analysis = mismatch::analyze_observed(
         &log,
         &model,
         &model_path.display().to_string(),
         &mismatch::AnalysisSettings::default(),
-    )?;
+        &|pass, stage| spinner.set_message(format!("pass {pass}: {}", stage.describe())),
+    );
+    spinner.finish_and_clear();
+    let analysis = analysis?;
     super::staged_write(&staged, || {
         mismatch::write_outputs(&analysis, staged.dir(out), true)
     })?;

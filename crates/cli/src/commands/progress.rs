@@ -24,6 +24,20 @@ pub fn progress_bar(show: bool, cells: usize, message: &str) -> ProgressBar {
     bar
 }
 
+/// A spinner with a message and the elapsed time on standard error, for work that is not counted
+/// in units (the stages of `learn mismatch`), drawn only when `show` (a terminal, not --quiet).
+pub fn spinner(show: bool, message: &str) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let spinner = ProgressBar::new_spinner().with_message(message.to_string());
+    spinner.set_style(
+        ProgressStyle::with_template("{spinner} {msg} ({elapsed})").expect("valid template"),
+    );
+    spinner.enable_steady_tick(std::time::Duration::from_millis(250));
+    spinner
+}
+
 /// A bar as an observer: one step per unit of work ([`Progress::advance`]), for a command that
 /// draws one bar over one run (`learn meta-train`, its seed spread).
 pub struct Bar(pub ProgressBar);

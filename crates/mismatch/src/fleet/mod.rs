@@ -42,6 +42,7 @@ use physics::{EffectId, NominalModel};
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::degenerate;
 use crate::error::{MismatchError, Result};
 use crate::output::{check_directory, check_run_outputs};
 use crate::problem::Problem;
@@ -119,6 +120,34 @@ fn spread(positions: &[[f64; 3]]) -> ([f64; 3], Vec<usize>) {
     (mean, axes)
 }
 
+/// (controller, condition index, path) of every flight `conditions` declares under `data_dir`,
+/// those present and those missing. A condition declares each controller's flight by the file
+/// pattern, or, when it lists `files`, only the controllers it lists.
+type DeclaredFlight = (String, usize, PathBuf);
+
+fn declared_flights(
+    conditions: &ExperimentConditions,
+    data_dir: &Path,
+) -> (Vec<DeclaredFlight>, Vec<DeclaredFlight>) {
+    let mut present = Vec::new();
+    let mut missing = Vec::new();
+    for (index, condition) in conditions.conditions.iter().enumerate() {
+        for controller in &conditions.controllers {
+            if !condition.files.is_empty() && !condition.files.contains_key(controller) {
+                continue;
+            }
+            let path = conditions.flight_path(data_dir, condition, controller);
+            let flight = (controller.clone(), index, path);
+            if flight.2.exists() {
+                present.push(flight);
+            } else {
+                missing.push(flight);
+            }
+        }
+    }
+    (present, missing)
+}
+
 /// One flight of the fleet.
 pub struct FleetFlight {
     pub controller: String,
@@ -153,8 +182,9 @@ pub struct FleetPlan {
 }
 
 impl FleetPlan {
-    /// Finds every controller's flight at every condition under `data_dir`. Fails if `out` exists
-    /// but is not a directory, if no flight is present, or if no condition is declared calm.
+    /// Finds every flight the conditions file declares under `data_dir`. Fails if `out` exists
+    /// but is not a directory, if no condition is declared calm, or if a declared flight is
+    /// missing (all of them: naming the data directory).
     pub fn load(conditions_path: &Path, data_dir: &Path, model: &Path, out: &Path) -> Result<Self> {
         let conditions = ExperimentConditions::load(conditions_path)?;
         check_directory(out)?;
@@ -165,43 +195,23 @@ impl FleetPlan {
                 message: "no condition is declared calm (\"calm\": true): the joint analysis calibrates the vehicle on still-air flights".into(),
             });
         }
-        let mut flights = Vec::new();
-        for (index, condition) in conditions.conditions.iter().enumerate() {
-            for controller in &conditions.controllers {
-                let path = conditions.flight_path(data_dir, condition, controller);
-                if path.exists() {
-                    flights.push((controller.clone(), index, path));
-                }
-            }
-        }
+        let (flights, missing) = declared_flights(&conditions, data_dir);
         if flights.is_empty() {
             return Err(MismatchError::NoFlights {
                 data_dir: data_dir.to_path_buf(),
                 conditions: conditions_path.to_path_buf(),
-                count: conditions.conditions.len() * conditions.controllers.len(),
-                example: conditions.conditions.first().map(|c| {
-                    conditions.flight_path(data_dir, c, &conditions.evaluation_controller)
-                }),
+                count: missing.len(),
+                example: missing.first().map(|(_, _, path)| path.clone()),
             });
         }
-        if !flights
-            .iter()
-            .any(|(_, index, _)| conditions.conditions[*index].calm)
-        {
-            let calm: Vec<&str> = conditions
-                .conditions
-                .iter()
-                .filter(|c| c.calm)
-                .map(|c| c.name.as_str())
-                .collect();
-            return Err(MismatchError::Config {
-                path: conditions_path.to_path_buf(),
-                field: "conditions".into(),
-                message: format!(
-                    "no flight of a calm condition ({}) is in {}: the joint analysis calibrates the vehicle on still-air flights",
-                    calm.join(", "),
-                    data_dir.display()
-                ),
+        if let Some((controller, index, path)) = missing.first() {
+            return Err(MismatchError::MissingFlight {
+                conditions: conditions_path.to_path_buf(),
+                condition: conditions.conditions[*index].name.clone(),
+                controller: controller.clone(),
+                path: path.clone(),
+                missing: missing.len(),
+                declared: missing.len() + flights.len(),
             });
         }
         let stem = model
@@ -267,6 +277,12 @@ impl FleetPlan {
                     settings.test_function,
                     settings.heldout_fraction,
                 )?;
+                degenerate::check_noise(&problem).map_err(|degeneracy| {
+                    MismatchError::Degenerate {
+                        path: path.clone(),
+                        degeneracy,
+                    }
+                })?;
                 let residual_force = log.residual_force.as_ref().map(|fa| {
                     let per_mass: Vec<[f64; 3]> =
                         fa.iter().map(|f| f.map(|v| v / model.mass_kg)).collect();

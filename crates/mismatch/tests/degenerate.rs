@@ -1,0 +1,200 @@
+//! Degenerate recordings are refused, never reported as physics (issue 31, class 11): a recording
+//! without measurement noise of the exact nominal model, a constant recording, one whose thrust
+//! commands never lift the vehicle, and one longer than the analysis's cost bound. Each refusal is
+//! one line naming the recording and what is degenerate.
+
+use std::path::PathBuf;
+
+use mismatch::degenerate::{MAX_ANALYSED_ROWS, MIN_THRUST_TO_WEIGHT};
+use mismatch::{AnalysisSettings, MismatchError, NoiseFree, analyze};
+use physics::{Effects, Noise, Scenario, simulate};
+
+mod common;
+
+use common::{model, model_for_scenario};
+
+/// A 12 s simulated figure-8 of the demo vehicle with `noise`, named `generated/flight.csv`.
+fn flight(noise: Noise) -> data::FlightLog {
+    let scenario = Scenario {
+        duration_s: 12.0,
+        noise,
+        ..common::scenario(Effects::default(), 7)
+    };
+    let mut log = simulate(&model("vehicles/quad-a.json"), &scenario, "test").unwrap();
+    log.path = PathBuf::from("generated/flight.csv");
+    log
+}
+
+fn noisy() -> Noise {
+    common::scenario(Effects::default(), 0).noise
+}
+
+fn settings() -> AnalysisSettings {
+    AnalysisSettings {
+        block_s: 0.5,
+        selection: mismatch::SelectionSettings {
+            resamples: 10,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+/// The analysis's refusal: a degenerate-recording error, one line naming the recording.
+fn refusal(log: &data::FlightLog, model: &physics::NominalModel) -> String {
+    let error = match analyze(log, model, "test", &settings()) {
+        Ok(analysis) => panic!(
+            "accepted: effects {:?}, unexplained {:?}",
+            analysis.fitted.ids(),
+            analysis.report.unexplained
+        ),
+        Err(error) => error,
+    };
+    let message = error.to_string();
+    assert!(
+        matches!(error, MismatchError::Degenerate { .. }),
+        "{message}"
+    );
+    assert!(!message.contains('\n'), "one line: {message}");
+    assert!(
+        message.starts_with("generated/flight.csv: degenerate recording"),
+        "{message}"
+    );
+    message
+}
+
+/// Without noise the exact nominal model used to leave "unexplained residual" on every channel
+/// over the whole flight (its floor ~1e-7, the comparison's own error ~1e-4).
+#[test]
+fn a_recording_without_noise_is_refused_not_explained() {
+    let message = refusal(&flight(Noise::default()), &model_for_scenario());
+    assert!(
+        message
+            .contains("no measurement noise on vdot_x, vdot_y, vdot_z, wdot_x, wdot_y and wdot_z"),
+        "{message}"
+    );
+    assert!(message.contains("simulated without noise?"), "{message}");
+    // For development the analysis can still be asked for; its evidence is then no evidence
+    // (on this flight the exact model had three effects named on the comparison's own error).
+    let development = AnalysisSettings {
+        noise_free: NoiseFree::Analyse,
+        ..settings()
+    };
+    let analysis = analyze(
+        &flight(Noise::default()),
+        &model_for_scenario(),
+        "test",
+        &development,
+    )
+    .unwrap();
+    assert!(analysis.report.channels.len() == 6);
+    // With the demo's noise the same flight is analysed, and nothing is found.
+    let analysis = analyze(&flight(noisy()), &model_for_scenario(), "test", &settings()).unwrap();
+    assert!(analysis.report.effects.is_empty());
+    assert!(analysis.report.unexplained.is_empty());
+}
+
+/// Every row a copy of the first (times kept): gains of 1e22 were reported as physics.
+#[test]
+fn a_constant_recording_is_refused_naming_the_constant_columns() {
+    let mut log = flight(noisy());
+    let first = log.clone();
+    for k in 0..log.len() {
+        log.position[k] = first.position[0];
+        log.velocity[k] = first.velocity[0];
+        log.quaternion[k] = first.quaternion[0];
+        log.rotation[k] = first.rotation[0];
+        log.body_rate[k] = first.body_rate[0];
+        log.thrust_setpoint[k] = first.thrust_setpoint[0];
+        log.motor_command[k] = first.motor_command[0];
+    }
+    for model_name in ["neural-fly.json", "vehicles/quad-a.json"] {
+        let message = refusal(&log, &model(model_name));
+        assert!(
+            message.contains("no excitation: v_x, v_y, v_z, w_x, w_y, w_z, p, q, T_sp and pwm are the same on every row"),
+            "{message}"
+        );
+    }
+    // One compared component held is enough: it has nothing to differentiate.
+    let mut log = flight(noisy());
+    for v in &mut log.velocity {
+        v[2] = 0.0;
+    }
+    let message = refusal(&log, &model("neural-fly.json"));
+    assert!(
+        message.contains("no excitation: v_z is the same"),
+        "{message}"
+    );
+    // A constant rate is not compared by a thrust-only model, but is by a mixer model.
+    let mut log = flight(noisy());
+    for w in &mut log.body_rate {
+        *w = [0.0; 3];
+    }
+    let message = refusal(&log, &model_for_scenario());
+    assert!(
+        message.contains("w_x, w_y and w_z are the same"),
+        "{message}"
+    );
+}
+
+/// A thrust setpoint of 0 on every row was explained by a linear drag and a 183 m/s wind.
+#[test]
+fn a_recording_without_thrust_is_refused_naming_the_column() {
+    let mut log = flight(noisy());
+    for thrust in &mut log.thrust_setpoint {
+        *thrust = 0.0;
+    }
+    let message = refusal(&log, &model("neural-fly.json"));
+    assert!(
+        message.contains("no thrust: the thrust the model reads from T_sp stays below 0.1 of the weight on every row (at most 0.000)"),
+        "{message}"
+    );
+    // The motors at their zero-speed command, for a mixer model.
+    let mut log = flight(noisy());
+    for pwm in &mut log.motor_command {
+        *pwm = [1000.0; 4];
+    }
+    let message = refusal(&log, &model_for_scenario());
+    assert!(message.contains("reads from pwm"), "{message}");
+    // Just above the bound on one row is flight enough to compare.
+    let mut log = flight(noisy());
+    let hover = log.hover_throttle[0];
+    for thrust in &mut log.thrust_setpoint {
+        *thrust = 0.0;
+    }
+    log.thrust_setpoint[300] = 1.01 * MIN_THRUST_TO_WEIGHT * hover;
+    let error = analyze(&log, &model("neural-fly.json"), "test", &settings());
+    assert!(
+        !matches!(error, Err(MismatchError::Degenerate { .. })),
+        "{:?}",
+        error.err()
+    );
+}
+
+/// The cost bound is checked before any work.
+#[test]
+fn a_recording_over_the_cost_bound_is_refused_before_the_work() {
+    let scenario = Scenario {
+        duration_s: MAX_ANALYSED_ROWS as f64 / 50.0,
+        warmup_s: 0.0,
+        noise: noisy(),
+        ..common::scenario(Effects::default(), 7)
+    };
+    let mut log = simulate(&model("vehicles/quad-a.json"), &scenario, "test").unwrap();
+    log.path = PathBuf::from("generated/flight.csv");
+    assert_eq!(log.len(), MAX_ANALYSED_ROWS + 1);
+    let start = std::time::Instant::now();
+    let error = analyze(&log, &model_for_scenario(), "test", &settings()).unwrap_err();
+    assert!(start.elapsed().as_secs_f64() < 1.0, "refused before work");
+    let message = error.to_string();
+    assert!(matches!(error, MismatchError::TooLong { .. }), "{message}");
+    assert!(!message.contains('\n'), "one line: {message}");
+    assert!(
+        message.starts_with(&format!(
+            "generated/flight.csv: {} rows, more than the {MAX_ANALYSED_ROWS}",
+            MAX_ANALYSED_ROWS + 1
+        )) && message.contains("n^1.75")
+            && message.contains("--rows A:B"),
+        "{message}"
+    );
+}

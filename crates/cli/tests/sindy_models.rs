@@ -56,8 +56,21 @@ fn uneven_time_steps_use_the_true_time_stamps_and_savgol_refuses_them() {
     let run = fit(&dir, &["jitter.csv"], &["--derivative", "central"]);
     let equations = run.success();
     assert!(equations.contains("x' = -0.100 x + 1.000 y"), "{equations}");
+    // Read in blocks, the same fit on the same time stamps.
+    let streamed = fit(
+        &dir,
+        &["jitter.csv"],
+        &["--derivative", "central", "--stream"],
+    );
+    assert_eq!(streamed.success(), equations);
     let run = fit(&dir, &["jitter.csv"], &["--derivative", "savgol:7:2"]);
     run.one_line_error(&["jitter.csv:3:t", "needs uniform samples"]);
+    let run = fit(
+        &dir,
+        &["jitter.csv"],
+        &["--derivative", "savgol:7:2", "--stream"],
+    );
+    run.one_line_error(&["jitter.csv:", "savgol:7:2 derivative needs even time steps"]);
 }
 
 #[test]

@@ -99,7 +99,7 @@ pub(crate) fn check_interval_range(
 const REFERENCE_GAPS: usize = 4096;
 
 /// The checks of `check_time_column` on a time column read in blocks, in constant memory:
-/// strictly increasing, and every gap within `tolerance` of a reference step, the median of the
+/// strictly increasing, and every gap within `tolerance` (infinite: any gap) of a reference step, the median of the
 /// first `REFERENCE_GAPS` gaps (the whole column's median would need every gap at once). Errors
 /// name the line of the row.
 pub struct StreamedTimeAxis {
@@ -110,6 +110,8 @@ pub struct StreamedTimeAxis {
     last: f64,
     rows: usize,
     reference: Option<f64>,
+    smallest_step: f64,
+    largest_step: f64,
     /// The first gaps, with the line of the row each ends on, until the reference is known.
     pending: Vec<(usize, f64)>,
 }
@@ -124,6 +126,8 @@ impl StreamedTimeAxis {
             last: f64::NAN,
             rows: 0,
             reference: None,
+            smallest_step: f64::INFINITY,
+            largest_step: 0.0,
             pending: Vec::new(),
         }
     }
@@ -148,6 +152,8 @@ impl StreamedTimeAxis {
             }
             let gap = value - self.last;
             self.last = value;
+            self.smallest_step = self.smallest_step.min(gap);
+            self.largest_step = self.largest_step.max(gap);
             match self.reference {
                 Some(step) => self.check_gap(line, gap, step)?,
                 None => {
@@ -159,6 +165,11 @@ impl StreamedTimeAxis {
             }
         }
         Ok(())
+    }
+
+    /// The smallest and the largest step pushed so far (`None` before the second row).
+    pub fn step_range(&self) -> Option<(f64, f64)> {
+        (self.rows > 1).then_some((self.smallest_step, self.largest_step))
     }
 
     /// The number of rows and the mean step `(t_last − t_first) / (rows − 1)`.

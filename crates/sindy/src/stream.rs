@@ -12,10 +12,12 @@ use crate::error::{Result, SindyError, shape};
 use crate::model::{CONSTANT_RELATIVE_SPREAD, FeatureSizes, Score, SindyModel, SindyParams};
 use crate::optimizers::tsqr::{Reduction, SEGMENT_ROWS, segment_triangle};
 
-/// Consecutive rows of a recording: one vector per state, then one per control.
+/// Consecutive rows of a recording: one vector per state, then one per control; and their time
+/// stamps when the steps are uneven (`None`: every step is the `dt` of the fit).
 #[derive(Clone, Debug, Default)]
 pub struct RowBlock {
     pub columns: Vec<Vec<f64>>,
+    pub time: Option<Vec<f64>>,
 }
 
 /// A model fitted on a streamed recording, with its score on all rows.
@@ -81,13 +83,22 @@ struct Segment {
     targets: Mat<f64>,
 }
 
+/// The times of the buffered rows: every `dt` seconds, or stamped (one time per row).
+#[derive(Clone, Copy)]
+enum Sampling<'a> {
+    Every(f64),
+    Stamped(&'a [f64]),
+}
+
 /// What a reduced segment hands to the merge: its triangle, target moments, feature sizes.
 type Reduced = (Mat<f64>, Vec<Moments>, Vec<f64>, usize);
 
 impl SindyParams {
     /// Fits on a recording of `rows` rows sampled every `dt` seconds whose blocks `next` yields in
     /// order (any block sizes; `None` at the end). Its derivatives are those of
-    /// [`crate::Trajectory`] with the same `dt`. Errors name rows 0-based from the first.
+    /// [`crate::Trajectory`] with the same `dt`; blocks that carry their time stamps (every block
+    /// or none) have them estimated on those stamps ([`Derivative::apply_at_times`]). Errors name
+    /// rows 0-based from the first.
     pub fn fit_streamed(
         &self,
         rows: usize,
@@ -108,6 +119,7 @@ impl SindyParams {
         let (left, right) = context(derivative);
         let optimizer = self.checked_optimizer()?;
         let mut buffer: Vec<Vec<f64>> = vec![Vec::new(); width];
+        let mut times: Option<Vec<f64>> = None;
         let mut buffer_start = 0;
         let mut read = 0;
         let mut reduction = Reduction::new(features, dim_x);
@@ -134,15 +146,25 @@ impl SindyParams {
                         ),
                     ));
                 }
+                if read > 0 && block.time.is_some() != times.is_some() {
+                    return Err(shape("recording", "time stamps in some blocks only"));
+                }
                 read += block.columns[0].len();
+                if let Some(time) = block.time {
+                    times.get_or_insert_with(Vec::new).extend(time);
+                }
                 for (column, values) in buffer.iter_mut().zip(block.columns) {
                     column.extend(values);
                 }
             }
-            pending.push(self.segment(&buffer, buffer_start, start..end, needed, dt)?);
+            let sampling = match &times {
+                Some(times) => Sampling::Stamped(times),
+                None => Sampling::Every(dt),
+            };
+            pending.push(self.segment(&buffer, sampling, buffer_start, start..end, needed)?);
             // Keep the rows the next segment's left context needs.
             let keep_from = end.saturating_sub(left).max(buffer_start);
-            for column in &mut buffer {
+            for column in buffer.iter_mut().chain(times.as_mut()) {
                 column.drain(..keep_from - buffer_start);
             }
             buffer_start = keep_from;
@@ -181,10 +203,10 @@ impl SindyParams {
     fn segment(
         &self,
         buffer: &[Vec<f64>],
+        sampling: Sampling<'_>,
         buffer_start: usize,
         range: std::ops::Range<usize>,
         available: usize,
-        dt: f64,
     ) -> Result<Segment> {
         let dim_x = self.state_names().len();
         let (left, _) = context(self.derivative_estimator());
@@ -193,8 +215,14 @@ impl SindyParams {
         let rows = range.len();
         let mut targets = Mat::zeros(rows, dim_x);
         for (j, column) in buffer.iter().take(dim_x).enumerate() {
-            let window = &column[local(from)..local(available)];
-            let derivative = self.derivative_estimator().apply(window, dt)?;
+            let (first, last) = (local(from), local(available));
+            let window = &column[first..last];
+            let derivative = match sampling {
+                Sampling::Every(dt) => self.derivative_estimator().apply(window, dt)?,
+                Sampling::Stamped(times) => self
+                    .derivative_estimator()
+                    .apply_at_times(window, &times[first..last])?,
+            };
             for k in 0..rows {
                 targets[(k, j)] = derivative[range.start - from + k];
             }

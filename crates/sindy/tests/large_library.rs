@@ -138,7 +138,10 @@ fn a_streamed_recording_fits_as_the_whole_one() {
                     columns.push((next_row..end).map(|i| controls[(i, j)]).collect());
                 }
                 next_row = end;
-                Ok(Some(RowBlock { columns }))
+                Ok(Some(RowBlock {
+                    columns,
+                    time: None,
+                }))
             })
             .unwrap();
         assert_eq!(streamed.rows, rows);

@@ -116,3 +116,53 @@ fn a_fit_on_jittered_samples_recovers_the_coefficients() {
     let first = model.score(&trajectories[0]).unwrap();
     assert!(pooled.r2 > 0.9999 && first.r2 > 0.9999, "{pooled:?}");
 }
+
+#[test]
+fn a_streamed_fit_on_stamped_blocks_is_the_fit_of_the_whole_trajectory() {
+    let trajectory = forced_decay(&jittered_times(3000, 0.01, 0.3));
+    let params = SindyParams::new(&["x"], &["u"])
+        .library(FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap())
+        .optimizer(OptimizerSpec::stlsq(0.05))
+        .derivative(Derivative::Central);
+    let whole = params.fit(std::slice::from_ref(&trajectory)).unwrap();
+    let rows = trajectory.time.len();
+    let mean = (trajectory.time[rows - 1] - trajectory.time[0]) / (rows - 1) as f64;
+    let mut start = 0;
+    let streamed = params
+        .fit_streamed(rows, mean, || {
+            let end = (start + 777).min(rows);
+            let block = (start < end).then(|| sindy::RowBlock {
+                columns: vec![
+                    trajectory
+                        .states
+                        .col(0)
+                        .iter()
+                        .skip(start)
+                        .take(end - start)
+                        .copied()
+                        .collect(),
+                    trajectory
+                        .controls
+                        .col(0)
+                        .iter()
+                        .skip(start)
+                        .take(end - start)
+                        .copied()
+                        .collect(),
+                ],
+                time: Some(trajectory.time[start..end].to_vec()),
+            });
+            start = end;
+            Ok(block)
+        })
+        .unwrap();
+    for (a, b) in whole
+        .coefficients()
+        .col_iter()
+        .zip(streamed.model.coefficients().col_iter())
+    {
+        for (x, y) in a.iter().zip(b.iter()) {
+            assert!((x - y).abs() < 1e-9 * (1.0 + x.abs()), "{x} {y}");
+        }
+    }
+}

@@ -167,7 +167,10 @@ fn trajectories(failures: &mut Vec<String>, small_inputs: &Mat<f64>) {
                 .collect();
             columns.extend((0..4).map(|j| (next..end).map(|i| controls[(i, j)]).collect()));
             next = end;
-            Ok(Some(RowBlock { columns }))
+            Ok(Some(RowBlock {
+                columns,
+                time: None,
+            }))
         })
         .unwrap();
     check(failures, "fit_streamed");

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow, bail};
 use data::{DEFAULT_UNIFORM_TOLERANCE, NumericStream, NumericTable, StreamedTimeAxis};
-use sindy::{Derivative, DifferentiationError};
+use sindy::{Derivative, DifferentiationError, UNIFORM_STEP_TOLERANCE};
 use sindy::{
     FeatureLibrary, FitShape, LibrarySpec, Mat, OptimizerSpec, RowBlock, RowSource, Score,
     SindyError, SindyModel, SindyParams, Trajectory,
@@ -305,23 +305,43 @@ fn fit_streamed(
             args.csv.len()
         );
     };
+    // Savitzky–Golay takes steps within 1 % of the reference as even; the differences take any.
+    let (tolerance, stamps_allowed) = match args.derivative {
+        Derivative::SavitzkyGolay { .. } => (DEFAULT_UNIFORM_TOLERANCE, false),
+        Derivative::Forward | Derivative::Central => (f64::INFINITY, true),
+    };
     let mut stream = NumericStream::open(csv, &[args.time.as_str()])?;
-    let mut axis = StreamedTimeAxis::new(csv, &args.time, DEFAULT_UNIFORM_TOLERANCE);
+    let mut axis = StreamedTimeAxis::new(csv, &args.time, tolerance);
     while let Some(block) = stream.next_block(STREAM_BLOCK_ROWS)? {
         axis.push(&block.columns[0], &block.lines)
-            .map_err(streamed_time_error)?;
+            .map_err(|error| streamed_time_error(args.derivative, error))?;
     }
-    let (n, dt) = axis.finish()?;
+    let (smallest, largest) = axis.step_range().unwrap_or((0.0, 0.0));
+    let (n, dt) = axis
+        .finish()
+        .map_err(|error| streamed_time_error(args.derivative, error))?;
     check_rows(args, n, feature_count, columns)?;
     check_memory(args, n, feature_count, RowSource::Streamed)?;
-    let mut stream = NumericStream::open(csv, columns)?;
+    // Uneven steps: the time column is read again with the rows, and the differences use it.
+    let uneven = (largest - dt).max(dt - smallest) > UNIFORM_STEP_TOLERANCE * dt;
+    let stamped = stamps_allowed && uneven;
+    let mut names = Vec::with_capacity(columns.len() + 1);
+    if stamped {
+        names.push(args.time.as_str());
+    }
+    names.extend_from_slice(columns);
+    let mut stream = NumericStream::open(csv, &names)?;
     let fit = params
         .fit_streamed(n, dt, || {
             let block = stream
                 .next_block(STREAM_BLOCK_ROWS)
                 .map_err(|error| SindyError::Source(Box::new(error)))?;
-            Ok(block.map(|block| RowBlock {
-                columns: block.columns,
+            Ok(block.map(|mut block| {
+                let time = stamped.then(|| block.columns.remove(0));
+                RowBlock {
+                    columns: block.columns,
+                    time,
+                }
             }))
         })
         .map_err(|error| {
@@ -332,12 +352,13 @@ fn fit_streamed(
     Ok((fit.model, fit.score, n))
 }
 
-/// A time column a fit read in blocks cannot use; uneven steps are named as what the whole-file
-/// fit takes and this one does not.
-fn streamed_time_error(error: data::DataError) -> anyhow::Error {
+/// A time column a fit read in blocks cannot use; uneven steps (refused for Savitzky–Golay only)
+/// are named as such.
+fn streamed_time_error(derivative: Derivative, error: data::DataError) -> anyhow::Error {
     match error {
         data::DataError::NonUniformSampling { .. } => anyhow!(
-            "{error} (a file read in blocks, with --stream or over 8 MiB, needs even time steps)"
+            "{error} (the {derivative} derivative needs even time steps; forward and central take \
+             any)"
         ),
         other => other.into(),
     }

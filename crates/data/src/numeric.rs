@@ -2,10 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-use std::io::BufReader;
 
 use crate::cells::NumericColumn;
-use crate::error::{DataError, Result};
+use crate::error::Result;
 use crate::records::CsvRecords;
 use crate::stream::NumericRows;
 use crate::table::TextTable;
@@ -29,17 +28,7 @@ impl NumericTable {
     /// read once (a file or a pipe, at most [`inputs::MAX_CSV_BYTES`]): the same values, or the
     /// same first error in file order.
     pub fn read(path: &Path, columns: &[&str]) -> Result<Self> {
-        let io = |source| DataError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        if std::fs::metadata(path).map_err(io)?.is_dir() {
-            return Err(DataError::IsDirectory {
-                path: path.to_path_buf(),
-            });
-        }
-        let file = inputs::open(path, inputs::InputKind::Csv).map_err(io)?;
-        let records = CsvRecords::new(path, BufReader::with_capacity(1 << 16, file));
+        let records = CsvRecords::open(path)?;
         let mut rows = NumericRows::new(path, records, columns)?;
         let block = rows
             .next_block(usize::MAX)?

@@ -159,6 +159,24 @@ struct Splitter {
 
 const BYTE_ORDER_MARK: [u8; 3] = [0xEF, 0xBB, 0xBF];
 
+impl CsvRecords<std::io::BufReader<inputs::BoundedFile>> {
+    /// The records of the file or pipe `path`, read once within [`inputs::MAX_CSV_BYTES`]; a
+    /// directory or an unreadable path is an error naming it.
+    pub(crate) fn open(path: &Path) -> Result<Self> {
+        let io = |source| DataError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        if std::fs::metadata(path).map_err(io)?.is_dir() {
+            return Err(DataError::IsDirectory {
+                path: path.to_path_buf(),
+            });
+        }
+        let file = inputs::open(path, inputs::InputKind::Csv).map_err(io)?;
+        Ok(Self::new(path, std::io::BufReader::with_capacity(1 << 16, file)))
+    }
+}
+
 impl<R: BufRead> CsvRecords<R> {
     /// A splitter of the text `input` read from `path` (named in errors).
     pub fn new(path: &Path, input: R) -> Self {

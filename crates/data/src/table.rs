@@ -8,7 +8,6 @@
 //! Each row keeps the line it starts on, so that errors name the right line after a cell that
 //! spans lines.
 
-use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use crate::cells::{bad_cell, cell_numbers, check_finite, column_list};
@@ -61,17 +60,7 @@ impl TextTable {
     /// Reads `path` (a file, or a pipe: the bytes are read, whatever the length reported) and checks
     /// its layout ([`CsvRecords`]). Errors name the file and the line.
     pub fn read(path: &Path) -> Result<Self> {
-        let io = |source| DataError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        if std::fs::metadata(path).map_err(io)?.is_dir() {
-            return Err(DataError::IsDirectory {
-                path: path.to_path_buf(),
-            });
-        }
-        let file = inputs::open(path, inputs::InputKind::Csv).map_err(io)?;
-        let mut records = CsvRecords::new(path, BufReader::with_capacity(1 << 16, file));
+        let mut records = CsvRecords::open(path)?;
         let names = records.header()?;
         let mut columns = vec![TextColumn::default(); names.len()];
         let mut lines = Vec::new();

@@ -511,8 +511,13 @@ fn a_streamed_file_fits_as_the_whole_file_and_names_bad_lines() {
     std::fs::write(dir.join("gap.csv"), text).unwrap();
     // An uneven step: central differences take the time stamps, Savitzky–Golay names the line.
     sindy(&dir, "gap.csv", "poly:2", &["--stream"]).success();
-    sindy(&dir, "gap.csv", "poly:2", &["--stream", "--derivative", "savgol:11:3"])
-        .one_line_error(&["gap.csv:2600:t"]);
+    sindy(
+        &dir,
+        "gap.csv",
+        "poly:2",
+        &["--stream", "--derivative", "savgol:11:3"],
+    )
+    .one_line_error(&["gap.csv:2600:t"]);
     let text = with_line(&signal(3000), 1500, "14.98,0.5,0.5");
     std::fs::write(dir.join("short-row.csv"), text).unwrap();
     sindy(&dir, "short-row.csv", "poly:2", &["--stream"])

@@ -2,7 +2,6 @@
 
 use std::path::{Path, PathBuf};
 
-
 use crate::cells::NumericColumn;
 use crate::error::Result;
 use crate::records::CsvRecords;

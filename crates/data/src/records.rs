@@ -173,7 +173,10 @@ impl CsvRecords<std::io::BufReader<inputs::BoundedFile>> {
             });
         }
         let file = inputs::open(path, inputs::InputKind::Csv).map_err(io)?;
-        Ok(Self::new(path, std::io::BufReader::with_capacity(1 << 16, file)))
+        Ok(Self::new(
+            path,
+            std::io::BufReader::with_capacity(1 << 16, file),
+        ))
     }
 }
 

@@ -309,23 +309,7 @@ impl ExperimentConditions {
     /// Every flight the configuration names (each condition with each controller, then the paper's
     /// training flights), with whether the file is present under `data_dir`.
     pub fn flight_files(&self, data_dir: &Path) -> Vec<FlightFile> {
-        let mut files = Vec::new();
-        for condition in &self.conditions {
-            for controller in &self.controllers {
-                let path = self.flight_path(data_dir, condition, controller);
-                let explicit = condition.files.contains_key(controller);
-                // Conditions with explicit files list only those controllers.
-                if !condition.files.is_empty() && !explicit {
-                    continue;
-                }
-                files.push(FlightFile {
-                    condition: condition.name.clone(),
-                    controller: controller.clone(),
-                    present: path.is_file(),
-                    path,
-                });
-            }
-        }
+        let mut files = self.condition_flight_files(data_dir);
         for condition in &self.paper_training.conditions {
             let path = data_dir.join(
                 self.paper_training
@@ -338,6 +322,28 @@ impl ExperimentConditions {
                 present: path.is_file(),
                 path,
             });
+        }
+        files
+    }
+
+    /// The flights of the experiment's conditions: each condition with each controller (a
+    /// condition that lists `files` declares only the controllers it lists), in the order of the
+    /// conditions, with whether the file is present under `data_dir`.
+    pub fn condition_flight_files(&self, data_dir: &Path) -> Vec<FlightFile> {
+        let mut files = Vec::new();
+        for condition in &self.conditions {
+            for controller in &self.controllers {
+                if !condition.files.is_empty() && !condition.files.contains_key(controller) {
+                    continue;
+                }
+                let path = self.flight_path(data_dir, condition, controller);
+                files.push(FlightFile {
+                    condition: condition.name.clone(),
+                    controller: controller.clone(),
+                    present: path.is_file(),
+                    path,
+                });
+            }
         }
         files
     }

@@ -121,8 +121,7 @@ fn spread(positions: &[[f64; 3]]) -> ([f64; 3], Vec<usize>) {
 }
 
 /// (controller, condition index, path) of every flight `conditions` declares under `data_dir`,
-/// those present and those missing. A condition declares each controller's flight by the file
-/// pattern, or, when it lists `files`, only the controllers it lists.
+/// those present and those missing ([`ExperimentConditions::condition_flight_files`]).
 type DeclaredFlight = (String, usize, PathBuf);
 
 fn declared_flights(
@@ -131,18 +130,17 @@ fn declared_flights(
 ) -> (Vec<DeclaredFlight>, Vec<DeclaredFlight>) {
     let mut present = Vec::new();
     let mut missing = Vec::new();
-    for (index, condition) in conditions.conditions.iter().enumerate() {
-        for controller in &conditions.controllers {
-            if !condition.files.is_empty() && !condition.files.contains_key(controller) {
-                continue;
-            }
-            let path = conditions.flight_path(data_dir, condition, controller);
-            let flight = (controller.clone(), index, path);
-            if flight.2.exists() {
-                present.push(flight);
-            } else {
-                missing.push(flight);
-            }
+    for file in conditions.condition_flight_files(data_dir) {
+        let index = conditions
+            .conditions
+            .iter()
+            .position(|condition| condition.name == file.condition)
+            .expect("a file of a declared condition");
+        let flight = (file.controller, index, file.path);
+        if file.present {
+            present.push(flight);
+        } else {
+            missing.push(flight);
         }
     }
     (present, missing)

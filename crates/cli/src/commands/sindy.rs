@@ -247,16 +247,24 @@ fn fit_whole(
     let n = recordings.iter().map(|r| r.table.rows()).sum();
     check_rows(args, n, feature_count, columns)?;
     check_memory(args, n, feature_count, RowSource::Whole)?;
-    let trajectories: Vec<Trajectory> = recordings.iter().map(|r| r.trajectory.clone()).collect();
+    // The trajectories are fitted together; each file's table still names the lines of its rows.
+    let (trajectories, sources): (Vec<Trajectory>, Vec<(PathBuf, NumericTable)>) = recordings
+        .into_iter()
+        .map(|r| (r.trajectory, (r.path, r.table)))
+        .unzip();
     let model = params
         .fit(&trajectories)
-        .map_err(|error| whole_fit_error(args, &recordings, error))?;
+        .map_err(|error| whole_fit_error(args, &sources, error))?;
     let score = model.score_all(&trajectories)?;
     Ok((model, score, n))
 }
 
 /// A fit's error over stacked recordings: a non-finite value named by its file and line.
-fn whole_fit_error(args: &Args, recordings: &[Recording], error: SindyError) -> anyhow::Error {
+fn whole_fit_error(
+    args: &Args,
+    sources: &[(PathBuf, NumericTable)],
+    error: SindyError,
+) -> anyhow::Error {
     let SindyError::NonFinite {
         what,
         row,
@@ -267,8 +275,8 @@ fn whole_fit_error(args: &Args, recordings: &[Recording], error: SindyError) -> 
         return fit_error(args, &args.csv[0], error, |row| row);
     };
     let mut first = 0;
-    for recording in recordings {
-        let rows = recording.table.rows();
+    for (path, table) in sources {
+        let rows = table.rows();
         if row < first + rows {
             let local = SindyError::NonFinite {
                 what,
@@ -276,9 +284,7 @@ fn whole_fit_error(args: &Args, recordings: &[Recording], error: SindyError) -> 
                 column,
                 value,
             };
-            return fit_error(args, &recording.path, local, |row| {
-                recording.table.line(row)
-            });
+            return fit_error(args, path, local, |row| table.line(row));
         }
         first += rows;
     }

@@ -610,7 +610,7 @@ fn build_report(
                 .parameters(evidence.id)
                 .expect("a named effect is in the judged set"),
             noise_bias: biases.as_ref().and_then(|b| b.parameters(evidence.id)),
-            description: describe(evidence.id, &effects),
+            description: describe(evidence.id, &effects, problem.model.gravity_m_s2),
             explained_fraction: share,
             evidence: evidence.clone(),
         })

@@ -3,22 +3,26 @@
 //! fit rows), with the timing term resolved into a delay, a motor lag or both, and an air velocity
 //! when a drag was kept.
 
-use physics::{EffectId, Effects};
+use physics::{EffectId, EffectNumber, Effects};
 use report::mismatch::recording::TimingScores;
 use serde::Serialize;
 
 use crate::library::{Candidate, CandidateId};
 use crate::problem::{Channels, Problem};
 use crate::refine::{
-    FitRows, Parameter, effect_column, effects_from, levenberg_marquardt, profile_search,
-    profile_wind, unit_drag_in_wind,
+    FitRows, effect_column, effects_from, levenberg_marquardt, profile_search, profile_wind,
+    unit_drag_in_wind,
 };
 use crate::selection::{Design, Selection};
+
+const GROUND_RADIUS: EffectNumber = EffectNumber::new(EffectId::GroundEffect, 0);
+const DELAY: EffectNumber = EffectNumber::new(EffectId::Delay, 0);
+const MOTOR_LAG: EffectNumber = EffectNumber::new(EffectId::MotorLag, 0);
 
 /// Parameters and their values: a set of effects being fitted.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FittedSet {
-    pub parameters: Vec<Parameter>,
+    pub parameters: Vec<EffectNumber>,
     pub values: Vec<f64>,
 }
 
@@ -32,23 +36,22 @@ impl FittedSet {
     pub fn ids(&self) -> Vec<EffectId> {
         let mut ids: Vec<EffectId> = Vec::new();
         for p in &self.parameters {
-            if !ids.contains(&p.effect_id()) {
-                ids.push(p.effect_id());
+            if !ids.contains(&p.effect) {
+                ids.push(p.effect);
             }
         }
         ids
     }
 
-    /// The set without the parameters of effect `id` (and without the wind when no drag is left).
+    /// The set without the parameters of effect `id` (and without the effects left without what
+    /// they need: the wind when no drag is left).
     pub fn without(&self, id: EffectId) -> Self {
-        let drag_left = self.parameters.iter().any(|p| {
-            matches!(p, Parameter::LinearDrag(_) | Parameter::QuadraticDrag) && p.effect_id() != id
-        });
+        let left = self.effects().without(id);
         let (parameters, values) = self
             .parameters
             .iter()
             .zip(&self.values)
-            .filter(|(p, _)| p.effect_id() != id && (drag_left || !matches!(p, Parameter::Wind(_))))
+            .filter(|(p, _)| left.contains(p.effect))
             .map(|(p, v)| (*p, *v))
             .unzip();
         Self { parameters, values }
@@ -119,13 +122,13 @@ pub fn profile_nonlinear(
     if let Some(candidate) = find(CandidateId::GroundEffect) {
         let others = others_of(candidate);
         let radius = profiled_ground_radius(problem, columns, &others, block_rows);
-        let effect = effects_from(&[Parameter::GroundRadius], &[radius]);
+        let effect = effects_from(&[GROUND_RADIUS], &[radius]);
         columns[candidate.columns[0]] = effect_column(problem, &base, &effect, radius * radius);
     }
     if let Some(candidate) = find(CandidateId::DelayOrMotorLag) {
         let others = others_of(candidate);
         let grid: Vec<f64> = timing_grid().into_iter().skip(1).collect();
-        let best = [Parameter::Delay, Parameter::MotorLag]
+        let best = [DELAY, MOTOR_LAG]
             .into_iter()
             .map(|kind| {
                 let (value, sse) = profile_search(
@@ -172,22 +175,29 @@ fn screen_estimates(
             .expect("kept")]
     };
     let mut set = FittedSet::default();
-    let mut push = |p: Parameter, v: f64| {
+    let mut push = |p: EffectNumber, v: f64| {
         set.parameters.push(p);
         set.values.push(v);
     };
     for candidate in candidates {
         let cols = &candidate.columns;
         match candidate.id {
-            CandidateId::ThrustScale => push(Parameter::ThrustScale, 1.0 + coefficient(cols[0])),
+            CandidateId::ThrustScale => push(
+                EffectNumber::new(EffectId::ThrustScale, 0),
+                1.0 + coefficient(cols[0]),
+            ),
             CandidateId::LinearDrag => {
                 for (i, &c) in cols.iter().enumerate() {
-                    push(Parameter::LinearDrag(i), coefficient(c).max(0.0));
+                    push(
+                        EffectNumber::new(EffectId::LinearDrag, i),
+                        coefficient(c).max(0.0),
+                    );
                 }
             }
-            CandidateId::QuadraticDrag => {
-                push(Parameter::QuadraticDrag, coefficient(cols[0]).max(0.0))
-            }
+            CandidateId::QuadraticDrag => push(
+                EffectNumber::new(EffectId::QuadraticDrag, 0),
+                coefficient(cols[0]).max(0.0),
+            ),
             CandidateId::GroundEffect => {
                 let others: Vec<usize> = kept_columns
                     .iter()
@@ -195,17 +205,17 @@ fn screen_estimates(
                     .filter(|c| !cols.contains(c))
                     .collect();
                 let radius = profiled_ground_radius(problem, columns, &others, block_rows);
-                push(Parameter::GroundRadius, radius);
+                push(GROUND_RADIUS, radius);
             }
             CandidateId::TorqueBias => {
                 for (i, &c) in cols.iter().enumerate() {
-                    push(Parameter::TorqueBias(i), coefficient(c));
+                    push(EffectNumber::new(EffectId::TorqueBias, i), coefficient(c));
                 }
             }
             CandidateId::InertiaScale => {
                 for (i, &c) in cols.iter().enumerate() {
                     push(
-                        Parameter::InertiaScale(i),
+                        EffectNumber::new(EffectId::InertiaScale, i),
                         1.0 / (1.0 + coefficient(c)).max(0.05),
                     );
                 }
@@ -232,7 +242,7 @@ fn profiled_ground_radius(
         0..problem.split,
         block_rows,
         &radius_grid(),
-        |r| effects_from(&[Parameter::GroundRadius], &[r]),
+        |r| effects_from(&[GROUND_RADIUS], &[r]),
     );
     radius
 }
@@ -281,14 +291,17 @@ pub fn fit_parameters(
         set.refit(problem, iterations);
         set
     };
+    let wind_acts_through = EffectId::Wind.needs().map_or(&[][..], |n| n.one_of);
     let has_drag = set
         .parameters
         .iter()
-        .any(|p| matches!(p, Parameter::LinearDrag(_) | Parameter::QuadraticDrag));
+        .any(|p| wind_acts_through.contains(&p.effect));
     if has_drag {
         let still = set.refit(problem, 0);
         let mut with_wind = set.clone();
-        with_wind.parameters.extend((0..3).map(Parameter::Wind));
+        with_wind
+            .parameters
+            .extend(EffectNumber::all_of(EffectId::Wind));
         with_wind.values.extend(wind_start);
         let windy = with_wind.refit(problem, iterations);
         alternatives.wind = Some(WindScores {
@@ -315,7 +328,7 @@ fn fit_timing(
     block_rows: usize,
 ) -> (FittedSet, TimingScores) {
     let mut singles = Vec::new();
-    for kind in [Parameter::Delay, Parameter::MotorLag] {
+    for kind in [DELAY, MOTOR_LAG] {
         let (start, _) = profile_search(
             problem,
             columns,
@@ -336,8 +349,7 @@ fn fit_timing(
     let mut best_both: Option<(FittedSet, f64)> = None;
     for (d, l) in [(delay, 0.0), (0.0, lag), (0.5 * delay, 0.5 * lag)] {
         let mut set = linear.clone();
-        set.parameters
-            .extend([Parameter::Delay, Parameter::MotorLag]);
+        set.parameters.extend([DELAY, MOTOR_LAG]);
         set.values.extend([d, l]);
         let sse = set.refit(problem, iterations);
         if best_both.as_ref().is_none_or(|b| sse < b.1) {

@@ -70,7 +70,7 @@ pub use output::{
 };
 pub use problem::{CHANNEL_NAMES, Channels, Problem};
 pub use recording::Recording;
-pub use refine::{FitRows, Parameter, effects_from, levenberg_marquardt};
+pub use refine::{FitRows, effects_from, levenberg_marquardt};
 pub use selection::{
     Design, Selection, SelectionSettings, stability_selection, stepwise, trimmed_gain,
 };

@@ -5,106 +5,17 @@
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
-use physics::{
-    Delay, EffectId, Effects, GroundEffect, InertiaScale, LinearDrag, MotorLag, QuadraticDrag,
-    ThrustScale, TorqueBias, Wind,
-};
+use physics::{EffectNumber, Effects, QuadraticDrag, Wind};
 
 use crate::problem::{Channels, Problem};
 use crate::selection::Design;
 
-/// One scalar parameter of the vocabulary.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Parameter {
-    ThrustScale,
-    LinearDrag(usize),
-    QuadraticDrag,
-    Wind(usize),
-    GroundRadius,
-    TorqueBias(usize),
-    InertiaScale(usize),
-    Delay,
-    MotorLag,
-}
-
-impl Parameter {
-    /// The smallest admissible value.
-    fn lower_bound(self) -> f64 {
-        match self {
-            Self::ThrustScale | Self::InertiaScale(_) => 0.05,
-            Self::LinearDrag(_)
-            | Self::QuadraticDrag
-            | Self::GroundRadius
-            | Self::Delay
-            | Self::MotorLag => 0.0,
-            Self::Wind(_) | Self::TorqueBias(_) => f64::NEG_INFINITY,
-        }
-    }
-
-    /// The largest admissible value (a ground-effect radius beyond 1 m or a delay or lag beyond
-    /// 0.2 s is not the physics these names stand for).
-    fn upper_bound(self) -> f64 {
-        match self {
-            Self::GroundRadius => 1.0,
-            Self::Delay | Self::MotorLag => 0.2,
-            _ => f64::INFINITY,
-        }
-    }
-
-    /// `value` within the admissible range.
-    pub fn clamp(self, value: f64) -> f64 {
-        value.clamp(self.lower_bound(), self.upper_bound())
-    }
-
-    /// A typical magnitude, for finite-difference steps.
-    fn typical(self) -> f64 {
-        match self {
-            Self::ThrustScale | Self::InertiaScale(_) | Self::Wind(_) => 1.0,
-            Self::LinearDrag(_) | Self::GroundRadius | Self::TorqueBias(_) => 0.1,
-            Self::QuadraticDrag => 0.01,
-            Self::Delay | Self::MotorLag => 0.01,
-        }
-    }
-
-    /// The effect the parameter belongs to.
-    pub fn effect_id(self) -> EffectId {
-        match self {
-            Self::ThrustScale => EffectId::ThrustScale,
-            Self::LinearDrag(_) => EffectId::LinearDrag,
-            Self::QuadraticDrag => EffectId::QuadraticDrag,
-            Self::Wind(_) => EffectId::Wind,
-            Self::GroundRadius => EffectId::GroundEffect,
-            Self::TorqueBias(_) => EffectId::TorqueBias,
-            Self::InertiaScale(_) => EffectId::InertiaScale,
-            Self::Delay => EffectId::Delay,
-            Self::MotorLag => EffectId::MotorLag,
-        }
-    }
-}
-
-/// Effects built from parameter values (absent parameters keep their effect absent).
-pub fn effects_from(parameters: &[Parameter], values: &[f64]) -> Effects {
+/// Effects built from parameter values (absent parameters keep their effect absent; the other
+/// numbers of a present effect are neutral).
+pub fn effects_from(parameters: &[EffectNumber], values: &[f64]) -> Effects {
     let mut e = Effects::default();
     for (p, &v) in parameters.iter().zip(values) {
-        match *p {
-            Parameter::ThrustScale => e.thrust_scale = Some(ThrustScale { k: v }),
-            Parameter::LinearDrag(i) => {
-                e.linear_drag.get_or_insert(LinearDrag { d: [0.0; 3] }).d[i] = v
-            }
-            Parameter::QuadraticDrag => e.quadratic_drag = Some(QuadraticDrag { c: v }),
-            Parameter::Wind(i) => e.wind.get_or_insert(Wind { w_air: [0.0; 3] }).w_air[i] = v,
-            Parameter::GroundRadius => e.ground_effect = Some(GroundEffect { r_m: v }),
-            Parameter::TorqueBias(i) => {
-                e.torque_bias.get_or_insert(TorqueBias { b: [0.0; 3] }).b[i] = v
-            }
-            Parameter::InertiaScale(i) => {
-                e.inertia_scale
-                    .get_or_insert(InertiaScale { k: [1.0; 3] })
-                    .k[i] = v
-            }
-            Parameter::Delay => e.delay = Some(Delay { delay_s: v }),
-            Parameter::MotorLag => e.motor_lag = Some(MotorLag { tau_s: v }),
-        }
+        e.set_number(*p, v);
     }
     e
 }
@@ -223,7 +134,7 @@ impl StepBasis {
 /// The whitened residual on the fit's rows of the effects `parameters` take at `values`.
 fn whitened_residual(
     problem: &Problem,
-    parameters: &[Parameter],
+    parameters: &[EffectNumber],
     values: &[f64],
     rows: &FitRows,
 ) -> Vec<f64> {
@@ -236,7 +147,7 @@ fn whitened_residual(
 
 /// The forward-difference Jacobian of `evaluate` at `values` (one column per parameter, as rows).
 fn forward_jacobian(
-    parameters: &[Parameter],
+    parameters: &[EffectNumber],
     values: &[f64],
     residual: &[f64],
     evaluate: &dyn Fn(&[f64]) -> Vec<f64>,
@@ -279,7 +190,7 @@ fn normal_matrix(jacobian: &[Vec<f64>]) -> Mat<f64> {
 /// where `JᵀJ` is singular.
 pub fn standard_errors(
     problem: &Problem,
-    parameters: &[Parameter],
+    parameters: &[EffectNumber],
     values: &[f64],
     rows: &FitRows,
     scale: f64,
@@ -307,7 +218,7 @@ pub fn standard_errors(
 /// (weighted) whitened residual of the fit's rows.
 pub fn levenberg_marquardt(
     problem: &Problem,
-    parameters: &[Parameter],
+    parameters: &[EffectNumber],
     initial: &[f64],
     rows: &FitRows,
     iterations: usize,
@@ -448,15 +359,11 @@ pub fn effect_column(
 
 /// A quadratic drag of coefficient 1 in air moving at `w`.
 pub fn unit_drag_in_wind(w: [f64; 3]) -> Effects {
-    effects_from(
-        &[
-            Parameter::QuadraticDrag,
-            Parameter::Wind(0),
-            Parameter::Wind(1),
-            Parameter::Wind(2),
-        ],
-        &[1.0, w[0], w[1], w[2]],
-    )
+    Effects {
+        quadratic_drag: Some(QuadraticDrag { c: 1.0 }),
+        wind: Some(Wind { w_air: w }),
+        ..Effects::default()
+    }
 }
 
 /// Air velocity that best explains `residual` with a free drag coefficient on the column

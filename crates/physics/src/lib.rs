@@ -2,7 +2,9 @@
 //!
 //! What it is for: the nominal model read from JSON ([`NominalModel`]: mass, gravity, inertia, and
 //! how thrust and torques follow from a recorded command); the vocabulary of unmodelled effects
-//! ([`Effects`], each named by an [`EffectId`]; ids and parameter names are an output contract); a
+//! ([`effects`]: one file per effect implementing [`Effect`] and [`EffectKind`], listed by its
+//! registry; a set of them is [`Effects`], each named by an [`EffectId`]; ids and parameter names
+//! are an output contract); a
 //! closed-loop simulator ([`simulate`]: RK4 rigid body, geometric tracking controller that knows
 //! only the nominal model, figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`]; a
 //! [`Scenario`] is read from JSON or, for examples and tests, built by [`Scenario::figure_eight`])
@@ -19,7 +21,7 @@
 
 mod controller;
 mod effect_id;
-mod effects;
+pub mod effects;
 mod error;
 mod jitter;
 mod logger;
@@ -33,12 +35,8 @@ pub mod vector;
 mod writer;
 
 pub use controller::{ControlOutput, Gains, GeometricController, MeasuredState};
-pub use effect_id::{EffectId, UnknownEffectId};
-pub use effects::{
-    Delay, DragLag, EffectParameters, Effects, GROUND_EFFECT_MAX_RATIO, GroundEffect, InertiaScale,
-    LinearDrag, MAX_TILT_RAD, MotorLag, ParameterValue, QuadraticDrag, RotorDrag, ThrustMap,
-    ThrustScale, ThrustTilt, TorqueBias, TranslationalLift, Wind, WindGradient, ground_ratio,
-};
+pub use effect_id::UnknownEffectId;
+pub use effects::*;
 pub use error::{PhysicsError, Result};
 pub use jitter::{Jitter, JitterSignal, MAX_JITTER};
 pub use logger::{

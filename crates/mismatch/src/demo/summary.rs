@@ -2,7 +2,9 @@
 //! Markdown and the terminal table are rendered by the `report` crate, [`report::mismatch::demo`],
 //! from the view [`DemoSummary::view`] fills).
 
-use physics::{EffectId, Effects, NominalModel, ParameterValue, Scenario, Trajectory};
+use physics::{
+    ChannelGroup, EffectId, Effects, NominalModel, ParameterValue, Scenario, Trajectory,
+};
 pub use report::mismatch::demo::Targets;
 use report::mismatch::demo::{CellLine, ConfigurationLine, DemoView, JitterLine, ParameterLine};
 use serde::Serialize;
@@ -191,10 +193,13 @@ const NOTED_MODEL_NOISE_SHARE: f64 = 0.01;
 /// For a factor, the channel it acts through whose model-side noise is the largest share of the
 /// model's value there, when that share is worth naming.
 fn model_noise_note(effect: EffectId, channels: &[crate::ChannelReport]) -> Option<String> {
-    let acts_on = match effect {
-        EffectId::ThrustScale => 0..3,
-        EffectId::InertiaScale => 3..6,
-        _ => return None,
+    if !effect.is_factor() {
+        return None;
+    }
+    let acts_on = match effect.acts_on() {
+        ChannelGroup::Translational => 0..3,
+        ChannelGroup::Angular => 3..6,
+        ChannelGroup::Both => 0..6,
     };
     let channel = channels
         .get(acts_on)?
@@ -209,27 +214,6 @@ fn model_noise_note(effect: EffectId, channels: &[crate::ChannelReport]) -> Opti
     })
 }
 
-/// Whether the effect's parameters are factors (1: no effect), whose errors are relative to
-/// |true − 1|.
-fn is_factor(id: EffectId) -> bool {
-    match id {
-        EffectId::ThrustScale | EffectId::InertiaScale => true,
-        EffectId::LinearDrag
-        | EffectId::QuadraticDrag
-        | EffectId::Wind
-        | EffectId::MotorLag
-        | EffectId::GroundEffect
-        | EffectId::TorqueBias
-        | EffectId::Delay
-        | EffectId::ThrustMap
-        | EffectId::ThrustTilt
-        | EffectId::RotorDrag
-        | EffectId::TranslationalLift
-        | EffectId::DragLag
-        | EffectId::WindGradient => false,
-    }
-}
-
 /// One check per parameter of `effect`, from its true and found parameters.
 fn parameter_checks(
     effect: EffectId,
@@ -237,7 +221,7 @@ fn parameter_checks(
     found: &Effects,
     standard_error: StandardErrorOf,
 ) -> Vec<ParameterCheck> {
-    let reference = if is_factor(effect) { 1.0 } else { 0.0 };
+    let reference = if effect.is_factor() { 1.0 } else { 0.0 };
     let found_values = found
         .parameters(effect)
         .map(|p| p.values())

@@ -6,102 +6,25 @@
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
-use physics::{
-    Delay, DragLag, EffectId, Effects, QuadraticDrag, RotorDrag, ThrustMap, ThrustTilt,
-    TranslationalLift, Wind, WindGradient,
-};
+use physics::{EffectId, EffectNumber, Effects, Wind, WindGradient};
 use rayon::prelude::*;
-use serde::Serialize;
 
 use crate::problem::Problem;
 
-/// One scalar parameter of the vehicle.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub enum VehicleParameter {
-    ThrustMap(usize),
-    Tilt(usize),
-    RotorDrag(usize),
-    Lift,
-    QuadraticDrag,
-    Delay,
-    DragLag,
-}
-
-impl VehicleParameter {
-    /// The effect it belongs to.
-    pub fn effect_id(self) -> EffectId {
-        match self {
-            Self::ThrustMap(_) => EffectId::ThrustMap,
-            Self::Tilt(_) => EffectId::ThrustTilt,
-            Self::RotorDrag(_) => EffectId::RotorDrag,
-            Self::Lift => EffectId::TranslationalLift,
-            Self::QuadraticDrag => EffectId::QuadraticDrag,
-            Self::Delay => EffectId::Delay,
-            Self::DragLag => EffectId::DragLag,
-        }
-    }
-
-    fn bounds(self) -> (f64, f64) {
-        match self {
-            Self::ThrustMap(0) | Self::ThrustMap(1) => (0.05, 20.0),
-            Self::ThrustMap(_) => (-20.0, 20.0),
-            Self::Tilt(_) => (-physics::MAX_TILT_RAD, physics::MAX_TILT_RAD),
-            Self::RotorDrag(_) | Self::Lift | Self::QuadraticDrag => (0.0, f64::INFINITY),
-            Self::Delay => (0.0, 0.3),
-            Self::DragLag => (0.0, 2.0),
-        }
-    }
-
-    /// The value that leaves the nominal model unchanged (a start for the fit).
-    pub fn neutral(self) -> f64 {
-        match self {
-            Self::ThrustMap(0) | Self::ThrustMap(1) => 1.0,
-            _ => 0.0,
-        }
-    }
-
-    /// A finite-difference step.
-    fn step(self, value: f64) -> f64 {
-        let typical = match self {
-            Self::ThrustMap(_) => 1.0,
-            Self::Tilt(_) => 0.01,
-            Self::RotorDrag(_) => 0.1,
-            Self::Lift => 0.001,
-            Self::QuadraticDrag => 0.01,
-            Self::Delay | Self::DragLag => 0.01,
-        };
-        1e-4 * value.abs().max(typical)
-    }
-}
-
-/// The vehicle parameters of effect `id`: none for the effects the joint analysis does not fit
-/// as a property of the vehicle (the air's velocity and gradient are fitted per flight, see
-/// [`Air`]; the others are not among its candidates).
-pub fn parameters_of(id: EffectId) -> Vec<VehicleParameter> {
-    use VehicleParameter as P;
-    match id {
-        EffectId::ThrustMap => vec![P::ThrustMap(0), P::ThrustMap(1), P::ThrustMap(2)],
-        EffectId::ThrustTilt => vec![P::Tilt(0), P::Tilt(1)],
-        EffectId::RotorDrag => vec![P::RotorDrag(0), P::RotorDrag(1)],
-        EffectId::TranslationalLift => vec![P::Lift],
-        EffectId::QuadraticDrag => vec![P::QuadraticDrag],
-        EffectId::Delay => vec![P::Delay],
-        EffectId::DragLag => vec![P::DragLag],
-        EffectId::Wind
-        | EffectId::WindGradient
-        | EffectId::LinearDrag
-        | EffectId::ThrustScale
-        | EffectId::MotorLag
-        | EffectId::GroundEffect
-        | EffectId::TorqueBias
-        | EffectId::InertiaScale => Vec::new(),
+/// The vehicle numbers of effect `id`: all of its numbers, none for the effects that describe
+/// the air (fitted per flight, see [`Air`]).
+pub fn parameters_of(id: EffectId) -> Vec<EffectNumber> {
+    if id.describes_the_air() {
+        Vec::new()
+    } else {
+        EffectNumber::all_of(id)
     }
 }
 
 /// A vehicle: effects and their values; and whether the air of its flights may vary in space.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Vehicle {
-    pub parameters: Vec<VehicleParameter>,
+    pub parameters: Vec<EffectNumber>,
     pub values: Vec<f64>,
     /// Each windy flight's air gets a gradient (`wind_gradient`) along the axes it flies.
     pub gradient: bool,
@@ -112,8 +35,8 @@ impl Vehicle {
     pub fn ids(&self) -> Vec<EffectId> {
         let mut ids: Vec<EffectId> = Vec::new();
         for p in &self.parameters {
-            if !ids.contains(&p.effect_id()) {
-                ids.push(p.effect_id());
+            if !ids.contains(&p.effect) {
+                ids.push(p.effect);
             }
         }
         if self.gradient {
@@ -141,40 +64,19 @@ impl Vehicle {
         out
     }
 
-    /// Whether an air velocity acts on this vehicle (it has a drag).
+    /// Whether an air velocity acts on this vehicle (it has an effect the wind acts through).
     pub fn feels_wind(&self) -> bool {
-        self.parameters.iter().any(|p| {
-            matches!(
-                p,
-                VehicleParameter::RotorDrag(_) | VehicleParameter::QuadraticDrag
-            )
-        })
+        let acts_through = EffectId::Wind.needs().map_or(&[][..], |n| n.one_of);
+        self.parameters
+            .iter()
+            .any(|p| acts_through.contains(&p.effect))
     }
 
     /// The effects of the vehicle in the air of `air` (none for still air).
     pub fn effects(&self, air: Option<&Air>) -> Effects {
-        use VehicleParameter as P;
         let mut e = Effects::default();
         for (p, &v) in self.parameters.iter().zip(&self.values) {
-            match *p {
-                P::ThrustMap(i) => {
-                    e.thrust_map
-                        .get_or_insert(ThrustMap { k: [1.0, 1.0, 0.0] })
-                        .k[i] = v
-                }
-                P::Tilt(i) => {
-                    e.thrust_tilt
-                        .get_or_insert(ThrustTilt {
-                            angles_rad: [0.0; 2],
-                        })
-                        .angles_rad[i] = v
-                }
-                P::RotorDrag(i) => e.rotor_drag.get_or_insert(RotorDrag { d: [0.0; 2] }).d[i] = v,
-                P::Lift => e.translational_lift = Some(TranslationalLift { c: v }),
-                P::QuadraticDrag => e.quadratic_drag = Some(QuadraticDrag { c: v }),
-                P::Delay => e.delay = Some(Delay { delay_s: v }),
-                P::DragLag => e.drag_lag = Some(DragLag { tau_s: v }),
-            }
+            e.set_number(*p, v);
         }
         if let Some(air) = air
             && self.feels_wind()
@@ -246,7 +148,7 @@ impl JointFlight<'_> {
 #[derive(Clone, Debug)]
 pub struct JointSettings {
     /// Parameters not fitted (kept at their values).
-    pub fixed: Vec<VehicleParameter>,
+    pub fixed: Vec<EffectNumber>,
     /// Whether the vehicle is fitted at all (false: only the winds).
     pub fit_vehicle: bool,
     /// Noise scale per channel (the residual is divided by it).
@@ -364,7 +266,7 @@ pub fn fit(
             };
             let mut trial = vehicle.clone();
             for (k, &j) in free.iter().enumerate() {
-                let (lo, hi) = trial.parameters[j].bounds();
+                let (lo, hi) = trial.parameters[j].fit_range();
                 trial.values[j] = (trial.values[j] - vehicle_step[k]).clamp(lo, hi);
             }
             let trial_airs: Vec<Air> = airs

@@ -38,7 +38,7 @@ mod tests;
 use std::path::{Path, PathBuf};
 
 use data::ExperimentConditions;
-use physics::{EffectId, NominalModel};
+use physics::{EffectId, EffectNumber, NominalModel};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -53,7 +53,7 @@ pub use self::report::FleetReport;
 pub use ::report::mismatch::fleet::{
     AttitudeCheck, FlightHeldout, FlightSpeedRange, FlightWind, ScaleReport, Targets,
 };
-pub use joint::{Air, Vehicle, VehicleParameter};
+pub use joint::{Air, Vehicle};
 use joint::{JointFit, JointFlight, JointSettings};
 pub use scale_report::scale_report;
 pub use sensitivity::{LAG_GRID_S, LagProfile, LagSensitivity};
@@ -400,7 +400,7 @@ enum Rows {
 fn fit_two_step(
     flights: &[JointFlight],
     start: &Vehicle,
-    fixed: &[VehicleParameter],
+    fixed: &[EffectNumber],
     fit_vehicle: bool,
     iterations: usize,
 ) -> JointFit {
@@ -442,25 +442,14 @@ fn still_airs(flights: &[FleetFlight], vehicle: &Vehicle) -> Vec<Air> {
         .collect()
 }
 
-/// Starting values tried for effect `id`: several for the nonlinear effects, one at its neutral
-/// values (`None`) for the others.
+/// Starting values tried for effect `id`: its fit starts (several for the nonlinear effects), or
+/// one at its neutral values (`None`).
 fn starts(id: EffectId) -> Vec<Option<Vec<f64>>> {
-    match id {
-        EffectId::Delay => vec![Some(vec![0.04]), Some(vec![0.1]), Some(vec![0.16])],
-        EffectId::DragLag => vec![Some(vec![0.1]), Some(vec![0.3]), Some(vec![0.6])],
-        EffectId::RotorDrag => vec![Some(vec![0.3, 0.1])],
-        EffectId::QuadraticDrag => vec![Some(vec![0.02])],
-        EffectId::LinearDrag
-        | EffectId::Wind
-        | EffectId::ThrustScale
-        | EffectId::MotorLag
-        | EffectId::GroundEffect
-        | EffectId::TorqueBias
-        | EffectId::InertiaScale
-        | EffectId::ThrustMap
-        | EffectId::ThrustTilt
-        | EffectId::TranslationalLift
-        | EffectId::WindGradient => vec![None],
+    let starts = id.fit_starts();
+    if starts.is_empty() {
+        vec![None]
+    } else {
+        starts.into_iter().map(Some).collect()
     }
 }
 
@@ -543,12 +532,12 @@ fn forward_select(
 }
 
 /// The parameters held at their calm-calibrated values once other flights join.
-fn timing_parameters(vehicle: &Vehicle) -> Vec<VehicleParameter> {
+fn timing_parameters(vehicle: &Vehicle) -> Vec<EffectNumber> {
     vehicle
         .parameters
         .iter()
         .copied()
-        .filter(|p| matches!(p, VehicleParameter::Delay | VehicleParameter::DragLag))
+        .filter(|p| matches!(p.effect, EffectId::Delay | EffectId::DragLag))
         .collect()
 }
 

@@ -173,7 +173,7 @@ impl FleetReport {
                         parameters: VehicleParameters::Fitted(
                             effects.parameters(id).expect("an effect of the vehicle"),
                         ),
-                        description: describe(id, &effects),
+                        description: describe(id, &effects, model.gravity_m_s2),
                     }
                 })
                 .collect(),

@@ -9,10 +9,11 @@
 //! the lags the selection rule cannot tell from the best (error within `min_step` of it), and
 //! every flight's air with the lag at either end of that band.
 
+use physics::{EffectId, EffectNumber};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::joint::{Air, Vehicle, VehicleParameter};
+use super::joint::{Air, Vehicle};
 use super::{
     FleetFlight, FleetSettings, Rows, fit_two_step, heldout_error, joint_flight, joint_flights,
     still_airs, timing_parameters,
@@ -39,8 +40,11 @@ pub struct LagSensitivity {
     pub airs_high: Vec<Air>,
 }
 
+/// The drag lag's time constant, the number this sensitivity varies.
+const DRAG_LAG: EffectNumber = EffectNumber::new(EffectId::DragLag, 0);
+
 /// `vehicle` with the value of `parameter` replaced (unchanged if it has none).
-fn with_value(vehicle: &Vehicle, parameter: VehicleParameter, value: f64) -> Vehicle {
+fn with_value(vehicle: &Vehicle, parameter: EffectNumber, value: f64) -> Vehicle {
     let mut out = vehicle.clone();
     for (p, v) in out.parameters.iter().zip(out.values.iter_mut()) {
         if *p == parameter {
@@ -63,14 +67,8 @@ fn calm_fit_at(
         .iter()
         .map(|&i| joint_flight(&flights[i], true, Rows::Fit))
         .collect();
-    let start = with_value(calm_vehicle, VehicleParameter::DragLag, lag_s);
-    let fitted = fit_two_step(
-        &fit_rows,
-        &start,
-        &[VehicleParameter::DragLag],
-        true,
-        settings.iterations,
-    );
+    let start = with_value(calm_vehicle, DRAG_LAG, lag_s);
+    let fitted = fit_two_step(&fit_rows, &start, &[DRAG_LAG], true, settings.iterations);
     let still = still_airs(flights, &Vehicle::default());
     let error = heldout_error(flights, &calm, &fitted.vehicle, &still);
     (fitted.vehicle, error)
@@ -107,7 +105,7 @@ impl LagProfile {
         calm_vehicle: &Vehicle,
         settings: &FleetSettings,
     ) -> Option<Self> {
-        if !calm_vehicle.parameters.contains(&VehicleParameter::DragLag) {
+        if !calm_vehicle.parameters.contains(&DRAG_LAG) {
             return None;
         }
         let fits = LAG_GRID_S
@@ -162,7 +160,7 @@ impl LagProfile {
         full_vehicle: &Vehicle,
         settings: &FleetSettings,
     ) -> Option<LagSensitivity> {
-        if !full_vehicle.parameters.contains(&VehicleParameter::DragLag) {
+        if !full_vehicle.parameters.contains(&DRAG_LAG) {
             return None;
         }
         let best = self.fits.iter().map(|f| f.2).fold(f64::INFINITY, f64::min);

@@ -1,0 +1,72 @@
+//! `rotor_drag`: drag proportional to the thrust and linear in the airspeed (the rotors' H-force):
+//! `a = −f R diag(dh, dh, dv) Rᵀ (v − w_air)` with `f = T_real / (m g)`, `d` in 1/s.
+
+use serde::{Deserialize, Serialize};
+
+use super::{
+    ChannelGroup, Effect, EffectId, EffectKind, InvalidParameter, ParameterValue, require,
+};
+use crate::vector::{Mat3, Vec3, hadamard, mat_vec};
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotorDrag {
+    pub d: [f64; 2],
+}
+
+impl Effect for RotorDrag {
+    fn id(&self) -> EffectId {
+        EffectId::RotorDrag
+    }
+
+    fn values(&self) -> Vec<(&'static str, ParameterValue)> {
+        vec![("d", ParameterValue::Vector(self.d.to_vec()))]
+    }
+
+    fn check(&self) -> Result<(), InvalidParameter> {
+        require(
+            self.d.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "rotor_drag.d",
+            "must be two finite non-negative numbers",
+        )
+    }
+
+    fn describe(&self, _gravity_m_s2: f64) -> String {
+        let d = self.d;
+        format!(
+            "Rotor drag proportional to the thrust and linear in the airspeed: {:.3} 1/s edgewise and {:.3} 1/s along the rotor axis (at hover thrust and 5 m/s edgewise airspeed about {:.2} m/s²).",
+            d[0],
+            d[1],
+            5.0 * d[0]
+        )
+    }
+
+    fn thrust_drag(&self, rotation: &Mat3, air_body: Vec3) -> Option<Vec3> {
+        let d = [self.d[0], self.d[0], self.d[1]];
+        Some(mat_vec(rotation, hadamard(d, air_body)))
+    }
+}
+
+impl EffectKind for RotorDrag {
+    const ID: EffectId = EffectId::RotorDrag;
+    const NEUTRAL: Self = Self { d: [0.0; 2] };
+    const ACTS_ON: ChannelGroup = ChannelGroup::Translational;
+
+    fn from_numbers(numbers: &[f64]) -> Self {
+        Self {
+            d: [numbers[0], numbers[1]],
+        }
+    }
+
+    fn fit_range(_index: usize) -> (f64, f64) {
+        (0.0, f64::INFINITY)
+    }
+
+    fn typical(_index: usize) -> f64 {
+        0.1
+    }
+
+    fn fit_starts() -> Vec<Vec<f64>> {
+        vec![vec![0.3, 0.1]]
+    }
+}

@@ -27,6 +27,7 @@
 //! | `translational_lift` | `c` | `T_real ×= 1 + c (v_bx² + v_by²)`, `v_b = Rᵀ (v − w_air)` (s²/m²) |
 //! | `drag_lag` | `tau_s` | the velocity the air terms (drags, lift) see lags `v` by a first-order lag |
 //! | `wind_gradient` | `per_m: 3 × 3`, `reference_m` | the air velocity varies in space: `w_air + G (p − p_ref)` |
+//! | `axial_thrust_loss` | `c` | `T_real ×= max(0, 1 − c v_bz)`: less thrust climbing through the air (s/m) |
 //!
 //! How the hooks compose (the order of each sum and product is the registry's):
 //! `a = [0, 0, −g] + g f R a_T − f Σ thrust drags + Σ air drags` with
@@ -60,6 +61,7 @@ registry::vocabulary! {
     TranslationalLift translational_lift;
     DragLag drag_lag;
     WindGradient wind_gradient;
+    AxialThrustLoss axial_thrust_loss;
 }
 
 use crate::model::{NominalModel, angular_acceleration_with_inertia};

@@ -312,3 +312,32 @@ fn numbers_are_set_and_dependants_removed_through_the_registry() {
     assert!(!drags_gone.contains(EffectId::Wind) && !drags_gone.contains(EffectId::WindGradient));
     assert!(drags_gone.validate().is_ok());
 }
+
+/// The effect added as one file: climbing through the air at 2 m/s with `c = 0.1 s/m` leaves
+/// 80% of the thrust; descending does not add any beyond `1 + c |v_bz|`, and it is checked.
+#[test]
+fn axial_thrust_loss_acts_as_documented() {
+    let m = model();
+    let hover = 20.0;
+    let loss = Effects {
+        axial_thrust_loss: Some(AxialThrustLoss { c: 0.1 }),
+        ..Effects::default()
+    };
+    let climbing =
+        loss.translational_acceleration(&m, &LEVEL, [0.0, 0.0, 2.0], [0.0, 0.0, 5.0], hover);
+    assert!(
+        (climbing[2] - (10.0 * 0.8 - 10.0)).abs() < 1e-12,
+        "{climbing:?}"
+    );
+    let descending =
+        loss.translational_acceleration(&m, &LEVEL, [0.0, 0.0, -2.0], [0.0, 0.0, 5.0], hover);
+    assert!(
+        (descending[2] - (10.0 * 1.2 - 10.0)).abs() < 1e-12,
+        "{descending:?}"
+    );
+    let negative = Effects {
+        axial_thrust_loss: Some(AxialThrustLoss { c: -0.1 }),
+        ..Effects::default()
+    };
+    assert_eq!(negative.validate().unwrap_err().0, "axial_thrust_loss.c");
+}

@@ -266,3 +266,17 @@ fn the_link_check_catches_what_it_is_for() {
         vec!["x.md", "y.svg"]
     );
 }
+
+/// The README's table of effects (its only rows starting with a code span) lists every effect of the registry (`physics::effects`), in its
+/// order, by id: a new effect is documented where users look for it.
+#[test]
+fn the_readme_documents_every_effect_of_the_registry() {
+    let readme = std::fs::read_to_string(root().join("README.md")).expect("README.md");
+    let documented: Vec<&str> = readme
+        .lines()
+        .filter_map(|line| line.strip_prefix("| `"))
+        .filter_map(|rest| rest.split_once('`').map(|(id, _)| id))
+        .collect();
+    let registry: Vec<&str> = physics::EffectId::ALL.map(physics::EffectId::name).to_vec();
+    assert_eq!(documented, registry, "README.md's table of effects");
+}

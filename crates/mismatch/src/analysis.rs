@@ -22,9 +22,9 @@ use crate::noise_reaction::{self, NoiseReaction};
 use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
 use crate::refine::{FitRows, StepBasis, effects_from};
-use crate::selection::{Design, Selection, SelectionSettings, stability_selection};
 use crate::simex::NoiseSources;
-use crate::weak_form::{TestFunction, white_noise_sigma};
+use sindy::stability::{Selection, SelectionSettings, stability_selection};
+use sindy::weak_form::{TestFunction, white_noise_sigma};
 
 /// Settings of an analysis (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -305,7 +305,7 @@ fn analyze_recording(
     let (candidates, mut columns) = build_library(&problem);
     let wind_start = profile_nonlinear(&problem, &before, &candidates, &mut columns, block_rows);
     let groups: Vec<Vec<usize>> = candidates.iter().map(|c| c.columns.clone()).collect();
-    let design = Design::new(&problem, &before, &columns, 0..problem.split, block_rows);
+    let design = problem.design(&before, &columns, 0..problem.split, block_rows);
     observe(Stage::Screening);
     let selection = stability_selection(&design, &groups, &settings.selection);
     let screened = Screened {

@@ -11,7 +11,7 @@
 //!   independent noise, and `ΔSSE` of a noise-only term is about `κ s² χ²_p`;
 //! - **size** (fit part): the mean gain per row and channel is at least `min_gain` noise variances;
 //! - **consistency** (fit part): the mean gain is still at least `min_trimmed_gain` when the two
-//!   blocks (of about a second) that gain most are left out ([`crate::selection::trimmed_gain`]):
+//!   blocks (of about a second) that gain most are left out ([`sindy::stability::trimmed_gain`]):
 //!   not one transient;
 //! - **held out**: on the held-out part, which no fit or choice has seen, the noise-normalised
 //!   residual sum of squares falls by at least `min_heldout_reduction` of its value without the
@@ -27,7 +27,7 @@ use serde::Serialize;
 use crate::fit::FittedSet;
 use crate::problem::{Channels, Problem};
 use crate::refine::{FitRows, standard_errors};
-use crate::selection::trimmed_gain;
+use sindy::stability::trimmed_gain;
 
 /// The thresholds of the rule (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -13,7 +13,7 @@ use crate::refine::{
     FitRows, effect_column, effects_from, levenberg_marquardt, profile_search, profile_wind,
     unit_drag_in_wind,
 };
-use crate::selection::{Design, Selection};
+use sindy::stability::{BlockDesign, Selection};
 
 const GROUND_RADIUS: EffectNumber = EffectNumber::new(EffectId::GroundEffect, 0);
 const DELAY: EffectNumber = EffectNumber::new(EffectId::Delay, 0);
@@ -163,7 +163,7 @@ fn screen_estimates(
     problem: &Problem,
     candidates: &[&Candidate],
     columns: &[Vec<Channels>],
-    design: &Design,
+    design: &BlockDesign,
     block_rows: usize,
 ) -> FittedSet {
     let kept_columns: Vec<usize> = candidates.iter().flat_map(|c| c.columns.clone()).collect();
@@ -251,7 +251,7 @@ fn profiled_ground_radius(
 pub struct Screened<'a> {
     pub candidates: &'a [Candidate],
     pub columns: &'a [Vec<Channels>],
-    pub design: &'a Design,
+    pub design: &'a BlockDesign,
     pub selection: &'a Selection,
 }
 

@@ -15,7 +15,7 @@
 //! `report`'s types, re-exported here. This crate computes the results and writes the files.
 //!
 //! Method in one paragraph (the long version: `docs/mismatch.md`): the recording and the model are
-//! compared in the weak form ([`weak_form`]: the recorded velocity and body rate against the model's
+//! compared in the weak form ([`weak_form`], from `sindy`: the recorded velocity and body rate against the model's
 //! acceleration through the same smooth test function), the model's commands reconstructed as its
 //! logger says ([`forward`]; instantaneous samples of a mixer's speeds through the per-rotor thrust,
 //! runs at an actuator limit continued beyond it: [`command_samples`]); sampled commands of a faster
@@ -52,9 +52,8 @@ mod output;
 mod problem;
 mod recording;
 mod refine;
-mod selection;
+
 pub mod simex;
-pub mod weak_form;
 
 pub use analysis::{
     Analysis, AnalysisSettings, ChannelReport, EffectReport, Fit, NoiseFree, Report, Stage, Window,
@@ -71,6 +70,7 @@ pub use output::{
 pub use problem::{CHANNEL_NAMES, Channels, Problem};
 pub use recording::Recording;
 pub use refine::{FitRows, effects_from, levenberg_marquardt};
-pub use selection::{
-    Design, Selection, SelectionSettings, stability_selection, stepwise, trimmed_gain,
+pub use sindy::stability::{
+    BlockDesign, Selection, SelectionSettings, stability_selection, stepwise, trimmed_gain,
 };
+pub use sindy::weak_form;

@@ -3,13 +3,14 @@
 //! the residual and its noise floor, per channel.
 
 use physics::{CommandLogging, Effects, NominalModel};
+use sindy::stability::BlockDesign;
+use sindy::weak_form::{TestFunction, WeakForm, white_noise_sigma};
 
 use crate::error::{MismatchError, Result};
 use crate::forward::{
     RowPrediction, SUBSTEPS, accelerations_at_rows, predict_at_rows, predict_substeps,
 };
 use crate::recording::Recording;
-use crate::weak_form::{TestFunction, WeakForm, white_noise_sigma};
 
 /// The fewest test-function windows a recording must span.
 pub const MIN_WINDOWS: usize = 8;
@@ -52,6 +53,28 @@ pub struct Problem {
 }
 
 impl Problem {
+    /// The whitened regression of `residual` on `columns` over analysed rows `range`, by blocks
+    /// of `block_rows` rows: every channel of a row is a sample, divided by the channel's noise
+    /// floor.
+    pub fn design(
+        &self,
+        residual: &[Channels],
+        columns: &[Vec<Channels>],
+        range: std::ops::Range<usize>,
+        block_rows: usize,
+    ) -> BlockDesign {
+        let channels = self.channels;
+        let samples = range.len() * channels;
+        BlockDesign::from_samples(samples, block_rows * channels, columns.len(), |i, x| {
+            let (row, c) = (range.start + i / channels, i % channels);
+            let scale = 1.0 / self.noise_floor[c];
+            for (value, column) in x.iter_mut().zip(columns) {
+                *value = column[row][c] * scale;
+            }
+            residual[row][c] * scale
+        })
+    }
+
     /// Builds the comparison; `heldout_fraction` of the analysed rows (the last ones) are held out.
     pub fn new(
         recording: Recording,

@@ -11,7 +11,7 @@ use crate::command_samples::{ActuatorLimits, CommandSamples, SampleDomain, detec
 use crate::degenerate;
 use crate::error::{MismatchError, Result};
 use crate::noise_reaction::{self, NoiseReaction};
-use crate::weak_form::white_noise_sigma;
+use sindy::weak_form::white_noise_sigma;
 
 /// The recorded signals, per row.
 #[derive(Clone, Debug)]

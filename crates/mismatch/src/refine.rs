@@ -8,7 +8,6 @@ use faer::linalg::solvers::Solve;
 use physics::{EffectNumber, Effects, QuadraticDrag, Wind};
 
 use crate::problem::{Channels, Problem};
-use crate::selection::Design;
 
 /// Effects built from parameter values (absent parameters keep their effect absent; the other
 /// numbers of a present effect are neutral).
@@ -289,7 +288,7 @@ pub fn projected_sse(
         .map(|c| (*c).clone())
         .chain(others.iter().map(|&c| columns[c].clone()))
         .collect();
-    let design = Design::new(problem, residual, &used, range, block_rows);
+    let design = problem.design(residual, &used, range, block_rows);
     let all: Vec<usize> = (0..used.len()).collect();
     if !extra.is_empty() {
         // Extra columns are physical effects with non-negative coefficients (drag): a negative

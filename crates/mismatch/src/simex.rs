@@ -37,7 +37,7 @@ use crate::fit::FittedSet;
 use crate::noise_reaction;
 use crate::problem::Problem;
 use crate::refine::{FitRows, levenberg_marquardt};
-use crate::weak_form::white_noise_sigma;
+use sindy::weak_form::white_noise_sigma;
 
 /// Settings of the correction (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -18,7 +18,10 @@
 //!
 //! Beyond PySINDy: regularised regressions of targets on any feature matrix with the penalty
 //! chosen by blocked cross-validation, and bagged ensembles with a predictive band
-//! ([`RegressionSpec`]).
+//! ([`RegressionSpec`]); the weak form of an equation through a smooth test function
+//! ([`weak_form`], as PySINDy's weak libraries); forward stepwise selection of column groups
+//! with time-blocked cross-validation and stability selection over block-bootstrap resamples
+//! ([`stability`]).
 //!
 //! # What it is not for
 //! Reading recordings or CSV files (the `data` crate does: this crate depends on no file reader
@@ -75,7 +78,9 @@ mod model;
 mod optimizers;
 mod persist;
 mod regression;
+pub mod stability;
 mod stream;
+pub mod weak_form;
 
 pub use differentiation::{
     Derivative, DifferentiationError, SAVITZKY_GOLAY_STEP_TOLERANCE, UNIFORM_STEP_TOLERANCE,

@@ -47,7 +47,7 @@ use crate::error::{MismatchError, Result};
 use crate::output::{check_directory, check_run_outputs};
 use crate::problem::Problem;
 use crate::recording::Recording;
-use crate::weak_form::TestFunction;
+use sindy::weak_form::TestFunction;
 
 pub use self::report::FleetReport;
 pub use ::report::mismatch::fleet::{

@@ -13,7 +13,7 @@ use super::{
     AttitudeCheck, FleetReport, FleetSettings, FlightHeldout, FlightSpeedRange, FlightWind,
     ScaleReport, SelectionStep, Targets,
 };
-use crate::weak_form::TestFunction;
+use sindy::weak_form::TestFunction;
 
 fn committed(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

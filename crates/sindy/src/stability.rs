@@ -1,8 +1,13 @@
-//! Model selection on the residual: forward stepwise selection of candidate groups scored by
-//! time-blocked cross-validation, repeated on block-bootstrap resamples (stability selection).
+//! Selection of groups of columns: forward stepwise selection scored by time-blocked
+//! cross-validation, repeated on block-bootstrap resamples (stability selection, as PySINDy's
+//! ensembles but over contiguous blocks of a time series).
 //!
-//! Rows are whitened (each channel divided by its noise floor), so on noise alone the mean square
-//! per row and channel is about 1. A group enters only when it lowers the cross-validated error in
+//! The regression `target ≈ columns · θ` is summarised per contiguous block of samples by its Gram
+//! matrix ([`BlockDesign`]); the folds of the cross-validation are contiguous runs of blocks (block
+//! `b` of `B` in fold `⌊b F / B⌋`), and a resample draws `B` blocks with replacement (a block drawn
+//! `w` times has weight `w`). Samples are expected whitened (divided by their noise scale), so on
+//! noise alone the mean square per sample is about 1. A group enters only when it lowers the
+//! cross-validated error in
 //! every sense that matters: on average by at least `min_gain` (noise-floor units), and still by
 //! `min_gain` once the two blocks that gain most are left out ([`trimmed_gain`]), so that an effect
 //! present in only part of the flight, or much stronger in some blocks than in others, can enter,
@@ -16,8 +21,6 @@ use faer::linalg::solvers::Solve;
 use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use serde::Serialize;
-
-use crate::problem::{Channels, Problem};
 
 /// Settings of the selection (all recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -41,9 +44,9 @@ impl Default for SelectionSettings {
     }
 }
 
-/// Per-block sufficient statistics of the whitened regression `residual ≈ columns · θ`.
+/// Per-block sufficient statistics of the whitened regression `target ≈ columns · θ`.
 #[derive(Clone, Debug)]
-pub struct Design {
+pub struct BlockDesign {
     grams: Vec<Mat<f64>>,
     cross: Vec<Vec<f64>>,
     target_squares: Vec<f64>,
@@ -52,16 +55,17 @@ pub struct Design {
     parameters: usize,
 }
 
-impl Design {
-    /// Builds the block statistics over analysed rows `range`.
-    pub fn new(
-        problem: &Problem,
-        residual: &[Channels],
-        columns: &[Vec<Channels>],
-        range: std::ops::Range<usize>,
-        block_rows: usize,
+impl BlockDesign {
+    /// Builds the block statistics of `samples` samples in order, cut into blocks of
+    /// `block_samples` (the last may be shorter), with `parameters` columns: `sample(i, x)` writes
+    /// the columns of sample `i` into `x` and returns its target.
+    pub fn from_samples(
+        samples: usize,
+        block_samples: usize,
+        parameters: usize,
+        mut sample: impl FnMut(usize, &mut [f64]) -> f64,
     ) -> Self {
-        let p = columns.len();
+        let p = parameters;
         let mut design = Self {
             grams: Vec::new(),
             cross: Vec::new(),
@@ -69,28 +73,22 @@ impl Design {
             counts: Vec::new(),
             parameters: p,
         };
-        let mut start = range.start;
-        while start < range.end {
-            let end = (start + block_rows).min(range.end);
+        let mut x = vec![0.0; p];
+        let mut start = 0;
+        while start < samples {
+            let end = (start + block_samples.max(1)).min(samples);
             let mut gram = Mat::<f64>::zeros(p, p);
             let mut cross = vec![0.0; p];
             let mut squares = 0.0;
-            let mut x = vec![0.0; p];
-            for row in start..end {
-                for c in 0..problem.channels {
-                    let scale = 1.0 / problem.noise_floor[c];
-                    let y = residual[row][c] * scale;
-                    for j in 0..p {
-                        x[j] = columns[j][row][c] * scale;
+            for k in start..end {
+                let y = sample(k, &mut x);
+                for i in 0..p {
+                    cross[i] += x[i] * y;
+                    for j in 0..=i {
+                        gram[(i, j)] += x[i] * x[j];
                     }
-                    for i in 0..p {
-                        cross[i] += x[i] * y;
-                        for j in 0..=i {
-                            gram[(i, j)] += x[i] * x[j];
-                        }
-                    }
-                    squares += y * y;
                 }
+                squares += y * y;
             }
             for i in 0..p {
                 for j in 0..i {
@@ -100,9 +98,7 @@ impl Design {
             design.grams.push(gram);
             design.cross.push(cross);
             design.target_squares.push(squares);
-            design
-                .counts
-                .push(((end - start) * problem.channels) as f64);
+            design.counts.push((end - start) as f64);
             start = end;
         }
         design
@@ -141,7 +137,7 @@ impl Design {
         (0..k).map(|i| solution[(i, 0)]).collect()
     }
 
-    /// Sum of squared whitened residuals of block `b` with coefficients `theta` on `columns`.
+    /// Sum of squared residuals of block `b` with coefficients `theta` on `columns`.
     fn block_sse(&self, b: usize, columns: &[usize], theta: &[f64]) -> f64 {
         let mut sse = self.target_squares[b];
         for (i, &ci) in columns.iter().enumerate() {
@@ -153,7 +149,7 @@ impl Design {
         sse
     }
 
-    /// Cross-validated mean square per row and channel of every block: each block is predicted by
+    /// Cross-validated mean square per sample of every block: each block is predicted by
     /// the fit on the folds it is not in. Blocks with zero weight give NaN.
     pub fn block_errors(
         &self,
@@ -179,7 +175,7 @@ impl Design {
         errors
     }
 
-    /// In-sample whitened sum of squares with all blocks and least-squares coefficients.
+    /// In-sample sum of squares with all blocks and least-squares coefficients.
     pub fn fitted_sse(&self, columns: &[usize]) -> f64 {
         let ones = vec![1.0; self.blocks()];
         let theta = self.solve(&ones, columns);
@@ -217,7 +213,7 @@ pub fn trimmed_gain(gains: &[(f64, f64)]) -> f64 {
 
 /// Forward stepwise selection of groups; returns the chosen group indices in order of entry.
 pub fn stepwise(
-    design: &Design,
+    design: &BlockDesign,
     weights: &[f64],
     groups: &[Vec<usize>],
     settings: &SelectionSettings,
@@ -283,7 +279,7 @@ pub struct Selection {
 
 /// Stepwise selection on the data and on block-bootstrap resamples.
 pub fn stability_selection(
-    design: &Design,
+    design: &BlockDesign,
     groups: &[Vec<usize>],
     settings: &SelectionSettings,
 ) -> Selection {
@@ -315,5 +311,70 @@ pub fn stability_selection(
         chosen_on_data,
         frequencies,
         kept,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    use super::*;
+
+    /// `samples` whitened samples of `y = 0.8 x0 − 0.5 x1 + noise` with four columns in two
+    /// groups of two ({x0, x1} acts, {x2, x3} is noise), in blocks of 50.
+    fn design(samples: usize, signal: f64) -> BlockDesign {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let rows: Vec<([f64; 4], f64)> = (0..samples)
+            .map(|_| {
+                let x: [f64; 4] = std::array::from_fn(|_| StandardNormal.sample(&mut rng));
+                let noise: f64 = StandardNormal.sample(&mut rng);
+                (x, signal * (0.8 * x[0] - 0.5 * x[1]) + noise)
+            })
+            .collect();
+        BlockDesign::from_samples(samples, 50, 4, |i, x| {
+            x.copy_from_slice(&rows[i].0);
+            rows[i].1
+        })
+    }
+
+    const GROUPS: [&[usize]; 2] = [&[0, 1], &[2, 3]];
+
+    fn groups() -> Vec<Vec<usize>> {
+        GROUPS.iter().map(|g| g.to_vec()).collect()
+    }
+
+    #[test]
+    fn the_acting_group_is_kept_and_the_other_is_not() {
+        let design = design(2000, 1.0);
+        assert_eq!(design.blocks(), 40);
+        let settings = SelectionSettings::default();
+        let selection = stability_selection(&design, &groups(), &settings);
+        assert_eq!(selection.chosen_on_data, [0]);
+        assert_eq!(selection.kept, [0]);
+        assert!(selection.frequencies[0] > 0.95 && selection.frequencies[1] < 0.3);
+        let theta = design.solve(&vec![1.0; design.blocks()], &[0, 1]);
+        assert!(
+            (theta[0] - 0.8).abs() < 0.05 && (theta[1] + 0.5).abs() < 0.05,
+            "{theta:?}"
+        );
+    }
+
+    #[test]
+    fn on_noise_alone_nothing_is_kept() {
+        let design = design(2000, 0.0);
+        let selection = stability_selection(&design, &groups(), &SelectionSettings::default());
+        assert!(selection.kept.is_empty(), "{selection:?}");
+    }
+
+    /// A gain carried by two blocks is trimmed away; one spread over every block is kept.
+    #[test]
+    fn the_trimmed_gain_ignores_the_two_largest_blocks() {
+        let transient: Vec<(f64, f64)> = (0..10)
+            .map(|b| (1.0, if b < 2 { 5.0 } else { 0.0 }))
+            .collect();
+        assert_eq!(trimmed_gain(&transient), 0.0);
+        let spread: Vec<(f64, f64)> = (0..10).map(|_| (1.0, 0.2)).collect();
+        assert!((trimmed_gain(&spread) - 0.2).abs() < 1e-12);
     }
 }

@@ -323,7 +323,7 @@ impl RecordingView<'_> {
         };
         let _ = write!(
             md,
-            "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is {shares}. The gain a factor fits through such a channel (a thrust scale's k, an inertia scale's 1/k) comes out smaller by up to about that share, and its standard error does not include it (errors in variables; `docs/mismatch.md` §3); the noise floor does include it, so a weak effect on such a channel may go unnamed."
+            "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is {shares}. The gain a factor fits through such a channel (a thrust scale's k, an inertia scale's 1/k) comes out smaller by up to about that share, and its standard error does not include it (errors in variables; `docs/mismatch.md`, \"Noise in the model's inputs\"); the noise floor does include it, so a weak effect on such a channel may go unnamed."
         );
         let remedy = "Logging the mean command over each log period (`\"command\": \"period_mean\"`) or every command removes most of it.";
         let _ = match self.command_sampling {

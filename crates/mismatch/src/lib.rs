@@ -46,6 +46,7 @@ pub mod evidence;
 mod fit;
 pub mod fleet;
 pub mod forward;
+pub mod least_squares;
 mod library;
 pub mod noise_reaction;
 mod output;

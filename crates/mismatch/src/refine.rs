@@ -10,8 +10,8 @@ use faer::linalg::solvers::Solve;
 use physics::{EffectNumber, Effects, QuadraticDrag, Wind};
 
 use crate::least_squares::{
-    DenseProblem, LevenbergMarquardt, LevenbergMarquardtParams, Solution, forward_jacobian,
-    normal_matrix,
+    ActiveBounds, DenseProblem, LevenbergMarquardt, LevenbergMarquardtParams, Solution,
+    forward_jacobian, normal_matrix,
 };
 use crate::problem::{Channels, Problem};
 
@@ -220,6 +220,7 @@ static SOLVER: LazyLock<LevenbergMarquardt> = LazyLock::new(|| {
         increase: 10.0,
         decrease: 3.0,
         tolerance: 1e-9,
+        active_bounds: ActiveBounds::Project,
     }
     .checked()
     .expect("the single-recording solver's settings are valid")

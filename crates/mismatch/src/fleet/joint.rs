@@ -12,7 +12,7 @@ use physics::{EffectId, EffectNumber, Effects, Wind, WindGradient};
 use rayon::prelude::*;
 
 use crate::least_squares::{
-    LeastSquares, LevenbergMarquardt, LevenbergMarquardtParams, Termination,
+    ActiveBounds, LeastSquares, LevenbergMarquardt, LevenbergMarquardtParams, Termination, hold,
 };
 use crate::problem::Problem;
 
@@ -243,6 +243,7 @@ static SOLVER: LazyLock<LevenbergMarquardt> = LazyLock::new(|| {
         increase: 10.0,
         decrease: 3.0,
         tolerance: 1e-7,
+        active_bounds: ActiveBounds::Project,
     }
     .checked()
     .expect("the joint solver's settings are valid")
@@ -343,8 +344,15 @@ impl LeastSquares for JointProblem<'_> {
             .collect()
     }
 
-    fn damped_step(&self, parts: &Vec<Linearisation>, damping: f64) -> Option<Vec<f64>> {
-        let (vehicle_step, air_steps) = solve_step(parts, self.free.len(), damping)?;
+    fn damped_step(
+        &self,
+        parts: &Vec<Linearisation>,
+        damping: f64,
+        held: &[bool],
+    ) -> Option<Vec<f64>> {
+        // Only vehicle parameters have bounds: the airs' are never held.
+        let held = &held[..self.free.len()];
+        let (vehicle_step, air_steps) = solve_step(parts, self.free.len(), damping, held)?;
         Some(
             vehicle_step
                 .into_iter()
@@ -392,11 +400,13 @@ pub fn fit(
 }
 
 /// One damped Gauss–Newton step for the vehicle and every flight's air, through the Schur
-/// complement of the air blocks. `None` when a system is singular.
+/// complement of the air blocks, the `held` vehicle parameters not moving. `None` when a system is
+/// singular.
 fn solve_step(
     parts: &[Linearisation],
     free: usize,
     damping: f64,
+    held: &[bool],
 ) -> Option<(Vec<f64>, Vec<Vec<f64>>)> {
     let mut reduced = Mat::<f64>::zeros(free, free);
     let mut rhs = Mat::<f64>::zeros(free, 1);
@@ -446,9 +456,12 @@ fn solve_step(
             }
         }
     }
+    hold(&mut reduced, &mut rhs, held);
     let vehicle_step: Vec<f64> = if free > 0 {
         let solution = reduced.full_piv_lu().solve(&rhs);
-        (0..free).map(|i| solution[(i, 0)]).collect()
+        (0..free)
+            .map(|i| if held[i] { 0.0 } else { solution[(i, 0)] })
+            .collect()
     } else {
         Vec::new()
     };

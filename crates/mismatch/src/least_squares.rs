@@ -1,6 +1,6 @@
 //! The nonlinear least-squares solver of the crate: Levenberg–Marquardt with bounds, for the fits
-//! of one recording ([`crate::refine`]) and the joint fit of a fleet ([`crate::fleet`]'s vehicle
-//! and airs).
+//! of one recording ([`crate::levenberg_marquardt`]) and the joint fit of a fleet
+//! ([`crate::fleet`]'s vehicle and airs).
 //!
 //! It minimises `S(x) = ‖r(x)‖²` over parameters `x` within bounds `l ≤ x ≤ u` (each bound may be
 //! infinite). From the start, projected onto the bounds, each iteration linearises `r` at `x`
@@ -50,7 +50,8 @@ pub trait LeastSquares {
     /// The number of parameters.
     fn dimension(&self) -> usize;
 
-    /// The lower and upper bound of parameter `index` (infinite where there is none).
+    /// The lower and upper bound of parameter `index` (infinite where there is none; lower ≤
+    /// upper, neither NaN).
     fn bounds(&self, index: usize) -> (f64, f64);
 
     /// The residual at `x`.

@@ -17,6 +17,7 @@ use crate::estimate::{self, Estimate, EstimateSettings};
 use crate::evidence::{self, Evidence, EvidenceSettings, explained_fractions};
 use crate::fit::{FitAlternatives, Screened, fit_parameters, profile_nonlinear};
 use crate::forward;
+use crate::least_squares::Termination;
 use crate::library::{Candidate, build_library};
 use crate::noise_reaction::{self, NoiseReaction};
 use crate::problem::{CHANNEL_NAMES, Channels, Problem};
@@ -145,6 +146,10 @@ pub struct Report {
     pub estimate_downweighted_fraction: f64,
     /// Times (s) of the command steps between samples whose place the final estimate left free.
     pub estimate_step_times: Vec<f64>,
+    /// Why the solver stopped in the final estimate's last reweighting pass (absent when it fitted
+    /// nothing).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimate_termination: Option<Termination>,
     /// The noises whose bias the final estimate measured and removed ([`crate::simex`]), when it did.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub estimate_noise_bias: Option<NoiseSources>,
@@ -646,6 +651,7 @@ fn build_report(
         },
         estimate_downweighted_fraction: estimate.downweighted_fraction,
         estimate_step_times: estimate.step_times.clone(),
+        estimate_termination: estimate.termination,
         estimate_noise_bias: estimate.noise_bias.as_ref().map(|b| b.sources),
         command_limits: (problem.recording.samples.rows_held() > 0)
             .then_some(problem.recording.command_limits),

@@ -78,6 +78,12 @@ pub enum MismatchError {
         field: String,
         message: String,
     },
+    /// A Levenberg–Marquardt setting out of its range ([`crate::least_squares`]).
+    #[error("Levenberg–Marquardt setting '{setting}': {message}")]
+    SolverSetting {
+        setting: &'static str,
+        message: String,
+    },
     /// An output the `report` crate could not render (a figure that cannot be drawn is [`Plot`]).
     ///
     /// [`Plot`]: MismatchError::Plot

@@ -28,6 +28,7 @@ use serde::Serialize;
 
 use crate::evidence::autocorrelation_factor;
 use crate::fit::FittedSet;
+use crate::least_squares::Termination;
 use crate::noise_reaction::median;
 use crate::problem::{Channels, Problem};
 use crate::refine::{FitRows, StepBasis, levenberg_marquardt, standard_errors};
@@ -66,6 +67,8 @@ pub struct Estimate {
     pub noise_bias: Option<NoiseBias>,
     /// Times of the command steps between samples whose place within their interval was left free.
     pub step_times: Vec<f64>,
+    /// Why the last reweighting pass's fit stopped (none when no fit ran: no parameters or passes).
+    pub termination: Option<Termination>,
 }
 
 /// Estimates the parameters of `judged` (the evidence rule's set) on all rows with Huber weights.
@@ -85,10 +88,12 @@ pub fn estimate(
             downweighted_fraction: 0.0,
             noise_bias: None,
             step_times,
+            termination: None,
         };
     }
     let mut residual = problem.residual(&set.effects());
     let mut weights = huber_weights(problem, &residual, settings);
+    let mut termination = None;
     for _ in 0..settings.passes {
         let weighted = FitRows {
             range: all.clone(),
@@ -100,8 +105,10 @@ pub fn estimate(
             steps: Some(&steps),
             ..weighted
         };
-        set.values =
-            levenberg_marquardt(problem, &set.parameters, &set.values, &rows, iterations).0;
+        let solution =
+            levenberg_marquardt(problem, &set.parameters, &set.values, &rows, iterations);
+        set.values = solution.values;
+        termination = Some(solution.termination);
         residual = problem.residual(&set.effects());
         weights = huber_weights(problem, &residual, settings);
     }
@@ -147,6 +154,7 @@ pub fn estimate(
         downweighted_fraction: downweighted as f64 / count,
         noise_bias,
         step_times,
+        termination,
     }
 }
 

@@ -59,15 +59,15 @@ impl FittedSet {
 
     /// Refits all values by Levenberg–Marquardt on the fit rows; returns the whitened error.
     pub fn refit(&mut self, problem: &Problem, iterations: usize) -> f64 {
-        let (values, sse) = levenberg_marquardt(
+        let solution = levenberg_marquardt(
             problem,
             &self.parameters,
             &self.values,
             &FitRows::plain(0..problem.split),
             iterations,
         );
-        self.values = values;
-        sse
+        self.values = solution.values;
+        solution.sum_of_squares
     }
 }
 

@@ -22,7 +22,8 @@
 //! controller first lose their unfelt reaction to the logged noise ([`noise_reaction`]). Candidates are
 //! screened by forward stepwise selection with blocked cross-validation and kept by stability
 //! selection over block-bootstrap resamples; their parameters are fitted jointly with the exact model
-//! on the first part of the recording; each effect is then named only when the evidence rule holds
+//! on the first part of the recording (Levenberg–Marquardt, [`least_squares`], the solver of every
+//! fit here); each effect is then named only when the evidence rule holds
 //! for it ([`evidence`]), and the named effects' parameters are estimated again on all rows with
 //! robust weights, each command step between samples with its time left free, and the bias the
 //! sampled commands' noise leaves measured and removed ([`estimate`], [`simex`]). Several
@@ -46,6 +47,7 @@ pub mod evidence;
 mod fit;
 pub mod fleet;
 pub mod forward;
+pub mod least_squares;
 mod library;
 pub mod noise_reaction;
 mod output;

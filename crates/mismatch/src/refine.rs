@@ -3,10 +3,16 @@
 //! ground-effect radius), then Levenberg–Marquardt on all parameters together (whitened residual,
 //! fit rows only).
 
+use std::sync::LazyLock;
+
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use physics::{EffectNumber, Effects, QuadraticDrag, Wind};
 
+use crate::least_squares::{
+    ActiveBounds, DenseProblem, LevenbergMarquardt, LevenbergMarquardtParams, Solution,
+    forward_jacobian, normal_matrix,
+};
 use crate::problem::{Channels, Problem};
 
 /// Effects built from parameter values (absent parameters keep their effect absent; the other
@@ -144,45 +150,6 @@ fn whitened_residual(
     )
 }
 
-/// The forward-difference Jacobian of `evaluate` at `values` (one column per parameter, as rows).
-fn forward_jacobian(
-    parameters: &[EffectNumber],
-    values: &[f64],
-    residual: &[f64],
-    evaluate: &dyn Fn(&[f64]) -> Vec<f64>,
-) -> Vec<Vec<f64>> {
-    (0..parameters.len())
-        .map(|j| {
-            let step = 1e-4 * values[j].abs().max(parameters[j].typical());
-            let mut shifted = values.to_vec();
-            shifted[j] += step;
-            evaluate(&shifted)
-                .iter()
-                .zip(residual)
-                .map(|(a, b)| (a - b) / step)
-                .collect()
-        })
-        .collect()
-}
-
-/// `JᵀJ` of a Jacobian given by columns.
-fn normal_matrix(jacobian: &[Vec<f64>]) -> Mat<f64> {
-    let k = jacobian.len();
-    let mut normal = Mat::<f64>::zeros(k, k);
-    for i in 0..k {
-        for j in 0..=i {
-            let v: f64 = jacobian[i]
-                .iter()
-                .zip(&jacobian[j])
-                .map(|(a, b)| a * b)
-                .sum();
-            normal[(i, j)] = v;
-            normal[(j, i)] = v;
-        }
-    }
-    normal
-}
-
 /// Standard errors of fitted `values`: `√diag(scale · (JᵀJ)⁻¹)` with `J` the Jacobian of the
 /// (weighted) whitened residual on the fit's rows, and `scale` the variance of a whitened residual
 /// element times the residual's integrated autocorrelation (neighbouring rows share samples). NaN
@@ -194,9 +161,13 @@ pub fn standard_errors(
     rows: &FitRows,
     scale: f64,
 ) -> Vec<f64> {
-    let evaluate = |values: &[f64]| whitened_residual(problem, parameters, values, rows);
-    let residual = evaluate(values);
-    let jacobian = forward_jacobian(parameters, values, &residual, &evaluate);
+    let fit = WhitenedFit {
+        problem,
+        parameters,
+        rows,
+    };
+    let residual = fit.residual(values);
+    let jacobian = forward_jacobian(&fit, values, &residual);
     let k = parameters.len();
     let inverse = normal_matrix(&jacobian)
         .full_piv_lu()
@@ -213,64 +184,63 @@ pub fn standard_errors(
         .collect()
 }
 
-/// Levenberg–Marquardt with a forward-difference Jacobian and bounds by projection, on the
-/// (weighted) whitened residual of the fit's rows.
+/// The whitened residual of the fit's rows as a function of the parameters' values.
+struct WhitenedFit<'a> {
+    problem: &'a Problem,
+    parameters: &'a [EffectNumber],
+    rows: &'a FitRows<'a>,
+}
+
+impl DenseProblem for WhitenedFit<'_> {
+    fn dimension(&self) -> usize {
+        self.parameters.len()
+    }
+
+    fn bounds(&self, index: usize) -> (f64, f64) {
+        self.parameters[index].fit_range()
+    }
+
+    fn residual(&self, values: &[f64]) -> Vec<f64> {
+        whitened_residual(self.problem, self.parameters, values, self.rows)
+    }
+
+    fn difference_step(&self, index: usize, value: f64) -> f64 {
+        self.parameters[index].step(value)
+    }
+}
+
+/// The solver of one recording's fits: 8 damped steps an iteration, converged when a step lowers
+/// the sum of squares by at most 1e-9 of it (the values the fits were tuned with).
+static SOLVER: LazyLock<LevenbergMarquardt> = LazyLock::new(|| {
+    LevenbergMarquardtParams {
+        iterations: 40,
+        tries: 8,
+        initial_damping: 1e-3,
+        min_damping: 1e-9,
+        increase: 10.0,
+        decrease: 3.0,
+        tolerance: 1e-9,
+        active_bounds: ActiveBounds::Project,
+    }
+    .checked()
+    .expect("the single-recording solver's settings are valid")
+});
+
+/// Levenberg–Marquardt ([`crate::least_squares`]) on the (weighted) whitened residual of the
+/// fit's rows, at most `iterations` linearisations, the parameters within their fit ranges.
 pub fn levenberg_marquardt(
     problem: &Problem,
     parameters: &[EffectNumber],
     initial: &[f64],
     rows: &FitRows,
     iterations: usize,
-) -> (Vec<f64>, f64) {
-    let project = |values: &mut [f64]| {
-        for (v, p) in values.iter_mut().zip(parameters) {
-            *v = p.clamp(*v);
-        }
+) -> Solution {
+    let fit = WhitenedFit {
+        problem,
+        parameters,
+        rows,
     };
-    let mut values = initial.to_vec();
-    project(&mut values);
-    let evaluate = |values: &[f64]| whitened_residual(problem, parameters, values, rows);
-    let mut residual = evaluate(&values);
-    let mut sse: f64 = residual.iter().map(|r| r * r).sum();
-    let k = parameters.len();
-    if k == 0 {
-        return (values, sse);
-    }
-    let mut damping = 1e-3;
-    for _ in 0..iterations {
-        let jacobian = forward_jacobian(parameters, &values, &residual, &evaluate);
-        let normal = normal_matrix(&jacobian);
-        let mut gradient = Mat::<f64>::zeros(k, 1);
-        for i in 0..k {
-            gradient[(i, 0)] = jacobian[i].iter().zip(&residual).map(|(a, b)| a * b).sum();
-        }
-        let mut improved = false;
-        for _ in 0..8 {
-            let mut system = normal.clone();
-            for i in 0..k {
-                system[(i, i)] += damping * normal[(i, i)].max(1e-12);
-            }
-            let step = system.full_piv_lu().solve(&gradient);
-            let mut trial: Vec<f64> = (0..k).map(|i| values[i] - step[(i, 0)]).collect();
-            project(&mut trial);
-            let trial_residual = evaluate(&trial);
-            let trial_sse: f64 = trial_residual.iter().map(|r| r * r).sum();
-            if trial_sse.is_finite() && trial_sse < sse {
-                let relative = (sse - trial_sse) / sse.max(1e-300);
-                values = trial;
-                residual = trial_residual;
-                sse = trial_sse;
-                damping = (damping / 3.0).max(1e-9);
-                improved = relative > 1e-9;
-                break;
-            }
-            damping *= 10.0;
-        }
-        if !improved {
-            break;
-        }
-    }
-    (values, sse)
+    SOLVER.with_iterations(iterations).run(&fit, initial)
 }
 
 /// Whitened sum of squares of `residual` after regressing it on `extra` and `columns[others]`.

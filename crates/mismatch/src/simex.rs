@@ -136,7 +136,7 @@ pub fn noise_bias(
                 );
                 let values =
                     levenberg_marquardt(&perturbed, &set.parameters, &set.values, rows, iterations)
-                        .0;
+                        .values;
                 for ((m, v), v0) in mean.iter_mut().zip(&values).zip(&set.values) {
                     *m += 0.5 * (v - v0);
                 }

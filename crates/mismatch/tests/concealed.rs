@@ -1,6 +1,7 @@
 //! Behaviour on short simulated flights: nothing on noise alone, the right effect and parameter
 //! when one is concealed, outputs that refuse to overwrite, errors that name the problem.
 
+use mismatch::least_squares::Termination;
 use mismatch::{AnalysisSettings, MismatchError, NoiseFree, analyze, check_outputs, write_outputs};
 use physics::{EffectId, Effects, NominalModel, Scenario, ThrustScale, TorqueBias, simulate};
 
@@ -267,6 +268,8 @@ fn a_misplaced_command_step_is_not_an_unexplained_residual() {
         analysis.report.unexplained
     );
     assert!(analysis.report.estimate_step_times.len() >= 3);
+    // Nothing named, nothing estimated: no solver ran, and the report says none.
+    assert_eq!(analysis.report.estimate_termination, None);
 
     // A bump of 0.5 rad/s on the logged roll rate over 30-33 s (peak 0.52 rad/s², about five
     // noise floors), across the step at 31.0 s.
@@ -355,6 +358,10 @@ fn command_steps_between_samples_do_not_pull_a_noisy_estimate() {
     assert!(!analysis.report.estimate_step_times.is_empty());
     let (k, error) = inertia_error(&analysis);
     assert!(error < 0.04, "{k:?}: {error}");
+    assert_eq!(
+        analysis.report.estimate_termination,
+        Some(Termination::Converged)
+    );
 }
 
 /// Configuration A's sampled commands carry the controller's reaction to the gyro noise, which

@@ -4,11 +4,16 @@
 //! dense, each flight's wind block touches only its flight), solved through the Schur complement of
 //! the wind blocks, so a fit of thirty flights costs a few small solves per iteration.
 
+use std::sync::LazyLock;
+
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use physics::{EffectId, EffectNumber, Effects, Wind, WindGradient};
 use rayon::prelude::*;
 
+use crate::least_squares::{
+    ActiveBounds, LeastSquares, LevenbergMarquardt, LevenbergMarquardtParams, Termination, hold,
+};
 use crate::problem::Problem;
 
 /// The vehicle numbers of effect `id`: all of its numbers, none for the effects that describe
@@ -162,6 +167,8 @@ pub struct JointFit {
     pub vehicle: Vehicle,
     /// Per flight: its air (still for calm flights or a vehicle without drag).
     pub airs: Vec<Air>,
+    /// Why the solver stopped.
+    pub termination: Termination,
 }
 
 fn scaled_residual(
@@ -182,15 +189,15 @@ fn scaled_residual(
 /// and to the flight's air parameters (empty for calm flights).
 type Linearisation = (Vec<f64>, Vec<Vec<f64>>, Vec<Vec<f64>>);
 
+/// The linearisation of one flight, whose scaled residual is `base`.
 fn linearise(
     flight: &JointFlight,
-    vehicle: &Vehicle,
-    air: &Air,
+    (vehicle, air): (&Vehicle, &Air),
+    base: Vec<f64>,
     free: &[usize],
     fit_air: bool,
     scale: &[f64; 3],
 ) -> Linearisation {
-    let base = scaled_residual(flight, vehicle, air, scale);
     let difference = |shifted: &[f64], step: f64| -> Vec<f64> {
         shifted
             .iter()
@@ -225,8 +232,134 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-fn total_sse(flights: &[JointFlight], vehicle: &Vehicle, airs: &[Air], scale: &[f64; 3]) -> f64 {
-    scaled_sse_on(flights, vehicle, airs, scale).iter().sum()
+/// The solver of the joint fit: 10 damped steps an iteration, converged when a step lowers the sum
+/// of squares by at most 1e-7 of it (the values the joint fit was tuned with).
+static SOLVER: LazyLock<LevenbergMarquardt> = LazyLock::new(|| {
+    LevenbergMarquardtParams {
+        iterations: 30,
+        tries: 10,
+        initial_damping: 1e-3,
+        min_damping: 1e-9,
+        increase: 10.0,
+        decrease: 3.0,
+        tolerance: 1e-7,
+        active_bounds: ActiveBounds::Project,
+    }
+    .checked()
+    .expect("the joint solver's settings are valid")
+});
+
+/// The joint fit as a least-squares problem. Its parameters: the free vehicle parameters, then
+/// the air values of each flight whose air is fitted, in the flights' order.
+struct JointProblem<'a> {
+    flights: &'a [JointFlight<'a>],
+    /// The vehicle and airs the parameters are written into (the rest held at these values).
+    vehicle: &'a Vehicle,
+    airs: &'a [Air],
+    free: Vec<usize>,
+    fit_air: Vec<bool>,
+    scale: [f64; 3],
+}
+
+impl JointProblem<'_> {
+    /// The parameters of the vehicle and airs.
+    fn parameters(&self, vehicle: &Vehicle, airs: &[Air]) -> Vec<f64> {
+        let fitted_airs = airs.iter().zip(&self.fit_air).filter(|(_, fit)| **fit);
+        self.free
+            .iter()
+            .map(|&j| vehicle.values[j])
+            .chain(fitted_airs.flat_map(|(air, _)| air.values.iter().copied()))
+            .collect()
+    }
+
+    /// The vehicle and airs at parameters `x`.
+    fn at(&self, x: &[f64]) -> (Vehicle, Vec<Air>) {
+        let mut vehicle = self.vehicle.clone();
+        for (&j, &v) in self.free.iter().zip(x) {
+            vehicle.values[j] = v;
+        }
+        let mut rest = &x[self.free.len()..];
+        let airs = self
+            .airs
+            .iter()
+            .zip(&self.fit_air)
+            .map(|(air, &fit)| {
+                let mut air = air.clone();
+                if fit {
+                    let (values, others) = rest.split_at(air.values.len());
+                    air.values.copy_from_slice(values);
+                    rest = others;
+                }
+                air
+            })
+            .collect();
+        (vehicle, airs)
+    }
+}
+
+impl LeastSquares for JointProblem<'_> {
+    /// Per flight, the scaled residual on its rows.
+    type Residual = Vec<Vec<f64>>;
+    type Linearisation = Vec<Linearisation>;
+
+    fn dimension(&self) -> usize {
+        let airs = self.airs.iter().zip(&self.fit_air).filter(|(_, fit)| **fit);
+        self.free.len() + airs.map(|(air, _)| air.values.len()).sum::<usize>()
+    }
+
+    fn bounds(&self, index: usize) -> (f64, f64) {
+        match self.free.get(index) {
+            Some(&j) => self.vehicle.parameters[j].fit_range(),
+            None => (f64::NEG_INFINITY, f64::INFINITY),
+        }
+    }
+
+    fn residual(&self, x: &[f64]) -> Vec<Vec<f64>> {
+        let (vehicle, airs) = self.at(x);
+        self.flights
+            .par_iter()
+            .zip(&airs)
+            .map(|(flight, air)| scaled_residual(flight, &vehicle, air, &self.scale))
+            .collect()
+    }
+
+    fn sum_of_squares(&self, residual: &Vec<Vec<f64>>) -> f64 {
+        let per_flight: Vec<f64> = residual
+            .iter()
+            .map(|r| r.iter().map(|v| v * v).sum::<f64>())
+            .collect();
+        per_flight.iter().sum()
+    }
+
+    fn linearise(&self, x: &[f64], residual: &Vec<Vec<f64>>) -> Vec<Linearisation> {
+        let (vehicle, airs) = self.at(x);
+        self.flights
+            .par_iter()
+            .enumerate()
+            .map(|(f, flight)| {
+                let base = residual[f].clone();
+                let at = (&vehicle, &airs[f]);
+                linearise(flight, at, base, &self.free, self.fit_air[f], &self.scale)
+            })
+            .collect()
+    }
+
+    fn damped_step(
+        &self,
+        parts: &Vec<Linearisation>,
+        damping: f64,
+        held: &[bool],
+    ) -> Option<Vec<f64>> {
+        // Only vehicle parameters have bounds: the airs' are never held.
+        let held = &held[..self.free.len()];
+        let (vehicle_step, air_steps) = solve_step(parts, self.free.len(), damping, held)?;
+        Some(
+            vehicle_step
+                .into_iter()
+                .chain(air_steps.into_iter().flatten())
+                .collect(),
+        )
+    }
 }
 
 /// Fits the vehicle (its free parameters) and the air of the flights that are not calm.
@@ -236,75 +369,44 @@ pub fn fit(
     airs: &[Air],
     settings: &JointSettings,
 ) -> JointFit {
-    let mut vehicle = start.clone();
-    let mut airs = airs.to_vec();
     let free: Vec<usize> = if settings.fit_vehicle {
-        (0..vehicle.parameters.len())
-            .filter(|&j| !settings.fixed.contains(&vehicle.parameters[j]))
+        (0..start.parameters.len())
+            .filter(|&j| !settings.fixed.contains(&start.parameters[j]))
             .collect()
     } else {
         Vec::new()
     };
     let fit_air: Vec<bool> = flights
         .iter()
-        .map(|f| !f.calm && vehicle.feels_wind())
+        .map(|f| !f.calm && start.feels_wind())
         .collect();
-    let scale = &settings.scale;
-    let mut sse = total_sse(flights, &vehicle, &airs, scale);
-    let mut damping = 1e-3;
-    for _ in 0..settings.iterations {
-        let parts: Vec<Linearisation> = flights
-            .par_iter()
-            .enumerate()
-            .map(|(f, flight)| linearise(flight, &vehicle, &airs[f], &free, fit_air[f], scale))
-            .collect();
-        let mut improved = false;
-        for _ in 0..10 {
-            let Some((vehicle_step, air_steps)) = solve_step(&parts, free.len(), damping) else {
-                damping *= 10.0;
-                continue;
-            };
-            let mut trial = vehicle.clone();
-            for (k, &j) in free.iter().enumerate() {
-                let (lo, hi) = trial.parameters[j].fit_range();
-                trial.values[j] = (trial.values[j] - vehicle_step[k]).clamp(lo, hi);
-            }
-            let trial_airs: Vec<Air> = airs
-                .iter()
-                .zip(&air_steps)
-                .map(|(a, s)| {
-                    let mut moved = a.clone();
-                    for (v, d) in moved.values.iter_mut().zip(s) {
-                        *v -= d;
-                    }
-                    moved
-                })
-                .collect();
-            let trial_sse = total_sse(flights, &trial, &trial_airs, scale);
-            if trial_sse.is_finite() && trial_sse < sse {
-                let relative = (sse - trial_sse) / sse.max(1e-300);
-                vehicle = trial;
-                airs = trial_airs;
-                sse = trial_sse;
-                damping = (damping / 3.0).max(1e-9);
-                improved = relative > 1e-7;
-                break;
-            }
-            damping *= 10.0;
-        }
-        if !improved {
-            break;
-        }
+    let problem = JointProblem {
+        flights,
+        vehicle: start,
+        airs,
+        free,
+        fit_air,
+        scale: settings.scale,
+    };
+    let solution = SOLVER
+        .with_iterations(settings.iterations)
+        .run(&problem, &problem.parameters(start, airs));
+    let (vehicle, airs) = problem.at(&solution.values);
+    JointFit {
+        vehicle,
+        airs,
+        termination: solution.termination,
     }
-    JointFit { vehicle, airs }
 }
 
 /// One damped Gauss–Newton step for the vehicle and every flight's air, through the Schur
-/// complement of the air blocks. `None` when a system is singular.
+/// complement of the air blocks, the `held` vehicle parameters not moving. `None` when a system is
+/// singular.
 fn solve_step(
     parts: &[Linearisation],
     free: usize,
     damping: f64,
+    held: &[bool],
 ) -> Option<(Vec<f64>, Vec<Vec<f64>>)> {
     let mut reduced = Mat::<f64>::zeros(free, free);
     let mut rhs = Mat::<f64>::zeros(free, 1);
@@ -354,9 +456,12 @@ fn solve_step(
             }
         }
     }
+    hold(&mut reduced, &mut rhs, held);
     let vehicle_step: Vec<f64> = if free > 0 {
         let solution = reduced.full_piv_lu().solve(&rhs);
-        (0..free).map(|i| solution[(i, 0)]).collect()
+        (0..free)
+            .map(|i| if held[i] { 0.0 } else { solution[(i, 0)] })
+            .collect()
     } else {
         Vec::new()
     };

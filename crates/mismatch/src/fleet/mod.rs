@@ -44,6 +44,7 @@ use serde::Serialize;
 
 use crate::degenerate;
 use crate::error::{MismatchError, Result};
+use crate::least_squares::Termination;
 use crate::output::{check_directory, check_run_outputs};
 use crate::problem::Problem;
 use crate::recording::Recording;
@@ -351,6 +352,8 @@ pub struct Identification {
     pub vehicle: Vehicle,
     /// Per flight: the air from the joint fit.
     pub airs: Vec<Air>,
+    /// Why the solver stopped in that joint fit (its second, whitened pass).
+    pub termination: Termination,
     /// Per flight: the air with the vehicle fitted without its condition (without the flight
     /// itself for calm ones).
     pub validation_airs: Vec<Air>,
@@ -710,6 +713,7 @@ pub fn identify(flights: &[FleetFlight], settings: &FleetSettings) -> Identifica
         lag_sensitivity,
         vehicle: full.vehicle,
         airs: full.airs,
+        termination: full.termination,
         validation_airs,
         validation_vehicles,
         heldout,

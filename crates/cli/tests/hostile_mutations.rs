@@ -411,7 +411,7 @@ fn kinds(scratch: &Path) -> Vec<(&'static str, Value, Loader)> {
 /// A SINDy model file as `learn sindy --out` writes it.
 fn sindy_model(dir: &Path) -> Value {
     let time: Vec<f64> = (0..100).map(|i| f64::from(i) * 0.01).collect();
-    let states = data::Mat::from_fn(
+    let states = sindy::Mat::from_fn(
         100,
         2,
         |i, j| {

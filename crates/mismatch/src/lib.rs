@@ -57,8 +57,8 @@ pub mod simex;
 pub mod weak_form;
 
 pub use analysis::{
-    Analysis, AnalysisSettings, ChannelReport, EffectReport, Fit, NoiseFree, Report, Stage, Window,
-    analyze, analyze_observed,
+    Analysis, AnalysisSettings, ChannelReport, EffectReport, Fit, NoiseFree, RateFrame, Report,
+    Stage, Window, analyze, analyze_observed,
 };
 pub use describe::{describe, remove_effect};
 pub use error::{MismatchError, Result};

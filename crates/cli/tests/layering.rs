@@ -4,8 +4,9 @@
 //! must never pull in. `sindy` and `learn` are libraries on in-memory data (no flight-log crate,
 //! CSV reader, data-frame library or file hash); `data` reads files and computes nothing (no
 //! `sindy`, no linear algebra, no output sets); `evaluation` draws no progress bar (the `learn`
-//! binary does); `report` depends on no crate that computes results, however indirectly (data
-//! flows cli → evaluation / mismatch → report).
+//! binary does); `mismatch` returns results and file contents (the binary checks and writes
+//! them); `report` depends on no crate that computes results, however indirectly (data flows
+//! cli → evaluation / mismatch → report).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -123,6 +124,11 @@ fn learn_depends_on_no_flight_log_csv_reader_or_data_frame_library() {
 fn data_reads_files_and_computes_nothing() {
     let forbidden = ["sindy", "learn", "faer", "clarabel", "outputs", "report"];
     assert_layered("data", &["inputs"], &forbidden);
+}
+
+#[test]
+fn mismatch_returns_results_and_writes_no_output_set() {
+    assert_layered("mismatch", &["report"], &["outputs", "indicatif"]);
 }
 
 #[test]

@@ -339,7 +339,7 @@ fn kinds(scratch: &Path) -> Vec<(&'static str, Value, Loader)> {
     let scenarios: Vec<&str> = scenarios.iter().map(String::as_str).collect();
     demo = absolute(demo, &scenarios, &root.join("experiments/mismatch"));
     let sindy_model = sindy_model(scratch);
-    let (work, out) = (scratch.join("work"), scratch.join("out"));
+    let work = scratch.join("work");
     let root_for_run = root.clone();
     let root_for_variants = root.clone();
     vec![
@@ -395,7 +395,7 @@ fn kinds(scratch: &Path) -> Vec<(&'static str, Value, Loader)> {
             "demo.json",
             demo,
             Box::new(move |p: &Path| {
-                mismatch::demo::DemoPlan::load(p, &work, &out)
+                mismatch::demo::DemoPlan::load(p, &work)
                     .map(drop)
                     .map_err(err)
             }),
@@ -411,7 +411,7 @@ fn kinds(scratch: &Path) -> Vec<(&'static str, Value, Loader)> {
 /// A SINDy model file as `learn sindy --out` writes it.
 fn sindy_model(dir: &Path) -> Value {
     let time: Vec<f64> = (0..100).map(|i| f64::from(i) * 0.01).collect();
-    let states = data::Mat::from_fn(
+    let states = sindy::Mat::from_fn(
         100,
         2,
         |i, j| {

@@ -1,50 +1,103 @@
-//! The workspace's layering (issue 19), read from the crates' manifests: `sindy` and `learn` are
-//! libraries on in-memory data (no flight-log crate, CSV reader, data-frame library or file hash
-//! among their dependencies, nor among those of the workspace crates they use); `evaluation` draws
-//! no progress bar (the `learn` binary does); `report` depends on no crate that computes results
-//! (data flows cli → evaluation / mismatch → report).
+//! The workspace's layering (issues 19 and 32), read from the dependency graph `cargo metadata`
+//! resolves: for each crate the full closure of what it depends on (normal and build
+//! dependencies, through every crate on the way, not dev-dependencies), checked against what it
+//! must never pull in. `sindy` and `learn` are libraries on in-memory data (no flight-log crate,
+//! CSV reader, data-frame library or file hash); `data` reads files and computes nothing (no
+//! `sindy`, no linear algebra, no output sets); `evaluation` draws no progress bar (the `learn`
+//! binary does); `mismatch` returns results and file contents (the binary checks and writes
+//! them); `report` depends on no crate that computes results, however indirectly (data flows
+//! cli → evaluation / mismatch → report).
 
-use std::path::{Path, PathBuf};
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+use std::sync::OnceLock;
 
-/// The folder of the workspace crate `name`.
-fn crate_dir(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(name)
+use serde_json::Value;
+
+/// Every package of the workspace's resolved graph, by name: the names of the packages it depends
+/// on as a library (normal or build dependencies; dev-dependencies are the tests' own).
+fn graph() -> &'static BTreeMap<String, BTreeSet<String>> {
+    static GRAPH: OnceLock<BTreeMap<String, BTreeSet<String>>> = OnceLock::new();
+    GRAPH.get_or_init(|| {
+        let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../Cargo.toml");
+        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+        let output = std::process::Command::new(cargo)
+            .args(["metadata", "--format-version", "1", "--manifest-path"])
+            .arg(&manifest)
+            .output()
+            .expect("cargo metadata runs");
+        assert!(
+            output.status.success(),
+            "cargo metadata: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let metadata: Value = serde_json::from_slice(&output.stdout).expect("metadata is JSON");
+        let name_of: BTreeMap<&str, &str> = metadata["packages"]
+            .as_array()
+            .expect("packages")
+            .iter()
+            .map(|p| (p["id"].as_str().unwrap(), p["name"].as_str().unwrap()))
+            .collect();
+        let mut graph = BTreeMap::<String, BTreeSet<String>>::new();
+        for node in metadata["resolve"]["nodes"].as_array().expect("resolve") {
+            let dependencies = node["deps"]
+                .as_array()
+                .expect("deps")
+                .iter()
+                .filter(|d| {
+                    d["dep_kinds"]
+                        .as_array()
+                        .expect("dep_kinds")
+                        .iter()
+                        .any(|k| k["kind"].as_str() != Some("dev"))
+                })
+                .map(|d| name_of[d["pkg"].as_str().unwrap()].to_string());
+            graph
+                .entry(name_of[node["id"].as_str().unwrap()].to_string())
+                .or_default()
+                .extend(dependencies);
+        }
+        graph
+    })
 }
 
-/// The names in the `[dependencies]` table of the workspace crate `name`.
-fn dependencies(name: &str) -> Vec<String> {
-    let path = crate_dir(name).join("Cargo.toml");
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut in_table = false;
-    let mut names = Vec::new();
-    for line in text.lines().map(str::trim) {
-        if line.starts_with('[') {
-            in_table = line == "[dependencies]";
-        } else if in_table && !line.is_empty() && !line.starts_with('#') {
-            let name = line.split(['=', '.', ' ']).next().unwrap_or_default();
-            names.push(name.to_string());
+/// The packages `name` depends on directly.
+fn direct(name: &str) -> &'static BTreeSet<String> {
+    graph()
+        .get(name)
+        .unwrap_or_else(|| panic!("{name} is not in the workspace's graph"))
+}
+
+/// Every package `name` depends on, directly or through others, each with the path that pulls it
+/// in (`name → a → b`).
+fn closure(name: &str) -> BTreeMap<String, String> {
+    let mut reached = BTreeMap::new();
+    let mut frontier = vec![(name.to_string(), name.to_string())];
+    while let Some((package, path)) = frontier.pop() {
+        for dependency in direct(&package) {
+            if !reached.contains_key(dependency) {
+                let through = format!("{path} → {dependency}");
+                reached.insert(dependency.clone(), through.clone());
+                frontier.push((dependency.clone(), through));
+            }
         }
     }
-    names
+    reached
 }
 
-/// Asserts that `name` (which must depend on every one of `required`) and the workspace crates
-/// it depends on directly have none of `forbidden` among their dependencies.
+/// Asserts that `name` depends directly on every one of `required` and, however indirectly, on
+/// none of `forbidden` (the message names the path that pulls one in).
 fn assert_layered(name: &str, required: &[&str], forbidden: &[&str]) {
-    let direct = dependencies(name);
+    let direct = direct(name);
     for needed in required {
-        assert!(direct.iter().any(|d| d == needed), "{name}: {direct:?}");
+        assert!(
+            direct.contains(*needed),
+            "{name} needs {needed}: {direct:?}"
+        );
     }
-    let crates = std::iter::once(name.to_string())
-        .chain(direct.iter().filter(|d| crate_dir(d).is_dir()).cloned());
-    for crate_name in crates {
-        for dependency in dependencies(&crate_name) {
-            assert!(
-                !forbidden.contains(&dependency.as_str()),
-                "{crate_name} depends on {dependency}"
-            );
-        }
-    }
+    let reached = closure(name);
+    let pulled: Vec<&String> = forbidden.iter().filter_map(|f| reached.get(*f)).collect();
+    assert!(pulled.is_empty(), "{name} depends on: {pulled:?}");
 }
 
 #[test]
@@ -68,27 +121,57 @@ fn learn_depends_on_no_flight_log_csv_reader_or_data_frame_library() {
 }
 
 #[test]
-fn the_evaluation_crate_draws_no_progress_bar() {
-    let direct = dependencies("evaluation");
-    assert!(direct.contains(&"report".to_string()), "{direct:?}");
-    assert!(!direct.contains(&"indicatif".to_string()), "{direct:?}");
+fn data_reads_files_and_computes_nothing() {
+    let forbidden = ["sindy", "learn", "faer", "clarabel", "outputs", "report"];
+    assert_layered("data", &["inputs"], &forbidden);
 }
 
 #[test]
-fn report_depends_on_no_crate_that_runs_the_experiments() {
-    let direct = dependencies("report");
-    assert!(direct.contains(&"plotters".to_string()), "{direct:?}");
-    for forbidden in [
+fn mismatch_returns_results_and_writes_no_output_set() {
+    assert_layered("mismatch", &["report"], &["outputs", "indicatif"]);
+}
+
+#[test]
+fn the_evaluation_crate_draws_no_progress_bar() {
+    assert_layered("evaluation", &["report"], &["indicatif"]);
+}
+
+#[test]
+fn report_depends_on_no_crate_that_computes() {
+    let forbidden = [
         "evaluation",
         "learn",
         "sindy",
         "physics",
         "mismatch",
+        "data",
+        "faer",
+        "clarabel",
+        "polars",
+        "rayon",
         "indicatif",
-    ] {
-        assert!(
-            !direct.contains(&forbidden.to_string()),
-            "report depends on {forbidden}: {direct:?}"
-        );
-    }
+    ];
+    assert_layered("report", &["plotters"], &forbidden);
+    // What it may use at all: the plotting library, serialisation, its error type and the
+    // bounded JSON reads.
+    let allowed = ["plotters", "serde", "serde_json", "thiserror", "inputs"];
+    let direct = direct("report");
+    let other: Vec<&String> = direct
+        .iter()
+        .filter(|d| !allowed.contains(&d.as_str()))
+        .collect();
+    assert!(other.is_empty(), "report depends on {other:?}");
+}
+
+/// The closure is transitive: a crate's dependencies' dependencies count (a check of direct
+/// dependencies alone let `report` pull `sindy` through `data`).
+#[test]
+fn the_closure_follows_every_crate_on_the_way() {
+    let mismatch = closure("mismatch");
+    assert!(mismatch.contains_key("physics"), "{mismatch:?}");
+    // mismatch → report → plotters: two steps, and named with the path.
+    assert!(
+        mismatch["plotters"].ends_with("report → plotters"),
+        "{mismatch:?}"
+    );
 }

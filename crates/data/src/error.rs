@@ -155,9 +155,6 @@ pub enum DataError {
     },
     #[error("{what}: {message}")]
     Invalid { what: String, message: String },
-    /// A derivative estimator misconfigured or given too few samples.
-    #[error(transparent)]
-    Differentiation(#[from] sindy::DifferentiationError),
     /// A task that does not fit with the others (e.g. sampled at another interval), named by
     /// its file.
     #[error("{}: {message}", path.display())]

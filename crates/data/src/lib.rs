@@ -4,8 +4,7 @@
 //! numeric CSVs by column name ([`NumericTable`], [`ColumnRef`] for `v[k]`); several CSV
 //! recordings of one system as the tasks of meta-learning ([`read_file_tasks`],
 //! [`read_column_tasks`]); support/query splits ([`SplitSpec`]); the experiment's wind conditions
-//! ([`ExperimentConditions`]); the noise floor of forward-difference targets
-//! ([`forward_difference_noise_floor`]); file hashes ([`file_sha256`]); finding the data directory
+//! ([`ExperimentConditions`]); file hashes ([`file_sha256`]); finding the data directory
 //! ([`resolve_data_dir`]).
 //!
 //! What it is not for: fitting anything (models live in `sindy` and `learn`, tables in `report`),
@@ -19,7 +18,6 @@ mod cells;
 mod conditions;
 mod error;
 mod flight_log;
-mod noise_floor;
 mod numeric;
 mod records;
 mod source;
@@ -36,7 +34,6 @@ pub use flight_log::{
     FlightLog, FlightMeta, REQUIRED_COLUMNS, RateFrame, quaternion_from_rotation,
     rotation_from_quaternion,
 };
-pub use noise_floor::{NoiseFloor, forward_difference_noise_floor};
 pub use numeric::NumericTable;
 pub use records::LayoutFault;
 pub use source::{
@@ -49,6 +46,3 @@ pub use table::ColumnRef;
 pub use tasks::{MAX_TASKS, TaskTable, interval_text, read_column_tasks, read_file_tasks};
 pub use time::{DEFAULT_UNIFORM_TOLERANCE, StreamedTimeAxis, check_time_axis};
 pub use write::write_numeric_csv;
-
-/// Re-exported so that downstream crates name the same matrix type.
-pub use faer::Mat;

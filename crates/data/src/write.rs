@@ -25,13 +25,23 @@ fn matrix(m: &[[f64; 3]; 3]) -> String {
 }
 
 impl FlightLog {
-    /// Writes the log as a Neural-Fly CSV (unnamed index column first; optional columns only when
-    /// present). Numbers are written with full precision, so reading the file back is lossless.
+    /// Writes the log as a Neural-Fly CSV ([`FlightLog::csv_text`]), creating its folder.
     pub fn write_csv(&self, path: &Path) -> Result<()> {
         let io = |source| DataError::Io {
             path: path.to_path_buf(),
             source,
         };
+        let text = self.csv_text();
+        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(parent).map_err(io)?;
+        }
+        let mut file = std::fs::File::create(path).map_err(io)?;
+        file.write_all(text.as_bytes()).map_err(io)
+    }
+
+    /// The log as a Neural-Fly CSV (unnamed index column first; optional columns only when
+    /// present). Numbers are written with full precision, so reading the file back is lossless.
+    pub fn csv_text(&self) -> String {
         let mut header = String::from(",t,p");
         let optional = [
             ("p_d", self.position_desired.is_some()),
@@ -82,11 +92,7 @@ impl FlightLog {
             }
             let _ = writeln!(text, ",{}", list(&self.motor_command[k]));
         }
-        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-            std::fs::create_dir_all(parent).map_err(io)?;
-        }
-        let mut file = std::fs::File::create(path).map_err(io)?;
-        file.write_all(text.as_bytes()).map_err(io)
+        text
     }
 }
 

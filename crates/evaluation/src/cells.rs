@@ -1,7 +1,8 @@
 //! The qualitative figure of a cell: time and ground truth over both segments of an evaluation
 //! flight, one trace per method.
 
-use data::{Condition, Mat};
+use data::Condition;
+use faer::Mat;
 use learn::Formulation;
 use report::{MethodTrace, OutputAxis, QualitativeFigure};
 

@@ -14,7 +14,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use data::{Condition, ExperimentConditions, FlightLog, Mat};
+use data::{Condition, ExperimentConditions, FlightLog};
+use faer::Mat;
 use learn::{
     AdaptationConfig, Architecture, Batch, CHECKPOINT_FORMAT, CheckedConfig, DataFile,
     FlightTraining, Formulation, InputRange, LearnConfig, LearnError, MetaTrainedModel,

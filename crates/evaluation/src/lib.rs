@@ -13,8 +13,9 @@
 //! and every variant as peer [`Method`]s run by one [`Runner`] over cells × methods × seeds;
 //! running them on every formulation × evaluation condition of `experiments/conditions.json`
 //! ([`run`]); turning the numbers and predictions into the paper's tables and figures and a
-//! `summary.json` with full provenance ([`write_outputs`]); and the check of the results against the
-//! paper ([`check_paper`]).
+//! `summary.json` with full provenance ([`write_outputs`]); the noise floor of a segment's
+//! forward-difference targets, which the ablation tables show ([`forward_difference_noise_floor`]);
+//! and the check of the results against the paper ([`check_paper`]).
 //!
 //! LeARN on your own data ([`own_data`]): reading CSV tasks and recordings for `learn`
 //! ([`own_data::read_tasks`], [`own_data::read_recording`]), a model of CSV tasks next to SINDy on
@@ -56,6 +57,7 @@ mod config;
 mod error;
 mod experiment;
 mod flights;
+mod noise_floor;
 mod output;
 pub mod own_data;
 mod progress;
@@ -84,6 +86,7 @@ pub use experiment::{
     SpreadCell, ValidationDetail, WorkItem, explain_flight, spread_cells,
 };
 pub use flights::{Flight, Protocol, evaluation_condition_of, read_evaluation_flights};
+pub use noise_floor::forward_difference_noise_floor;
 pub use output::{
     OutputPaths, README_BEGIN, README_END, ablation_files, check_paper, check_readme, latex_files,
     result_files, update_readme, updated_readme, write_outputs,

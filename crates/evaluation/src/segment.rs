@@ -72,7 +72,7 @@ impl Segment {
         }
         let targets = derivative
             .apply_columns(states.as_ref(), log.sample_interval())
-            .map_err(data::DataError::from)?;
+            .map_err(sindy::SindyError::from)?;
         Ok(Self {
             formulation,
             time: log.time[rows.clone()].to_vec(),

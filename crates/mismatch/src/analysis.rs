@@ -6,7 +6,9 @@ use std::collections::BTreeMap;
 use data::FlightLog;
 use physics::vector::Vec3;
 use physics::{EffectId, EffectParameters, Effects, Logger, NominalModel, ParameterValue};
-pub use report::mismatch::recording::{ChannelReport, Fit, Heldout, Mse, RateFrameReport, Window};
+pub use report::mismatch::recording::{
+    ChannelReport, Fit, Heldout, Mse, RateFrame, RateFrameReport, Window,
+};
 use serde::Serialize;
 
 use crate::command_samples::ActuatorLimits;
@@ -656,7 +658,10 @@ fn build_report(
         command_limits: (problem.recording.samples.rows_held() > 0)
             .then_some(problem.recording.command_limits),
         rate_frame: RateFrameReport {
-            used: problem.recording.rate_frame,
+            used: match problem.recording.rate_frame {
+                data::RateFrame::Body => RateFrame::Body,
+                data::RateFrame::World => RateFrame::World,
+            },
             body_rms: problem.recording.rate_frame_errors.0,
             world_rms: problem.recording.rate_frame_errors.1,
         },

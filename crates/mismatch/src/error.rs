@@ -14,16 +14,6 @@ pub enum MismatchError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{}: already exists (pass --force to overwrite)", path.display())]
-    Exists { path: PathBuf },
-    /// An output refused by the output-set checks (see the `outputs` crate).
-    #[error(transparent)]
-    Output(#[from] outputs::OutputError),
-    #[error(
-        "{}: is both a demo case's directory (--work) and a summary file (--out)",
-        path.display()
-    )]
-    CaseDirectoryIsSummary { path: PathBuf },
     #[error("{}: {message}", path.display())]
     Recording { path: PathBuf, message: String },
     /// More rows than one analysis accepts ([`crate::degenerate::MAX_ANALYSED_ROWS`]).

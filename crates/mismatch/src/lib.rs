@@ -3,7 +3,7 @@
 //! What it is for: given a recording and a nominal model, locate where they disagree (channels and
 //! time windows, against a noise floor), name the missing physics from a library of candidate terms
 //! (sparse selection that finds nothing on noise alone), fit the effects' parameters — nonlinear
-//! ones included — and show the fit improve on a held-out part ([`analyze`], [`write_outputs`]);
+//! ones included — and show the fit improve on a held-out part ([`analyze`]; its files: [`Analysis::render`]);
 //! prove it on simulated recordings with concealed effects ([`demo`]) and run it on the real
 //! Neural-Fly flights together ([`fleet`]).
 //!
@@ -12,7 +12,10 @@
 //! `report` crate ([`report::mismatch`]) from views this crate fills ([`Analysis::view`] and
 //! [`Analysis::figure`], [`fleet::FleetReport::view`], [`demo::DemoSummary::view`]); the plain
 //! parts of the results (windows, channels, fit errors, every flight's air, the targets) are
-//! `report`'s types, re-exported here. This crate computes the results and writes the files.
+//! `report`'s types, re-exported here; nor writing files or checking where they go: this crate
+//! computes the results and renders each file's contents ([`Analysis::render`],
+//! [`fleet::FleetReport::render`], [`demo::DemoSummary::render`]), and the caller (the `learn`
+//! binary, through the `outputs` crate) checks the outputs and writes them.
 //!
 //! Method in one paragraph (the long version: `docs/mismatch.md`): the recording and the model are
 //! compared in the weak form ([`weak_form`], from `sindy`: the recorded velocity and body rate against the model's
@@ -44,13 +47,13 @@ mod describe;
 mod error;
 pub mod estimate;
 pub mod evidence;
+mod files;
 mod fit;
 pub mod fleet;
 pub mod forward;
 pub mod least_squares;
 mod library;
 pub mod noise_reaction;
-mod output;
 mod problem;
 mod recording;
 mod refine;
@@ -58,17 +61,15 @@ mod refine;
 pub mod simex;
 
 pub use analysis::{
-    Analysis, AnalysisSettings, ChannelReport, EffectReport, Fit, NoiseFree, Report, Stage, Window,
-    analyze, analyze_observed,
+    Analysis, AnalysisSettings, ChannelReport, EffectReport, Fit, NoiseFree, RateFrame, Report,
+    Stage, Window, analyze, analyze_observed,
 };
 pub use describe::{describe, remove_effect};
 pub use error::{MismatchError, Result};
 pub use evidence::{Evidence, EvidenceSettings};
+pub use files::ANALYSIS_FILES;
 pub use fit::FittedSet;
 pub use library::{Candidate, CandidateId, Term, build_library};
-pub use output::{
-    check_directory, check_outputs, check_run_outputs, output_paths, write_figure, write_outputs,
-};
 pub use problem::{CHANNEL_NAMES, Channels, Problem};
 pub use recording::Recording;
 pub use refine::{FitRows, effects_from, levenberg_marquardt};

@@ -2,7 +2,7 @@
 //! when one is concealed, outputs that refuse to overwrite, errors that name the problem.
 
 use mismatch::least_squares::Termination;
-use mismatch::{AnalysisSettings, MismatchError, NoiseFree, analyze, check_outputs, write_outputs};
+use mismatch::{ANALYSIS_FILES, AnalysisSettings, NoiseFree, analyze};
 use physics::{EffectId, Effects, NominalModel, Scenario, ThrustScale, TorqueBias, simulate};
 
 mod common;
@@ -67,7 +67,7 @@ fn names_and_fits_a_concealed_thrust_loss() {
 }
 
 #[test]
-fn names_a_torque_bias_and_writes_outputs_once() {
+fn names_a_torque_bias_and_renders_its_files() {
     let effects = Effects {
         torque_bias: Some(TorqueBias {
             b: [0.6, -0.4, 0.25],
@@ -80,12 +80,12 @@ fn names_a_torque_bias_and_writes_outputs_once() {
     for (found, truth) in b.iter().zip([0.6, -0.4, 0.25]) {
         assert!((found - truth).abs() < 0.05, "{b:?}");
     }
-    let tmp = common::temp_dir("test");
-    // A folder that does not exist yet.
-    let dir = tmp.path().join("out");
-    write_outputs(&analysis, &dir, false).unwrap();
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("mismatch.json")).unwrap()).unwrap();
+    assert_eq!(
+        ANALYSIS_FILES,
+        ["mismatch.json", "mismatch.svg", "mismatch.md"]
+    );
+    let [json, svg, markdown] = analysis.render(std::path::Path::new("out")).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(json["effects"][0]["id"], "torque_bias");
     assert!(json["fit"]["heldout"]["after"]["mse"].as_f64().unwrap() > 0.0);
     // Each component comes with a standard error that is small and covers the truth.
@@ -95,15 +95,8 @@ fn names_a_torque_bias_and_writes_outputs_once() {
         assert!(error > 0.0 && error < 0.05, "{errors}");
         assert!((b[i] - truth).abs() <= 4.0 * error, "{b:?} ± {errors}");
     }
-    let markdown = std::fs::read_to_string(dir.join("mismatch.md")).unwrap();
     assert!(markdown.contains("Standard errors: b ± ["), "{markdown}");
-    let svg = std::fs::read_to_string(dir.join("mismatch.svg")).unwrap();
     assert!(svg.contains("<text") && svg.contains("wdot_x"));
-    assert!(matches!(
-        check_outputs(&dir, false),
-        Err(MismatchError::Exists { .. })
-    ));
-    assert!(write_outputs(&analysis, &dir, true).is_ok());
 }
 
 #[test]

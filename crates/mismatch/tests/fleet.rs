@@ -70,18 +70,10 @@ fn analyse(name: &str, conditions: &[Condition], lag_s: Option<f64>) -> FleetRep
         &dir.join("vehicle.json"),
     )
     .unwrap();
-    let out = dir.join("out");
-    let plan = FleetPlan::load(
-        &dir.join("conditions.json"),
-        &dir.join("data"),
-        &dir.join("vehicle.json"),
-        &out,
-    )
-    .unwrap();
-    let (report, _) = plan.run(&model, "vehicle.json", false).unwrap();
-    for ext in ["json", "md", "svg"] {
-        assert!(out.join(format!("vehicle.{ext}")).exists());
-    }
+    let plan = FleetPlan::load(&dir.join("conditions.json"), &dir.join("data")).unwrap();
+    let report = plan.run(&model, "vehicle.json").unwrap();
+    let [json, markdown, svg] = report.render(&dir.join("out"), "vehicle").unwrap();
+    assert!(json.ends_with("}\n") && markdown.contains("(vehicle.svg)") && svg.contains("<svg"));
     report
 }
 

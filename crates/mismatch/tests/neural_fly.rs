@@ -28,7 +28,7 @@ fn names_drag_on_the_relative_wind_in_the_strongest_wind() {
         &mismatch::AnalysisSettings::default(),
     )
     .unwrap();
-    assert_eq!(analysis.report.rate_frame.used, data::RateFrame::World);
+    assert_eq!(analysis.report.rate_frame.used, mismatch::RateFrame::World);
     let ids = analysis.fitted.ids();
     let drag = ids.contains(&EffectId::QuadraticDrag) || ids.contains(&EffectId::LinearDrag);
     assert!(drag && ids.contains(&EffectId::Wind), "{ids:?}");

@@ -2,9 +2,9 @@
 //! never a panic, a hang, or NaN and infinite numbers in the outputs. The flights are generated and
 //! corrupted in memory (the data crate's reader rejects such values in files before they get here).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use mismatch::{Analysis, AnalysisSettings, MismatchError, analyze, write_figure, write_outputs};
+use mismatch::{Analysis, AnalysisSettings, MismatchError, analyze};
 use physics::{Effects, Scenario, simulate};
 
 mod common;
@@ -112,9 +112,7 @@ fn valid_analysis() -> Analysis {
 #[test]
 fn figures_are_never_drawn_from_non_finite_or_undrawable_data() {
     let valid = valid_analysis();
-    let tmp = common::temp_dir("robustness-figure");
-    let dir = tmp.path();
-    write_figure(&valid, &dir.join("valid.svg")).unwrap();
+    valid.figure_svg(Path::new("valid.svg")).unwrap();
 
     let mut nan = valid.clone();
     nan.after[3][1] = f64::NAN;
@@ -141,7 +139,7 @@ fn figures_are_never_drawn_from_non_finite_or_undrawable_data() {
         w.t_start *= 1e-300;
         w.t_end *= 1e-300;
     }
-    write_figure(&tiny, &dir.join("tiny.svg")).unwrap();
+    tiny.figure_svg(Path::new("tiny.svg")).unwrap();
     let mut subnormal = valid.clone();
     for t in &mut subnormal.problem.time {
         *t *= 1e-320;
@@ -155,8 +153,8 @@ fn figures_are_never_drawn_from_non_finite_or_undrawable_data() {
         ("time", time),
         ("window", window),
     ] {
-        let path = dir.join(format!("{name}.svg"));
-        let error = write_figure(&analysis, &path).unwrap_err();
+        let path = PathBuf::from(format!("{name}.svg"));
+        let error = analysis.figure_svg(&path).unwrap_err();
         assert!(
             matches!(error, MismatchError::Plot { .. }),
             "{name}: {error}"
@@ -167,34 +165,26 @@ fn figures_are_never_drawn_from_non_finite_or_undrawable_data() {
             message.contains(&format!("{name}.svg: cannot draw the figure")),
             "{message}"
         );
-        assert!(!path.exists(), "{name}: nothing drawn");
     }
 }
 
 #[test]
-fn outputs_are_not_written_from_non_finite_results() {
+fn no_file_is_rendered_from_non_finite_results() {
     let mut analysis = valid_analysis();
     analysis.report.fit.after.mse = f64::INFINITY;
-    let tmp = common::temp_dir("robustness-outputs");
-    let dir = tmp.path().join("out");
-    let message = write_outputs(&analysis, &dir, false)
-        .unwrap_err()
-        .to_string();
+    let dir = Path::new("out");
+    let message = analysis.render(dir).unwrap_err().to_string();
     assert_eq!(
         message,
         "generated/corrupt_flight.csv: the analysis of this recording gives a non-finite fit.after.mse in the report: its values are outside the range the analysis can handle"
     );
-    assert!(mismatch::output_paths(&dir).iter().all(|p| !p.exists()));
     let mut analysis = valid_analysis();
     analysis.after[10][2] = f64::NAN;
-    let message = write_outputs(&analysis, &dir, false)
-        .unwrap_err()
-        .to_string();
+    let message = analysis.render(dir).unwrap_err().to_string();
     assert!(
         message.contains("non-finite residual of the fitted model in vdot_z (NaN at t = "),
         "{message}"
     );
-    assert!(mismatch::output_paths(&dir).iter().all(|p| !p.exists()));
 }
 
 #[test]

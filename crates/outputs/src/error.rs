@@ -13,6 +13,16 @@ pub enum OutputError {
         path.display()
     )]
     OutputIsInput { path: PathBuf, what: String },
+    #[error(
+        "{}: is both a file to write ({option}) and the folder of {} ({inner_option})",
+        path.display(), inner.display()
+    )]
+    FileIsFolderOfAnother {
+        path: PathBuf,
+        option: String,
+        inner: PathBuf,
+        inner_option: String,
+    },
     #[error("{option}: an empty path (give the file or directory to write)")]
     EmptyPath { option: String },
     #[error("{}: is a directory, not a file to write ({option})", path.display())]

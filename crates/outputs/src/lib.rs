@@ -4,7 +4,8 @@
 //! 1. **plan**: the folders it writes into (with the files it will put there, relative to each)
 //!    and the single files the user named, and every file the run reads;
 //! 2. **check** ([`OutputSet::check`], no side effects): no output is an input (whatever the
-//!    spelling of either path), each can be a file or folder, and an existing file is replaced only
+//!    spelling of either path), nor the folder of another output, each can be a file or folder,
+//!    and an existing file is replaced only
 //!    when allowed: in a folder only a file `learn` wrote there itself (its manifest says so), and
 //!    then only with [`Existing::Replace`] (`--force`, or the tool's scratch); a named file only
 //!    with `--force`, and only a regular file (a link is written through); below a folder, only
@@ -186,12 +187,24 @@ impl OutputSet {
 
     /// Every final path the set writes: the planned files of each folder, then the named files.
     pub fn targets(&self) -> Vec<PathBuf> {
+        self.targets_with_options()
+            .into_iter()
+            .map(|(path, _)| path)
+            .collect()
+    }
+
+    /// [`OutputSet::targets`], each with the option that places it.
+    fn targets_with_options(&self) -> Vec<(PathBuf, &str)> {
         let in_folders = self
             .folders
             .iter()
-            .flat_map(|f| f.files.iter().map(|r| f.dir.join(r)));
+            .flat_map(|f| f.files.iter().map(|r| (f.dir.join(r), f.option.as_str())));
         in_folders
-            .chain(self.files.iter().map(|f| f.path.clone()))
+            .chain(
+                self.files
+                    .iter()
+                    .map(|f| (f.path.clone(), f.option.as_str())),
+            )
             .collect()
     }
 
@@ -200,6 +213,7 @@ impl OutputSet {
         for target in self.targets() {
             self.refuse_input(&target)?;
         }
+        self.refuse_file_as_folder()?;
         for folder in &self.folders {
             check_folder(folder, &self.producer, self.remove_stale, &self.inputs)?;
         }
@@ -213,6 +227,42 @@ impl OutputSet {
     pub fn prepare(self) -> Result<Staged> {
         self.check()?;
         stage::prepare(self)
+    }
+
+    /// Fails if an output is also a folder another output goes into (e.g. a file of one option
+    /// that is a subfolder of another's), whatever the spelling: it cannot be both. Only folders
+    /// that do not exist yet are compared (an existing one is refused as a file to write, and a
+    /// file below an existing file as below a non-directory).
+    fn refuse_file_as_folder(&self) -> Result<()> {
+        let targets = self.targets_with_options();
+        let places: std::collections::HashMap<PathBuf, usize> = targets
+            .iter()
+            .enumerate()
+            .filter_map(|(index, (path, _))| Some((paths::resolved(path)?, index)))
+            .collect();
+        let mut seen = std::collections::HashSet::new();
+        for (inner, inner_option) in &targets {
+            let new_folders = inner
+                .ancestors()
+                .skip(1)
+                .take_while(|a| !a.as_os_str().is_empty() && std::fs::symlink_metadata(a).is_err());
+            for folder in new_folders {
+                if !seen.insert(folder.to_path_buf()) {
+                    break;
+                }
+                let found = paths::resolved(folder).and_then(|place| places.get(&place));
+                if let Some(&index) = found {
+                    let (path, option) = &targets[index];
+                    return Err(OutputError::FileIsFolderOfAnother {
+                        path: path.clone(),
+                        option: option.to_string(),
+                        inner: inner.clone(),
+                        inner_option: inner_option.to_string(),
+                    });
+                }
+            }
+        }
+        Ok(())
     }
 
     fn refuse_input(&self, target: &Path) -> Result<()> {

@@ -123,7 +123,7 @@ pub fn non_directory_ancestor(path: &Path) -> Option<&Path> {
 /// canonicalised (links and `..` resolved in that order, as the OS does), then its remaining
 /// components applied lexically (`.` dropped, `..` pops). `None` if the current directory is
 /// unknown.
-fn resolved(path: &Path) -> Option<PathBuf> {
+pub(crate) fn resolved(path: &Path) -> Option<PathBuf> {
     let absolute = std::env::current_dir().ok()?.join(path);
     let mut base = absolute.as_path();
     let mut rest = Vec::new();

@@ -478,3 +478,40 @@ fn errors_name_final_paths_after_the_set_is_gone() {
         )
     );
 }
+
+/// A file to write that is also the folder of another output (however spelt, in a folder or
+/// named) is refused before anything is made: it cannot be both.
+#[test]
+fn an_output_that_is_the_folder_of_another_is_refused() {
+    let tmp = scratch("file-as-folder");
+    let dir = tmp.path();
+    let mut set = OutputSet::new("p");
+    let out = set.folder(dir.join("out"), "--out", Existing::Refuse);
+    set.file_in(out, "summary.json");
+    set.file(
+        dir.join("out/./sub/../summary.json/case/recording.csv"),
+        "--work",
+        Existing::Refuse,
+    );
+    let message = set.check().unwrap_err().to_string();
+    assert!(
+        message.contains("out/summary.json: is both a file to write (--out) and the folder of ")
+            && message.contains("recording.csv (--work)"),
+        "{message}"
+    );
+    assert!(matches!(
+        set.prepare(),
+        Err(OutputError::FileIsFolderOfAnother { .. })
+    ));
+    assert!(listing(dir).is_empty());
+    // Side by side, they are fine.
+    let mut set = OutputSet::new("p");
+    let out = set.folder(dir.join("out"), "--out", Existing::Refuse);
+    set.file_in(out, "summary.json");
+    set.file(
+        dir.join("out/case/recording.csv"),
+        "--work",
+        Existing::Refuse,
+    );
+    set.check().unwrap();
+}

@@ -5,10 +5,19 @@
 
 use std::collections::BTreeMap;
 
-use data::NoiseFloor;
 use serde::{Deserialize, Serialize};
 
 use crate::table::{MethodPair, Mse};
+
+/// The noise-floor estimates of one segment's forward-difference targets (computed by
+/// `evaluation::forward_difference_noise_floor`), in the tables' MSE unit.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NoiseFloor {
+    /// Mean square of forward difference minus the Savitzky–Golay derivative.
+    pub upper: f64,
+    /// Twice the negative lag-one autocovariance of that residual (clipped to [0, upper]).
+    pub lower: f64,
+}
 
 /// Mean and spread of one variant on one cell over the seeds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -138,7 +147,7 @@ fn introduction(tables: &AblationTables) -> String {
     format!(
         "# Ablations: {}\n\n{}\n\nProtocol: {}. Seeds: {seeds}. MSE = mean over samples and state \
          dimensions; `±` is the standard deviation over seeds (0 for deterministic variants).\n\n\
-         Noise floor of the forward-difference target on the query segment (`data::forward_difference_noise_floor`): \
+         Noise floor of the forward-difference target on the query segment (`evaluation::forward_difference_noise_floor`): \
          `lower–upper`, where upper = mean square of forward difference minus a Savitzky–Golay(21, 3) \
          derivative (counts motion faster than 0.4 s as noise) and lower = twice the negative lag-one \
          autocovariance of that residual.\n\n",

@@ -32,7 +32,8 @@ mod render;
 mod table;
 
 pub use ablations::{
-    AblationRow, AblationTables, Choice, SeedCell, VariantCell, VariantNote, ablations_markdown,
+    AblationRow, AblationTables, Choice, NoiseFloor, SeedCell, VariantCell, VariantNote,
+    ablations_markdown,
 };
 pub use compare::{CellComparison, CellStatus, Comparison, Direction, ToleranceRule, Tolerances};
 pub use coverage::{FarthestInput, QueryCoverage, coverage_note};

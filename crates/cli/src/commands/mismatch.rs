@@ -16,6 +16,8 @@
 
 use std::path::{Path, PathBuf};
 
+use mismatch::ANALYSIS_FILES;
+use mismatch::demo::SUMMARY_FILES;
 use outputs::{Existing, OutputSet};
 
 use super::Global;
@@ -84,34 +86,65 @@ fn load_model(path: &Path) -> anyhow::Result<physics::NominalModel> {
     Ok(physics::NominalModel::from_json(&text, path)?)
 }
 
-/// The name of `path` relative to `dir` (its file name when it is not below it).
-fn relative_to(path: &Path, dir: &Path) -> PathBuf {
-    path.strip_prefix(dir)
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|_| path.file_name().map(PathBuf::from).unwrap_or_default())
+/// Writes `contents` to `path`, creating its folder; the error names the file.
+fn write_file(path: &Path, contents: &str) -> mismatch::Result<()> {
+    let io = |source| mismatch::MismatchError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(io)?;
+    }
+    std::fs::write(path, contents).map_err(io)
+}
+
+/// Writes each of `files` (its name, its contents) into `dir`.
+fn write_files<N: AsRef<Path>>(
+    dir: &Path,
+    files: impl IntoIterator<Item = (N, String)>,
+) -> mismatch::Result<()> {
+    files
+        .into_iter()
+        .try_for_each(|(name, contents)| write_file(&dir.join(name), &contents))
 }
 
 /// The demo: its summary (`--out`) is an output set; the cases' files in `--work` are a scratch
-/// of intermediate files (recordings, per-case analyses naming their paths), written in place
-/// after the same checks as before any work.
+/// of intermediate files (recordings, per-case analyses naming their paths), checked with the
+/// summary before any work and written in place as each case ends.
 fn run_demo(manifest: &Path, args: &Args) -> anyhow::Result<()> {
     let work = args.work.as_deref().unwrap_or(Path::new(DEFAULT_WORK));
-    let plan = mismatch::demo::DemoPlan::load(manifest, work, &args.out)?;
-    plan.check_outputs(args.force)?;
+    let plan = mismatch::demo::DemoPlan::load(manifest, work)?;
+    let existing = Existing::from_force(args.force);
+    let mut every_file = OutputSet::new("mismatch --demo");
+    for (what, path) in plan.inputs() {
+        every_file.input(what, path);
+    }
+    for name in SUMMARY_FILES {
+        every_file.file(args.out.join(name), "--out", existing);
+    }
+    for path in plan.case_outputs() {
+        every_file.file(path, "--work", existing);
+    }
+    every_file.check()?;
     let mut set = OutputSet::new("mismatch --demo");
     for (what, path) in plan.inputs() {
         set.input(what, path);
     }
-    let out = set.folder(&args.out, "--out", Existing::from_force(args.force));
-    for path in plan.summary_paths() {
-        set.file_in(out, relative_to(&path, &args.out));
+    let out = set.folder(&args.out, "--out", existing);
+    for name in SUMMARY_FILES {
+        set.file_in(out, name);
     }
     let staged = set.prepare()?;
-    let staged_plan = plan.with_out(staged.dir(out));
-    let summary = super::staged_write(&staged, || staged_plan.run(args.force))?;
+    let summary = plan.run(&write_file)?;
+    super::staged_write(&staged, || {
+        write_files(
+            staged.dir(out),
+            SUMMARY_FILES.into_iter().zip(summary.render()),
+        )
+    })?;
     staged.commit()?;
     say_part!("{}", summary.view().table_text());
-    say!("wrote {}", plan.summary_paths()[0].display());
+    say!("wrote {}", args.out.join(SUMMARY_FILES[0]).display());
     Ok(())
 }
 
@@ -122,35 +155,35 @@ fn run_flights(
     args: &Args,
 ) -> anyhow::Result<()> {
     let data_dir = global.data_dir()?;
-    let plan = mismatch::fleet::FleetPlan::load(conditions, &data_dir, model_path, &args.out)?;
+    let plan = mismatch::fleet::FleetPlan::load(conditions, &data_dir)?;
     let stem = model_path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+        .unwrap_or_else(|| "fleet".into());
+    let names = mismatch::fleet::file_names(&stem);
     let mut set = OutputSet::new(format!("mismatch --flights --model {stem}"));
     for (what, path) in plan.inputs() {
         set.input(what, path);
     }
     set.input("the --model file", model_path);
     let out = set.folder(&args.out, "--out", Existing::from_force(args.force));
-    for path in plan.outputs() {
-        set.file_in(out, relative_to(&path, &args.out));
+    for name in &names {
+        set.file_in(out, name);
     }
     set.check()?;
     let model = load_model(model_path)?;
     let staged = set.prepare()?;
-    let staged_plan =
-        mismatch::fleet::FleetPlan::load(conditions, &data_dir, model_path, staged.dir(out))?;
-    let (_, lines) = super::staged_write(&staged, || {
-        staged_plan.run(&model, &model_path.display().to_string(), true)
+    let report = plan.run(&model, &model_path.display().to_string())?;
+    super::staged_write(&staged, || {
+        let dir = staged.dir(out);
+        write_files(dir, names.iter().zip(report.render(dir, &stem)?))
     })?;
     staged.commit()?;
-    for line in lines {
+    for line in report.view().lines() {
         say!("{line}");
     }
-    // The files by their final names (the run wrote them in the staging folder).
-    for path in plan.outputs() {
-        say!("wrote {}", path.display());
+    for name in &names {
+        say!("wrote {}", args.out.join(name).display());
     }
     Ok(())
 }
@@ -185,8 +218,8 @@ fn run_recording(
     set.input("the --model file", model_path);
     set.input("the --recording", recording);
     let out = set.folder(&args.out, "--out", Existing::from_force(args.force));
-    for path in mismatch::output_paths(Path::new("")) {
-        set.file_in(out, path);
+    for name in ANALYSIS_FILES {
+        set.file_in(out, name);
     }
     set.check()?;
     let model = load_model(model_path)?;
@@ -203,7 +236,8 @@ fn run_recording(
     spinner.finish_and_clear();
     let analysis = analysis?;
     super::staged_write(&staged, || {
-        mismatch::write_outputs(&analysis, staged.dir(out), true)
+        let dir = staged.dir(out);
+        write_files(dir, ANALYSIS_FILES.into_iter().zip(analysis.render(dir)?))
     })?;
     staged.commit()?;
     let report = &analysis.report;

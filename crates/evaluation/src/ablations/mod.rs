@@ -13,8 +13,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use crate::experiment::{Cells, WorkItem};
-use data::NoiseFloor;
 use learn::Formulation;
+use report::NoiseFloor;
 use report::{AblationRow, AblationTables, QualitativeFigure, SeedCell, VariantCell, VariantNote};
 use serde::{Deserialize, Serialize};
 

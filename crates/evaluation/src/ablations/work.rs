@@ -7,9 +7,10 @@ use std::sync::Arc;
 
 use crate::experiment::{Cells, EvaluationCell, Experiment, WorkItem, evaluation_cells};
 use crate::flights::read_evaluation_flights;
+use crate::noise_floor::forward_difference_noise_floor;
 use crate::runner::{Method, Outcome, Runner, item_cells};
 use crate::sindy_variant::SegmentPredictions;
-use data::{Condition, forward_difference_noise_floor};
+use data::Condition;
 use learn::{Formulation, MetaTrainedModel};
 use report::{MethodTrace, PublishedTables, QualitativeFigure, SeedCell};
 use sindy::{EnsemblePrediction, Mat, RegressionFit};

@@ -3,7 +3,9 @@
 //! command is logged, jitter, gyro filter, noise, trajectory). The closed loop keeps the position on
 //! the reference, so an effect shows only in the dynamics and the control effort. The analysis runs
 //! blind on each written CSV with only the configuration's nominal model (and its logger), and each
-//! cell is judged against fixed targets (`summary.rs`).
+//! cell is judged against fixed targets (`summary.rs`). The caller writes every file: the work
+//! folder's as the run goes ([`DemoPlan::run`] hands them over), the summary's at the end
+//! ([`DemoSummary::render`]).
 
 mod summary;
 #[cfg(test)]
@@ -17,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis::{AnalysisSettings, analyze};
 use crate::error::{MismatchError, Result, io_error};
-use crate::output::{check_directory, check_run_outputs, output_paths, write_outputs};
+use crate::files::ANALYSIS_FILES;
 
 pub use summary::{CellOutcome, DemoSummary, ParameterCheck, Targets, compare_parameters};
 
@@ -196,7 +198,7 @@ struct LoadedConfiguration {
 }
 
 /// A demo run read and checked, ready to run: the manifest, every configuration's scenario and
-/// model, every cell, what the run reads and what it writes.
+/// model, every cell, what the run reads and the files it hands over in the work folder.
 #[derive(Clone, Debug)]
 pub struct DemoPlan {
     manifest_path: PathBuf,
@@ -204,16 +206,21 @@ pub struct DemoPlan {
     configurations: Vec<LoadedConfiguration>,
     cases: Vec<(String, Effects, String)>,
     work: PathBuf,
-    out: PathBuf,
 }
+
+/// The summary's files in the `--out` folder, in the order of [`DemoSummary::render`].
+pub const SUMMARY_FILES: [&str; 2] = ["summary.md", "summary.json"];
+
+/// Where the run's work files go: called with a path below the work folder and the file's
+/// contents (a configuration's `model.json`, a case's `recording.csv` and analysis), from several
+/// cases at once; it writes the file, creating its folder.
+pub type WriteFile<'a> = dyn Fn(&Path, &str) -> Result<()> + Sync + 'a;
 
 impl DemoPlan {
     /// Reads and checks the manifest, every configuration's scenario (and its model) and every
-    /// cell's scenario with its effects. Fails if `work` or `out` exists but is not a directory.
-    pub fn load(manifest_path: &Path, work: &Path, out: &Path) -> Result<Self> {
+    /// cell's scenario with its effects; the cells will be written below `work`.
+    pub fn load(manifest_path: &Path, work: &Path) -> Result<Self> {
         let manifest = load_manifest(manifest_path)?;
-        check_directory(work)?;
-        check_directory(out)?;
         let base = manifest_path.parent().unwrap_or(Path::new("."));
         let cases = manifest.all_cases();
         let mut configurations = Vec::new();
@@ -258,7 +265,6 @@ impl DemoPlan {
             configurations,
             cases,
             work: work.to_path_buf(),
-            out: out.to_path_buf(),
         })
     }
 
@@ -290,19 +296,6 @@ impl DemoPlan {
         inputs
     }
 
-    /// The same plan writing its summary into `out` instead (a staging folder).
-    pub fn with_out(&self, out: &Path) -> Self {
-        Self {
-            out: out.to_path_buf(),
-            ..self.clone()
-        }
-    }
-
-    /// The summary files, `out/summary.md` and `out/summary.json`.
-    pub fn summary_paths(&self) -> [PathBuf; 2] {
-        [self.out.join("summary.md"), self.out.join("summary.json")]
-    }
-
     /// Each configuration's directory, `work/<configuration>`.
     fn configuration_dir(&self, index: usize) -> PathBuf {
         self.work.join(&self.manifest.configurations[index].name)
@@ -323,51 +316,22 @@ impl DemoPlan {
     pub fn case_outputs(&self) -> Vec<PathBuf> {
         let models =
             (0..self.configurations.len()).map(|i| self.configuration_dir(i).join("model.json"));
-        let cells = self
-            .case_dirs()
-            .into_iter()
-            .flat_map(|dir| std::iter::once(dir.join("recording.csv")).chain(output_paths(&dir)));
+        let cells = self.case_dirs().into_iter().flat_map(|dir| {
+            std::iter::once("recording.csv")
+                .chain(ANALYSIS_FILES)
+                .map(move |name| dir.join(name))
+        });
         models.chain(cells).collect()
     }
 
-    /// Fails, before any work, if the run would write over a file it reads: a cell's directory
-    /// that is a summary file (`work` and `out` may be the same directory), or any output that is
-    /// one of [`DemoPlan::inputs`] (even with `force`); then if an output cannot be written, or
-    /// (unless `force`) exists. See [`check_run_outputs`].
-    pub fn check_outputs(&self, force: bool) -> Result<()> {
-        let summaries = self.summary_paths();
-        let dirs = self
-            .case_dirs()
-            .into_iter()
-            .chain((0..self.configurations.len()).map(|i| self.configuration_dir(i)));
-        for dir in dirs {
-            if let Some(summary) = summaries
-                .iter()
-                .find(|s| outputs::paths::same_file(&dir, s))
-            {
-                return Err(MismatchError::CaseDirectoryIsSummary {
-                    path: summary.clone(),
-                });
-            }
-        }
-        let outputs: Vec<(PathBuf, &str)> = summaries
-            .into_iter()
-            .map(|p| (p, "--out"))
-            .chain(self.case_outputs().into_iter().map(|p| (p, "--work")))
-            .collect();
-        check_run_outputs(&outputs, &self.inputs(), force)
-    }
-
-    /// Runs every cell and writes `out/summary.md` and `out/summary.json`; each cell writes its
-    /// recording and analysis in `work/<configuration>/<case>/` (existing files replaced only with
-    /// `force`).
-    pub fn run(&self, force: bool) -> Result<DemoSummary> {
+    /// Runs every cell and returns the summary. Every file of the work folder
+    /// ([`DemoPlan::case_outputs`]) goes to `write`: each configuration's `model.json` first, then
+    /// each cell's recording (which the analysis then reads back as written) and its analysis in
+    /// `work/<configuration>/<case>/`.
+    pub fn run(&self, write: &WriteFile) -> Result<DemoSummary> {
         for (i, loaded) in self.configurations.iter().enumerate() {
-            let dir = self.configuration_dir(i);
-            std::fs::create_dir_all(&dir).map_err(io_error(&dir))?;
-            let path = dir.join("model.json");
-            std::fs::write(&path, loaded.model_for_tool.to_json() + "\n")
-                .map_err(io_error(&path))?;
+            let path = self.configuration_dir(i).join("model.json");
+            write(&path, &(loaded.model_for_tool.to_json() + "\n"))?;
         }
         let cells: Vec<(usize, usize)> = (0..self.configurations.len())
             .flat_map(|c| (0..self.cases.len()).map(move |k| (c, k)))
@@ -375,7 +339,7 @@ impl DemoPlan {
         let outcomes: Vec<CellOutcome> = cells
             .par_iter()
             .map(|&(c, k)| {
-                self.run_cell(c, k, force)
+                self.run_cell(c, k, write)
                     .map_err(|e| MismatchError::Config {
                         path: self.manifest_path.clone(),
                         field: format!("configurations[{c}] × {}", self.cases[k].0),
@@ -383,7 +347,7 @@ impl DemoPlan {
                     })
             })
             .collect::<Result<_>>()?;
-        let summary = DemoSummary::new(
+        Ok(DemoSummary::new(
             self.manifest
                 .configurations
                 .iter()
@@ -395,19 +359,15 @@ impl DemoPlan {
                 .map(|(name, _, purpose)| (name.clone(), purpose.clone()))
                 .collect(),
             outcomes,
-        );
-        let [markdown, json] = self.summary_paths();
-        std::fs::create_dir_all(&self.out).map_err(io_error(&self.out))?;
-        std::fs::write(
-            &json,
-            serde_json::to_string_pretty(&summary).expect("serialises") + "\n",
-        )
-        .map_err(io_error(&json))?;
-        std::fs::write(&markdown, summary.view().markdown()).map_err(io_error(&markdown))?;
-        Ok(summary)
+        ))
     }
 
-    fn run_cell(&self, configuration: usize, case: usize, force: bool) -> Result<CellOutcome> {
+    fn run_cell(
+        &self,
+        configuration: usize,
+        case: usize,
+        write: &WriteFile,
+    ) -> Result<CellOutcome> {
         let loaded = &self.configurations[configuration];
         let (name, effects, _) = &self.cases[case];
         let scenario = Scenario {
@@ -418,11 +378,7 @@ impl DemoPlan {
         let dir = self.configuration_dir(configuration).join(name);
         let csv = dir.join("recording.csv");
         let log = simulate(&loaded.model, &scenario, name)?;
-        if !force && csv.exists() {
-            return Err(MismatchError::Exists { path: csv });
-        }
-        std::fs::create_dir_all(&dir).map_err(io_error(&dir))?;
-        log.write_csv(&csv)?;
+        write(&csv, &log.csv_text())?;
         // Blind: the analysis sees only the CSV as written and the model file's contents.
         let recording = data::FlightLog::read(&csv)?;
         let model_name = self.configuration_dir(configuration).join("model.json");
@@ -432,7 +388,9 @@ impl DemoPlan {
             &model_name.display().to_string(),
             &AnalysisSettings::default(),
         )?;
-        write_outputs(&analysis, &dir, force)?;
+        for (name, contents) in ANALYSIS_FILES.iter().zip(analysis.render(&dir)?) {
+            write(&dir.join(name), &contents)?;
+        }
         Ok(CellOutcome::judge(
             &self.manifest.configurations[configuration].name,
             name,

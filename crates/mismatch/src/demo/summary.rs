@@ -377,6 +377,12 @@ impl DemoSummary {
             cells: self.cells.iter().map(cell_line).collect(),
         }
     }
+
+    /// The contents of the files [`super::SUMMARY_FILES`] names: the Markdown and the JSON.
+    pub fn render(&self) -> [String; 2] {
+        let json = serde_json::to_string_pretty(self).expect("serialises");
+        [self.view().markdown(), json + "\n"]
+    }
 }
 
 fn configuration_line(c: &ConfigurationSummary) -> ConfigurationLine<'_> {

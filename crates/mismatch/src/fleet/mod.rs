@@ -45,12 +45,11 @@ use serde::Serialize;
 use crate::degenerate;
 use crate::error::{MismatchError, Result};
 use crate::least_squares::Termination;
-use crate::output::{check_directory, check_run_outputs};
 use crate::problem::Problem;
 use crate::recording::Recording;
 use sindy::weak_form::TestFunction;
 
-pub use self::report::FleetReport;
+pub use self::report::{FleetReport, file_names};
 pub use ::report::mismatch::fleet::{
     AttitudeCheck, FlightHeldout, FlightSpeedRange, FlightWind, ScaleReport, Targets,
 };
@@ -168,25 +167,21 @@ pub struct FleetFlight {
     pub residual_force: Option<Vec<[f64; 3]>>,
 }
 
-/// Flights of a conditions file, read and checked, ready to analyse; what the run reads and
-/// writes.
+/// Flights of a conditions file, found and checked, ready to analyse; what the run reads.
 #[derive(Clone, Debug)]
 pub struct FleetPlan {
     conditions_path: PathBuf,
     conditions: ExperimentConditions,
     /// (controller, condition index, path) of every flight present.
     flights: Vec<(String, usize, PathBuf)>,
-    out: PathBuf,
-    stem: String,
 }
 
 impl FleetPlan {
-    /// Finds every flight the conditions file declares under `data_dir`. Fails if `out` exists
-    /// but is not a directory, if no condition is declared calm, or if a declared flight is
-    /// missing (all of them: naming the data directory).
-    pub fn load(conditions_path: &Path, data_dir: &Path, model: &Path, out: &Path) -> Result<Self> {
+    /// Finds every flight the conditions file declares under `data_dir`. Fails if no condition
+    /// is declared calm, or if a declared flight is missing (all of them: naming the data
+    /// directory).
+    pub fn load(conditions_path: &Path, data_dir: &Path) -> Result<Self> {
         let conditions = ExperimentConditions::load(conditions_path)?;
-        check_directory(out)?;
         if !conditions.conditions.iter().any(|c| c.calm) {
             return Err(MismatchError::Config {
                 path: conditions_path.to_path_buf(),
@@ -213,16 +208,10 @@ impl FleetPlan {
                 declared: missing.len() + flights.len(),
             });
         }
-        let stem = model
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "fleet".into());
         Ok(Self {
             conditions_path: conditions_path.to_path_buf(),
             conditions,
             flights,
-            out: out.to_path_buf(),
-            stem,
         })
     }
 
@@ -242,24 +231,6 @@ impl FleetPlan {
             ));
         }
         inputs
-    }
-
-    /// Every file the run writes: `<out>/<model stem>.{json,md,svg}`.
-    pub fn outputs(&self) -> Vec<PathBuf> {
-        ["json", "md", "svg"]
-            .iter()
-            .map(|ext| self.out.join(format!("{}.{ext}", self.stem)))
-            .collect()
-    }
-
-    /// Fails, before any work, if an output is an input (the model at `model` included), cannot be
-    /// written, or (unless `force`) exists.
-    pub fn check_outputs(&self, model: &Path, force: bool) -> Result<()> {
-        let mut inputs = self.inputs();
-        inputs.push(("the --model file".to_string(), model.to_path_buf()));
-        let outputs: Vec<(PathBuf, &str)> =
-            self.outputs().into_iter().map(|p| (p, "--out")).collect();
-        check_run_outputs(&outputs, &inputs, force)
     }
 
     /// Reads every flight and prepares its comparison with `model`.
@@ -305,14 +276,9 @@ impl FleetPlan {
             .collect()
     }
 
-    /// Runs the analysis and writes the outputs; returns the report and one line per flight and
-    /// target.
-    pub fn run(
-        &self,
-        model: &NominalModel,
-        model_name: &str,
-        force: bool,
-    ) -> Result<(FleetReport, Vec<String>)> {
+    /// Runs the analysis: the report (its files: [`FleetReport::render`]; its terminal lines:
+    /// `report.view().lines()`).
+    pub fn run(&self, model: &NominalModel, model_name: &str) -> Result<FleetReport> {
         let settings = FleetSettings::default();
         let flights = self.read(model, &settings)?;
         let identification = identify(&flights, &settings);
@@ -328,9 +294,7 @@ impl FleetPlan {
             &self.conditions_path.display().to_string(),
             settings,
         );
-        report::write(&report, &self.outputs(), force)?;
-        let lines = report.view().lines();
-        Ok((report, lines))
+        Ok(report)
     }
 }
 

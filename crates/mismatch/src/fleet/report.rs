@@ -3,7 +3,7 @@
 //! The Markdown, the terminal lines and the figure are rendered by the `report` crate
 //! ([`report::mismatch::fleet`]) from the view [`FleetReport::view`] fills.
 
-use std::path::PathBuf;
+use std::path::Path;
 
 use physics::{EffectId, EffectParameters, Effects, NominalModel};
 use report::mismatch::fleet::{
@@ -15,7 +15,7 @@ use serde::Serialize;
 use super::scale_report::scale_report;
 use super::{Air, FleetFlight, FleetSettings, Identification, SelectionStep};
 use crate::describe::describe;
-use crate::error::{MismatchError, Result, io_error};
+use crate::error::Result;
 
 /// One vehicle effect: id, parameters, plain words.
 #[derive(Clone, Debug, Serialize)]
@@ -270,29 +270,20 @@ impl FleetReport {
     }
 }
 
-/// Writes the JSON, Markdown and SVG (paths in that order); existing files replaced only with
-/// `force` (checked before any work by the caller too).
-pub fn write(report: &FleetReport, outputs: &[PathBuf], force: bool) -> Result<()> {
-    let [json, markdown, svg] = outputs else {
-        unreachable!("three outputs");
-    };
-    for path in outputs {
-        if !force && path.exists() {
-            return Err(MismatchError::Exists { path: path.clone() });
-        }
+/// The names of the joint analysis's files for a nominal model whose file is `<stem>.json`:
+/// `<stem>.json`, `<stem>.md` and `<stem>.svg`, in the order of [`FleetReport::render`].
+pub fn file_names(stem: &str) -> [String; 3] {
+    ["json", "md", "svg"].map(|ext| format!("{stem}.{ext}"))
+}
+
+impl FleetReport {
+    /// The contents of the files [`file_names`] names for `stem`, to be written in `dir` (which
+    /// the figure's errors name): the JSON, the Markdown (linking the figure) and the SVG.
+    pub fn render(&self, dir: &Path, stem: &str) -> Result<[String; 3]> {
+        let [_, _, figure] = file_names(stem);
+        let text = serde_json::to_string_pretty(self).expect("the report serialises");
+        let view = self.view();
+        let svg = view.svg(&dir.join(&figure))?;
+        Ok([text + "\n", view.markdown(&figure), svg])
     }
-    if let Some(parent) = json.parent() {
-        std::fs::create_dir_all(parent).map_err(io_error(parent))?;
-    }
-    let text = serde_json::to_string_pretty(report).expect("the report serialises");
-    std::fs::write(json, text + "\n").map_err(io_error(json))?;
-    let view = report.view();
-    let figure = view.svg(svg)?;
-    std::fs::write(svg, figure).map_err(io_error(svg))?;
-    let figure = svg
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    std::fs::write(markdown, view.markdown(&figure)).map_err(io_error(markdown))?;
-    Ok(())
 }

@@ -5,7 +5,6 @@
 
 use std::fmt::Write as _;
 
-use data::RateFrame;
 use serde::{Deserialize, Serialize};
 
 pub use super::residual_figure::ResidualFigure;
@@ -67,6 +66,15 @@ pub struct Fit {
     pub comparison: String,
     pub t_start: f64,
     pub t_end: f64,
+}
+
+/// The frame in which a recording's angular rate was read: `data`'s `RateFrame` as the report
+/// names it (the report depends on no crate that reads or computes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RateFrame {
+    Body,
+    World,
 }
 
 /// The frame the recording's body rates were read in, and how well each frame matches the rate

@@ -1,9 +1,10 @@
-//! Writing an analysis: `mismatch.json`, `mismatch.svg` (residual per channel before and after,
-//! located windows shaded) and `mismatch.md` (plain words). The text and the figure are rendered by
-//! the `report` crate ([`report::mismatch::recording`]) from the views this module fills
-//! ([`Analysis::view`], [`Analysis::figure`]).
+//! The files of an analysis, rendered: `mismatch.json`, `mismatch.svg` (residual per channel
+//! before and after, located windows shaded) and `mismatch.md` (plain words). The text and the
+//! figure are rendered by the `report` crate ([`report::mismatch::recording`]) from the views this
+//! module fills ([`Analysis::view`], [`Analysis::figure`]); the caller writes them (the `learn`
+//! binary, into an output set).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use physics::CommandLogging;
 use report::mismatch::recording::{
@@ -12,80 +13,30 @@ use report::mismatch::recording::{
 };
 
 use crate::analysis::{Analysis, check_finite};
-use crate::error::{MismatchError, Result, io_error};
+use crate::error::Result;
 use crate::evidence::Evidence;
 use crate::noise_reaction;
 use crate::problem::CHANNEL_NAMES;
 
-/// The three files of an analysis in `dir`.
-pub fn output_paths(dir: &Path) -> [PathBuf; 3] {
-    ["mismatch.json", "mismatch.svg", "mismatch.md"].map(|name| dir.join(name))
-}
+/// The names of an analysis's files in its folder, in the order of [`Analysis::render`].
+pub const ANALYSIS_FILES: [&str; 3] = ["mismatch.json", "mismatch.svg", "mismatch.md"];
 
-/// Fails if `dir` exists but is not a directory, or if any output file exists and `force` is off.
-pub fn check_outputs(dir: &Path, force: bool) -> Result<()> {
-    check_directory(dir)?;
-    if force {
-        return Ok(());
+impl Analysis {
+    /// The contents of the files [`ANALYSIS_FILES`] names, to be written in `dir` (which the
+    /// figure's errors name). Fails, with nothing to write, unless every number of the analysis
+    /// is finite and the figure can be drawn.
+    pub fn render(&self, dir: &Path) -> Result<[String; 3]> {
+        check_finite(self)?;
+        let json = serde_json::to_string_pretty(&self.report).expect("the report serialises");
+        let svg = self.figure_svg(&dir.join(ANALYSIS_FILES[1]))?;
+        Ok([json + "\n", svg, self.view().markdown()])
     }
-    match output_paths(dir).into_iter().find(|p| p.exists()) {
-        Some(path) => Err(MismatchError::Exists { path }),
-        None => Ok(()),
-    }
-}
 
-/// Checks every file a run will write (each with the option that places it), before any work,
-/// as named files of an output set (see the `outputs` crate, the home of these checks): none is
-/// one of the run's `inputs` (what each is, its path), whatever `force` says; each can be written
-/// (not a directory, not below something that is not one); none exists unless `force`.
-pub fn check_run_outputs(
-    outputs: &[(PathBuf, &str)],
-    inputs: &[(String, PathBuf)],
-    force: bool,
-) -> Result<()> {
-    let mut set = outputs::OutputSet::new("mismatch");
-    for (what, path) in inputs {
-        set.input(what.clone(), path);
+    /// The figure (one panel per channel), named `path` in errors. Fails unless the data are
+    /// finite and every axis spans a drawable range (finite ends, a normal positive span).
+    pub fn figure_svg(&self, path: &Path) -> Result<String> {
+        Ok(self.figure().svg(path)?)
     }
-    for (path, option) in outputs {
-        set.file(path, option, outputs::Existing::from_force(force));
-    }
-    Ok(set.check()?)
-}
-
-/// Fails if `dir` exists but is not a directory (checked before any work that would write there).
-pub fn check_directory(dir: &Path) -> Result<()> {
-    if dir.exists() && !dir.is_dir() {
-        return Err(MismatchError::Io {
-            path: dir.to_path_buf(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::NotADirectory,
-                "exists and is not a directory",
-            ),
-        });
-    }
-    Ok(())
-}
-
-/// Writes the three files; fails before writing any of them unless every number of the analysis is
-/// finite.
-pub fn write_outputs(analysis: &Analysis, dir: &Path, force: bool) -> Result<()> {
-    check_outputs(dir, force)?;
-    check_finite(analysis)?;
-    std::fs::create_dir_all(dir).map_err(io_error(dir))?;
-    let [json, svg, markdown] = output_paths(dir);
-    let text = serde_json::to_string_pretty(&analysis.report).expect("the report serialises");
-    std::fs::write(&json, text + "\n").map_err(io_error(&json))?;
-    write_figure(analysis, &svg)?;
-    std::fs::write(&markdown, analysis.view().markdown()).map_err(io_error(&markdown))?;
-    Ok(())
-}
-
-/// Writes the figure (one panel per channel). Fails, without writing, unless the data are finite
-/// and every axis spans a drawable range (finite ends, a normal positive span).
-pub fn write_figure(analysis: &Analysis, path: &Path) -> Result<()> {
-    let svg = analysis.figure().svg(path)?;
-    std::fs::write(path, svg).map_err(io_error(path))
 }
 
 /// The evidence for one effect as the report prints it.

@@ -14,24 +14,16 @@
 //!   for white noise (clipped to [0, upper]).
 
 use faer::MatRef;
-use serde::{Deserialize, Serialize};
-
-use crate::error::Result;
+use report::NoiseFloor;
 use sindy::Derivative;
-
-/// The noise-floor estimates of one segment's forward-difference targets.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct NoiseFloor {
-    /// Mean square of forward difference minus the Savitzky–Golay derivative.
-    pub upper: f64,
-    /// Twice the negative lag-one autocovariance of that residual (clipped to [0, upper]).
-    pub lower: f64,
-}
 
 /// Estimates the noise floor of the forward-difference targets of a segment's `states` (one row
 /// per sample, one column per state), sampled every `dt` seconds. Both derivatives are computed
 /// from the states (a segment's own targets are not needed).
-pub fn forward_difference_noise_floor(states: MatRef<'_, f64>, dt: f64) -> Result<NoiseFloor> {
+pub fn forward_difference_noise_floor(
+    states: MatRef<'_, f64>,
+    dt: f64,
+) -> sindy::Result<NoiseFloor> {
     let (n, dims) = (states.nrows(), states.ncols());
     let (mut square, mut lagged, mut pairs) = (0.0, 0.0, 0usize);
     for j in 0..dims {

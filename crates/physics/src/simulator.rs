@@ -16,8 +16,9 @@
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
 
 use data::{FlightLog, quaternion_from_rotation, rotation_from_quaternion};
 
@@ -187,10 +188,7 @@ struct Gaussian {
 
 impl Gaussian {
     fn sample(&mut self) -> f64 {
-        // Box–Muller; 1 − u keeps the logarithm finite.
-        let u: f64 = 1.0 - self.rng.random::<f64>();
-        let v: f64 = self.rng.random::<f64>();
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+        StandardNormal.sample(&mut self.rng)
     }
 
     fn vector(&mut self, sigma: f64) -> Vec3 {

@@ -16,9 +16,8 @@
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
-use rand::SeedableRng;
+use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, StandardNormal};
 
 use data::{FlightLog, quaternion_from_rotation, rotation_from_quaternion};
 
@@ -188,7 +187,11 @@ struct Gaussian {
 
 impl Gaussian {
     fn sample(&mut self) -> f64 {
-        StandardNormal.sample(&mut self.rng)
+        // Box–Muller (1 − u keeps the logarithm finite), kept rather than rand_distr's draw: this
+        // stream is the noise of every committed simulated recording (docs/mismatch-history.md).
+        let u: f64 = 1.0 - self.rng.random::<f64>();
+        let v: f64 = self.rng.random::<f64>();
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
     }
 
     fn vector(&mut self, sigma: f64) -> Vec3 {

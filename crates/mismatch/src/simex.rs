@@ -28,8 +28,9 @@
 //! noise variance).
 
 use physics::vector::Vec3;
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -291,9 +292,8 @@ fn square_root(matrix: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
     std::array::from_fn(|i| std::array::from_fn(|j| u[(i, j)] * s[j].max(0.0).sqrt()))
 }
 
-/// A standard normal draw times `sigma` (Box–Muller).
+/// A standard normal draw times `sigma`.
 pub(crate) fn gaussian(rng: &mut ChaCha8Rng, sigma: f64) -> f64 {
-    let u: f64 = rng.random_range(f64::EPSILON..1.0);
-    let v: f64 = rng.random_range(0.0..1.0);
-    sigma * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    let draw: f64 = StandardNormal.sample(rng);
+    sigma * draw
 }

@@ -187,7 +187,8 @@ struct Gaussian {
 
 impl Gaussian {
     fn sample(&mut self) -> f64 {
-        // Box–Muller; 1 − u keeps the logarithm finite.
+        // Box–Muller (1 − u keeps the logarithm finite), kept rather than rand_distr's draw: this
+        // stream is the noise of every committed simulated recording (docs/mismatch-history.md).
         let u: f64 = 1.0 - self.rng.random::<f64>();
         let v: f64 = self.rng.random::<f64>();
         (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()

@@ -10,6 +10,7 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
 /// A closed range `[low, high]` a parameter is drawn from uniformly.
@@ -126,11 +127,9 @@ impl SimulatedTask {
     }
 }
 
-/// A standard normal draw (Box–Muller).
+/// A standard normal draw.
 fn normal(rng: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = rng.random_range(f64::EPSILON..1.0);
-    let u2: f64 = rng.random_range(0.0..1.0);
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    StandardNormal.sample(rng)
 }
 
 /// Task `index` of the family drawn with `seed`.

@@ -51,6 +51,7 @@ mod fit;
 pub mod fleet;
 pub mod forward;
 mod library;
+mod median;
 pub mod noise_reaction;
 mod problem;
 mod recording;

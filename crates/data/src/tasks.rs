@@ -12,7 +12,7 @@ use inputs::Excerpt;
 use crate::error::{DataError, Result};
 use crate::numeric::NumericTable;
 use crate::table::TextTable;
-use crate::time::{DEFAULT_UNIFORM_TOLERANCE, check_time_axis_at};
+use crate::time::{DEFAULT_UNIFORM_TOLERANCE, check_time_axis_at, median_interval};
 
 /// The most tasks read at once.
 pub const MAX_TASKS: usize = 10_000;
@@ -179,13 +179,6 @@ fn read_task_runs(
             })
         })
         .collect()
-}
-
-/// The median gap of a time axis of at least two samples.
-fn median_interval(time: &[f64]) -> f64 {
-    let mut gaps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
-    gaps.sort_by(f64::total_cmp);
-    gaps.get(gaps.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// A sampling interval in seconds as a person writes it: 0.1, not the median gap

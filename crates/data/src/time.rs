@@ -2,8 +2,22 @@
 
 use std::path::Path;
 
+use statrs::statistics::{Data, OrderStatistics};
+
 use crate::error::{DataError, Result};
 use crate::table::file_row;
+
+/// The median of the sample intervals: of an even count the larger middle value (statrs' order
+/// statistic n/2 + 1); NaN for none.
+pub(crate) fn median_interval(time: &[f64]) -> f64 {
+    upper_median(time.windows(2).map(|w| w[1] - w[0]).collect())
+}
+
+/// Of an even count the larger middle value (statrs' order statistic n/2 + 1); NaN for none.
+fn upper_median(values: Vec<f64>) -> f64 {
+    let order = values.len() / 2 + 1;
+    Data::new(values).order_statistic(order)
+}
 
 /// Largest relative deviation of a sample interval from the median interval that still counts as
 /// uniform sampling (the Neural-Fly logs deviate by ~1e-12).
@@ -43,21 +57,19 @@ pub(crate) fn check_time_axis_at(
             });
         }
     }
-    let mut gaps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
-    let in_order = gaps.clone();
-    gaps.sort_by(f64::total_cmp);
-    let median = gaps[gaps.len() / 2];
+    let median = median_interval(time);
     // The first of the worst gaps.
-    let (index, gap) = in_order
-        .iter()
-        .enumerate()
-        .fold((0, median), |best, (k, &g)| {
-            if (g - median).abs() > (best.1 - median).abs() {
-                (k, g)
-            } else {
-                best
-            }
-        });
+    let (index, gap) =
+        time.windows(2)
+            .map(|w| w[1] - w[0])
+            .enumerate()
+            .fold((0, median), |best, (k, g)| {
+                if (g - median).abs() > (best.1 - median).abs() {
+                    (k, g)
+                } else {
+                    best
+                }
+            });
     if (gap - median).abs() > tolerance * median {
         return Err(DataError::NonUniformSampling {
             path: path.to_path_buf(),
@@ -188,9 +200,7 @@ impl StreamedTimeAxis {
     }
 
     fn settle(&mut self) -> Result<()> {
-        let mut gaps: Vec<f64> = self.pending.iter().map(|p| p.1).collect();
-        gaps.sort_by(f64::total_cmp);
-        let step = gaps[gaps.len() / 2];
+        let step = upper_median(self.pending.iter().map(|p| p.1).collect());
         self.reference = Some(step);
         for (line, gap) in std::mem::take(&mut self.pending) {
             self.check_gap(line, gap, step)?;

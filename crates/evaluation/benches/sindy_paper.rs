@@ -17,17 +17,18 @@ use evaluation::{SindyConfig, evaluate_flight};
 use learn::Formulation;
 use rayon::prelude::*;
 use sindy::{Derivative, FeatureLibrary, SindyParams};
+use statrs::statistics::{Data, OrderStatistics};
 
 fn median_seconds(runs: usize, mut work: impl FnMut()) -> f64 {
-    let mut times: Vec<f64> = (0..runs)
+    let times: Vec<f64> = (0..runs)
         .map(|_| {
             let start = Instant::now();
             work();
             start.elapsed().as_secs_f64()
         })
         .collect();
-    times.sort_by(f64::total_cmp);
-    times[runs / 2]
+    // Of an even count the larger middle value.
+    Data::new(times).order_statistic(runs / 2 + 1)
 }
 
 fn flight_paths() -> Vec<(String, PathBuf)> {

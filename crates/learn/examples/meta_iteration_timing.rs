@@ -14,6 +14,7 @@ use learn::{
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use statrs::statistics::{Data, Min, OrderStatistics};
 
 fn batch(rng: &mut ChaCha8Rng, rows: usize, architecture: &Architecture) -> Batch {
     Batch {
@@ -26,10 +27,11 @@ fn batch(rng: &mut ChaCha8Rng, rows: usize, architecture: &Architecture) -> Batc
     }
 }
 
-/// (median, minimum).
-fn median_and_min(mut values: Vec<f64>) -> (f64, f64) {
-    values.sort_by(f64::total_cmp);
-    (values[values.len() / 2], values[0])
+/// (median, minimum): of an even count the larger middle value.
+fn median_and_min(values: Vec<f64>) -> (f64, f64) {
+    let mut data = Data::new(values);
+    let order = data.len() / 2 + 1;
+    (data.order_statistic(order), data.min())
 }
 
 fn main() {

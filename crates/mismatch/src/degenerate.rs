@@ -6,6 +6,7 @@
 use data::FlightLog;
 use physics::{NominalModel, ThrustSource};
 
+use crate::median::median;
 use crate::problem::{CHANNEL_NAMES, Problem};
 
 /// What makes a recording degenerate.
@@ -152,12 +153,9 @@ pub fn check_thrust(commands: &[[f64; 4]], model: &NominalModel) -> Result<(), D
 pub fn check_noise(problem: &Problem) -> Result<(), Degeneracy> {
     let channels: Vec<&'static str> = (0..problem.channels)
         .filter(|&c| {
-            let mut squares: Vec<f64> = problem.target.iter().map(|t| t[c] * t[c]).collect();
-            let Some(middle) = squares.len().checked_sub(1).map(|last| last / 2) else {
-                return false;
-            };
-            let (_, median, _) = squares.select_nth_unstable_by(middle, f64::total_cmp);
-            let typical = median.sqrt();
+            let squares: Vec<f64> = problem.target.iter().map(|t| t[c] * t[c]).collect();
+            // No rows: 0, and no noise floor is below 0.
+            let typical = median(squares).sqrt();
             typical.is_finite() && problem.noise_floor[c] < NOISE_RESOLUTION * typical
         })
         .map(|c| CHANNEL_NAMES[c])

@@ -21,6 +21,7 @@ use physics::vector::{Mat3, Vec3, mat_mul, transpose, vee};
 use physics::{CommandLogging, Logger};
 use serde::Serialize;
 
+use crate::median::median;
 use crate::recording::Recording;
 use sindy::weak_form::{white_noise_sigma, white_noise_sigma_of_fourth_differences};
 
@@ -302,15 +303,6 @@ fn least_squares(
         .iter()
         .all(|g| g.iter().all(|v| v.is_finite()))
         .then_some(gains)
-}
-
-/// The median (the upper one of an even count; 0 for none).
-pub(crate) fn median(mut values: Vec<f64>) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    let middle = values.len() / 2;
-    *values.select_nth_unstable_by(middle, f64::total_cmp).1
 }
 
 /// Each row's attitude noise (body frame): the logged turn between rows minus the trapezoid of the

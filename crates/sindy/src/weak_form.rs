@@ -17,6 +17,8 @@
 
 use serde::Serialize;
 
+use crate::median::median;
+
 /// The test function's settings.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct TestFunction {
@@ -226,13 +228,8 @@ pub fn white_noise_sigma(x: &[f64]) -> f64 {
 /// [`white_noise_sigma`] from fourth differences already taken (of a signal that is not a plain
 /// series, such as the attitude).
 pub fn white_noise_sigma_of_fourth_differences(fourth: &[f64]) -> f64 {
-    if fourth.is_empty() {
-        return 0.0;
-    }
-    let mut squares: Vec<f64> = fourth.iter().map(|d| d * d).collect();
-    let middle = squares.len() / 2;
-    let (_, median, _) = squares.select_nth_unstable_by(middle, f64::total_cmp);
-    (*median / (70.0 * 0.4549)).sqrt()
+    let squares: Vec<f64> = fourth.iter().map(|d| d * d).collect();
+    (median(squares) / (70.0 * 0.4549)).sqrt()
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sindy::Derivative;
 use sindy::{BlockedFolds, FeatureLibrary, LibrarySpec, OptimizerSpec, Penalty, RegressionSpec};
+use statrs::statistics::{Data, Median};
 
 use super::family::{FamilyConfig, SimulatedTask, TaskParameters, simulate_task};
 use super::{SindySettings, matrix, mse, sindy_scores};
@@ -327,8 +328,12 @@ impl SeedCurve {
         let column = |s: usize, m: usize| -> Vec<f64> { scores.iter().map(|t| t[s][m]).collect() };
         Self {
             seed,
-            learn_median: (0..sizes).map(|s| median(&column(s, 0))).collect(),
-            unadapted_median: (0..sizes).map(|s| median(&column(s, 3))).collect(),
+            learn_median: (0..sizes)
+                .map(|s| Data::new(column(s, 0)).median())
+                .collect(),
+            unadapted_median: (0..sizes)
+                .map(|s| Data::new(column(s, 3)).median())
+                .collect(),
         }
     }
 }
@@ -435,7 +440,7 @@ fn curve_points(sizes: &[usize], scores: &[Vec<[f64; 4]>]) -> Vec<CurvePoint> {
             points.push(CurvePoint {
                 method,
                 support,
-                median: median(&per_task),
+                median: Data::new(per_task.clone()).median(),
                 mean: per_task.iter().sum::<f64>() / per_task.len().max(1) as f64,
                 per_task,
                 learn_lower_on,
@@ -445,25 +450,17 @@ fn curve_points(sizes: &[usize], scores: &[Vec<[f64; 4]>]) -> Vec<CurvePoint> {
     points
 }
 
-/// The median (the mean of the two middle values for an even count); NaN sorts last.
-fn median(values: &[f64]) -> f64 {
-    let mut sorted = values.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    match sorted.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => sorted[n / 2],
-        n => (sorted[n / 2 - 1] + sorted[n / 2]) / 2.0,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn median_and_wins_per_method_and_size() {
-        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+        // statrs' median, as the curve's numbers were made: the mean of the two middle values.
+        let median = |values: Vec<f64>| Data::new(values).median();
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert!(median(Vec::new()).is_nan());
         let scores = vec![
             vec![[1.0, 2.0, 0.5, 3.0]],
             vec![[1.0, 0.5, 2.0, 3.0]],

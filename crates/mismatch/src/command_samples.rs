@@ -226,7 +226,7 @@ impl CommandSamples {
                 .collect();
             let magnitude = self.values.iter().map(|v| v[i].abs()).fold(0.0, f64::max);
             let scale = (1.4826
-                * crate::median::median(departure.iter().map(|d| d.abs()).collect()))
+                * sindy::median::median(departure.iter().map(|d| d.abs()).collect()))
             .max(1e-9 * magnitude);
             for (k, d) in departure.iter().enumerate() {
                 let inside = (k..k + 4).all(|j| self.held[j][i] == Held::Inside);

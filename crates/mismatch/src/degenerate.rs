@@ -6,7 +6,7 @@
 use data::FlightLog;
 use physics::{NominalModel, ThrustSource};
 
-use crate::median::median;
+use sindy::median::median;
 use crate::problem::{CHANNEL_NAMES, Problem};
 
 /// What makes a recording degenerate.

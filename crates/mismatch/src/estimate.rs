@@ -29,7 +29,7 @@ use serde::Serialize;
 use crate::evidence::autocorrelation_factor;
 use crate::fit::FittedSet;
 use crate::least_squares::Termination;
-use crate::median::median;
+use sindy::median::median;
 use crate::problem::{Channels, Problem};
 use crate::refine::{FitRows, StepBasis, levenberg_marquardt, standard_errors};
 use crate::simex::{NoiseBias, SimexSettings, noise_bias};

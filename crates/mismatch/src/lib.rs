@@ -53,7 +53,7 @@ pub mod fleet;
 pub mod forward;
 pub mod least_squares;
 mod library;
-mod median;
+
 pub mod noise_reaction;
 mod problem;
 mod recording;

@@ -21,7 +21,7 @@ use physics::vector::{Mat3, Vec3, mat_mul, transpose, vee};
 use physics::{CommandLogging, Logger};
 use serde::Serialize;
 
-use crate::median::median;
+use sindy::median::median;
 use crate::recording::Recording;
 use sindy::weak_form::{white_noise_sigma, white_noise_sigma_of_fourth_differences};
 

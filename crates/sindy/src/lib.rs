@@ -70,6 +70,7 @@
 //! Every error is a [`SindyError`] with a one-line message.
 
 pub mod differentiation;
+pub mod median;
 mod error;
 mod library;
 mod linalg;

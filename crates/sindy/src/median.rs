@@ -1,12 +1,13 @@
-//! The one median of the analysis (statrs), which its robust scales are built on: the noise of
-//! fourth differences, the spread of residuals and of command departures, the typical size of a
-//! target. Of an even count it is the larger of the two middle values.
+//! The one median of the robust scales (statrs' order statistic): the noise of fourth differences
+//! ([`crate::weak_form`]) and, in the mismatch analysis, the spread of residuals and of command
+//! departures and the typical size of a target. Of an even count it is the larger of the two middle
+//! values.
 
 use statrs::statistics::{Data, OrderStatistics};
 
 /// The median of `values`: of an even count the larger middle value (statrs' order statistic
 /// n/2 + 1); 0 for none.
-pub(crate) fn median(values: Vec<f64>) -> f64 {
+pub fn median(values: Vec<f64>) -> f64 {
     if values.is_empty() {
         return 0.0;
     }

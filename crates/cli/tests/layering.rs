@@ -127,6 +127,16 @@ fn data_reads_files_and_computes_nothing() {
 }
 
 #[test]
+fn the_rotation_maths_depends_on_nothing() {
+    let direct = direct("rotation");
+    assert!(direct.is_empty(), "rotation depends on {direct:?}");
+    // Its users share it, and no second copy of the maths lives in them.
+    for user in ["data", "physics"] {
+        assert!(closure(user).contains_key("rotation"), "{user}");
+    }
+}
+
+#[test]
 fn mismatch_returns_results_and_writes_no_output_set() {
     assert_layered("mismatch", &["report"], &["outputs", "indicatif"]);
 }

@@ -2,6 +2,10 @@
 
 use std::path::{Path, PathBuf};
 
+use rotation::{
+    Mat3, mat_mul, mat_scale, mat_sub, quaternion_from_rotation, rotation_from_quaternion,
+    transpose, vee,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{DataError, Result};
@@ -58,7 +62,7 @@ pub struct FlightLog {
     pub velocity: Vec<[f64; 3]>,
     pub quaternion: Vec<[f64; 4]>,
     /// Body to world, row-major.
-    pub rotation: Vec<[[f64; 3]; 3]>,
+    pub rotation: Vec<Mat3>,
     /// The `w` column, rad/s.
     pub body_rate: Vec<[f64; 3]>,
     /// `T_sp`: normalised thrust setpoint.
@@ -410,7 +414,7 @@ fn check_unit_quaternions(
 }
 
 /// The largest |a_ij − b_ij|.
-fn largest_difference(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> f64 {
+fn largest_difference(a: &Mat3, b: &Mat3) -> f64 {
     a.iter()
         .flatten()
         .zip(b.iter().flatten())
@@ -422,7 +426,7 @@ fn largest_difference(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> f64 {
 /// deviate by at most 3e-4).
 const ROTATION_TOLERANCE: f64 = 1e-2;
 
-fn check_rotations(table: &TextTable, rotation: &[[[f64; 3]; 3]], recorded: bool) -> Result<()> {
+fn check_rotations(table: &TextTable, rotation: &[Mat3], recorded: bool) -> Result<()> {
     if !recorded {
         return Ok(());
     }
@@ -449,11 +453,7 @@ fn check_rotations(table: &TextTable, rotation: &[[[f64; 3]; 3]], recorded: bool
 
 /// When both are recorded, `q` and `R` must describe the same attitude (the Neural-Fly logs differ
 /// by at most 2e-4 per entry).
-fn check_agreement(
-    table: &TextTable,
-    quaternion: &[[f64; 4]],
-    rotation: &[[[f64; 3]; 3]],
-) -> Result<()> {
+fn check_agreement(table: &TextTable, quaternion: &[[f64; 4]], rotation: &[Mat3]) -> Result<()> {
     for (index, (q, r)) in quaternion.iter().zip(rotation).enumerate() {
         let difference = largest_difference(&rotation_from_quaternion(q), r);
         if difference > ROTATION_TOLERANCE {
@@ -471,112 +471,6 @@ fn check_agreement(
     Ok(())
 }
 
-/// Rotation matrix (body to world) of a unit quaternion `[x, y, z, w]`.
-pub fn rotation_from_quaternion(q: &[f64; 4]) -> [[f64; 3]; 3] {
-    let [x, y, z, w] = *q;
-    [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - z * w),
-            2.0 * (x * z + y * w),
-        ],
-        [
-            2.0 * (x * y + z * w),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - x * w),
-        ],
-        [
-            2.0 * (x * z - y * w),
-            2.0 * (y * z + x * w),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ]
-}
-
-/// Unit quaternion `[x, y, z, w]` (w ≥ 0) of a rotation matrix.
-pub fn quaternion_from_rotation(r: &[[f64; 3]; 3]) -> [f64; 4] {
-    let trace = r[0][0] + r[1][1] + r[2][2];
-    let q = if trace > 0.0 {
-        let s = (trace + 1.0).sqrt() * 2.0;
-        [
-            (r[2][1] - r[1][2]) / s,
-            (r[0][2] - r[2][0]) / s,
-            (r[1][0] - r[0][1]) / s,
-            0.25 * s,
-        ]
-    } else if r[0][0] > r[1][1] && r[0][0] > r[2][2] {
-        let s = (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt() * 2.0;
-        [
-            0.25 * s,
-            (r[0][1] + r[1][0]) / s,
-            (r[0][2] + r[2][0]) / s,
-            (r[2][1] - r[1][2]) / s,
-        ]
-    } else if r[1][1] > r[2][2] {
-        let s = (1.0 + r[1][1] - r[0][0] - r[2][2]).sqrt() * 2.0;
-        [
-            (r[0][1] + r[1][0]) / s,
-            0.25 * s,
-            (r[1][2] + r[2][1]) / s,
-            (r[0][2] - r[2][0]) / s,
-        ]
-    } else {
-        let s = (1.0 + r[2][2] - r[0][0] - r[1][1]).sqrt() * 2.0;
-        [
-            (r[0][2] + r[2][0]) / s,
-            (r[1][2] + r[2][1]) / s,
-            0.25 * s,
-            (r[1][0] - r[0][1]) / s,
-        ]
-    };
-    if q[3] < 0.0 { q.map(|v| -v) } else { q }
-}
-
-type Mat3 = [[f64; 3]; 3];
-
-fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    let mut out = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            out[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
-        }
-    }
-    out
-}
-
-fn transpose(a: &Mat3) -> Mat3 {
-    let mut out = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            out[i][j] = a[j][i];
-        }
-    }
-    out
-}
-
-fn mat_sub(a: &Mat3, b: &Mat3) -> Mat3 {
-    let mut out = *a;
-    for i in 0..3 {
-        for j in 0..3 {
-            out[i][j] -= b[i][j];
-        }
-    }
-    out
-}
-
-fn mat_scale(a: &Mat3, s: f64) -> Mat3 {
-    a.map(|row| row.map(|v| v * s))
-}
-
-/// The vector of a skew-symmetric matrix (its antisymmetric part, to be robust to noise).
-fn vee(s: &Mat3) -> [f64; 3] {
-    [
-        0.5 * (s[2][1] - s[1][2]),
-        0.5 * (s[0][2] - s[2][0]),
-        0.5 * (s[1][0] - s[0][1]),
-    ]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -590,26 +484,5 @@ mod tests {
         assert_eq!(meta.method, "NF-C");
         assert_eq!(meta.condition, "70p20sint");
         assert!(FlightMeta::from_file_name(Path::new("flight.csv")).is_none());
-    }
-
-    #[test]
-    fn quaternion_and_rotation_round_trip() {
-        let q = {
-            let raw = [0.1, -0.3, 0.2, 0.9];
-            let n = raw.iter().map(|v: &f64| v * v).sum::<f64>().sqrt();
-            raw.map(|v| v / n)
-        };
-        let r = rotation_from_quaternion(&q);
-        let back = quaternion_from_rotation(&r);
-        for i in 0..4 {
-            assert!((q[i] - back[i]).abs() < 1e-12);
-        }
-        let rrt = mat_mul(&r, &transpose(&r));
-        for (i, row) in rrt.iter().enumerate() {
-            for (j, value) in row.iter().enumerate() {
-                let expected = if i == j { 1.0 } else { 0.0 };
-                assert!((value - expected).abs() < 1e-12);
-            }
-        }
     }
 }

@@ -30,10 +30,7 @@ mod write;
 
 pub use conditions::{Condition, ExperimentConditions, FlightFile, PaperTraining, Role};
 pub use error::{DataError, Result};
-pub use flight_log::{
-    FlightLog, FlightMeta, REQUIRED_COLUMNS, RateFrame, quaternion_from_rotation,
-    rotation_from_quaternion,
-};
+pub use flight_log::{FlightLog, FlightMeta, REQUIRED_COLUMNS, RateFrame};
 pub use numeric::NumericTable;
 pub use records::LayoutFault;
 pub use source::{

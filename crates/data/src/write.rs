@@ -5,6 +5,8 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;
 
+use rotation::Mat3;
+
 use crate::error::{DataError, Result};
 use crate::flight_log::FlightLog;
 
@@ -13,7 +15,7 @@ fn list(values: &[f64]) -> String {
     format!("\"[{}]\"", inner.join(", "))
 }
 
-fn matrix(m: &[[f64; 3]; 3]) -> String {
+fn matrix(m: &Mat3) -> String {
     let rows: Vec<String> = m
         .iter()
         .map(|row| {

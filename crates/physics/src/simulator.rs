@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use data::{FlightLog, quaternion_from_rotation, rotation_from_quaternion};
+use data::FlightLog;
 
 use crate::controller::{ControlOutput, GeometricController, MeasuredState};
 use crate::effects::Effects;
@@ -29,8 +29,8 @@ use crate::logger::CommandLogging;
 use crate::model::NominalModel;
 use crate::scenario::{Noise, Scenario};
 use crate::vector::{
-    Vec3, add, mat_mul, norm, quaternion_multiply, quaternion_normalize,
-    rotation_from_rotation_vector, scale, sub,
+    Vec3, add, mat_mul, norm, quaternion_from_rotation, quaternion_multiply, quaternion_normalize,
+    rotation_from_quaternion, rotation_from_rotation_vector, scale, sub,
 };
 
 /// The true state of the plant.

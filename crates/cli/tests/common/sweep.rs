@@ -7,7 +7,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use data::{FlightLog, rotation_from_quaternion};
+use data::FlightLog;
+use physics::vector::rotation_from_quaternion;
 use serde_json::{Value, json};
 
 use super::Run;

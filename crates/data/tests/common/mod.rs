@@ -3,7 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use data::{FlightLog, rotation_from_quaternion};
+use data::FlightLog;
+use rotation::rotation_from_quaternion;
 
 /// A smooth synthetic flight of `n` samples at 50 Hz with every column present.
 pub fn synthetic_log(n: usize) -> FlightLog {

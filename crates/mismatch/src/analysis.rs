@@ -10,6 +10,8 @@ pub use report::mismatch::recording::{
     ChannelReport, Fit, Heldout, Mse, RateFrame, RateFrameReport, Window,
 };
 use serde::Serialize;
+use sindy::stability::{Selection, SelectionSettings, stability_selection};
+use sindy::weak_form::{TestFunction, white_noise_sigma};
 
 use crate::command_samples::ActuatorLimits;
 use crate::degenerate;
@@ -26,8 +28,6 @@ use crate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::recording::Recording;
 use crate::refine::{FitRows, StepBasis, effects_from};
 use crate::simex::NoiseSources;
-use sindy::stability::{Selection, SelectionSettings, stability_selection};
-use sindy::weak_form::{TestFunction, white_noise_sigma};
 
 /// Settings of an analysis (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -5,8 +5,8 @@
 
 use data::FlightLog;
 use physics::{NominalModel, ThrustSource};
-
 use sindy::median::median;
+
 use crate::problem::{CHANNEL_NAMES, Problem};
 
 /// What makes a recording degenerate.

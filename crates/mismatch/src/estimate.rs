@@ -25,11 +25,11 @@
 //! of 88 instead of 78).
 
 use serde::Serialize;
+use sindy::median::median;
 
 use crate::evidence::autocorrelation_factor;
 use crate::fit::FittedSet;
 use crate::least_squares::Termination;
-use sindy::median::median;
 use crate::problem::{Channels, Problem};
 use crate::refine::{FitRows, StepBasis, levenberg_marquardt, standard_errors};
 use crate::simex::{NoiseBias, SimexSettings, noise_bias};

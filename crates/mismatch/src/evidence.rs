@@ -23,12 +23,12 @@
 use physics::EffectId;
 use rayon::prelude::*;
 use serde::Serialize;
+use sindy::stability::trimmed_gain;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 use crate::fit::FittedSet;
 use crate::problem::{Channels, Problem};
 use crate::refine::{FitRows, standard_errors};
-use sindy::stability::trimmed_gain;
 
 /// The thresholds of the rule (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -6,6 +6,7 @@
 use physics::{EffectId, EffectNumber, Effects};
 use report::mismatch::recording::TimingScores;
 use serde::Serialize;
+use sindy::stability::{BlockDesign, Selection};
 
 use crate::library::{Candidate, CandidateId};
 use crate::problem::{Channels, Problem};
@@ -13,7 +14,6 @@ use crate::refine::{
     FitRows, effect_column, effects_from, levenberg_marquardt, profile_search, profile_wind,
     unit_drag_in_wind,
 };
-use sindy::stability::{BlockDesign, Selection};
 
 const GROUND_RADIUS: EffectNumber = EffectNumber::new(EffectId::GroundEffect, 0);
 const DELAY: EffectNumber = EffectNumber::new(EffectId::Delay, 0);

@@ -21,8 +21,8 @@ use physics::vector::{Mat3, Vec3, mat_mul, transpose, vee};
 use physics::{CommandLogging, Logger};
 use serde::Serialize;
 
-use sindy::median::median;
 use crate::recording::Recording;
+use sindy::median::median;
 use sindy::weak_form::{white_noise_sigma, white_noise_sigma_of_fourth_differences};
 
 /// Fourth-difference weights; white noise of variance σ² has fourth differences of variance 70 σ².

@@ -6,12 +6,12 @@ use std::path::PathBuf;
 use data::{FlightLog, RateFrame};
 use physics::vector::{Mat3, Vec3, mat_t_vec};
 use physics::{CommandLogging, NominalModel};
+use sindy::weak_form::white_noise_sigma;
 
 use crate::command_samples::{ActuatorLimits, CommandSamples, SampleDomain, detect_limits};
 use crate::degenerate;
 use crate::error::{MismatchError, Result};
 use crate::noise_reaction::{self, NoiseReaction};
-use sindy::weak_form::white_noise_sigma;
 
 /// The recorded signals, per row.
 #[derive(Clone, Debug)]

@@ -33,12 +33,12 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::Serialize;
+use sindy::weak_form::white_noise_sigma;
 
 use crate::fit::FittedSet;
 use crate::noise_reaction;
 use crate::problem::Problem;
 use crate::refine::{FitRows, levenberg_marquardt};
-use sindy::weak_form::white_noise_sigma;
 
 /// Settings of the correction (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

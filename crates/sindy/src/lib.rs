@@ -70,10 +70,10 @@
 //! Every error is a [`SindyError`] with a one-line message.
 
 pub mod differentiation;
-pub mod median;
 mod error;
 mod library;
 mod linalg;
+pub mod median;
 mod memory;
 mod model;
 mod optimizers;

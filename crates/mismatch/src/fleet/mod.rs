@@ -41,13 +41,13 @@ use data::ExperimentConditions;
 use physics::{EffectId, EffectNumber, NominalModel};
 use rayon::prelude::*;
 use serde::Serialize;
+use sindy::weak_form::TestFunction;
 
 use crate::degenerate;
 use crate::error::{MismatchError, Result};
 use crate::least_squares::Termination;
 use crate::problem::Problem;
 use crate::recording::Recording;
-use sindy::weak_form::TestFunction;
 
 pub use self::report::{FleetReport, file_names};
 pub use ::report::mismatch::fleet::{

@@ -7,13 +7,13 @@ use std::path::{Path, PathBuf};
 use physics::{EffectId, Effects};
 use serde::de::DeserializeOwned;
 use serde_json::Value;
+use sindy::weak_form::TestFunction;
 
 use super::report::{VehicleEffect, VehicleParameters, VehicleReport, file_names};
 use super::{
     AttitudeCheck, FleetReport, FleetSettings, FlightHeldout, FlightSpeedRange, FlightWind,
     ScaleReport, SelectionStep, Targets,
 };
-use sindy::weak_form::TestFunction;
 
 fn committed(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -20,10 +20,10 @@ use faer::linalg::solvers::Solve;
 use physics::vector::{Mat3, Vec3, mat_mul, transpose, vee};
 use physics::{CommandLogging, Logger};
 use serde::Serialize;
-
-use crate::recording::Recording;
 use sindy::median::median;
 use sindy::weak_form::{white_noise_sigma, white_noise_sigma_of_fourth_differences};
+
+use crate::recording::Recording;
 
 /// Fourth-difference weights; white noise of variance σ² has fourth differences of variance 70 σ².
 const FOURTH_DIFFERENCE: [f64; 5] = [1.0, -4.0, 6.0, -4.0, 1.0];

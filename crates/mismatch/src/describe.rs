@@ -1,12 +1,6 @@
-//! Plain words for effects (each effect's own sentence, from the registry), and the effects
-//! without one of them.
+//! Plain words for effects: each effect's own sentence, from the registry.
 
 use physics::{EffectId, Effects};
-
-/// The effects without one of them (and without the wind when no drag is left for it to act on).
-pub fn remove_effect(effects: &Effects, id: EffectId) -> Effects {
-    effects.without(id)
-}
 
 /// One sentence for effect `id` of `effects` (its neutral values when absent), in plain words,
 /// for a vehicle under gravity `gravity_m_s2`.

@@ -291,7 +291,7 @@ pub fn fit_parameters(
         set.refit(problem, iterations);
         set
     };
-    let wind_acts_through = EffectId::Wind.needs().map_or(&[][..], |n| n.one_of);
+    let wind_acts_through = EffectId::Wind.needs_one_of();
     let has_drag = set
         .parameters
         .iter()

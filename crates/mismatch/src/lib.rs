@@ -65,7 +65,7 @@ pub use analysis::{
     Analysis, AnalysisSettings, ChannelReport, EffectReport, Fit, NoiseFree, RateFrame, Report,
     Stage, Window, analyze, analyze_observed,
 };
-pub use describe::{describe, remove_effect};
+pub use describe::describe;
 pub use error::{MismatchError, Result};
 pub use evidence::{Evidence, EvidenceSettings};
 pub use files::ANALYSIS_FILES;

@@ -71,7 +71,7 @@ impl Vehicle {
 
     /// Whether an air velocity acts on this vehicle (it has an effect the wind acts through).
     pub fn feels_wind(&self) -> bool {
-        let acts_through = EffectId::Wind.needs().map_or(&[][..], |n| n.one_of);
+        let acts_through = EffectId::Wind.needs_one_of();
         self.parameters
             .iter()
             .any(|p| acts_through.contains(&p.effect))

@@ -237,6 +237,13 @@ pub const SCREENING_STEP: f64 = 1e-3;
 /// The axes' names, for terms per axis.
 pub(crate) const AXES: [&str; 3] = ["x", "y", "z"];
 
+impl EffectId {
+    /// The effects one of which must be present for this one to act (empty: it acts alone).
+    pub fn needs_one_of(self) -> &'static [EffectId] {
+        self.needs().map_or(&[], |needs| needs.one_of)
+    }
+}
+
 /// One number of an effect's parameters: the effect and the number's index in its
 /// [`Effect::numbers`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

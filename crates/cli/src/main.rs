@@ -46,9 +46,9 @@ fn main() -> ExitCode {
         Err(error) => {
             // An error caused by an interrupt's removal of the staging is not reported: the
             // interrupt ends the process once the staging is gone.
-            outputs::wait_if_interrupted();
+            output_set::wait_if_interrupted();
             // Writers are given staging paths: every error names the final paths instead.
-            note!("error: {}", outputs::in_final_terms(&one_line(&error)));
+            note!("error: {}", output_set::in_final_terms(&one_line(&error)));
             ExitCode::FAILURE
         }
     }

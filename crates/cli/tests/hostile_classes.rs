@@ -268,7 +268,7 @@ fn interrupted_runs_leave_the_old_set_and_foreign_files_survive() {
 /// Class 3 at every moment: SIGINT sent from 0 to 15 ms after the run's staging appears (while
 /// it probes its folders, stages, works) leaves no staging name anywhere in the folder. Sent at the
 /// first sight of the staging only, an unregistered probe file once survived on a loaded CI
-/// machine; the race is too narrow to hit on demand, so `outputs`' unit test pins that cause.
+/// machine; the race is too narrow to hit on demand, so `output_set`'s unit test pins that cause.
 #[test]
 fn an_interrupt_at_any_moment_leaves_no_staging() {
     let Some(data) = data::real_data_dir_for_tests(&workspace()) else {

@@ -296,8 +296,10 @@ fn err(e: impl std::fmt::Display) -> String {
 
 /// A nominal model read as the `learn` command reads it: bounded, under the JSON policy.
 fn load_model(path: &Path) -> Result<(), String> {
-    let text = inputs::read_json_text(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let text = inputs::json::checked_text(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text =
+        bounded_read::read_json_text(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text =
+        bounded_read::json::checked_text(&text).map_err(|e| format!("{}: {e}", path.display()))?;
     physics::NominalModel::from_json(text, path)
         .map(drop)
         .map_err(err)

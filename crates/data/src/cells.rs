@@ -1,10 +1,10 @@
 //! Numbers from the cells of a CSV, shared by the whole-file reader and the block reader so that
 //! a cell reads the same, or fails with the same message, whichever reads it. A message shows a
-//! cell through [`inputs::Excerpt`] only: at most 80 characters, once.
+//! cell through [`bounded_read::Excerpt`] only: at most 80 characters, once.
 
 use std::path::Path;
 
-use inputs::Excerpt;
+use bounded_read::Excerpt;
 
 use crate::error::{DataError, Result};
 use crate::table::ColumnRef;

@@ -91,12 +91,12 @@ pub struct FlightFile {
 impl ExperimentConditions {
     /// Reads and checks `conditions.json`.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = inputs::read_json_text(path).map_err(|source| DataError::Io {
+        let text = bounded_read::read_json_text(path).map_err(|source| DataError::Io {
             path: path.to_path_buf(),
             source,
         })?;
         let mut config: Self =
-            inputs::json::from_str(&text).map_err(|error| DataError::Config {
+            bounded_read::json::from_str(&text).map_err(|error| DataError::Config {
                 path: path.to_path_buf(),
                 field: error.field,
                 message: error.message,

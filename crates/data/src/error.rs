@@ -53,8 +53,8 @@ pub enum DataError {
         path: PathBuf,
         row: usize,
         column: String,
-        /// The cell as a message shows it: quoted, at most [`inputs::EXCERPT_CHARACTERS`]
-        /// characters ([`inputs::Excerpt`]).
+        /// The cell as a message shows it: quoted, at most [`bounded_read::EXCERPT_CHARACTERS`]
+        /// characters ([`bounded_read::Excerpt`]).
         value: String,
         reason: String,
     },

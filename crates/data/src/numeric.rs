@@ -24,7 +24,7 @@ impl NumericTable {
     /// of the file reads element k of the list cells of column `v` ([`crate::ColumnRef`]).
     ///
     /// The rows are read as [`crate::NumericStream`] reads them, by the same code from a source
-    /// read once (a file or a pipe, at most [`inputs::MAX_CSV_BYTES`]): the same values, or the
+    /// read once (a file or a pipe, at most [`bounded_read::MAX_CSV_BYTES`]): the same values, or the
     /// same first error in file order.
     pub fn read(path: &Path, columns: &[&str]) -> Result<Self> {
         let records = CsvRecords::open(path)?;

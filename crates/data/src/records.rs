@@ -9,13 +9,13 @@
 //! text that is not UTF-8 or holds control bytes, a `#` comment line, a blank line between rows,
 //! a quote inside an unquoted cell, text after a closing quote, a quoted cell never closed, a
 //! carriage return that is not followed by a line feed (classic Mac line endings), a header wider
-//! than [`inputs::MAX_CSV_COLUMNS`] or with a name given twice, a row with more or fewer fields
+//! than [`bounded_read::MAX_CSV_COLUMNS`] or with a name given twice, a row with more or fewer fields
 //! than the header. Lines are counted by line feeds, including those inside quoted cells.
 
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
-use inputs::{Excerpt, MAX_CSV_COLUMNS};
+use bounded_read::{Excerpt, MAX_CSV_COLUMNS};
 
 use crate::error::{DataError, Result};
 
@@ -159,8 +159,8 @@ struct Splitter {
 
 const BYTE_ORDER_MARK: [u8; 3] = [0xEF, 0xBB, 0xBF];
 
-impl CsvRecords<std::io::BufReader<inputs::BoundedFile>> {
-    /// The records of the file or pipe `path`, read once within [`inputs::MAX_CSV_BYTES`]; a
+impl CsvRecords<std::io::BufReader<bounded_read::BoundedFile>> {
+    /// The records of the file or pipe `path`, read once within [`bounded_read::MAX_CSV_BYTES`]; a
     /// directory or an unreadable path is an error naming it.
     pub(crate) fn open(path: &Path) -> Result<Self> {
         let io = |source| DataError::Io {
@@ -172,7 +172,7 @@ impl CsvRecords<std::io::BufReader<inputs::BoundedFile>> {
                 path: path.to_path_buf(),
             });
         }
-        let file = inputs::open(path, inputs::InputKind::Csv).map_err(io)?;
+        let file = bounded_read::open(path, bounded_read::InputKind::Csv).map_err(io)?;
         Ok(Self::new(
             path,
             std::io::BufReader::with_capacity(1 << 16, file),

@@ -110,7 +110,7 @@ mod tests {
 
     #[test]
     fn unknown_fields_are_errors_in_every_kind() {
-        let read = |text: &str| inputs::json::from_str::<SplitSpec>(text);
+        let read = |text: &str| bounded_read::json::from_str::<SplitSpec>(text);
         assert_eq!(read(r#"{"kind": "halves"}"#).unwrap(), SplitSpec::Halves);
         assert_eq!(
             read(r#"{"support": 0.25, "kind": "fraction"}"#).unwrap(),

@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use inputs::Excerpt;
+use bounded_read::Excerpt;
 
 use crate::error::{DataError, Result};
 use crate::numeric::NumericTable;

@@ -73,7 +73,7 @@ fn wide(columns: usize, rows: usize) -> String {
 #[test]
 fn a_wide_file_is_read_and_a_duplicate_far_apart_is_named_with_both_positions() {
     // The widest file read (10 000 columns): the header check is one pass (it was quadratic).
-    let columns = inputs::MAX_CSV_COLUMNS - 2;
+    let columns = bounded_read::MAX_CSV_COLUMNS - 2;
     let good = write("wide.csv", wide(columns, 5).as_bytes());
     let last = format!("c{}", columns - 1);
     let table = NumericTable::read_with_time(&good, "t", &["x", &last]).unwrap();

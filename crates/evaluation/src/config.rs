@@ -125,8 +125,8 @@ impl RunConfig {
     /// Reads and checks a run configuration; relative paths are taken from `root`.
     pub fn load(path: &Path, root: &Path) -> Result<CheckedRunConfig> {
         let text = read(path)?;
-        let raw: RunConfig =
-            inputs::json::from_str(&text).map_err(|error| EvaluationError::json(path, error))?;
+        let raw: RunConfig = bounded_read::json::from_str(&text)
+            .map_err(|error| EvaluationError::json(path, error))?;
         raw.check(path, root)
     }
 
@@ -263,7 +263,7 @@ pub(crate) fn check_seeds(seeds: &[u64]) -> std::result::Result<(), String> {
 }
 
 fn read(path: &Path) -> Result<String> {
-    inputs::read_json_text(path).map_err(|source| EvaluationError::Io {
+    bounded_read::read_json_text(path).map_err(|source| EvaluationError::Io {
         path: path.to_path_buf(),
         source,
     })
@@ -284,7 +284,7 @@ fn load_learn_config(
     }
     let text = read(path)?;
     let mut value: serde_json::Value =
-        inputs::json::from_str(&text).map_err(|error| EvaluationError::json(path, error))?;
+        bounded_read::json::from_str(&text).map_err(|error| EvaluationError::json(path, error))?;
     merge_patch(&mut value, overrides);
     // With overrides, a bad value may be the override's: the error names both files.
     let with_overrides = |message: String| EvaluationError::Config {
@@ -294,9 +294,9 @@ fn load_learn_config(
     };
     // Without overrides a fault is the file's own: named with its line and column.
     let config: LearnConfig = if overrides.is_null() {
-        inputs::json::from_str(&text).map_err(|error| EvaluationError::json(path, error))?
+        bounded_read::json::from_str(&text).map_err(|error| EvaluationError::json(path, error))?
     } else {
-        inputs::json::from_value(value).map_err(|error| with_overrides(error.to_string()))?
+        bounded_read::json::from_value(value).map_err(|error| with_overrides(error.to_string()))?
     };
     match config.check(path) {
         Ok(checked) => Ok(checked),

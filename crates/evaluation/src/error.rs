@@ -57,7 +57,7 @@ pub enum EvaluationError {
 
 impl EvaluationError {
     /// A JSON document at `path` that did not deserialise, with the failing field.
-    pub(crate) fn json(path: &std::path::Path, error: inputs::json::JsonError) -> Self {
+    pub(crate) fn json(path: &std::path::Path, error: bounded_read::json::JsonError) -> Self {
         Self::Config {
             path: path.to_path_buf(),
             field: error.field,

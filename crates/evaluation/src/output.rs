@@ -17,7 +17,7 @@ pub const README_BEGIN: &str = "<!-- tables:begin -->";
 /// See [`README_BEGIN`].
 pub const README_END: &str = "<!-- tables:end -->";
 
-/// Where a run writes: the staging folders of its output set (see the `outputs` crate), whose
+/// Where a run writes: the staging folders of its output set (see the `output_set` crate), whose
 /// contents are moved into place only when the whole run has been written.
 #[derive(Clone, Debug)]
 pub struct OutputPaths {

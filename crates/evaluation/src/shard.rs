@@ -340,14 +340,15 @@ pub fn read_shard(dir: &Path) -> Result<ShardDocument> {
              or meta-train --seed-spread with --shard K/N --out DIR)"
         )));
     }
-    let text = inputs::read_text(&path, inputs::InputKind::ShardResult).map_err(|source| {
-        EvaluationError::Io {
-            path: path.clone(),
-            source,
-        }
-    })?;
+    let text =
+        bounded_read::read_text(&path, bounded_read::InputKind::ShardResult).map_err(|source| {
+            EvaluationError::Io {
+                path: path.clone(),
+                source,
+            }
+        })?;
     let value: serde_json::Value =
-        inputs::json::from_str(&text).map_err(|error| EvaluationError::json(&path, error))?;
+        bounded_read::json::from_str(&text).map_err(|error| EvaluationError::json(&path, error))?;
     let format = value.get("format").and_then(|f| f.as_str());
     if let Some(earlier) = format.filter(|f| EARLIER_FORMATS.contains(f)) {
         return Err(EvaluationError::Config {
@@ -367,13 +368,12 @@ pub fn read_shard(dir: &Path) -> Result<ShardDocument> {
             message: format!("not a shard result ({found}; a shard has '{SHARD_FORMAT}')"),
         });
     }
-    let kind = inputs::json::from_value(value.get("kind").cloned().unwrap_or_default()).map_err(
-        |error| EvaluationError::Config {
+    let kind = bounded_read::json::from_value(value.get("kind").cloned().unwrap_or_default())
+        .map_err(|error| EvaluationError::Config {
             path: path.clone(),
             field: "kind".to_string(),
             message: error.message,
-        },
-    )?;
+        })?;
     Ok(ShardDocument { path, kind, value })
 }
 
@@ -384,7 +384,7 @@ impl ShardDocument {
         C: DeserializeOwned + Serialize,
         R: DeserializeOwned + Serialize,
     {
-        let file = inputs::json::from_value(self.value)
+        let file = bounded_read::json::from_value(self.value)
             .map_err(|error| EvaluationError::json(&self.path, error))?;
         Ok((self.path, file))
     }

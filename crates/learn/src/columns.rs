@@ -236,11 +236,11 @@ impl TaskConfig {
             field,
             message,
         };
-        let text = inputs::read_json_text(path).map_err(|cause| LearnError::Io {
+        let text = bounded_read::read_json_text(path).map_err(|cause| LearnError::Io {
             path: path.to_path_buf(),
             cause,
         })?;
-        let text = inputs::json::checked_text(&text)
+        let text = bounded_read::json::checked_text(&text)
             .map_err(|error| config_error(error.field, error.message))?;
         let given: Value = serde_json::from_str(text)
             .map_err(|error| config_error("the document".to_string(), error.to_string()))?;
@@ -254,7 +254,7 @@ impl TaskConfig {
         let mut merged = serde_json::to_value(LearnConfig::task_defaults())
             .expect("the default settings serialise");
         merge(&mut merged, given);
-        let config: LearnConfig = inputs::json::from_value(merged)
+        let config: LearnConfig = bounded_read::json::from_value(merged)
             .map_err(|error| config_error(error.field, error.message))?;
         Ok(Self {
             checked: config.check(path)?,

@@ -173,15 +173,16 @@ impl CheckedConfig {
 impl LearnConfig {
     /// Reads and checks a configuration file.
     pub fn load(path: &Path) -> Result<CheckedConfig> {
-        let text = inputs::read_json_text(path).map_err(|cause| LearnError::Io {
+        let text = bounded_read::read_json_text(path).map_err(|cause| LearnError::Io {
             path: path.to_path_buf(),
             cause,
         })?;
-        let config: Self = inputs::json::from_str(&text).map_err(|error| LearnError::Config {
-            path: path.to_path_buf(),
-            field: error.field,
-            message: error.message,
-        })?;
+        let config: Self =
+            bounded_read::json::from_str(&text).map_err(|error| LearnError::Config {
+                path: path.to_path_buf(),
+                field: error.field,
+                message: error.message,
+            })?;
         config.check(path)
     }
 

@@ -348,7 +348,7 @@ impl MetaTrainedModel {
 
     /// Reads and checks a checkpoint.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = inputs::read_json_text(path).map_err(|cause| LearnError::Io {
+        let text = bounded_read::read_json_text(path).map_err(|cause| LearnError::Io {
             path: path.to_path_buf(),
             cause,
         })?;
@@ -356,7 +356,8 @@ impl MetaTrainedModel {
             path: path.to_path_buf(),
             message,
         };
-        let model: Self = inputs::json::from_str(&text).map_err(|error| bad(error.to_string()))?;
+        let model: Self =
+            bounded_read::json::from_str(&text).map_err(|error| bad(error.to_string()))?;
         if model.format != CHECKPOINT_FORMAT {
             return Err(bad(format!(
                 "format '{}', expected '{CHECKPOINT_FORMAT}'",

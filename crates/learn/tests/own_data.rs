@@ -215,6 +215,6 @@ fn a_flight_checkpoint_is_written_with_the_fields_it_always_had() {
         "{}",
         &text[..120]
     );
-    let read: MetaTrainedModel = inputs::json::from_str(&text).unwrap();
+    let read: MetaTrainedModel = bounded_read::json::from_str(&text).unwrap();
     assert_eq!(read, model);
 }

@@ -15,7 +15,7 @@
 //! `report`'s types, re-exported here; nor writing files or checking where they go: this crate
 //! computes the results and renders each file's contents ([`Analysis::render`],
 //! [`fleet::FleetReport::render`], [`demo::DemoSummary::render`]), and the caller (the `learn`
-//! binary, through the `outputs` crate) checks the outputs and writes them.
+//! binary, through the `output_set` crate) checks the outputs and writes them.
 //!
 //! Method in one paragraph (the long version: `docs/mismatch.md`): the recording and the model are
 //! compared in the weak form ([`weak_form`], from `sindy`: the recorded velocity and body rate against the model's

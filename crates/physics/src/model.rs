@@ -109,7 +109,7 @@ impl Mixer {
 impl NominalModel {
     /// Reads and validates a model file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = inputs::read_json_text(path).map_err(|source| PhysicsError::Io {
+        let text = bounded_read::read_json_text(path).map_err(|source| PhysicsError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -120,7 +120,7 @@ impl NominalModel {
     /// accepted, a key given twice refused); every number must lie in its physical range
     /// ([`crate::ranges`]); `origin` names the file in errors.
     pub fn from_json(text: &str, origin: &Path) -> Result<Self> {
-        let text = inputs::json::checked_text(text).map_err(|error| PhysicsError::Json {
+        let text = bounded_read::json::checked_text(text).map_err(|error| PhysicsError::Json {
             path: origin.to_path_buf(),
             message: format!("{}: {}", error.field, error.message),
         })?;
@@ -426,7 +426,7 @@ impl FieldReader {
             ],
         )?;
         // Read from its own text, the error's position is not the file's: only its field is kept.
-        let logger: Logger = inputs::json::from_str(&value.to_string()).map_err(|error| {
+        let logger: Logger = bounded_read::json::from_str(&value.to_string()).map_err(|error| {
             let field = error.field.split(" (").next().unwrap_or_default();
             let field = if field.starts_with("the document") {
                 "logger".to_string()

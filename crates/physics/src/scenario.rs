@@ -172,7 +172,7 @@ impl Scenario {
             source,
         })?;
         let scenario: Self =
-            inputs::json::from_str(&text).map_err(|error| PhysicsError::Field {
+            bounded_read::json::from_str(&text).map_err(|error| PhysicsError::Field {
                 path: path.to_path_buf(),
                 field: error.field,
                 message: error.message,

@@ -34,11 +34,11 @@ pub type Result<T> = std::result::Result<T, ReportError>;
 pub(crate) fn read_json<T: serde::de::DeserializeOwned + serde::Serialize>(
     path: &std::path::Path,
 ) -> Result<T> {
-    let text = inputs::read_json_text(path).map_err(|source| ReportError::Io {
+    let text = bounded_read::read_json_text(path).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    inputs::json::from_str(&text).map_err(|error| ReportError::Json {
+    bounded_read::json::from_str(&text).map_err(|error| ReportError::Json {
         path: path.to_path_buf(),
         field: error.field,
         message: error.message,

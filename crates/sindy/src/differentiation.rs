@@ -528,7 +528,7 @@ mod tests {
 
     #[test]
     fn unknown_fields_are_errors_in_every_kind() {
-        let read = |text: &str| inputs::json::from_str::<Derivative>(text);
+        let read = |text: &str| bounded_read::json::from_str::<Derivative>(text);
         assert_eq!(read(r#"{"kind": "forward"}"#).unwrap(), Derivative::Forward);
         assert_eq!(read(r#"{"kind": "central"}"#).unwrap(), Derivative::Central);
         assert_eq!(
@@ -638,7 +638,7 @@ mod tests {
              precision computes accurately"
         );
         let json = r#"{"kind": "savitzky_golay", "window": 5, "order": 0}"#;
-        let read: Derivative = inputs::json::from_str(json).unwrap();
+        let read: Derivative = bounded_read::json::from_str(json).unwrap();
         assert_eq!(read.validate(), Err(DifferentiationError::ZeroOrder));
     }
 }

@@ -96,7 +96,7 @@ impl SindyModel {
     /// Reads a model written by [`SindyModel::save`], checking that names, library and
     /// coefficients agree.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = inputs::read_json_text(path).map_err(|source| SindyError::Io {
+        let text = bounded_read::read_json_text(path).map_err(|source| SindyError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -111,7 +111,7 @@ impl SindyModel {
             message,
         };
         let file: ModelFile =
-            inputs::json::from_str(text).map_err(|e| error(&e.field, e.message))?;
+            bounded_read::json::from_str(text).map_err(|e| error(&e.field, e.message))?;
         if file.format != MODEL_FORMAT {
             return Err(error(
                 "format",

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use evaluation::{AblationsOutcome, ShardSpec, VariantsConfig};
-use outputs::{Existing, FolderId, OutputSet, Staged};
+use output_set::{Existing, FolderId, OutputSet, Staged};
 
 use super::Global;
 use super::progress::ItemLines;
@@ -134,10 +134,10 @@ pub fn write_outcome(
 /// `--render-only`: `ablations.md` again from the `ablations.json` of an earlier run.
 fn render_only(args: &Args) -> anyhow::Result<()> {
     let json = args.out.join("ablations.json");
-    let text =
-        inputs::read_json_text(&json).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
-    let ablations: evaluation::Ablations =
-        inputs::json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
+    let text = bounded_read::read_json_text(&json)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
+    let ablations: evaluation::Ablations = bounded_read::json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", json.display()))?;
     let markdown = report::ablations_markdown(&ablations.tables());
     // Only ablations.md is rewritten: the run's other files stay its own.
     let mut set = OutputSet::new(PRODUCER).updating_only_its_files();

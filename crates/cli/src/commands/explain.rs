@@ -7,7 +7,7 @@ use data::{ExperimentConditions, FlightLog};
 use evaluation::{Segmentation, explain_flight, own_data};
 use learn::{EquationRule, Explanation, MetaTrainedModel};
 
-use outputs::{Existing, OutputSet};
+use output_set::{Existing, OutputSet};
 
 use super::Global;
 
@@ -154,7 +154,7 @@ fn print_explanation(explanation: &Explanation, json: Option<&std::path::Path>) 
 fn explain_columns(
     args: &Args,
     mut set: OutputSet,
-    json_file: Option<outputs::FileId>,
+    json_file: Option<output_set::FileId>,
     model: &MetaTrainedModel,
 ) -> anyhow::Result<()> {
     let Some(recording_path) = &args.flight else {

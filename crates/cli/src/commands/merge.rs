@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use evaluation::{ShardDocument, SweepKind};
-use outputs::{Existing, OutputSet};
+use output_set::{Existing, OutputSet};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 

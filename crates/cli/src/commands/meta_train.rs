@@ -14,7 +14,7 @@ use learn::{Formulation, LearnConfig};
 use report::{Method, PublishedTables};
 use serde_json::{Value, json};
 
-use outputs::{Existing, FileId, FolderId, OutputSet};
+use output_set::{Existing, FileId, FolderId, OutputSet};
 
 use super::Global;
 use super::progress::{Bar, progress_bar};

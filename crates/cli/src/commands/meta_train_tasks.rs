@@ -9,7 +9,7 @@ use data::file_sha256;
 use evaluation::own_data::{read_tasks, recording};
 use indicatif::{ProgressBar, ProgressStyle};
 use learn::{ColumnSpec, DataFile, TaskConfig, TaskSet, TaskSource};
-use outputs::{Existing, OutputSet};
+use output_set::{Existing, OutputSet};
 use sindy::Derivative;
 
 use super::Global;

@@ -9,7 +9,7 @@
 //!   the data directory analysed together (one vehicle, one air velocity per flight) →
 //!   `DIR/<model stem>.{json,md,svg}`.
 //!
-//! Every mode plans every file it will write in an output set (the `outputs` crate) and checks
+//! Every mode plans every file it will write in an output set (the `output_set` crate) and checks
 //! them all before any work: none may be one of the files the run reads (even with `--force`),
 //! each folder is proven writable and locked, and an existing file is replaced only when this
 //! command wrote it and `--force` is given. The results are staged and moved into place at the end.
@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 use mismatch::ANALYSIS_FILES;
 use mismatch::demo::SUMMARY_FILES;
-use outputs::{Existing, OutputSet};
+use output_set::{Existing, OutputSet};
 
 use super::Global;
 

@@ -24,8 +24,8 @@ use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
 
-/// Whether two paths name the same file whatever their spelling (see [`outputs::paths::same_file`]).
-pub use outputs::paths::same_file;
+/// Whether two paths name the same file whatever their spelling (see [`output_set::paths::same_file`]).
+pub use output_set::paths::same_file;
 
 /// Reproduces the LeARN paper against SINDy on the Neural-Fly quadrotor flights, fits SINDy and
 /// LeARN on your own recordings, and names the physics a nominal model leaves out of real flights.
@@ -160,7 +160,7 @@ impl Global {
 /// Runs `write` (a writer given the staging paths of `staged`), naming the final paths in its
 /// error rather than the staging ones.
 pub fn staged_write<T, E: std::fmt::Display>(
-    staged: &outputs::Staged,
+    staged: &output_set::Staged,
     write: impl FnOnce() -> Result<T, E>,
 ) -> anyhow::Result<T> {
     write().map_err(|error| anyhow::anyhow!(staged.in_final_terms(&error.to_string())))
@@ -170,9 +170,9 @@ pub fn staged_write<T, E: std::fmt::Display>(
 /// policy itself (a nominal model): bounded size, a regular file, no key given twice. Returns the
 /// text without a byte-order mark.
 pub fn read_policy_json(path: &Path) -> anyhow::Result<String> {
-    let text =
-        inputs::read_json_text(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let text = inputs::json::checked_text(&text)
+    let text = bounded_read::read_json_text(path)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let text = bounded_read::json::checked_text(&text)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     Ok(text.to_string())
 }

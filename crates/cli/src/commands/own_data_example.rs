@@ -12,7 +12,7 @@ use evaluation::own_data::example::{
     CurveMethod, CurvePoint, ExampleConfig, LearningCurve, run_example,
 };
 use indicatif::{ProgressBar, ProgressStyle};
-use outputs::{Existing, OutputSet};
+use output_set::{Existing, OutputSet};
 use report::{CurveFigure, CurveSeries, curve_markdown};
 
 use super::Global;
@@ -110,7 +110,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
 
 /// Each kind's tasks as `kind/task-NNN.csv` under the staging folder `staging`.
 fn write_tasks(
-    staged: &outputs::Staged,
+    staged: &output_set::Staged,
     staging: &Path,
     kinds: &[(&str, &Vec<SimulatedTask>)],
 ) -> anyhow::Result<()> {

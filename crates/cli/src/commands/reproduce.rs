@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::bail;
 use evaluation::{OutputPaths, RunConfig, RunOutcome, ShardSpec};
-use outputs::{Existing, FileId, FolderId, OutputSet, Staged};
+use output_set::{Existing, FileId, FolderId, OutputSet, Staged};
 
 use super::Global;
 use super::progress::StageBars;

@@ -12,7 +12,7 @@ use evaluation::{
     Experiment, Protocol, Segmentation, ShardProvenance, ShardSpec, SpreadCell, StageTiming,
 };
 use learn::LearnConfig;
-use outputs::{Existing, OutputSet, Staged};
+use output_set::{Existing, OutputSet, Staged};
 
 use super::Global;
 use super::meta_train::{Args, PRODUCER, formulations};
@@ -24,13 +24,13 @@ const SHARD_PRODUCER: &str = "seed-spread-shard";
 
 /// Where the spread goes: the spread file, or a shard's folder.
 enum Destination {
-    File(OutputSet, outputs::FileId),
+    File(OutputSet, output_set::FileId),
     Shard(ShardOutputs, ShardSpec),
 }
 
 /// A destination prepared before any training.
 enum Prepared {
-    File(Staged, outputs::FileId),
+    File(Staged, output_set::FileId),
     Shard(super::shard::StagedShard, ShardSpec),
 }
 

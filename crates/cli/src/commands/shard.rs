@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use evaluation::{SHARD_FILE, ShardFile, ShardSpec};
-use outputs::{Existing, OutputSet, Staged};
+use output_set::{Existing, OutputSet, Staged};
 use serde::Serialize;
 
 /// `--shard K/N`: a clap value parser whose message says what is wrong.
@@ -21,7 +21,7 @@ pub const SHARD_HELP: &str = "Run only shard K of N (K from 0): the work items w
 /// unsharded command's, so neither ever removes the other's files), and the run's inputs.
 pub struct ShardOutputs {
     set: OutputSet,
-    folder: outputs::FolderId,
+    folder: output_set::FolderId,
     out: PathBuf,
 }
 
@@ -60,7 +60,7 @@ impl ShardOutputs {
 /// A shard's output folder, staged.
 pub struct StagedShard {
     staged: Staged,
-    folder: outputs::FolderId,
+    folder: output_set::FolderId,
     out: PathBuf,
 }
 

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use outputs::{Existing, OutputSet};
+use output_set::{Existing, OutputSet};
 
 use super::Global;
 

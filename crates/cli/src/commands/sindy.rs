@@ -13,7 +13,7 @@ use sindy::{
     SindyError, SindyModel, SindyParams, Trajectory,
 };
 
-use outputs::{Existing, OutputSet};
+use output_set::{Existing, OutputSet};
 
 use super::Global;
 use super::sindy_apply::{self, ApplyCommand};

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use sindy::{Derivative, Mat, SindyModel};
 
-use outputs::{Existing, OutputSet};
+use output_set::{Existing, OutputSet};
 
 use super::Global;
 use super::sindy::{Recording, r2_text, read_recording};

@@ -78,12 +78,12 @@ pub struct ExampleConfig {
 impl ExampleConfig {
     /// Reads and checks the configuration; errors name the file and the field.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = inputs::read_json_text(path).map_err(|source| EvaluationError::Io {
+        let text = bounded_read::read_json_text(path).map_err(|source| EvaluationError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        let config: Self =
-            inputs::json::from_str(&text).map_err(|error| EvaluationError::json(path, error))?;
+        let config: Self = bounded_read::json::from_str(&text)
+            .map_err(|error| EvaluationError::json(path, error))?;
         config.check(path)?;
         Ok(config)
     }

@@ -76,12 +76,12 @@ impl LearnedBasisSpec {
 impl VariantsConfig {
     /// Reads and checks `path` alone (names, candidates, headline), without the run it names.
     pub fn read(path: &Path) -> Result<VariantsConfig> {
-        let text = inputs::read_json_text(path).map_err(|source| EvaluationError::Io {
+        let text = bounded_read::read_json_text(path).map_err(|source| EvaluationError::Io {
             path: path.to_path_buf(),
             source,
         })?;
         let raw: VariantsConfig =
-            inputs::json::from_str(&text).map_err(|e| EvaluationError::json(path, e))?;
+            bounded_read::json::from_str(&text).map_err(|e| EvaluationError::json(path, e))?;
         raw.check()
             .map_err(|(field, message)| EvaluationError::Config {
                 path: path.to_path_buf(),
@@ -343,7 +343,7 @@ pub(super) fn learned_basis_config(config: &CheckedVariants) -> Result<learn::Ch
     let mut value = serde_json::to_value(run.learn.get()).map_err(|e| error(e.to_string()))?;
     merge_patch(&mut value, &config.raw.learn_overrides);
     let learn_config: learn::LearnConfig =
-        inputs::json::from_value(value).map_err(|e| with_overrides(e.to_string()))?;
+        bounded_read::json::from_value(value).map_err(|e| with_overrides(e.to_string()))?;
     learn_config.check(&config.path).map_err(|e| match e {
         learn::LearnError::Config { field, message, .. } => {
             with_overrides(format!("field '{field}': {message}"))

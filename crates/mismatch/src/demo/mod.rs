@@ -58,9 +58,9 @@ pub struct DemoManifest {
 }
 
 fn load_manifest(path: &Path) -> Result<DemoManifest> {
-    let text = inputs::read_json_text(path).map_err(io_error(path))?;
+    let text = bounded_read::read_json_text(path).map_err(io_error(path))?;
     let manifest: DemoManifest =
-        inputs::json::from_str(&text).map_err(|e| MismatchError::Config {
+        bounded_read::json::from_str(&text).map_err(|e| MismatchError::Config {
             path: path.to_path_buf(),
             field: e.field,
             message: e.message,

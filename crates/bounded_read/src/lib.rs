@@ -7,7 +7,7 @@
 //! duplicated key or an array in place of an object refused, errors naming the failing field).
 //!
 //! What it is not for: what the files mean. Flight logs and numeric tables are read by `data`,
-//! models by `sindy` and `learn`; writing results is the `outputs` crate's.
+//! models by `sindy` and `learn`; writing results is the `output_set` crate's.
 //!
 //! Errors are `std::io::Error`s (reading) and [`json::JsonError`]s (deserialising); each crate's
 //! loader wraps them with the file's path in its own error type.

@@ -24,7 +24,7 @@
 //!    (the `journal` module).
 //!
 //! What it is not: a writer of formats (callers write their JSON, SVG or CSV into the staging
-//! paths), nor a checker of what is read (see the `inputs` crate). The protocol, and why, is in
+//! paths), nor a checker of what is read (see the `bounded_read` crate). The protocol, and why, is in
 //! `docs/data-safety.md`.
 
 mod error;

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use outputs::{Existing, OutputError, OutputSet};
+use output_set::{Existing, OutputError, OutputSet};
 
 /// A fresh, empty temporary directory, removed with everything in it when dropped.
 fn scratch(name: &str) -> tempfile::TempDir {
@@ -19,7 +19,7 @@ fn run(
     producer: &str,
     files: &[(&str, &str)],
     existing: Existing,
-) -> outputs::Result<()> {
+) -> output_set::Result<()> {
     let mut set = OutputSet::new(producer);
     let folder = set.folder(dir, "--out", existing);
     for (name, _) in files {
@@ -252,7 +252,7 @@ fn a_commit_that_fails_in_one_folder_changes_none() {
 }
 
 /// Runs `producer` with the named file `path` (`--out`) holding `content`.
-fn run_named(path: &Path, content: &str, existing: Existing) -> outputs::Result<()> {
+fn run_named(path: &Path, content: &str, existing: Existing) -> output_set::Result<()> {
     let mut set = OutputSet::new("sindy");
     let file = set.file(path, "--out", existing);
     let staged = set.prepare()?;
@@ -471,7 +471,7 @@ fn errors_name_final_paths_after_the_set_is_gone() {
     );
     drop(staged);
     assert_eq!(
-        outputs::in_final_terms(&message),
+        output_set::in_final_terms(&message),
         format!(
             "{}: No space left on device",
             out.join("figures/x.svg").display()

@@ -225,9 +225,8 @@ impl CommandSamples {
                 })
                 .collect();
             let magnitude = self.values.iter().map(|v| v[i].abs()).fold(0.0, f64::max);
-            let scale = (1.4826
-                * sindy::median::median(departure.iter().map(|d| d.abs()).collect()))
-            .max(1e-9 * magnitude);
+            let scale = sindy::median::robust_standard_deviation(departure.iter().copied())
+                .max(1e-9 * magnitude);
             for (k, d) in departure.iter().enumerate() {
                 let inside = (k..k + 4).all(|j| self.held[j][i] == Held::Inside);
                 if inside && d.abs() > STEP_SIGMAS * scale {

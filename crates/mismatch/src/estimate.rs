@@ -25,7 +25,7 @@
 //! of 88 instead of 78).
 
 use serde::Serialize;
-use sindy::median::median;
+use sindy::median::robust_standard_deviation;
 
 use crate::evidence::autocorrelation_factor;
 use crate::fit::FittedSet;
@@ -159,7 +159,7 @@ pub fn estimate(
 }
 
 /// Huber weights of a residual: per channel, `min(1, c / |z|)` with `z` the residual over its
-/// channel's robust standard deviation (the median absolute noise-normalised residual / 0.6745).
+/// channel's robust standard deviation (`sindy::median::robust_standard_deviation` of the noise-normalised residuals).
 fn huber_weights(
     problem: &Problem,
     residual: &[Channels],
@@ -171,7 +171,7 @@ fn huber_weights(
             .iter()
             .map(|r| (r[c] / problem.noise_floor[c]).abs())
             .collect();
-        let sigma = median(scaled.clone()) / 0.6745;
+        let sigma = robust_standard_deviation(scaled.iter().copied());
         if !(sigma.is_finite() && sigma > 0.0) {
             continue;
         }

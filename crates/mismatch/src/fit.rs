@@ -90,16 +90,6 @@ pub struct WindScores {
     pub with_wind: f64,
 }
 
-/// Grid of delays and lag time constants profiled, s.
-fn timing_grid() -> Vec<f64> {
-    (0..=80).map(|i| i as f64 * 0.0025).collect()
-}
-
-/// Grid of ground-effect radii profiled, m.
-fn radius_grid() -> Vec<f64> {
-    (1..=60).map(|i| i as f64 * 0.02).collect()
-}
-
 /// Replaces the screen columns of the nonlinear candidates by the exact effect at the parameters
 /// a profile search finds next to all other columns: the ground-effect radius, the better of a
 /// delay and a motor lag, and the air velocity of the quadratic drag. Returns that air velocity.
@@ -127,10 +117,11 @@ pub fn profile_nonlinear(
     }
     if let Some(candidate) = find(CandidateId::DelayOrMotorLag) {
         let others = others_of(candidate);
-        let grid: Vec<f64> = timing_grid().into_iter().skip(1).collect();
         let best = [DELAY, MOTOR_LAG]
             .into_iter()
             .map(|kind| {
+                // Zero, the neutral value, has no column to fit.
+                let grid: Vec<f64> = kind.profile_grid().into_iter().skip(1).collect();
                 let (value, sse) = profile_search(
                     problem,
                     columns,
@@ -241,7 +232,8 @@ fn profiled_ground_radius(
         others,
         0..problem.split,
         block_rows,
-        &radius_grid(),
+        // Without its zero, the neutral radius.
+        &GROUND_RADIUS.profile_grid()[1..],
         |r| effects_from(&[GROUND_RADIUS], &[r]),
     );
     radius
@@ -335,7 +327,7 @@ fn fit_timing(
             others,
             0..problem.split,
             block_rows,
-            &timing_grid(),
+            &kind.profile_grid(),
             |v| effects_from(&[kind], &[v]),
         );
         let mut set = linear.clone();

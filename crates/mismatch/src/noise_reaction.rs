@@ -20,7 +20,7 @@ use faer::linalg::solvers::Solve;
 use physics::vector::{Mat3, Vec3, mat_mul, transpose, vee};
 use physics::{CommandLogging, Logger};
 use serde::Serialize;
-use sindy::median::median;
+use sindy::median::robust_standard_deviation;
 use sindy::weak_form::{white_noise_sigma, white_noise_sigma_of_fourth_differences};
 
 use crate::recording::Recording;
@@ -261,7 +261,7 @@ fn reaction_gains(
             commands[r][i] - (0..STATES).map(|s| gains[i][s] * states[r][s]).sum::<f64>()
         };
         let scales: Vec<f64> = (0..actuators)
-            .map(|i| 1.4826 * median((0..states.len()).map(|r| residual(r, i).abs()).collect()))
+            .map(|i| robust_standard_deviation((0..states.len()).map(|r| residual(r, i))))
             .collect();
         for (r, kept) in keep.iter_mut().enumerate() {
             *kept = (0..actuators).all(|i| residual(r, i).abs() <= TRIM_SIGMAS * scales[i]);

@@ -1,9 +1,18 @@
 //! The one median of the robust scales (statrs' order statistic): the noise of fourth differences
 //! ([`crate::weak_form`]) and, in the mismatch analysis, the spread of residuals and of command
 //! departures and the typical size of a target. Of an even count it is the larger of the two middle
-//! values.
+//! values. [`robust_standard_deviation`] is the one median-absolute-deviation scale of them.
 
 use statrs::statistics::{Data, OrderStatistics};
+
+/// The median absolute deviation's factor to a normal standard deviation: 1 / Φ⁻¹(3/4).
+pub const MAD_TO_STANDARD_DEVIATION: f64 = 1.482_602_218_505_602;
+
+/// The robust standard deviation of deviations from a centre (or of residuals): the median of
+/// their magnitudes times [`MAD_TO_STANDARD_DEVIATION`], so that normal noise gives its σ.
+pub fn robust_standard_deviation(deviations: impl IntoIterator<Item = f64>) -> f64 {
+    MAD_TO_STANDARD_DEVIATION * median(deviations.into_iter().map(f64::abs).collect())
+}
 
 /// The median of `values`: of an even count the larger middle value (statrs' order statistic
 /// n/2 + 1); 0 for none.
@@ -18,6 +27,17 @@ pub fn median(values: Vec<f64>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use statrs::distribution::{ContinuousCDF, Normal};
+
+    #[test]
+    fn the_mad_factor_is_one_over_the_normal_upper_quartile() {
+        let quartile = Normal::standard().inverse_cdf(0.75);
+        assert!((MAD_TO_STANDARD_DEVIATION - 1.0 / quartile).abs() < 1e-12);
+        assert_eq!(
+            robust_standard_deviation([-2.0, 1.0, 3.0]),
+            2.0 * MAD_TO_STANDARD_DEVIATION
+        );
+    }
 
     /// The convention the analysis's numbers were made with: the upper middle value, NaN last.
     #[test]

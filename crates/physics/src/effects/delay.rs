@@ -62,6 +62,12 @@ impl EffectKind for Delay {
         0.01
     }
 
+    /// 2.5 ms, an eighth of a 50 Hz sample interval: the profile only starts the fit, which then
+    /// moves freely within the range.
+    fn profile_step(_index: usize) -> Option<f64> {
+        Some(0.0025)
+    }
+
     /// The first-order timing signature a delay shares with a motor lag: the command's rate,
     /// perturbed by a quarter of the sample interval.
     fn screening(sample_interval_s: f64) -> Option<Screening<Self>> {

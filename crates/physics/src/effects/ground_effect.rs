@@ -81,6 +81,11 @@ impl EffectKind for GroundEffect {
         0.1
     }
 
+    /// 2 cm: the profile only starts the fit, which then moves freely within the range.
+    fn profile_step(_index: usize) -> Option<f64> {
+        Some(0.02)
+    }
+
     fn screening(_sample_interval_s: f64) -> Option<Screening<Self>> {
         Some(Screening {
             terms: vec![Term::new(

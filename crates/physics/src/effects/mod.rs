@@ -172,6 +172,12 @@ pub trait EffectKind:
     fn fit_starts() -> Vec<Vec<f64>> {
         Vec::new()
     }
+    /// The spacing of the grid a profile search tries number `index` on, across its
+    /// [`Self::fit_range`] (none: not profiled; the range must then be finite).
+    fn profile_step(index: usize) -> Option<f64> {
+        let _ = index;
+        None
+    }
 }
 
 /// Effects one of which must be present for an effect to act.
@@ -278,6 +284,17 @@ impl EffectNumber {
     /// A typical magnitude, for finite-difference steps.
     pub fn typical(self) -> f64 {
         self.effect.typical(self.index)
+    }
+
+    /// The grid a profile search tries it on: its fit range from the lower end in steps of
+    /// [`EffectKind::profile_step`], both ends included (empty when it is not profiled).
+    pub fn profile_grid(self) -> Vec<f64> {
+        let Some(step) = self.effect.profile_step(self.index) else {
+            return Vec::new();
+        };
+        let (low, high) = self.fit_range();
+        let count = ((high - low) / step).round() as usize;
+        (0..=count).map(|i| low + i as f64 * step).collect()
     }
 
     /// Its value when the effect is neutral.

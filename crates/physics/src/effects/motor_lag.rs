@@ -59,4 +59,10 @@ impl EffectKind for MotorLag {
     fn typical(_index: usize) -> f64 {
         0.01
     }
+
+    /// 2.5 ms, an eighth of a 50 Hz sample interval: the profile only starts the fit, which then
+    /// moves freely within the range.
+    fn profile_step(_index: usize) -> Option<f64> {
+        Some(0.0025)
+    }
 }

@@ -45,6 +45,13 @@ macro_rules! vocabulary {
                 }
             }
 
+            /// The spacing of the profile grid of number `index` of the effect (none: not profiled).
+            pub fn profile_step(self, index: usize) -> Option<f64> {
+                match self {
+                    $(Self::$variant => <$variant as EffectKind>::profile_step(index),)*
+                }
+            }
+
             /// A typical magnitude of number `index`, for finite-difference steps.
             pub fn typical(self, index: usize) -> f64 {
                 match self {

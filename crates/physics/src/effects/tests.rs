@@ -341,3 +341,30 @@ fn axial_thrust_loss_acts_as_documented() {
     };
     assert_eq!(negative.validate().unwrap_err().0, "axial_thrust_loss.c");
 }
+
+/// A profile search tries only values a fit may keep: every grid point inside the number's fit
+/// range, both ends reached, and the profiled numbers (ground radius, delay, motor lag) present.
+#[test]
+fn every_profile_grid_spans_its_fit_range() {
+    let mut profiled = Vec::new();
+    for id in EffectId::ALL {
+        for number in EffectNumber::all_of(id) {
+            let grid = number.profile_grid();
+            if grid.is_empty() {
+                continue;
+            }
+            let (low, high) = number.fit_range();
+            assert!(
+                grid.iter().all(|v| (low..=high + 1e-12).contains(v)),
+                "{number:?}"
+            );
+            assert_eq!(grid[0], low, "{number:?}");
+            assert!((grid[grid.len() - 1] - high).abs() < 1e-9, "{number:?}");
+            profiled.push(id);
+        }
+    }
+    assert_eq!(
+        profiled,
+        [EffectId::MotorLag, EffectId::GroundEffect, EffectId::Delay]
+    );
+}

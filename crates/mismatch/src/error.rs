@@ -16,19 +16,19 @@ pub enum MismatchError {
     },
     #[error("{}: {message}", path.display())]
     Recording { path: PathBuf, message: String },
-    /// More rows than one analysis accepts ([`crate::degenerate::MAX_ANALYSED_ROWS`]).
+    /// More rows than one analysis accepts ([`crate::recording::degenerate::MAX_ANALYSED_ROWS`]).
     #[error(
         "{}: {rows} rows, more than the {} one analysis accepts: its time grows faster than the rows ({}); analyse a part (learn mismatch --recording takes --rows A:B)",
         path.display(),
-        crate::degenerate::MAX_ANALYSED_ROWS,
-        crate::degenerate::COST_MEASURED
+        crate::recording::degenerate::MAX_ANALYSED_ROWS,
+        crate::recording::degenerate::COST_MEASURED
     )]
     TooLong { path: PathBuf, rows: usize },
-    /// A recording that cannot be compared with a model ([`crate::degenerate`]).
+    /// A recording that cannot be compared with a model ([`crate::recording::degenerate`]).
     #[error("{}: {degeneracy}", path.display())]
     Degenerate {
         path: PathBuf,
-        degeneracy: crate::degenerate::Degeneracy,
+        degeneracy: crate::recording::degenerate::Degeneracy,
     },
     #[error(
         "{}: the analysis of this recording gives a non-finite {what}: its values are outside the range the analysis can handle",
@@ -68,7 +68,13 @@ pub enum MismatchError {
         field: String,
         message: String,
     },
-    /// A Levenberg–Marquardt setting out of its range ([`crate::least_squares`]).
+    /// A setting of the analyses out of its range ([`crate::Settings::checked`]).
+    #[error("setting '{setting}': {message}")]
+    Setting {
+        setting: &'static str,
+        message: String,
+    },
+    /// A Levenberg–Marquardt setting out of its range ([`crate::model::least_squares`]).
     #[error("Levenberg–Marquardt setting '{setting}': {message}")]
     SolverSetting {
         setting: &'static str,

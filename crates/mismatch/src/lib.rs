@@ -39,41 +39,35 @@
 // Index loops over channels and 3-vectors read like the formulas they implement.
 #![allow(clippy::needless_range_loop)]
 
+// The method's steps, in order (each module's header says what it does).
 mod analysis;
-pub mod command_samples;
-pub mod degenerate;
 pub mod demo;
-mod describe;
 mod error;
-pub mod estimate;
-pub mod evidence;
-mod files;
-mod fit;
+pub mod explain;
 pub mod fleet;
-pub mod forward;
-pub mod least_squares;
-mod library;
+pub mod improve;
+pub mod locate;
+pub mod model;
+pub mod recording;
+mod settings;
 
-pub mod noise_reaction;
-mod problem;
-mod recording;
-mod refine;
-
-pub mod simex;
-
+pub use analysis::files::ANALYSIS_FILES;
 pub use analysis::{
-    Analysis, AnalysisSettings, ChannelReport, EffectReport, Fit, NoiseFree, RateFrame, Report,
-    Stage, Window, analyze, analyze_observed,
+    Analysis, ChannelReport, EffectReport, Fit, RateFrame, Report, Stage, Window, analyze,
+    analyze_observed,
 };
-pub use describe::describe;
 pub use error::{MismatchError, Result};
-pub use evidence::{Evidence, EvidenceSettings};
-pub use files::ANALYSIS_FILES;
-pub use fit::FittedSet;
-pub use library::{Candidate, CandidateId, Term, build_library};
-pub use problem::{CHANNEL_NAMES, Channels, Problem};
+pub use explain::describe::describe;
+pub use explain::evidence::{Evidence, EvidenceSettings};
+pub use explain::fit::FittedSet;
+pub use explain::library::{Candidate, CandidateId, Term, build_library};
+pub use locate::problem::{CHANNEL_NAMES, Channels, Problem};
+pub use model::refine::{FitRows, effects_from, levenberg_marquardt};
 pub use recording::Recording;
-pub use refine::{FitRows, effects_from, levenberg_marquardt};
+pub use settings::{
+    AnalysisRecord, AnalysisSettings, CheckedSettings, ComparisonSettings, FleetRecord,
+    FleetSettings, LocateSettings, NoiseFree, Settings,
+};
 pub use sindy::stability::{
     BlockDesign, Selection, SelectionSettings, stability_selection, stepwise, trimmed_gain,
 };

@@ -1,8 +1,8 @@
 //! Behaviour on short simulated flights: nothing on noise alone, the right effect and parameter
 //! when one is concealed, outputs that refuse to overwrite, errors that name the problem.
 
-use mismatch::least_squares::Termination;
-use mismatch::{ANALYSIS_FILES, AnalysisSettings, NoiseFree, analyze};
+use mismatch::model::least_squares::Termination;
+use mismatch::{ANALYSIS_FILES, CheckedSettings, NoiseFree, Settings, analyze};
 use physics::{EffectId, Effects, NominalModel, Scenario, ThrustScale, TorqueBias, simulate};
 
 mod common;
@@ -17,15 +17,11 @@ fn flight(effects: Effects, seed: u64) -> data::FlightLog {
     simulate(&model(), &scenario(effects, seed), "test").unwrap()
 }
 
-fn settings() -> AnalysisSettings {
-    AnalysisSettings {
-        block_s: 0.5,
-        selection: mismatch::SelectionSettings {
-            resamples: 20,
-            ..Default::default()
-        },
-        ..Default::default()
-    }
+fn settings() -> CheckedSettings {
+    let mut settings = Settings::default();
+    settings.analysis.block_s = 0.5;
+    settings.analysis.selection.resamples = 20;
+    settings.checked().unwrap()
 }
 
 #[test]
@@ -142,7 +138,7 @@ fn the_shortest_simulated_flight_can_be_analysed() {
     };
     let log = simulate(&model(), &scenario, "short").unwrap();
     assert_eq!(log.len(), physics::MIN_LOG_ROWS);
-    analyze(&log, &model(), "demo", &AnalysisSettings::default()).unwrap();
+    analyze(&log, &model(), "demo", &CheckedSettings::standard()).unwrap();
     let mut shorter = scenario.clone();
     shorter.duration_s -= 0.02;
     assert!(simulate(&model(), &shorter, "shorter").is_err());
@@ -188,26 +184,22 @@ fn sampled_commands_of_a_fast_controller_leave_only_noise() {
 /// The demo's configuration A (a 500 Hz controller logged at 50 Hz) flown with `effects` (and
 /// without noise when `quiet`), analysed with the configuration's model.
 fn analysed_on_configuration_a(effects: Effects, quiet: bool) -> mismatch::Analysis {
-    analysed_on_configuration_a_with(effects, quiet, &AnalysisSettings::default())
+    analysed_on_configuration_a_with(effects, quiet, &CheckedSettings::standard())
 }
 
 /// [`analysed_on_configuration_a`] with the given settings.
 fn analysed_on_configuration_a_with(
     effects: Effects,
     quiet: bool,
-    settings: &AnalysisSettings,
+    settings: &CheckedSettings,
 ) -> mismatch::Analysis {
     let (log, model) = configuration_a(effects, quiet);
     // A flight without noise is refused unless the analysis is told it is development work.
-    let settings = AnalysisSettings {
-        noise_free: if quiet {
-            NoiseFree::Analyse
-        } else {
-            settings.noise_free
-        },
-        ..*settings
-    };
-    analyze(&log, &model, "a", &settings).unwrap()
+    let mut settings: Settings = **settings;
+    if quiet {
+        settings.analysis.noise_free = NoiseFree::Analyse;
+    }
+    analyze(&log, &model, "a", &settings.checked().unwrap()).unwrap()
 }
 
 /// The demo's configuration A flown with `effects` (without noise when `quiet`), and its model.
@@ -253,7 +245,7 @@ fn demo_configuration(
 #[test]
 fn a_misplaced_command_step_is_not_an_unexplained_residual() {
     let (mut log, model) = configuration_a(Effects::default(), false);
-    let analysis = analyze(&log, &model, "a", &AnalysisSettings::default()).unwrap();
+    let analysis = analyze(&log, &model, "a", &CheckedSettings::standard()).unwrap();
     assert!(analysis.report.effects.is_empty());
     assert!(
         analysis.report.unexplained.is_empty(),
@@ -271,7 +263,7 @@ fn a_misplaced_command_step_is_not_an_unexplained_residual() {
             w[0] += 0.5 * (std::f64::consts::PI * (t - 30.0) / 3.0).sin().powi(2);
         }
     }
-    let disturbed = analyze(&log, &model, "a", &AnalysisSettings::default()).unwrap();
+    let disturbed = analyze(&log, &model, "a", &CheckedSettings::standard()).unwrap();
     let found: Vec<_> = disturbed
         .report
         .unexplained
@@ -364,9 +356,10 @@ fn command_steps_between_samples_do_not_pull_a_noisy_estimate() {
 #[test]
 fn the_bias_of_the_reaction_to_the_gyro_noise_is_measured_and_removed() {
     let corrected = analysed_on_configuration_a(wrong_inertia(), false);
-    let mut settings = AnalysisSettings::default();
-    settings.estimate.noise_bias.pairs = 0;
-    let plain = analysed_on_configuration_a_with(wrong_inertia(), false, &settings);
+    let mut settings = Settings::default();
+    settings.analysis.estimate.noise_bias.pairs = 0;
+    let plain =
+        analysed_on_configuration_a_with(wrong_inertia(), false, &settings.checked().unwrap());
     let k = |analysis: &mismatch::Analysis| inertia_error(analysis).0;
     let report = &corrected.report.effects[0];
     let Some(physics::EffectParameters::InertiaScale(bias)) = &report.noise_bias else {
@@ -397,7 +390,7 @@ fn the_bias_of_the_reaction_to_the_gyro_noise_is_measured_and_removed() {
 #[test]
 fn the_attenuation_by_the_noise_of_late_command_samples_is_removed() {
     let (log, model) = demo_configuration("c", wrong_inertia(), false);
-    let analysis = analyze(&log, &model, "c", &AnalysisSettings::default()).unwrap();
+    let analysis = analyze(&log, &model, "c", &CheckedSettings::standard()).unwrap();
     let sources = analysis.report.estimate_noise_bias.expect("measured");
     assert!(sources.command_samples && !sources.rate, "{sources:?}");
     let (k, error) = inertia_error(&analysis);

@@ -5,8 +5,8 @@
 
 use std::path::PathBuf;
 
-use mismatch::degenerate::{MAX_ANALYSED_ROWS, MIN_THRUST_TO_WEIGHT};
-use mismatch::{AnalysisSettings, MismatchError, NoiseFree, analyze};
+use mismatch::recording::degenerate::{MAX_ANALYSED_ROWS, MIN_THRUST_TO_WEIGHT};
+use mismatch::{CheckedSettings, MismatchError, NoiseFree, Settings, analyze};
 use physics::{Effects, Noise, Scenario, simulate};
 
 mod common;
@@ -29,15 +29,15 @@ fn noisy() -> Noise {
     common::scenario(Effects::default(), 0).noise
 }
 
-fn settings() -> AnalysisSettings {
-    AnalysisSettings {
-        block_s: 0.5,
-        selection: mismatch::SelectionSettings {
-            resamples: 10,
-            ..Default::default()
-        },
-        ..Default::default()
-    }
+fn unchecked_settings() -> Settings {
+    let mut settings = Settings::default();
+    settings.analysis.block_s = 0.5;
+    settings.analysis.selection.resamples = 10;
+    settings
+}
+
+fn settings() -> CheckedSettings {
+    unchecked_settings().checked().unwrap()
 }
 
 /// The analysis's refusal: a degenerate-recording error, one line naming the recording.
@@ -76,10 +76,9 @@ fn a_recording_without_noise_is_refused_not_explained() {
     assert!(message.contains("simulated without noise?"), "{message}");
     // For development the analysis can still be asked for; its evidence is then no evidence
     // (on this flight the exact model had three effects named on the comparison's own error).
-    let development = AnalysisSettings {
-        noise_free: NoiseFree::Analyse,
-        ..settings()
-    };
+    let mut development = unchecked_settings();
+    development.analysis.noise_free = NoiseFree::Analyse;
+    let development = development.checked().unwrap();
     let analysis = analyze(
         &flight(Noise::default()),
         &model_for_scenario(),

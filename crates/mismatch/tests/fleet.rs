@@ -71,7 +71,13 @@ fn analyse(name: &str, conditions: &[Condition], lag_s: Option<f64>) -> FleetRep
     )
     .unwrap();
     let plan = FleetPlan::load(&dir.join("conditions.json"), &dir.join("data")).unwrap();
-    let report = plan.run(&model, "vehicle.json").unwrap();
+    let report = plan
+        .run(
+            &model,
+            "vehicle.json",
+            &mismatch::CheckedSettings::standard(),
+        )
+        .unwrap();
     let [json, markdown, svg] = report.render(&dir.join("out"), "vehicle").unwrap();
     assert!(json.ends_with("}\n") && markdown.contains("(vehicle.svg)") && svg.contains("<svg"));
     report

@@ -25,7 +25,7 @@ fn names_drag_on_the_relative_wind_in_the_strongest_wind() {
         &log,
         &model,
         "neural-fly",
-        &mismatch::AnalysisSettings::default(),
+        &mismatch::CheckedSettings::standard(),
     )
     .unwrap();
     assert_eq!(analysis.report.rate_frame.used, mismatch::RateFrame::World);

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use mismatch::{Analysis, AnalysisSettings, MismatchError, analyze};
+use mismatch::{Analysis, CheckedSettings, MismatchError, Settings, analyze};
 use physics::{Effects, Scenario, simulate};
 
 mod common;
@@ -22,15 +22,15 @@ fn flight() -> data::FlightLog {
     log
 }
 
-fn settings() -> AnalysisSettings {
-    AnalysisSettings {
-        block_s: 0.5,
-        selection: mismatch::SelectionSettings {
-            resamples: 10,
-            ..Default::default()
-        },
-        ..Default::default()
-    }
+fn unchecked_settings() -> Settings {
+    let mut settings = Settings::default();
+    settings.analysis.block_s = 0.5;
+    settings.analysis.selection.resamples = 10;
+    settings
+}
+
+fn settings() -> CheckedSettings {
+    unchecked_settings().checked().unwrap()
 }
 
 /// The analysis of a corrupted flight must fail with one line naming the recording.
@@ -190,10 +190,12 @@ fn no_file_is_rendered_from_non_finite_results() {
 #[test]
 fn too_few_rows_or_no_fit_rows_are_errors_not_underflows() {
     let log = flight();
-    let settings = AnalysisSettings {
-        heldout_fraction: 1.0,
-        ..settings()
-    };
+    let mut settings = unchecked_settings();
+    settings.comparison.heldout_fraction = 1.0;
+    let message = settings.checked().unwrap_err().to_string();
+    assert!(message.contains("comparison.heldout_fraction"), "{message}");
+    settings.comparison.heldout_fraction = 0.9999;
+    let settings = settings.checked().unwrap();
     let message = analyze(&log, &model("neural-fly.json"), "test", &settings)
         .unwrap_err()
         .to_string();

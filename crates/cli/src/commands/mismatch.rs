@@ -63,13 +63,14 @@ pub struct Args {
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     // clap's "mode" group gives exactly one of --recording, --demo and --flights, and --model
     // with the two that need it; the last arm only keeps the match total.
+    let settings = mismatch::Settings::default().checked()?;
     match (&args.recording, &args.demo, &args.flights, &args.model) {
-        (None, Some(manifest), None, None) => run_demo(manifest, &args),
+        (None, Some(manifest), None, None) => run_demo(manifest, &args, &settings),
         (None, None, Some(conditions), Some(model)) => {
-            run_flights(global, conditions, model, &args)
+            run_flights(global, conditions, model, &args, &settings)
         }
         (Some(recording), None, None, Some(model)) => {
-            run_recording(global, recording, model, &args)
+            run_recording(global, recording, model, &args, &settings)
         }
         _ => anyhow::bail!(
             "give one of --recording or --flights (each with --model), or --demo (without --model)"
@@ -111,7 +112,11 @@ fn write_files<N: AsRef<Path>>(
 /// The demo: its summary (`--out`) is an output set; the cases' files in `--work` are a scratch
 /// of intermediate files (recordings, per-case analyses naming their paths), checked with the
 /// summary before any work and written in place as each case ends.
-fn run_demo(manifest: &Path, args: &Args) -> anyhow::Result<()> {
+fn run_demo(
+    manifest: &Path,
+    args: &Args,
+    settings: &mismatch::CheckedSettings,
+) -> anyhow::Result<()> {
     let work = args.work.as_deref().unwrap_or(Path::new(DEFAULT_WORK));
     let plan = mismatch::demo::DemoPlan::load(manifest, work)?;
     let existing = Existing::from_force(args.force);
@@ -135,7 +140,7 @@ fn run_demo(manifest: &Path, args: &Args) -> anyhow::Result<()> {
         set.file_in(out, name);
     }
     let staged = set.prepare()?;
-    let summary = plan.run(&write_file)?;
+    let summary = plan.run(&write_file, settings)?;
     super::staged_write(&staged, || {
         write_files(
             staged.dir(out),
@@ -153,6 +158,7 @@ fn run_flights(
     conditions: &Path,
     model_path: &Path,
     args: &Args,
+    settings: &mismatch::CheckedSettings,
 ) -> anyhow::Result<()> {
     let data_dir = global.data_dir()?;
     let plan = mismatch::fleet::FleetPlan::load(conditions, &data_dir)?;
@@ -173,7 +179,7 @@ fn run_flights(
     set.check()?;
     let model = load_model(model_path)?;
     let staged = set.prepare()?;
-    let report = plan.run(&model, &model_path.display().to_string())?;
+    let report = plan.run(&model, &model_path.display().to_string(), settings)?;
     super::staged_write(&staged, || {
         let dir = staged.dir(out);
         write_files(dir, names.iter().zip(report.render(dir, &stem)?))
@@ -213,6 +219,7 @@ fn run_recording(
     recording: &Path,
     model_path: &Path,
     args: &Args,
+    settings: &mismatch::CheckedSettings,
 ) -> anyhow::Result<()> {
     let mut set = OutputSet::new("mismatch --recording");
     set.input("the --model file", model_path);
@@ -230,7 +237,7 @@ fn run_recording(
         &log,
         &model,
         &model_path.display().to_string(),
-        &mismatch::AnalysisSettings::default(),
+        settings,
         &|pass, stage| spinner.set_message(format!("pass {pass}: {}", stage.describe())),
     );
     spinner.finish_and_clear();

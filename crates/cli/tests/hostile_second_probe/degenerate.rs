@@ -274,5 +274,5 @@ fn a_recording_over_the_cost_bound_is_refused_and_a_part_is_analysed() {
 
 /// The bound the refusal states, as the library has it.
 fn mismatch_bound() -> usize {
-    mismatch::degenerate::MAX_ANALYSED_ROWS
+    mismatch::recording::degenerate::MAX_ANALYSED_ROWS
 }

@@ -17,9 +17,10 @@ use physics::{Effects, NominalModel, Scenario, simulate};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::{AnalysisSettings, analyze};
+use crate::analysis::analyze;
+use crate::analysis::files::ANALYSIS_FILES;
 use crate::error::{MismatchError, Result, io_error};
-use crate::files::ANALYSIS_FILES;
+use crate::settings::CheckedSettings;
 
 pub use summary::{CellOutcome, DemoSummary, ParameterCheck, Targets, compare_parameters};
 
@@ -328,7 +329,7 @@ impl DemoPlan {
     /// ([`DemoPlan::case_outputs`]) goes to `write`: each configuration's `model.json` first, then
     /// each cell's recording (which the analysis then reads back as written) and its analysis in
     /// `work/<configuration>/<case>/`.
-    pub fn run(&self, write: &WriteFile) -> Result<DemoSummary> {
+    pub fn run(&self, write: &WriteFile, settings: &CheckedSettings) -> Result<DemoSummary> {
         for (i, loaded) in self.configurations.iter().enumerate() {
             let path = self.configuration_dir(i).join("model.json");
             write(&path, &(loaded.model_for_tool.to_json() + "\n"))?;
@@ -339,7 +340,7 @@ impl DemoPlan {
         let outcomes: Vec<CellOutcome> = cells
             .par_iter()
             .map(|&(c, k)| {
-                self.run_cell(c, k, write)
+                self.run_cell(c, k, write, settings)
                     .map_err(|e| MismatchError::Config {
                         path: self.manifest_path.clone(),
                         field: format!("configurations[{c}] × {}", self.cases[k].0),
@@ -367,6 +368,7 @@ impl DemoPlan {
         configuration: usize,
         case: usize,
         write: &WriteFile,
+        settings: &CheckedSettings,
     ) -> Result<CellOutcome> {
         let loaded = &self.configurations[configuration];
         let (name, effects, _) = &self.cases[case];
@@ -386,7 +388,7 @@ impl DemoPlan {
             &recording,
             &loaded.model_for_tool,
             &model_name.display().to_string(),
-            &AnalysisSettings::default(),
+            settings,
         )?;
         for (name, contents) in ANALYSIS_FILES.iter().zip(analysis.render(&dir)?) {
             write(&dir.join(name), &contents)?;

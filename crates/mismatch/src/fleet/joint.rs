@@ -11,10 +11,10 @@ use faer::linalg::solvers::Solve;
 use physics::{EffectId, EffectNumber, Effects, Wind, WindGradient};
 use rayon::prelude::*;
 
-use crate::least_squares::{
+use crate::locate::problem::Problem;
+use crate::model::least_squares::{
     ActiveBounds, LeastSquares, LevenbergMarquardt, LevenbergMarquardtParams, Termination, hold,
 };
-use crate::problem::Problem;
 
 /// The vehicle numbers of effect `id`: all of its numbers, none for the effects that describe
 /// the air (fitted per flight, see [`Air`]).

@@ -10,7 +10,7 @@
 //! held-out rest:
 //! 1. **Calm calibration.** On the calm flights alone (air velocity zero), vehicle effects are added
 //!    one at a time, the one that lowers the held-out error most, while it lowers it by at least
-//!    [`FleetSettings::min_step`]: a thrust map, a thrust-axis tilt, rotor drag, quadratic drag, a
+//!    [`crate::FleetSettings::min_step`]: a thrust map, a thrust-axis tilt, rotor drag, quadratic drag, a
 //!    command delay, a lag of the air forces. The delay and the lag are fixed here: in still air
 //!    nothing else trades against them, while with wind their values slide with the wind's scale.
 //! 2. **Transfer.** On all flights, each not calm with its own air, the effects only moving air
@@ -37,17 +37,17 @@ mod tests;
 
 use std::path::{Path, PathBuf};
 
+use crate::settings::CheckedSettings;
 use data::ExperimentConditions;
 use physics::{EffectId, EffectNumber, NominalModel};
 use rayon::prelude::*;
 use serde::Serialize;
-use sindy::weak_form::TestFunction;
 
-use crate::degenerate;
 use crate::error::{MismatchError, Result};
-use crate::least_squares::Termination;
-use crate::problem::Problem;
+use crate::locate::problem::Problem;
+use crate::model::least_squares::Termination;
 use crate::recording::Recording;
+use crate::recording::degenerate;
 
 pub use self::report::{FleetReport, file_names};
 pub use ::report::mismatch::fleet::{
@@ -57,27 +57,6 @@ pub use joint::{Air, Vehicle};
 use joint::{JointFit, JointFlight, JointSettings};
 pub use scale_report::scale_report;
 pub use sensitivity::{LAG_GRID_S, LagProfile, LagSensitivity};
-
-/// Settings of the joint analysis (recorded in the output).
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct FleetSettings {
-    pub test_function: TestFunction,
-    pub heldout_fraction: f64,
-    /// An effect joins when it lowers the held-out (or transfer) error by at least this fraction.
-    pub min_step: f64,
-    pub iterations: usize,
-}
-
-impl Default for FleetSettings {
-    fn default() -> Self {
-        Self {
-            test_function: TestFunction::default(),
-            heldout_fraction: 0.3,
-            min_step: 0.05,
-            iterations: 30,
-        }
-    }
-}
 
 /// Effects the calm flights are tried with, in this order.
 const CALM_CANDIDATES: [EffectId; 6] = [
@@ -234,7 +213,11 @@ impl FleetPlan {
     }
 
     /// Reads every flight and prepares its comparison with `model`.
-    pub fn read(&self, model: &NominalModel, settings: &FleetSettings) -> Result<Vec<FleetFlight>> {
+    pub fn read(
+        &self,
+        model: &NominalModel,
+        settings: &CheckedSettings,
+    ) -> Result<Vec<FleetFlight>> {
         self.flights
             .iter()
             .map(|(controller, index, path)| {
@@ -244,8 +227,8 @@ impl FleetPlan {
                 let problem = Problem::new(
                     recording,
                     model.clone(),
-                    settings.test_function,
-                    settings.heldout_fraction,
+                    settings.comparison.test_function,
+                    settings.comparison.heldout_fraction,
                 )?;
                 degenerate::check_noise(&problem).map_err(|degeneracy| {
                     MismatchError::Degenerate {
@@ -278,10 +261,14 @@ impl FleetPlan {
 
     /// Runs the analysis: the report (its files: [`FleetReport::render`]; its terminal lines:
     /// `report.view().lines()`).
-    pub fn run(&self, model: &NominalModel, model_name: &str) -> Result<FleetReport> {
-        let settings = FleetSettings::default();
-        let flights = self.read(model, &settings)?;
-        let identification = identify(&flights, &settings);
+    pub fn run(
+        &self,
+        model: &NominalModel,
+        model_name: &str,
+        settings: &CheckedSettings,
+    ) -> Result<FleetReport> {
+        let flights = self.read(model, settings)?;
+        let identification = identify(&flights, settings);
         let attitude = (!model.predicts_torque())
             .then(|| attitude::check(&flights))
             .flatten();
@@ -292,7 +279,7 @@ impl FleetPlan {
             model,
             model_name,
             &self.conditions_path.display().to_string(),
-            settings,
+            settings.fleet_record(),
         );
         Ok(report)
     }
@@ -423,7 +410,7 @@ fn starts(id: EffectId) -> Vec<Option<Vec<f64>>> {
 /// Stage 1: effects added on the calm flights (fit part) while the held-out error falls.
 fn calibrate_calm(
     flights: &[FleetFlight],
-    settings: &FleetSettings,
+    settings: &CheckedSettings,
     selection: &mut Vec<SelectionStep>,
 ) -> Vehicle {
     let calm: Vec<usize> = (0..flights.len()).filter(|&i| flights[i].calm).collect();
@@ -439,7 +426,7 @@ fn calibrate_calm(
         "calm",
         start,
         error,
-        settings.min_step,
+        settings.fleet.min_step,
         selection,
         |vehicle| {
             let trials: Vec<(EffectId, Option<Vec<f64>>)> = CALM_CANDIDATES
@@ -452,7 +439,8 @@ fn calibrate_calm(
                 .par_iter()
                 .map(|(id, start)| {
                     let trial = vehicle.with(*id, start.as_deref());
-                    let fitted = fit_two_step(&fit_rows, &trial, &[], true, settings.iterations);
+                    let fitted =
+                        fit_two_step(&fit_rows, &trial, &[], true, settings.fleet.iterations);
                     let trial_error = score(&fitted.vehicle);
                     (*id, fitted.vehicle, trial_error)
                 })
@@ -530,7 +518,7 @@ fn leave_out(
     flights: &[FleetFlight],
     left_out: &[usize],
     vehicle: &Vehicle,
-    settings: &FleetSettings,
+    settings: &CheckedSettings,
     rows: Rows,
 ) -> (Vehicle, Vec<Air>) {
     let fixed = timing_parameters(vehicle);
@@ -541,7 +529,7 @@ fn leave_out(
         .iter()
         .map(|&i| joint_flight(&flights[i], flights[i].calm, rows))
         .collect();
-    let fitted = fit_two_step(&kept, vehicle, &fixed, true, settings.iterations);
+    let fitted = fit_two_step(&kept, vehicle, &fixed, true, settings.fleet.iterations);
     let mut airs = still_airs(flights, &fitted.vehicle);
     for (k, &i) in kept_indices.iter().enumerate() {
         airs[i] = fitted.airs[k].clone();
@@ -550,7 +538,13 @@ fn leave_out(
         .iter()
         .map(|&i| joint_flight(&flights[i], false, rows))
         .collect();
-    let only_airs = fit_two_step(&held, &fitted.vehicle, &[], false, settings.iterations);
+    let only_airs = fit_two_step(
+        &held,
+        &fitted.vehicle,
+        &[],
+        false,
+        settings.fleet.iterations,
+    );
     for (k, &i) in left_out.iter().enumerate() {
         airs[i] = only_airs.airs[k].clone();
     }
@@ -559,7 +553,7 @@ fn leave_out(
 
 /// The transfer error of a vehicle structure: for each windy condition, the held-out error of its
 /// flights with the vehicle fitted (fit rows) on the other flights and only their airs fitted.
-fn transfer_error(flights: &[FleetFlight], vehicle: &Vehicle, settings: &FleetSettings) -> f64 {
+fn transfer_error(flights: &[FleetFlight], vehicle: &Vehicle, settings: &CheckedSettings) -> f64 {
     let groups = windy_groups(flights);
     let errors: Vec<f64> = groups
         .par_iter()
@@ -576,7 +570,7 @@ fn transfer_error(flights: &[FleetFlight], vehicle: &Vehicle, settings: &FleetSe
 fn add_wind_effects(
     flights: &[FleetFlight],
     vehicle: Vehicle,
-    settings: &FleetSettings,
+    settings: &CheckedSettings,
     selection: &mut Vec<SelectionStep>,
 ) -> Vehicle {
     if windy_groups(flights).len() < 2 {
@@ -587,7 +581,7 @@ fn add_wind_effects(
         "transfer",
         vehicle,
         error,
-        settings.min_step,
+        settings.fleet.min_step,
         selection,
         |vehicle| {
             // Every wind candidate needs a drag for the air to act through.
@@ -610,7 +604,7 @@ fn add_wind_effects(
 }
 
 /// The whole joint analysis (see the module's documentation).
-pub fn identify(flights: &[FleetFlight], settings: &FleetSettings) -> Identification {
+pub fn identify(flights: &[FleetFlight], settings: &CheckedSettings) -> Identification {
     let mut selection = Vec::new();
     let mut calm_vehicle = calibrate_calm(flights, settings, &mut selection);
     // The lag is held from here on: at its calm held-out minimum, not its fit-part optimum.
@@ -623,7 +617,13 @@ pub fn identify(flights: &[FleetFlight], settings: &FleetSettings) -> Identifica
     let fixed = timing_parameters(&structure);
     // Held-out check: fitted on the first part of every flight.
     let fit_part = joint_flights(flights, Rows::Fit);
-    let on_fit_part = fit_two_step(&fit_part, &structure, &fixed, true, settings.iterations);
+    let on_fit_part = fit_two_step(
+        &fit_part,
+        &structure,
+        &fixed,
+        true,
+        settings.fleet.iterations,
+    );
     let nominal_airs = still_airs(flights, &Vehicle::default());
     let heldout: Vec<(f64, f64)> = (0..flights.len())
         .map(|i| {
@@ -645,7 +645,7 @@ pub fn identify(flights: &[FleetFlight], settings: &FleetSettings) -> Identifica
         &on_fit_part.vehicle,
         &fixed,
         true,
-        settings.iterations,
+        settings.fleet.iterations,
     );
     // Left out in turn: each windy condition, then each calm flight that has calm siblings.
     let mut groups = windy_groups(flights);

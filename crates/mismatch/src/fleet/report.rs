@@ -13,9 +13,10 @@ use report::mismatch::fleet::{
 use serde::Serialize;
 
 use super::scale_report::scale_report;
-use super::{Air, FleetFlight, FleetSettings, Identification, SelectionStep};
-use crate::describe::describe;
+use super::{Air, FleetFlight, Identification, SelectionStep};
 use crate::error::Result;
+use crate::explain::describe::describe;
+use crate::settings::FleetRecord;
 
 /// One vehicle effect: id, parameters, plain words.
 #[derive(Clone, Debug, Serialize)]
@@ -53,7 +54,7 @@ pub struct FleetReport {
     pub scale: Option<ScaleReport>,
     /// Per validation group: the vehicle fitted without it.
     pub validation_vehicles: Vec<(String, Effects)>,
-    pub settings: FleetSettings,
+    pub settings: FleetRecord,
     /// What the reader should know about how the numbers were made.
     pub notes: Vec<String>,
 }
@@ -154,7 +155,7 @@ impl FleetReport {
         model: &NominalModel,
         model_name: &str,
         conditions: &str,
-        settings: FleetSettings,
+        settings: FleetRecord,
     ) -> Self {
         let effects = found.vehicle.effects(None);
         let vehicle = VehicleReport {
@@ -258,8 +259,8 @@ impl FleetReport {
                     accepted: s.accepted,
                 })
                 .collect(),
-            min_step: self.settings.min_step,
-            heldout_fraction: self.settings.heldout_fraction,
+            min_step: self.settings.fleet.min_step,
+            heldout_fraction: self.settings.comparison.heldout_fraction,
             flights: &self.flights,
             targets: &self.targets,
             heldout: &self.heldout,

@@ -15,7 +15,7 @@ use serde::Serialize;
 
 use super::joint::{Air, Vehicle};
 use super::{
-    FleetFlight, FleetSettings, Rows, fit_two_step, heldout_error, joint_flight, joint_flights,
+    CheckedSettings, FleetFlight, Rows, fit_two_step, heldout_error, joint_flight, joint_flights,
     still_airs, timing_parameters,
 };
 
@@ -60,7 +60,7 @@ fn calm_fit_at(
     flights: &[FleetFlight],
     calm_vehicle: &Vehicle,
     lag_s: f64,
-    settings: &FleetSettings,
+    settings: &CheckedSettings,
 ) -> (Vehicle, f64) {
     let calm: Vec<usize> = (0..flights.len()).filter(|&i| flights[i].calm).collect();
     let fit_rows: Vec<_> = calm
@@ -68,7 +68,13 @@ fn calm_fit_at(
         .map(|&i| joint_flight(&flights[i], true, Rows::Fit))
         .collect();
     let start = with_value(calm_vehicle, DRAG_LAG, lag_s);
-    let fitted = fit_two_step(&fit_rows, &start, &[DRAG_LAG], true, settings.iterations);
+    let fitted = fit_two_step(
+        &fit_rows,
+        &start,
+        &[DRAG_LAG],
+        true,
+        settings.fleet.iterations,
+    );
     let still = still_airs(flights, &Vehicle::default());
     let error = heldout_error(flights, &calm, &fitted.vehicle, &still);
     (fitted.vehicle, error)
@@ -80,7 +86,7 @@ fn airs_at(
     flights: &[FleetFlight],
     full_vehicle: &Vehicle,
     calm_at_lag: &Vehicle,
-    settings: &FleetSettings,
+    settings: &CheckedSettings,
 ) -> Vec<Air> {
     let mut start = full_vehicle.clone();
     for parameter in timing_parameters(full_vehicle) {
@@ -90,7 +96,7 @@ fn airs_at(
     }
     let all_rows = joint_flights(flights, Rows::All);
     let fixed = timing_parameters(&start);
-    fit_two_step(&all_rows, &start, &fixed, true, settings.iterations).airs
+    fit_two_step(&all_rows, &start, &fixed, true, settings.fleet.iterations).airs
 }
 
 /// The calm flights' held-out error over the lag grid, each with the calm vehicle refitted at it.
@@ -103,7 +109,7 @@ impl LagProfile {
     pub fn measure(
         flights: &[FleetFlight],
         calm_vehicle: &Vehicle,
-        settings: &FleetSettings,
+        settings: &CheckedSettings,
     ) -> Option<Self> {
         if !calm_vehicle.parameters.contains(&DRAG_LAG) {
             return None;
@@ -148,7 +154,7 @@ impl LagProfile {
         flights: &[FleetFlight],
         calm_vehicle: &Vehicle,
         lag_s: f64,
-        settings: &FleetSettings,
+        settings: &CheckedSettings,
     ) -> Vehicle {
         calm_fit_at(flights, calm_vehicle, lag_s, settings).0
     }
@@ -158,7 +164,7 @@ impl LagProfile {
         &self,
         flights: &[FleetFlight],
         full_vehicle: &Vehicle,
-        settings: &FleetSettings,
+        settings: &CheckedSettings,
     ) -> Option<LagSensitivity> {
         if !full_vehicle.parameters.contains(&DRAG_LAG) {
             return None;
@@ -167,7 +173,7 @@ impl LagProfile {
         let open: Vec<&(f64, Vehicle, f64)> = self
             .fits
             .iter()
-            .filter(|f| best >= (1.0 - settings.min_step) * f.2)
+            .filter(|f| best >= (1.0 - settings.fleet.min_step) * f.2)
             .collect();
         let (low, high) = (open.first()?, open.last()?);
         let (airs_low, airs_high) = rayon::join(

@@ -11,9 +11,10 @@ use sindy::weak_form::TestFunction;
 
 use super::report::{VehicleEffect, VehicleParameters, VehicleReport, file_names};
 use super::{
-    AttitudeCheck, FleetReport, FleetSettings, FlightHeldout, FlightSpeedRange, FlightWind,
-    ScaleReport, SelectionStep, Targets,
+    AttitudeCheck, FleetReport, FlightHeldout, FlightSpeedRange, FlightWind, ScaleReport,
+    SelectionStep, Targets,
 };
+use crate::settings::{ComparisonSettings, FleetRecord, FleetSettings};
 
 fn committed(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -130,15 +131,19 @@ fn scale(s: &Value) -> ScaleReport {
     }
 }
 
-fn settings(s: &Value) -> FleetSettings {
-    FleetSettings {
-        test_function: TestFunction {
-            half_width_s: from(&s["test_function"]["half_width_s"]),
-            power: from(&s["test_function"]["power"]),
+fn settings(s: &Value) -> FleetRecord {
+    FleetRecord {
+        comparison: ComparisonSettings {
+            test_function: TestFunction {
+                half_width_s: from(&s["test_function"]["half_width_s"]),
+                power: from(&s["test_function"]["power"]),
+            },
+            heldout_fraction: from(&s["heldout_fraction"]),
         },
-        heldout_fraction: from(&s["heldout_fraction"]),
-        min_step: from(&s["min_step"]),
-        iterations: from(&s["iterations"]),
+        fleet: FleetSettings {
+            min_step: from(&s["min_step"]),
+            iterations: from(&s["iterations"]),
+        },
     }
 }
 

@@ -9,11 +9,11 @@ use faer::Mat;
 use faer::linalg::solvers::Solve;
 use physics::{EffectNumber, Effects, QuadraticDrag, Wind};
 
-use crate::least_squares::{
+use crate::locate::problem::{Channels, Problem};
+use crate::model::least_squares::{
     ActiveBounds, DenseProblem, LevenbergMarquardt, LevenbergMarquardtParams, Solution,
     forward_jacobian, normal_matrix,
 };
-use crate::problem::{Channels, Problem};
 
 /// Effects built from parameter values (absent parameters keep their effect absent; the other
 /// numbers of a present effect are neutral).
@@ -226,7 +226,7 @@ static SOLVER: LazyLock<LevenbergMarquardt> = LazyLock::new(|| {
     .expect("the single-recording solver's settings are valid")
 });
 
-/// Levenberg–Marquardt ([`crate::least_squares`]) on the (weighted) whitened residual of the
+/// Levenberg–Marquardt ([`crate::model::least_squares`]) on the (weighted) whitened residual of the
 /// fit's rows, at most `iterations` linearisations, the parameters within their fit ranges.
 pub fn levenberg_marquardt(
     problem: &Problem,

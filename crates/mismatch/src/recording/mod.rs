@@ -1,5 +1,12 @@
 //! A flight log turned into what the analysis needs: attitude, velocity, position, body rate and the
-//! actuator commands the nominal model reads from the recorded command columns.
+//! actuator commands the nominal model reads from the recorded command columns (step 0 of the
+//! method): the actuator limits and the samples a command is reconstructed through
+//! ([`command_samples`]), the reaction of sampled commands to logged noise removed
+//! ([`noise_reaction`]), and recordings no analysis can use refused ([`degenerate`]).
+
+pub mod command_samples;
+pub mod degenerate;
+pub mod noise_reaction;
 
 use std::path::PathBuf;
 
@@ -8,10 +15,9 @@ use physics::vector::{Mat3, Vec3, mat_t_vec};
 use physics::{CommandLogging, NominalModel};
 use sindy::weak_form::white_noise_sigma;
 
-use crate::command_samples::{ActuatorLimits, CommandSamples, SampleDomain, detect_limits};
-use crate::degenerate;
 use crate::error::{MismatchError, Result};
-use crate::noise_reaction::{self, NoiseReaction};
+use command_samples::{ActuatorLimits, CommandSamples, SampleDomain, detect_limits};
+use noise_reaction::NoiseReaction;
 
 /// The recorded signals, per row.
 #[derive(Clone, Debug)]
@@ -37,7 +43,7 @@ pub struct Recording {
     pub command_spread: [f64; 4],
     /// The rate of the commands a row averages, Hz (when known).
     pub command_rate_hz: Option<f64>,
-    /// The limits the logged commands sit at ([`crate::command_samples`]).
+    /// The limits the logged commands sit at ([`crate::recording::command_samples`]).
     pub command_limits: [ActuatorLimits; 4],
     /// What the model's command is reconstructed through: for instantaneous samples, per-rotor
     /// thrusts with the runs at a limit continued; otherwise the commands as they are. Kept in step
@@ -45,7 +51,7 @@ pub struct Recording {
     pub samples: CommandSamples,
     /// What was removed from sampled commands of a faster controller: their reaction to the
     /// logged attitude and position noise (and, after the analysis's first pass, velocity noise)
-    /// that the vehicle did not feel ([`crate::noise_reaction`]).
+    /// that the vehicle did not feel ([`crate::recording::noise_reaction`]).
     pub noise_reaction: Option<NoiseReaction>,
 }
 

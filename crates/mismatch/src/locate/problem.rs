@@ -7,7 +7,7 @@ use sindy::stability::BlockDesign;
 use sindy::weak_form::{TestFunction, WeakForm, white_noise_sigma};
 
 use crate::error::{MismatchError, Result};
-use crate::forward::{
+use crate::locate::forward::{
     RowPrediction, SUBSTEPS, accelerations_at_rows, predict_at_rows, predict_substeps,
 };
 use crate::recording::Recording;

@@ -6,14 +6,14 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
-use crate::command_samples::CommandSamples;
+use crate::recording::command_samples::CommandSamples;
 
 const DT: f64 = 0.02;
 const ROWS: usize = 2000;
 
 type Commands = Vec<[f64; 4]>;
 
-use crate::simex::gaussian;
+use crate::improve::simex::gaussian;
 
 fn noise(rng: &mut ChaCha8Rng, sigma: f64) -> Vec3 {
     std::array::from_fn(|_| gaussian(rng, sigma))

@@ -7,7 +7,7 @@ use data::FlightLog;
 use physics::{NominalModel, ThrustSource};
 use sindy::median::median;
 
-use crate::problem::{CHANNEL_NAMES, Problem};
+use crate::locate::problem::{CHANNEL_NAMES, Problem};
 
 /// What makes a recording degenerate.
 #[derive(Clone, Debug, PartialEq)]

@@ -12,8 +12,8 @@
 use physics::vector::{Mat3, Vec3};
 use physics::{CommandLogging, Effects, Logger, NominalModel};
 
-use crate::command_samples::CommandSamples;
 use crate::recording::Recording;
+use crate::recording::command_samples::CommandSamples;
 
 /// Sub-intervals per sample interval.
 pub const SUBSTEPS: usize = 10;
@@ -440,7 +440,7 @@ mod tests {
     /// the clipped demand within 2 · 10⁻³; a curve through the speeds missed it by up to 1.7 · 10⁻².
     #[test]
     fn a_rotor_held_at_zero_is_reconstructed_through_its_thrust() {
-        use crate::command_samples::{SampleDomain, detect_limits};
+        use crate::recording::command_samples::{SampleDomain, detect_limits};
         let dt = 0.02;
         let demand = |t: f64| 0.3 + 0.5 * (2.0 * std::f64::consts::PI * 2.0 * t).sin();
         let speeds: Vec<[f64; 4]> = (0..100)

@@ -26,9 +26,9 @@ use serde::Serialize;
 use sindy::stability::trimmed_gain;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
-use crate::fit::FittedSet;
-use crate::problem::{Channels, Problem};
-use crate::refine::{FitRows, standard_errors};
+use crate::explain::fit::FittedSet;
+use crate::locate::problem::{Channels, Problem};
+use crate::model::refine::{FitRows, standard_errors};
 
 /// The thresholds of the rule (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -2,7 +2,7 @@
 //! and removed by extrapolation (SIMEX: Cook and Stefanski, 1994).
 //!
 //! Instantaneous samples of a faster controller's commands carry its step-to-step reaction to its
-//! sensors' noise, which the vehicle averaged over the row ([`crate::noise_reaction`]). Two biases
+//! sensors' noise, which the vehicle averaged over the row ([`crate::recording::noise_reaction`]). Two biases
 //! follow:
 //!
 //! - **Correlation with the recorded rate.** Sampled with the state, the commands' reaction to the
@@ -35,10 +35,10 @@ use rayon::prelude::*;
 use serde::Serialize;
 use sindy::weak_form::white_noise_sigma;
 
-use crate::fit::FittedSet;
-use crate::noise_reaction;
-use crate::problem::Problem;
-use crate::refine::{FitRows, levenberg_marquardt};
+use crate::explain::fit::FittedSet;
+use crate::locate::problem::Problem;
+use crate::model::refine::{FitRows, levenberg_marquardt};
+use crate::recording::noise_reaction;
 
 /// Settings of the correction (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -229,7 +229,7 @@ fn with_noise(
 }
 
 /// For instantaneous samples of a faster controller from which no reaction to the logged noise was
-/// removed ([`crate::noise_reaction`]), the covariance of their unfelt white noise in the domain
+/// removed ([`crate::recording::noise_reaction`]), the covariance of their unfelt white noise in the domain
 /// the mixer is linear in (where the controller's reaction adds): `1 − 1/N` of the samples' own
 /// (`N` control steps per row); `None` otherwise. Where the reaction was removed, what remains of
 /// the samples' white noise is mostly the reaction to the row's other steps' noise, which the

@@ -1,7 +1,7 @@
 //! The final estimate of the named effects' parameters.
 //!
 //! The evidence rule judges the effects with parameters fitted on the fit part, so that the
-//! held-out part can test them ([`crate::evidence`]). Once the effects are named, their parameters
+//! held-out part can test them ([`crate::explain::evidence`]). Once the effects are named, their parameters
 //! are estimated again on every analysed row, with robust weights: per channel, a residual beyond
 //! `huber_threshold` robust standard deviations counts linearly instead of quadratically (Huber's
 //! loss, by iteratively reweighted least squares from the judged values): rows far off stop pulling
@@ -9,14 +9,14 @@
 //!
 //! A sampled command that steps between two samples says nothing of when within the interval it
 //! stepped, and the curve through the samples misplaces the step by up to half a row. Such steps
-//! are found in the commands alone ([`crate::command_samples::CommandSamples::unplaced_steps`]);
+//! are found in the commands alone ([`crate::recording::command_samples::CommandSamples::unplaced_steps`]);
 //! each step's time is a nuisance parameter, profiled out: per channel, the weighted residual's
 //! component along the test functions' value at the step (what moving the step changes) is left
 //! out of the fit. Unlike a robust weight, this does not depend on the noise level: with more
 //! noise, Huber's threshold grows and the rows around a step pulled the parameters more.
 //!
 //! When the commands are instantaneous samples of a faster controller, the bias their noise (and
-//! its correlation with the recorded rate's) leaves is measured and subtracted ([`crate::simex`]).
+//! its correlation with the recorded rate's) leaves is measured and subtracted ([`crate::improve::simex`]).
 //!
 //! The standard errors have the form of the fit part's (`refine::standard_errors`) with the
 //! weighted residual and Jacobian on all rows: `√diag(κ s² (JᵀWJ)⁻¹)`, with the Monte Carlo error
@@ -27,12 +27,12 @@
 use serde::Serialize;
 use sindy::median::robust_standard_deviation;
 
-use crate::evidence::autocorrelation_factor;
-use crate::fit::FittedSet;
-use crate::least_squares::Termination;
-use crate::problem::{Channels, Problem};
-use crate::refine::{FitRows, StepBasis, levenberg_marquardt, standard_errors};
-use crate::simex::{NoiseBias, SimexSettings, noise_bias};
+use crate::explain::evidence::autocorrelation_factor;
+use crate::explain::fit::FittedSet;
+use crate::improve::simex::{NoiseBias, SimexSettings, noise_bias};
+use crate::locate::problem::{Channels, Problem};
+use crate::model::least_squares::Termination;
+use crate::model::refine::{FitRows, StepBasis, levenberg_marquardt, standard_errors};
 
 /// Settings of the final estimate (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -41,7 +41,7 @@ pub struct EstimateSettings {
     pub huber_threshold: f64,
     /// Reweighting passes.
     pub passes: usize,
-    /// The correction of the bias the noise on sampled commands leaves ([`crate::simex`]).
+    /// The correction of the bias the noise on sampled commands leaves ([`crate::improve::simex`]).
     pub noise_bias: SimexSettings,
 }
 
@@ -63,7 +63,7 @@ pub struct Estimate {
     /// Share of the (row, channel) residuals that carry a weight below 1 at the end.
     pub downweighted_fraction: f64,
     /// The bias removed from the values, when the commands are instantaneous samples of a faster
-    /// controller ([`crate::simex`]).
+    /// controller ([`crate::improve::simex`]).
     pub noise_bias: Option<NoiseBias>,
     /// Times of the command steps between samples whose place within their interval was left free.
     pub step_times: Vec<f64>,
@@ -188,7 +188,7 @@ fn huber_weights(
 }
 
 /// The times of the command steps the samples cannot place
-/// ([`crate::command_samples::CommandSamples::unplaced_steps`]): adjacent flagged intervals count
+/// ([`crate::recording::command_samples::CommandSamples::unplaced_steps`]): adjacent flagged intervals count
 /// as one step, at the middle of their span.
 pub(crate) fn step_times(problem: &Problem) -> Vec<f64> {
     let time = &problem.recording.time;

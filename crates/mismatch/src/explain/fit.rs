@@ -8,9 +8,9 @@ use report::mismatch::recording::TimingScores;
 use serde::Serialize;
 use sindy::stability::{BlockDesign, Selection};
 
-use crate::library::{Candidate, CandidateId};
-use crate::problem::{Channels, Problem};
-use crate::refine::{
+use crate::explain::library::{Candidate, CandidateId};
+use crate::locate::problem::{Channels, Problem};
+use crate::model::refine::{
     FitRows, effect_column, effects_from, levenberg_marquardt, profile_search, profile_wind,
     unit_drag_in_wind,
 };

@@ -1,5 +1,7 @@
 //! The whole analysis of one recording: compare, locate, explain, fit, judge the evidence, validate
-//! on held-out data.
+//! on held-out data; its files ([`files`]).
+
+pub(crate) mod files;
 
 use std::collections::BTreeMap;
 
@@ -11,86 +13,31 @@ pub use report::mismatch::recording::{
 };
 use serde::Serialize;
 use sindy::stability::{Selection, SelectionSettings, stability_selection};
-use sindy::weak_form::{TestFunction, white_noise_sigma};
+use sindy::weak_form::white_noise_sigma;
 
-use crate::command_samples::ActuatorLimits;
-use crate::degenerate;
-use crate::describe::describe;
 use crate::error::{MismatchError, Result};
-use crate::estimate::{self, Estimate, EstimateSettings};
-use crate::evidence::{self, Evidence, EvidenceSettings, explained_fractions};
-use crate::fit::{FitAlternatives, Screened, fit_parameters, profile_nonlinear};
-use crate::forward;
-use crate::least_squares::Termination;
-use crate::library::{Candidate, build_library};
-use crate::noise_reaction::{self, NoiseReaction};
-use crate::problem::{CHANNEL_NAMES, Channels, Problem};
+use crate::explain::describe::describe;
+use crate::explain::evidence::{self, Evidence, explained_fractions};
+use crate::explain::fit::{FitAlternatives, Screened, fit_parameters, profile_nonlinear};
+use crate::explain::library::{Candidate, build_library};
+use crate::improve::estimate::{self, Estimate};
+use crate::improve::simex::NoiseSources;
+use crate::locate::forward;
+use crate::locate::problem::{CHANNEL_NAMES, Channels, Problem};
+use crate::locate::windows::{Residuals, channel_reports, locate_windows, without_steps};
+use crate::model::least_squares::Termination;
+use crate::model::refine::effects_from;
 use crate::recording::Recording;
-use crate::refine::{FitRows, StepBasis, effects_from};
-use crate::simex::NoiseSources;
-
-/// Settings of an analysis (recorded in the output).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct AnalysisSettings {
-    /// The comparison's test function.
-    pub test_function: TestFunction,
-    /// Fraction of the analysed rows, at the end, held out from every fit and choice.
-    pub heldout_fraction: f64,
-    /// Length of the blocks that the selection and the evidence rule compare, s.
-    pub block_s: f64,
-    pub selection: SelectionSettings,
-    pub evidence: EvidenceSettings,
-    /// The final estimate of the named effects' parameters ([`crate::estimate`]).
-    pub estimate: EstimateSettings,
-    /// A channel is significant when its residual RMS exceeds this multiple of its noise floor.
-    pub significance_factor: f64,
-    /// A window is located where the moving RMS of the residual exceeds this multiple of the floor.
-    pub window_factor: f64,
-    /// Length of the moving RMS, s.
-    pub window_s: f64,
-    /// Shortest window reported, s.
-    pub min_window_s: f64,
-    pub iterations: usize,
-    /// What to do with a recording without measurement noise ([`degenerate::check_noise`]).
-    #[serde(skip)]
-    pub noise_free: NoiseFree,
-}
-
-/// What [`analyze`] does with a recording whose noise floor is below the comparison's accuracy.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum NoiseFree {
-    /// Refuse it: the evidence rule measures residuals in units of the noise.
-    #[default]
-    Refuse,
-    /// Analyse it anyway, for development on noise-free simulations (the estimates are
-    /// meaningful; the evidence, the windows and the significance are not).
-    Analyse,
-}
-
-impl Default for AnalysisSettings {
-    fn default() -> Self {
-        Self {
-            test_function: TestFunction::default(),
-            heldout_fraction: 0.3,
-            block_s: 1.0,
-            selection: SelectionSettings::default(),
-            evidence: EvidenceSettings::default(),
-            estimate: EstimateSettings::default(),
-            significance_factor: 2.0,
-            window_factor: 2.5,
-            window_s: 1.0,
-            min_window_s: 0.5,
-            iterations: 40,
-            noise_free: NoiseFree::Refuse,
-        }
-    }
-}
+use crate::recording::command_samples::ActuatorLimits;
+use crate::recording::degenerate;
+use crate::recording::noise_reaction::{self, NoiseReaction};
+use crate::settings::{AnalysisRecord, CheckedSettings, NoiseFree};
 
 /// One effect found.
 #[derive(Clone, Debug, Serialize)]
 pub struct EffectReport {
     pub id: EffectId,
-    /// The final estimate: all rows, robust weights ([`crate::estimate`]).
+    /// The final estimate: all rows, robust weights ([`crate::improve::estimate`]).
     pub parameters: EffectParameters,
     /// The standard error of each parameter, by name, in the parameters' shape (from the final
     /// estimate's Jacobian, the residual's variance and its autocorrelation); absent where the fit
@@ -101,14 +48,14 @@ pub struct EffectReport {
     /// and the held-out part checked it.
     pub fit_part_parameters: EffectParameters,
     /// The bias the noise on the model's inputs left, measured and subtracted from `parameters`
-    /// ([`crate::simex`]); absent when the commands are not samples of a faster controller.
+    /// ([`crate::improve::simex`]); absent when the commands are not samples of a faster controller.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub noise_bias: Option<EffectParameters>,
     pub description: String,
     /// This effect's share of the nominal model's noise-normalised residual sum of squares (fit
     /// part) that the fitted effects remove, in [0, 1]; the shares sum to the total removed.
     pub explained_fraction: f64,
-    /// Why it is named ([`crate::evidence`]).
+    /// Why it is named ([`crate::explain::evidence`]).
     pub evidence: Evidence,
 }
 
@@ -152,11 +99,11 @@ pub struct Report {
     /// nothing).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub estimate_termination: Option<Termination>,
-    /// The noises whose bias the final estimate measured and removed ([`crate::simex`]), when it did.
+    /// The noises whose bias the final estimate measured and removed ([`crate::improve::simex`]), when it did.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub estimate_noise_bias: Option<NoiseSources>,
     /// The limits the logged commands sat at, when any did (instantaneous samples are reconstructed
-    /// through them: [`crate::command_samples`]).
+    /// through them: [`crate::recording::command_samples`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub command_limits: Option<[ActuatorLimits; 4]>,
     pub rate_frame: RateFrameReport,
@@ -167,7 +114,7 @@ pub struct Report {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub noise_reaction: Option<NoiseReaction>,
     pub selection: SelectionReport,
-    pub settings: AnalysisSettings,
+    pub settings: AnalysisRecord,
 }
 
 /// The report with the data behind it (for figures and summaries).
@@ -216,7 +163,7 @@ pub fn analyze(
     log: &FlightLog,
     model: &NominalModel,
     model_name: &str,
-    settings: &AnalysisSettings,
+    settings: &CheckedSettings,
 ) -> Result<Analysis> {
     analyze_observed(log, model, model_name, settings, &|_, _| {})
 }
@@ -227,7 +174,7 @@ pub fn analyze_observed(
     log: &FlightLog,
     model: &NominalModel,
     model_name: &str,
-    settings: &AnalysisSettings,
+    settings: &CheckedSettings,
     observe: &dyn Fn(usize, Stage),
 ) -> Result<Analysis> {
     if log.len() > degenerate::MAX_ANALYSED_ROWS {
@@ -290,23 +237,23 @@ fn analyze_recording(
     log: &FlightLog,
     model: &NominalModel,
     model_name: &str,
-    settings: &AnalysisSettings,
+    settings: &CheckedSettings,
     observe: &dyn Fn(Stage),
 ) -> Result<Analysis> {
     observe(Stage::Comparing);
     let problem = Problem::new(
         recording,
         model.clone(),
-        settings.test_function,
-        settings.heldout_fraction,
+        settings.comparison.test_function,
+        settings.comparison.heldout_fraction,
     )?;
-    if settings.noise_free == NoiseFree::Refuse {
+    if settings.analysis.noise_free == NoiseFree::Refuse {
         degenerate::check_noise(&problem).map_err(|degeneracy| MismatchError::Degenerate {
             path: problem.recording.path.clone(),
             degeneracy,
         })?;
     }
-    let block_rows = ((settings.block_s / problem.recording.dt).round() as usize).max(1);
+    let block_rows = ((settings.analysis.block_s / problem.recording.dt).round() as usize).max(1);
     let before = problem.residual(&Effects::default());
     observe(Stage::Candidates);
     let (candidates, mut columns) = build_library(&problem);
@@ -314,7 +261,7 @@ fn analyze_recording(
     let groups: Vec<Vec<usize>> = candidates.iter().map(|c| c.columns.clone()).collect();
     let design = problem.design(&before, &columns, 0..problem.split, block_rows);
     observe(Stage::Screening);
-    let selection = stability_selection(&design, &groups, &settings.selection);
+    let selection = stability_selection(&design, &groups, &settings.analysis.selection);
     let screened = Screened {
         candidates: &candidates,
         columns: &columns,
@@ -325,7 +272,7 @@ fn analyze_recording(
     let (set, alternatives) = fit_parameters(
         &problem,
         &screened,
-        settings.iterations,
+        settings.analysis.iterations,
         block_rows,
         wind_start,
     );
@@ -333,8 +280,8 @@ fn analyze_recording(
     let judgement = evidence::apply(
         &problem,
         set,
-        &settings.evidence,
-        settings.iterations / 2,
+        &settings.analysis.evidence,
+        settings.analysis.iterations / 2,
         block_rows,
     );
     // The model the evidence rule judged (fitted on the fit part) is the one the residuals and the
@@ -344,8 +291,8 @@ fn analyze_recording(
     let estimate = estimate::estimate(
         &problem,
         &judgement.set,
-        &settings.estimate,
-        settings.iterations,
+        &settings.analysis.estimate,
+        settings.analysis.iterations,
     );
     let effects = estimate.set.effects();
     let report = build_report(
@@ -433,88 +380,6 @@ fn first_null(value: &serde_json::Value, path: String) -> Option<String> {
     }
 }
 
-/// `residual` (all rows) without its components along the test functions' values at the command
-/// steps the samples cannot place: a step misplaced within its interval is not a missing effect.
-fn without_steps(problem: &Problem, residual: &[Channels], step_times: &[f64]) -> Vec<Channels> {
-    let mut remaining = residual.to_vec();
-    StepBasis::new(problem, &FitRows::plain(0..problem.rows()), step_times)
-        .remove_from(&mut remaining);
-    remaining
-}
-
-/// Windows where the centred moving RMS of a channel's residual exceeds `factor` × floor.
-fn locate_windows(
-    problem: &Problem,
-    residual: &[Channels],
-    settings: &AnalysisSettings,
-) -> Vec<Window> {
-    let rows = residual.len();
-    let half = half_window_rows(settings.window_s, problem.recording.dt, rows);
-    let mut windows = Vec::new();
-    for c in 0..problem.channels {
-        let threshold = (settings.window_factor * problem.noise_floor[c]).powi(2);
-        let squares: Vec<f64> = residual.iter().map(|r| r[c] * r[c]).collect();
-        let mut prefix = vec![0.0; rows + 1];
-        for k in 0..rows {
-            prefix[k + 1] = prefix[k] + squares[k];
-        }
-        let flagged: Vec<bool> = (0..rows)
-            .map(|k| {
-                let (a, b) = (k.saturating_sub(half), (k + half + 1).min(rows));
-                (prefix[b] - prefix[a]) / (b - a) as f64 > threshold
-            })
-            .collect();
-        let mut k = 0;
-        while k < rows {
-            if !flagged[k] {
-                k += 1;
-                continue;
-            }
-            let start = k;
-            while k < rows && flagged[k] {
-                k += 1;
-            }
-            let (t_start, t_end) = (problem.time[start], problem.time[k - 1]);
-            if t_end - t_start >= settings.min_window_s {
-                windows.push(Window {
-                    channel: CHANNEL_NAMES[c].to_string(),
-                    t_start,
-                    t_end,
-                });
-            }
-        }
-    }
-    windows
-}
-
-/// Half the length, in rows, of a moving window of `window_s` seconds at sample interval `dt`,
-/// capped at `rows` (a window longer than the recording is the whole recording), so that the
-/// window's row arithmetic cannot overflow however small `dt` is.
-fn half_window_rows(window_s: f64, dt: f64, rows: usize) -> usize {
-    (((window_s / dt) / 2.0).round() as usize).min(rows)
-}
-
-fn rms(values: impl Iterator<Item = f64>) -> f64 {
-    let (sum, count) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
-    (sum / count.max(1) as f64).sqrt()
-}
-
-/// The variance of a series about its mean (0 for fewer than two values).
-fn variance(values: impl Iterator<Item = f64>) -> f64 {
-    let values: Vec<f64> = values.collect();
-    if values.len() < 2 {
-        return 0.0;
-    }
-    let mean = values.iter().sum::<f64>() / values.len() as f64;
-    values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64
-}
-
-/// The nominal and the fitted model's residuals.
-struct Residuals<'a> {
-    before: &'a [Channels],
-    after: &'a [Channels],
-}
-
 /// The effects named: as the evidence rule judged them (fit part) and as finally estimated.
 struct Named<'a> {
     judgement: &'a evidence::Judgement,
@@ -528,55 +393,11 @@ struct Screen<'a> {
     alternatives: FitAlternatives,
 }
 
-fn channel_reports(
-    problem: &Problem,
-    settings: &AnalysisSettings,
-    residuals: &Residuals,
-) -> Vec<ChannelReport> {
-    let heldout_rows = problem.split..problem.rows();
-    let channel_mse = |residual: &[Channels], c: usize| {
-        residual[heldout_rows.clone()]
-            .iter()
-            .map(|r| r[c] * r[c])
-            .sum::<f64>()
-            / heldout_rows.len().max(1) as f64
-    };
-    let fit_rows = 0..problem.split;
-    (0..problem.channels)
-        .map(|c| {
-            let floor = problem.noise_floor[c];
-            let nominal = fit_rows
-                .clone()
-                .map(|row| problem.target[row][c] - residuals.before[row][c]);
-            let signal_variance = variance(nominal);
-            let model_noise_share = if signal_variance > 0.0 {
-                problem.model_noise[c].powi(2) / signal_variance
-            } else {
-                0.0
-            };
-            let residual_rms = rms(residuals.before.iter().map(|r| r[c]));
-            let residual_rms_after = rms(residuals.after.iter().map(|r| r[c]));
-            ChannelReport {
-                name: CHANNEL_NAMES[c].to_string(),
-                residual_rms,
-                noise_floor: floor,
-                noise_floor_model_side: problem.model_noise[c],
-                model_noise_share,
-                significant: residual_rms > settings.significance_factor * floor,
-                residual_rms_after,
-                significant_after: residual_rms_after > settings.significance_factor * floor,
-                heldout_mse_before: channel_mse(residuals.before, c),
-                heldout_mse_after: channel_mse(residuals.after, c),
-            }
-        })
-        .collect()
-}
-
 fn build_report(
     problem: &Problem,
     log: &FlightLog,
     model_name: &str,
-    settings: &AnalysisSettings,
+    settings: &CheckedSettings,
     residuals: Residuals,
     named: Named,
     screen: Screen,
@@ -627,13 +448,13 @@ fn build_report(
     Report {
         recording: log.path.display().to_string(),
         model: model_name.to_string(),
-        channels: channel_reports(problem, settings, &residuals),
-        windows: locate_windows(problem, residuals.before, settings),
+        channels: channel_reports(problem, &settings.analysis.locate, &residuals),
+        windows: locate_windows(problem, residuals.before, &settings.analysis.locate),
         effects: effect_reports,
         unexplained: locate_windows(
             problem,
             &without_steps(problem, residuals.after, &estimate.step_times),
-            settings,
+            &settings.analysis.locate,
         ),
         fit: Fit {
             before: Mse { mse: problem.mse(residuals.before, fit_rows.clone()) },
@@ -669,7 +490,7 @@ fn build_report(
         noise_reaction: problem.recording.noise_reaction.clone(),
         selection: SelectionReport {
             method: "forward stepwise selection of candidate groups scored by time-blocked cross-validation on the noise-normalised residual, kept when chosen in enough block-bootstrap resamples (stability selection); the kept effects fitted jointly with the exact model; each then kept only when the evidence rule holds for it".to_string(),
-            settings: settings.selection,
+            settings: settings.analysis.selection,
             candidates: screen
                 .candidates
                 .iter()
@@ -684,30 +505,13 @@ fn build_report(
             alternatives: screen.alternatives,
             dropped: judgement.dropped.clone(),
         },
-        settings: *settings,
+        settings: settings.analysis_record(),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_moving_window_cannot_overflow() {
-        // 1 s at 50 Hz: 25 rows either side, as before.
-        assert_eq!(half_window_rows(1.0, 0.02, 2500), 25);
-        // Times × 1e-300: the window would be ~1e300 rows; capped at the recording.
-        let rows = 2000;
-        let half = half_window_rows(1.0, 2e-302, rows);
-        assert_eq!(half, rows);
-        let k = rows - 1;
-        assert_eq!(
-            (k.saturating_sub(half), (k + half + 1).min(rows)),
-            (0, rows)
-        );
-        // A NaN interval gives a zero-row window, not a panic.
-        assert_eq!(half_window_rows(1.0, f64::NAN, rows), 0);
-    }
 
     #[test]
     fn nulls_are_found_with_their_path() {

@@ -8,7 +8,7 @@
 //! replaced by the smoothest continuation of its neighbours (least third differences) beyond the
 //! limit; the curve through the samples is then clipped to the limits, as the rotor clipped the
 //! demand. Commands held or averaged over the log period are used as logged
-//! ([`crate::forward`]).
+//! ([`crate::locate::forward`]).
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
@@ -392,7 +392,7 @@ mod tests {
     fn a_command_step_between_samples_is_found() {
         use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
-        let mut noise = || crate::simex::gaussian(&mut rng, 0.01);
+        let mut noise = || crate::improve::simex::gaussian(&mut rng, 0.01);
         let logged: Vec<[f64; 4]> = (0..300)
             .map(|k| {
                 let step = if k > 120 { 0.3 } else { 0.0 };

@@ -9,7 +9,7 @@ use serde::{Serialize, Serializer};
 
 pub use physics::Term;
 
-use crate::problem::{Channels, Problem};
+use crate::locate::problem::{Channels, Problem};
 
 /// What a candidate of the library stands for: one effect of the vocabulary, or the first-order
 /// timing signature a delay and a motor lag share (resolved into either or both by the fit).

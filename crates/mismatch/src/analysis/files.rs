@@ -14,9 +14,9 @@ use report::mismatch::recording::{
 
 use crate::analysis::{Analysis, check_finite};
 use crate::error::Result;
-use crate::evidence::Evidence;
-use crate::noise_reaction;
-use crate::problem::CHANNEL_NAMES;
+use crate::explain::evidence::Evidence;
+use crate::locate::problem::CHANNEL_NAMES;
+use crate::recording::noise_reaction;
 
 /// The names of an analysis's files in its folder, in the order of [`Analysis::render`].
 pub const ANALYSIS_FILES: [&str; 3] = ["mismatch.json", "mismatch.svg", "mismatch.md"];
@@ -65,14 +65,14 @@ impl Analysis {
             rate_frame: &report.rate_frame,
             channels: &report.channels,
             translational_only: self.problem.channels == 3,
-            window_factor: settings.window_factor,
+            window_factor: settings.analysis.locate.window_factor,
             windows: &report.windows,
             rule: EvidenceRule {
-                significance: settings.evidence.significance,
-                min_gain: settings.evidence.min_gain,
-                min_trimmed_gain: settings.evidence.min_trimmed_gain,
-                min_heldout_reduction: settings.evidence.min_heldout_reduction,
-                block_s: settings.block_s,
+                significance: settings.analysis.evidence.significance,
+                min_gain: settings.analysis.evidence.min_gain,
+                min_trimmed_gain: settings.analysis.evidence.min_trimmed_gain,
+                min_heldout_reduction: settings.analysis.evidence.min_heldout_reduction,
+                block_s: settings.analysis.block_s,
             },
             effects: report
                 .effects
@@ -117,12 +117,12 @@ impl Analysis {
             command_sampling: self.command_sampling(),
             rows_at_limit: self.problem.recording.samples.rows_held(),
             estimate: EstimateLine {
-                huber_threshold: settings.estimate.huber_threshold,
+                huber_threshold: settings.analysis.estimate.huber_threshold,
                 downweighted_fraction: report.estimate_downweighted_fraction,
                 steps: report.estimate_step_times.len(),
                 noise_bias: report.estimate_noise_bias.map(|sources| NoiseBiasLine {
-                    pairs: settings.estimate.noise_bias.pairs,
-                    seed: settings.estimate.noise_bias.seed,
+                    pairs: settings.analysis.estimate.noise_bias.pairs,
+                    seed: settings.analysis.estimate.noise_bias.seed,
                     rate: sources.rate,
                     attitude_estimate: sources.attitude_estimate,
                     command_samples: sources.command_samples,

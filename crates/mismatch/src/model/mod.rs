@@ -1,0 +1,5 @@
+//! The fits every step shares: effects' parameters fitted with the exact forward model
+//! ([`refine`]), through the crate's one bounded Levenberg–Marquardt solver ([`least_squares`]).
+
+pub mod least_squares;
+pub(crate) mod refine;

@@ -188,119 +188,117 @@ impl Settings {
     /// These settings, each value checked against its range; the first out of range is named.
     pub fn checked(self) -> Result<CheckedSettings> {
         let Self {
-            comparison,
+            comparison:
+                ComparisonSettings {
+                    test_function,
+                    heldout_fraction,
+                },
             analysis,
             fleet,
         } = self;
-        let test = comparison.test_function;
-        let (open, closed) = (Excluded(0.0), Included(1.0));
-        check(
-            "comparison.test_function.half_width_s",
-            test.half_width_s,
-            (open, Unbounded),
-        )?;
-        check(
-            "comparison.test_function.power",
-            test.power as f64,
-            (Included(1.0), Unbounded),
-        )?;
-        let heldout = comparison.heldout_fraction;
-        check(
-            "comparison.heldout_fraction",
-            heldout,
-            (open, Excluded(1.0)),
-        )?;
-        check("analysis.block_s", analysis.block_s, (open, Unbounded))?;
-        check(
-            "analysis.iterations",
-            analysis.iterations as f64,
-            (Included(1.0), Unbounded),
-        )?;
-        let selection = analysis.selection;
-        check(
-            "analysis.selection.folds",
-            selection.folds as f64,
-            (Included(2.0), Unbounded),
-        )?;
-        let resamples = selection.resamples as f64;
-        check(
-            "analysis.selection.resamples",
-            resamples,
-            (Included(1.0), Unbounded),
-        )?;
-        let threshold = selection.stability_threshold;
-        check(
-            "analysis.selection.stability_threshold",
-            threshold,
-            (open, closed),
-        )?;
-        let gain = selection.min_gain;
-        check(
-            "analysis.selection.min_gain",
-            gain,
-            (Included(0.0), Unbounded),
-        )?;
-        let evidence = analysis.evidence;
-        let significance = evidence.significance;
-        check(
-            "analysis.evidence.significance",
-            significance,
-            (open, Excluded(1.0)),
-        )?;
-        let gain = evidence.min_gain;
-        check(
-            "analysis.evidence.min_gain",
-            gain,
-            (Included(0.0), Unbounded),
-        )?;
-        let gain = evidence.min_trimmed_gain;
-        check(
-            "analysis.evidence.min_trimmed_gain",
-            gain,
-            (Included(0.0), Unbounded),
-        )?;
-        let reduction = evidence.min_heldout_reduction;
+        let AnalysisSettings {
+            selection,
+            evidence,
+            estimate,
+            locate,
+            ..
+        } = analysis;
+        let positive = (Excluded(0.0), Unbounded);
+        let non_negative = (Included(0.0), Unbounded);
+        let fraction = (Excluded(0.0), Excluded(1.0));
         let share = (Included(0.0), Excluded(1.0));
-        check("analysis.evidence.min_heldout_reduction", reduction, share)?;
-        let huber = analysis.estimate.huber_threshold;
-        check(
-            "analysis.estimate.huber_threshold",
-            huber,
-            (open, Unbounded),
-        )?;
-        let passes = analysis.estimate.passes as f64;
-        check(
-            "analysis.estimate.passes",
-            passes,
-            (Included(1.0), Unbounded),
-        )?;
-        let locate = analysis.locate;
-        let factor = locate.significance_factor;
-        check("analysis.significance_factor", factor, (open, Unbounded))?;
-        check(
-            "analysis.window_factor",
-            locate.window_factor,
-            (open, Unbounded),
-        )?;
-        check("analysis.window_s", locate.window_s, (open, Unbounded))?;
-        let shortest = locate.min_window_s;
-        check(
-            "analysis.min_window_s",
-            shortest,
-            (Included(0.0), Unbounded),
-        )?;
-        check("fleet.min_step", fleet.min_step, share)?;
-        check(
-            "fleet.iterations",
-            fleet.iterations as f64,
-            (Included(1.0), Unbounded),
-        )?;
+        let at_least = |low: f64| (Included(low), Unbounded);
+        let ranges: [(&'static str, f64, Range); 21] = [
+            (
+                "comparison.test_function.half_width_s",
+                test_function.half_width_s,
+                positive,
+            ),
+            (
+                "comparison.test_function.power",
+                test_function.power as f64,
+                at_least(1.0),
+            ),
+            ("comparison.heldout_fraction", heldout_fraction, fraction),
+            ("analysis.block_s", analysis.block_s, positive),
+            (
+                "analysis.iterations",
+                analysis.iterations as f64,
+                at_least(1.0),
+            ),
+            (
+                "analysis.selection.folds",
+                selection.folds as f64,
+                at_least(2.0),
+            ),
+            (
+                "analysis.selection.resamples",
+                selection.resamples as f64,
+                at_least(1.0),
+            ),
+            (
+                "analysis.selection.stability_threshold",
+                selection.stability_threshold,
+                (Excluded(0.0), Included(1.0)),
+            ),
+            (
+                "analysis.selection.min_gain",
+                selection.min_gain,
+                non_negative,
+            ),
+            (
+                "analysis.evidence.significance",
+                evidence.significance,
+                fraction,
+            ),
+            (
+                "analysis.evidence.min_gain",
+                evidence.min_gain,
+                non_negative,
+            ),
+            (
+                "analysis.evidence.min_trimmed_gain",
+                evidence.min_trimmed_gain,
+                non_negative,
+            ),
+            (
+                "analysis.evidence.min_heldout_reduction",
+                evidence.min_heldout_reduction,
+                share,
+            ),
+            (
+                "analysis.estimate.huber_threshold",
+                estimate.huber_threshold,
+                positive,
+            ),
+            (
+                "analysis.estimate.passes",
+                estimate.passes as f64,
+                at_least(1.0),
+            ),
+            (
+                "analysis.significance_factor",
+                locate.significance_factor,
+                positive,
+            ),
+            ("analysis.window_factor", locate.window_factor, positive),
+            ("analysis.window_s", locate.window_s, positive),
+            ("analysis.min_window_s", locate.min_window_s, non_negative),
+            ("fleet.min_step", fleet.min_step, share),
+            ("fleet.iterations", fleet.iterations as f64, at_least(1.0)),
+        ];
+        for (setting, value, range) in ranges {
+            check(setting, value, range)?;
+        }
         Ok(CheckedSettings(self))
     }
 }
 
+/// A setting's range: its lower and upper bound.
+type Range = (Bound<f64>, Bound<f64>);
+
 /// `value` finite and within `range`, or an error naming the setting and the range.
-fn check(setting: &'static str, value: f64, range: (Bound<f64>, Bound<f64>)) -> Result<()> {
+fn check(setting: &'static str, value: f64, range: Range) -> Result<()> {
     if value.is_finite() && range.contains(&value) {
         return Ok(());
     }

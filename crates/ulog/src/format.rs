@@ -262,7 +262,14 @@ impl Formats {
                     }
                     Element::Nested(nested) => {
                         let nested_prefix = format!("{element_name}.");
-                        self.flatten(nested, &nested_prefix, offset, fields, &mut None)?
+                        // A padding field of a nested type gives no columns either.
+                        let mut padding_fields = Vec::new();
+                        let into = if padding {
+                            &mut padding_fields
+                        } else {
+                            &mut *fields
+                        };
+                        self.flatten(nested, &nested_prefix, offset, into, &mut None)?
                     }
                 };
             }
@@ -327,6 +334,17 @@ mod tests {
         let layout = formats.layout("t").unwrap();
         assert_eq!(names(&layout), [("timestamp", 0), ("a", 8)]);
         assert_eq!((layout.min_size, layout.max_size), (9, 16));
+    }
+
+    #[test]
+    fn a_padding_field_of_a_nested_type_gives_no_column() {
+        let mut formats = formats(&[
+            "pair:float a;float b;",
+            "t:uint64_t timestamp;pair _padding0;",
+        ]);
+        let layout = formats.layout("t").unwrap();
+        assert_eq!(names(&layout), [("timestamp", 0)]);
+        assert_eq!((layout.min_size, layout.max_size), (8, 16));
     }
 
     #[test]

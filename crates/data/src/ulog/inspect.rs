@@ -351,7 +351,7 @@ fn column_rates(
             };
             let values = column.to_f64();
             let counts = ranges.iter().fold(NewSamples::default(), |sum, r| {
-                sum.add(NewSamples::count(
+                sum.and(NewSamples::count(
                     &times[r.clone()],
                     &values[r.clone()],
                     epsilon,

@@ -56,7 +56,7 @@ impl NewSamples {
     }
 
     /// The counts of two stretches of one column together.
-    pub fn add(self, other: Self) -> Self {
+    pub fn and(self, other: Self) -> Self {
         Self {
             samples: self.samples + other.samples,
             changes: self.changes + other.changes,

@@ -6,7 +6,7 @@ mod inspect;
 mod rates;
 
 pub use inspect::{
-    Airborne, ColumnRate, DropoutSummary, Gaps, StepSpread, TopicInspection, UlogInspection,
-    VehicleInfo, inspect,
+    Airborne, ColumnRate, DropoutSummary, Gaps, RatesOver, StepSpread, TopicInspection,
+    UlogInspection, VehicleInfo, inspect,
 };
 pub use rates::{ColumnPattern, NewSamples, column_pattern};

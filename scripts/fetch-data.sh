@@ -1,15 +1,20 @@
 #!/usr/bin/env bash
 # Fills data/neural-fly: a link to ../shared/data/neural-fly when it exists, otherwise a shallow
-# clone of the upstream public repository (its data/ folder has the same layout).
+# clone of the upstream public repository (its data/ folder has the same layout). Links
+# data/ulog to ../shared/data/ulog (the public PX4 logs the ulog crate's tests read) when it exists.
 # Never copies flight logs into the project: data/ is git-ignored.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+mkdir -p data
+if [ ! -e data/ulog ] && [ -d ../shared/data/ulog ]; then
+  ln -s "$(cd ../shared/data/ulog && pwd)" data/ulog
+  echo "data: linked data/ulog -> ../shared/data/ulog"
+fi
 target=data/neural-fly
 if [ -e "$target" ]; then
   echo "data: $target already present"
   exit 0
 fi
-mkdir -p data
 shared=../shared/data/neural-fly
 if [ -d "$shared" ]; then
   ln -s "$(cd "$shared" && pwd)" "$target"

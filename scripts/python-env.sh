@@ -1,13 +1,20 @@
 #!/usr/bin/env bash
-# Creates the Python virtual environments of the reference scripts (both git-ignored):
+# Creates the Python virtual environments of the reference scripts (all git-ignored):
 #   scripts/python-env.sh        -> .venv        PySINDy and JAX (small, CPU-only wheels)
 #   scripts/python-env.sh torch  -> .venv-torch  PyTorch for the LeARN bench's PyTorch reference.
+#   scripts/python-env.sh ulog   -> .venv-ulog   pyulog, the ULog reader's reference (scripts/golden/ulog_golden.py)
 # PyPI's Linux torch wheel depends on the CUDA libraries, so .venv-torch downloads ~2.5 GB and
 # takes ~5.3 GB on disk; it is kept apart so that the shared .venv stays small.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if [ "${1:-}" = torch ]; then
+if [ "${1:-}" = ulog ]; then
+    VENV=.venv-ulog
+    PACKAGES=(
+        pyulog==1.3.0
+        numpy==2.4.6
+    )
+elif [ "${1:-}" = torch ]; then
     VENV=.venv-torch
     PACKAGES=(
         # learn: PyTorch (torch.func) reference of the LeARN meta-iteration (scripts/bench/learn_torch.py)

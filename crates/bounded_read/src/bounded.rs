@@ -15,6 +15,9 @@ pub const MAX_CSV_BYTES: u64 = 1 << 30;
 /// The largest shard result read (`shard.json` of `learn … --shard K/N`, machine-written JSON that
 /// carries each item's traces for the figures): 1 GiB.
 pub const MAX_SHARD_BYTES: u64 = 1 << 30;
+/// The largest ULog flight log read: 1 GiB (a PX4 log of an hour at the default profile is
+/// about 100 MB; the reader holds the file and its topics' rows in memory once each).
+pub const MAX_ULOG_BYTES: u64 = 1 << 30;
 /// The most columns a CSV may have (the Neural-Fly logs have about 20).
 pub const MAX_CSV_COLUMNS: usize = 10_000;
 
@@ -27,6 +30,8 @@ pub enum InputKind {
     Csv,
     /// A shard result: a regular JSON file of at most [`MAX_SHARD_BYTES`].
     ShardResult,
+    /// A PX4 ULog flight log: a regular file of at most [`MAX_ULOG_BYTES`].
+    Ulog,
 }
 
 impl InputKind {
@@ -35,6 +40,7 @@ impl InputKind {
             Self::Json => MAX_JSON_BYTES,
             Self::Csv => MAX_CSV_BYTES,
             Self::ShardResult => MAX_SHARD_BYTES,
+            Self::Ulog => MAX_ULOG_BYTES,
         }
     }
 
@@ -43,6 +49,7 @@ impl InputKind {
             Self::Json => "a JSON file",
             Self::Csv => "a CSV file",
             Self::ShardResult => "a shard result",
+            Self::Ulog => "a ULog file",
         }
     }
 }

@@ -17,7 +17,7 @@ mod excerpt;
 pub mod json;
 
 pub use bounded::{
-    BoundedFile, InputKind, MAX_CSV_BYTES, MAX_CSV_COLUMNS, MAX_JSON_BYTES, MAX_SHARD_BYTES, open,
-    read_bytes, read_json_text, read_text,
+    BoundedFile, InputKind, MAX_CSV_BYTES, MAX_CSV_COLUMNS, MAX_JSON_BYTES, MAX_SHARD_BYTES,
+    MAX_ULOG_BYTES, open, read_bytes, read_json_text, read_text,
 };
 pub use excerpt::{EXCERPT_CHARACTERS, Excerpt};

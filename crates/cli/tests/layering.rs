@@ -127,6 +127,17 @@ fn data_reads_files_and_computes_nothing() {
 }
 
 #[test]
+fn the_ulog_reader_depends_only_on_the_bounded_reads() {
+    let direct = direct("ulog");
+    let expected: std::collections::BTreeSet<String> = ["bounded_read", "thiserror"]
+        .iter()
+        .map(|name| name.to_string())
+        .collect();
+    assert_eq!(direct, &expected, "ulog depends on {direct:?}");
+    assert!(closure("data").contains_key("ulog"));
+}
+
+#[test]
 fn the_rotation_maths_depends_on_nothing() {
     let direct = direct("rotation");
     assert!(direct.is_empty(), "rotation depends on {direct:?}");
@@ -155,6 +166,7 @@ fn report_depends_on_no_crate_that_computes() {
         "physics",
         "mismatch",
         "data",
+        "ulog",
         "faer",
         "clarabel",
         "polars",

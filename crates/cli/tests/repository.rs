@@ -69,7 +69,15 @@ fn every_target_that_reads_flights_or_runs_learn_sets_itself_up() {
 /// Every Markdown file of the repository a reader is pointed to (generated results included,
 /// build output, data and virtual environments not).
 fn markdown_files() -> Vec<PathBuf> {
-    let skip = ["target", "data", ".git", ".venv", ".venv-torch", ".scratch"];
+    let skip = [
+        "target",
+        "data",
+        ".git",
+        ".venv",
+        ".venv-torch",
+        ".venv-ulog",
+        ".scratch",
+    ];
     let mut found = Vec::new();
     let mut folders = vec![root()];
     while let Some(folder) = folders.pop() {

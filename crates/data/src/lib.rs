@@ -5,7 +5,8 @@
 //! recordings of one system as the tasks of meta-learning ([`read_file_tasks`],
 //! [`read_column_tasks`]); support/query splits ([`SplitSpec`]); the experiment's wind conditions
 //! ([`ExperimentConditions`]); file hashes ([`file_sha256`]); finding the data directory
-//! ([`resolve_data_dir`]).
+//! ([`resolve_data_dir`]); what a PX4 ULog holds for a flight analysis ([`ulog::inspect`]: rates,
+//! jitter, gaps, the rate at which each key column really changes; the `ulog` crate reads it).
 //!
 //! What it is not for: fitting anything (models live in `sindy` and `learn`, tables in `report`),
 //! nor the paper's protocol: a formulation's segments of a flight, the experiment and its
@@ -26,6 +27,7 @@ mod stream;
 mod table;
 mod tasks;
 mod time;
+pub mod ulog;
 mod write;
 
 pub use conditions::{Condition, ExperimentConditions, FlightFile, PaperTraining, Role};

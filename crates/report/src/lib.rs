@@ -19,6 +19,9 @@
 //! The sim-to-real mismatch tool's outputs are rendered here too ([`mismatch`]: the Markdown, the
 //! terminal text and the SVG figures of one recording, of several flights analysed together and
 //! of the demo matrix), from plain result types and views that the `mismatch` crate fills.
+//!
+//! What `learn data inspect` says of a PX4 ULog is rendered here too ([`ulog_inspection`]), from the
+//! `data` crate's inspection as its JSON hands it over.
 
 mod ablations;
 mod compare;
@@ -30,6 +33,7 @@ pub mod mismatch;
 mod published;
 mod render;
 mod table;
+pub mod ulog_inspection;
 
 pub use ablations::{
     AblationRow, AblationTables, Choice, NoiseFloor, SeedCell, VariantCell, VariantNote,

@@ -1,6 +1,6 @@
-//! `learn data inspect FILE`.
+//! `learn data inspect FILE`: a Neural-Fly CSV flight log, or a PX4 ULog (`.ulg`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use data::FlightLog;
 
@@ -8,7 +8,7 @@ use super::Global;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// A Neural-Fly CSV flight log.
+    /// A Neural-Fly CSV flight log, or a PX4 ULog file (`.ulg`).
     pub file: PathBuf,
 }
 
@@ -67,6 +67,13 @@ fn column_summary(columns: &[String]) -> String {
 }
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
+    let is_ulog = args
+        .file
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ulg"));
+    if is_ulog {
+        return inspect_ulog(&args.file);
+    }
     let (log, columns) = FlightLog::read_with_columns(&args.file)?;
     let n = log.len();
     let dt = log.sample_interval();
@@ -127,5 +134,19 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
             say!("  - {problem}");
         }
     }
+    Ok(())
+}
+
+/// A ULog: read by `ulog`, inspected by `data`, rendered by `report`. `report` depends on no crate
+/// that computes, so the inspection reaches it as JSON (whose fields it names, refusing others).
+fn inspect_ulog(path: &Path) -> anyhow::Result<()> {
+    let log = ulog::Log::read(path)?;
+    let inspection = serde_json::to_value(data::ulog::inspect(&log))?;
+    let view: report::ulog_inspection::UlogInspection = serde_json::from_value(inspection)?;
+    say!("file:      {}", path.display());
+    say!(
+        "{}",
+        report::ulog_inspection::ulog_inspection_text(&view).trim_end()
+    );
     Ok(())
 }

@@ -50,7 +50,8 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Flight logs: `learn data inspect FLIGHT.csv` shows a log's duration, rate, columns, ranges
-    /// and problems.
+    /// and problems; `learn data inspect LOG.ulg` a PX4 log's vehicle, airborne time and the
+    /// rates of the topics a flight analysis reads.
     Data {
         #[command(subcommand)]
         command: DataCommand,
@@ -87,7 +88,8 @@ pub enum Command {
 
 #[derive(Subcommand, Debug)]
 pub enum DataCommand {
-    /// Duration, rate, columns, ranges and problems of one flight log.
+    /// Duration, rate, columns, ranges and problems of one flight log (CSV), or the vehicle,
+    /// airborne time and topic rates of a PX4 ULog (`.ulg`).
     Inspect(inspect::Args),
 }
 

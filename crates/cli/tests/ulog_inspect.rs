@@ -1,0 +1,115 @@
+//! `learn data inspect FILE.ulg` on the two public PX4 logs of `data/ulog` (a link to
+//! `../shared/data/ulog` made by `make data`; without them the tests skip, except under CI): the
+//! vehicle, the airborne time, each analysis topic's rates; a truncated copy is read up to its
+//! last whole message and says so; a corrupt one is a one-line error naming the file and offset.
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::{learn_in, scratch, workspace};
+
+/// The log `file` of `data/ulog`, or `None` (skipping) where the logs are absent outside CI.
+fn log_file(file: &str) -> Option<PathBuf> {
+    let path = workspace().join("data/ulog").join(file);
+    if path.is_file() {
+        return Some(path.canonicalize().unwrap());
+    }
+    assert!(
+        std::env::var("CI").map_or(true, |ci| ci != "true"),
+        "CI=true but no ULog file at {} (run `make data`)",
+        path.display()
+    );
+    eprintln!(
+        "skipping: no ULog file at {} (run `make data`)",
+        path.display()
+    );
+    None
+}
+
+fn inspect(path: &std::path::Path) -> String {
+    let dir = scratch("ulog-inspect");
+    learn_in(&dir, &["data", "inspect", path.to_str().unwrap()])
+        .success()
+        .to_string()
+}
+
+fn assert_lines(text: &str, expected: &[&str]) {
+    for line in expected {
+        assert!(
+            text.lines().any(|l| l == *line),
+            "{line:?} missing from:\n{text}"
+        );
+    }
+}
+
+#[test]
+fn the_simulated_flight_is_described() {
+    let Some(path) = log_file("sample_px4_events.ulg") else {
+        return;
+    };
+    assert_lines(
+        &inspect(&path),
+        &[
+            "vehicle:   PX4 on PX4_SITL, software cb09dde606861b90e38b1682eebd3fd91be17ab7, airframe 10017, 4 rotors",
+            "airborne:  11.4 s (16.7-28.1 s)",
+            "dropouts:  0 (0 ms in all, longest 0 ms)",
+            "  actuator_motors[0]: 313 samples, logged at 10.0 Hz; step 100.0 ms (5-95%: 100.0-100.0)",
+            "      control[0], control[1], control[2], control[3]: new every sample (~10.0 Hz)",
+            "  vehicle_angular_velocity[0]: 1558 samples, logged at 50.0 Hz; step 20.0 ms (5-95%: 20.0-20.0)",
+            // The simulated battery discharges linearly: a line between rare knots.
+            "      voltage_v: interpolated, knots at ~0.1 Hz",
+            "absent:    wind",
+        ],
+    );
+}
+
+#[test]
+fn the_real_flight_is_described() {
+    let Some(path) = log_file("quadrotor_local.ulg") else {
+        return;
+    };
+    assert_lines(
+        &inspect(&path),
+        &[
+            "vehicle:   PX4 on PX4_FMU_V6C, software v1.16.1 (RC), airframe 4001, 4 rotors",
+            "airborne:  85.6 s (5.2-90.8 s)",
+            "  vehicle_local_position[0]: 926 samples, logged at 10.1 Hz; step 98.9 ms (5-95%: 94.4-107.9)",
+            "      x, y, z, vx, vy, vz, ax, ay, az: new every sample (~10.0 Hz)",
+            "  actuator_outputs[1]: 1 samples, logged at ? Hz",
+        ],
+    );
+}
+
+#[test]
+fn a_truncated_log_is_read_up_to_its_last_whole_message() {
+    let Some(path) = log_file("sample_px4_events.ulg") else {
+        return;
+    };
+    let dir = scratch("ulog-truncated");
+    let bytes = std::fs::read(&path).unwrap();
+    let cut = dir.join("cut.ulg");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let text = inspect(&cut);
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("truncated: "))
+        .expect(&text);
+    assert!(line.contains("the rest was read"), "{line}");
+}
+
+#[test]
+fn a_corrupt_log_is_a_one_line_error_naming_file_and_offset() {
+    let Some(path) = log_file("sample_px4_events.ulg") else {
+        return;
+    };
+    let dir = scratch("ulog-corrupt");
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[18] = 0; // the type of the first message (the flag bits, at byte 16)
+    std::fs::write(dir.join("bad.ulg"), &bytes).unwrap();
+    learn_in(&dir, &["data", "inspect", "bad.ulg"])
+        .one_line_error(&["bad.ulg: byte 16: message type 0x00"]);
+    std::fs::write(dir.join("short.ulg"), b"ULog\x01\x12\x35").unwrap();
+    learn_in(&dir, &["data", "inspect", "short.ulg"])
+        .one_line_error(&["short.ulg: byte 0: the file ends inside its 16-byte header"]);
+}

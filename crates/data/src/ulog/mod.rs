@@ -1,0 +1,12 @@
+//! PX4 ULog flight logs (read by the `ulog` crate): what a log holds for a flight analysis
+//! ([`inspect`]: vehicle, duration, airborne time, and per topic its rates, time-stamp jitter,
+//! gaps and the rate at which each key column really changes).
+
+mod inspect;
+mod rates;
+
+pub use inspect::{
+    Airborne, ColumnRate, DropoutSummary, Gaps, RatesOver, StepSpread, TopicInspection,
+    UlogInspection, VehicleInfo, inspect,
+};
+pub use rates::{ColumnPattern, NewSamples, column_pattern};

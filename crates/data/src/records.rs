@@ -377,10 +377,17 @@ impl Splitter {
         if let Err(error) = self.check_utf8() {
             return error;
         }
+        // A ULog's header begins "ULog" followed by control bytes.
+        let reason = if self.line == 1 && self.field.starts_with(b"ULog") {
+            "a PX4 ULog, which `learn data inspect` reads (no analysis imports ULog yet)"
+                .to_string()
+        } else {
+            format!("control byte 0x{byte:02X} (binary data?)")
+        };
         DataError::NotText {
             path: self.path.clone(),
             row: self.line,
-            reason: format!("control byte 0x{byte:02X} (binary data?)"),
+            reason,
         }
     }
 

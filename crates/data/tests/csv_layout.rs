@@ -255,6 +255,20 @@ fn binary_and_non_utf8_files_are_not_text() {
         message.contains("binary.csv:1: not a CSV text file: control byte 0x00"),
         "{message}"
     );
+    // A ULog given where a CSV belongs is named for what it is, by the flight-log reader too.
+    let ulog = write(
+        "flight.ulg",
+        b"ULog\x01\x12\x35\x01\x00\x00\x00\x00\x00\x00\x00",
+    );
+    for message in [
+        numeric_error(&ulog, &["x"]),
+        FlightLog::read(&ulog).unwrap_err().to_string(),
+    ] {
+        assert!(
+            message.contains("flight.ulg:1: not a CSV text file: a PX4 ULog"),
+            "{message}"
+        );
+    }
     let message = numeric_error(&write("latin1.csv", b"t,x\n0,1\n0.1,caf\xe9\n"), &["x"]);
     assert!(
         message.contains("latin1.csv:3: not a CSV text file: byte 0xE9 is not UTF-8"),

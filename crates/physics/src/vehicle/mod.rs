@@ -156,7 +156,7 @@ impl Rotor {
 
 fn check_position(position: &Vec3, field: &str) -> Result<()> {
     for (i, value) in position.iter().enumerate() {
-        if !(value.abs() <= MAX_POSITION_M) {
+        if !(-MAX_POSITION_M..=MAX_POSITION_M).contains(value) {
             return Err(invalid(
                 &format!("{field}[{i}]"),
                 format!("{} is outside ±{MAX_POSITION_M} m", readable(*value)),

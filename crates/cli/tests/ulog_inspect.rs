@@ -52,6 +52,10 @@ fn the_simulated_flight_is_described() {
         &inspect(&path),
         &[
             "vehicle:   PX4 on PX4_SITL, software cb09dde606861b90e38b1682eebd3fd91be17ab7, airframe 10017, 4 rotors",
+            // The 3DR Iris geometry of the airframe's script, not jMAVSim's 0.165 m X.
+            "airframe:  4 rotors, quad X with unequal front and rear arms; arms 0.288, 0.241, 0.288, 0.241 m; km 0.050 m (ccw, ccw, cw, cw); CT 6.50 N; THR_MDL_FAC 0; allocation rank 4 of 4",
+            "           CA_ROTOR* are the airframe defaults of SYS_AUTOSTART 10017: the geometry may not be this vehicle's",
+            "           CT and |KM| are PX4's built-in defaults: thrust and moment coefficients not measured on this vehicle",
             "airborne:  11.4 s (16.7-28.1 s)",
             "dropouts:  0 (0 ms in all, longest 0 ms)",
             "  actuator_motors[0]: 313 samples, logged at 10.0 Hz; step 100.0 ms (5-95%: 100.0-100.0)",
@@ -73,6 +77,9 @@ fn the_real_flight_is_described() {
         &inspect(&path),
         &[
             "vehicle:   PX4 on PX4_FMU_V6C, software v1.16.1 (RC), airframe 4001, 4 rotors",
+            // PX4's generic quad: a unit placeholder geometry.
+            "airframe:  4 rotors, quad X; arms 1.414 m; km 0.050 m (ccw, ccw, cw, cw); CT 6.50 N; THR_MDL_FAC 0; allocation rank 4 of 4",
+            "           CA_ROTOR* are the airframe defaults of SYS_AUTOSTART 4001: the geometry may not be this vehicle's",
             "airborne:  85.6 s (5.2-90.8 s)",
             "  vehicle_local_position[0]: 926 samples, logged at 10.1 Hz; step 98.9 ms (5-95%: 94.4-107.9)",
             "      x, y, z, vx, vy, vz, ax, ay, az: new every sample (~10.0 Hz)",

@@ -29,6 +29,12 @@ pub enum PhysicsError {
         out: PathBuf,
         cause: String,
     },
+    /// A vehicle description built in code (not read from a file) that breaks a rule.
+    #[error("vehicle description: {field}: {message}")]
+    Description { field: String, message: String },
+    /// A PX4 parameter that is missing or out of its range.
+    #[error("PX4 parameter {name}: {message}")]
+    Parameter { name: String, message: String },
     #[error("simulation: {0}")]
     Simulation(String),
     #[error(transparent)]

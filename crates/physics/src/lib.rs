@@ -9,7 +9,8 @@
 //! only the nominal model, figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`]; a
 //! [`Scenario`] is read from JSON or, for examples and tests, built by [`Scenario::figure_eight`])
 //! that writes Neural-Fly logs the data tools read back ([`write_readable`]); and the residual
-//! force of a recorded flight ([`residual_force`], the `fa` column).
+//! force of a recorded flight ([`residual_force`], the `fa` column); descriptions of any multirotor
+//! ([`vehicle`]: rotors, command map, the allocation matrix, PX4's airframe parameters).
 //!
 //! What it is not for: analysing mismatches (the `mismatch` crate), reading CSVs (the `data` crate).
 //!
@@ -32,6 +33,7 @@ mod scenario;
 mod simulator;
 mod trajectory;
 pub mod vector;
+pub mod vehicle;
 mod writer;
 
 pub use controller::{ControlOutput, Gains, GeometricController, MeasuredState};
@@ -54,4 +56,5 @@ pub use trajectory::{
     LowPass, MAX_POSITION_M, MAX_WAYPOINTS, MAX_YAW_RATE_RAD_S, Reference, ReferenceGenerator,
     Trajectory,
 };
+pub use vehicle::{Allocation, CommandMap, Layout, Rotor, Spin, VehicleDescription};
 pub use writer::write_readable;

@@ -1,5 +1,6 @@
 //! The text of `learn data inspect FILE.ulg`: [`UlogInspection`], as the `data` crate's
-//! inspection of a ULog serialises it (the CLI hands its JSON over; every field is named here,
+//! inspection of a ULog serialises it, and [`AirframeSection`], the `physics` crate's reading of
+//! the log's PX4 airframe parameters (the CLI hands their JSON over; every field is named here,
 //! an unknown one is refused), rendered by [`ulog_inspection_text`].
 
 use std::fmt::Write as _;
@@ -103,12 +104,160 @@ pub struct UlogInspection {
     pub warnings: usize,
 }
 
+/// A rotor's spin seen from above (see the `physics` crate's `Spin`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Spin {
+    #[serde(rename = "ccw")]
+    CounterClockwise,
+    #[serde(rename = "cw")]
+    Clockwise,
+}
+
+/// The layout a geometry is (see the `physics` crate's `Layout`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Layout {
+    QuadX,
+    QuadPlus,
+    QuadXUnequalArms,
+    HexaX,
+    HexaPlus,
+    OctoX,
+    OctoPlus,
+    Coaxial { arms: usize },
+    Unrecognised { rotors: usize },
+}
+
+/// Which geometry parameters the log's declared defaults show to be set for this vehicle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeometryDefaults {
+    pub declared: bool,
+    pub set_for_vehicle: Vec<String>,
+    pub builtin_coefficients: bool,
+}
+
+/// The vehicle the log's PX4 airframe parameters describe.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AirframeInspection {
+    pub airframe: Option<i64>,
+    pub rotor_count: usize,
+    pub layout: Layout,
+    pub arm_lengths_m: Vec<f64>,
+    pub moment_ratios_m: Vec<f64>,
+    pub spins: Vec<Spin>,
+    pub thrust_coefficients_n: Vec<f64>,
+    pub thrust_model_factor: f64,
+    pub allocation_rank: usize,
+    pub defaults: GeometryDefaults,
+}
+
+/// The airframe section: read, or why the parameters could not be read.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum AirframeSection {
+    Read(AirframeInspection),
+    Unreadable(String),
+}
+
+impl std::fmt::Display for Layout {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::QuadX => write!(f, "quad X"),
+            Self::QuadPlus => write!(f, "quad +"),
+            Self::QuadXUnequalArms => write!(f, "quad X with unequal front and rear arms"),
+            Self::HexaX => write!(f, "hexa X"),
+            Self::HexaPlus => write!(f, "hexa +"),
+            Self::OctoX => write!(f, "octo X"),
+            Self::OctoPlus => write!(f, "octo +"),
+            Self::Coaxial { arms } => write!(f, "coaxial: {arms} arms of two rotors"),
+            Self::Unrecognised { rotors } => write!(f, "unrecognised: {rotors} rotors"),
+        }
+    }
+}
+
+/// One value when all are equal (to 1e-9), else the list.
+fn values(list: &[f64], digits: usize) -> String {
+    match list.first() {
+        Some(first) if list.iter().all(|v| (v - first).abs() <= 1e-9) => {
+            format!("{first:.digits$}")
+        }
+        _ => list
+            .iter()
+            .map(|v| format!("{v:.digits$}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+    }
+}
+
+fn airframe_text(out: &mut String, section: &AirframeSection) {
+    let airframe = match section {
+        AirframeSection::Unreadable(message) => {
+            let _ = writeln!(out, "airframe:  not read: {message}");
+            return;
+        }
+        AirframeSection::Read(airframe) => airframe,
+    };
+    let spins: Vec<&str> = airframe
+        .spins
+        .iter()
+        .map(|s| match s {
+            Spin::CounterClockwise => "ccw",
+            Spin::Clockwise => "cw",
+        })
+        .collect();
+    let _ = writeln!(
+        out,
+        "airframe:  {} rotors, {}; arms {} m; km {} m ({}); CT {} N; THR_MDL_FAC {}; allocation rank {} of 4",
+        airframe.rotor_count,
+        airframe.layout,
+        values(&airframe.arm_lengths_m, 3),
+        values(&airframe.moment_ratios_m, 3),
+        spins.join(", "),
+        values(&airframe.thrust_coefficients_n, 2),
+        airframe.thrust_model_factor,
+        airframe.allocation_rank
+    );
+    let defaults = &airframe.defaults;
+    let script = airframe
+        .airframe
+        .map_or(String::new(), |a| format!(" of SYS_AUTOSTART {a}"));
+    if !defaults.declared {
+        let _ = writeln!(
+            out,
+            "           the log declares no parameter defaults: whether CA_ROTOR* were set for this vehicle is unknown"
+        );
+    } else if defaults.set_for_vehicle.is_empty() {
+        let _ = writeln!(
+            out,
+            "           CA_ROTOR* are the airframe defaults{script}: the geometry may not be this vehicle's"
+        );
+    } else {
+        let _ = writeln!(
+            out,
+            "           set for this vehicle: {}",
+            defaults.set_for_vehicle.join(", ")
+        );
+    }
+    if defaults.declared && defaults.builtin_coefficients {
+        let _ = writeln!(
+            out,
+            "           CT and |KM| are PX4's built-in defaults: thrust and moment coefficients not measured on this vehicle"
+        );
+    }
+}
+
 fn or_unknown(value: &Option<String>) -> &str {
     value.as_deref().unwrap_or("?")
 }
 
-/// The terminal text of an inspection: the vehicle, the times, one block per analysis topic.
-pub fn ulog_inspection_text(inspection: &UlogInspection) -> String {
+/// The terminal text of an inspection: the vehicle, its airframe (when the log has PX4's
+/// control-allocation parameters), the times, one block per analysis topic.
+pub fn ulog_inspection_text(
+    inspection: &UlogInspection,
+    airframe: Option<&AirframeSection>,
+) -> String {
     let mut out = String::new();
     let vehicle = &inspection.vehicle;
     let number = |v: Option<i64>| v.map_or("?".to_string(), |v| v.to_string());
@@ -121,6 +270,9 @@ pub fn ulog_inspection_text(inspection: &UlogInspection) -> String {
         number(vehicle.airframe),
         number(vehicle.rotor_count)
     );
+    if let Some(section) = airframe {
+        airframe_text(&mut out, section);
+    }
     let _ = writeln!(
         out,
         "duration:  {:.1} s logged (from {:.3} s on the autopilot's clock)",
@@ -297,12 +449,67 @@ mod tests {
             truncated_at: None,
             warnings: 1,
         };
-        let text = ulog_inspection_text(&inspection);
+        let text = ulog_inspection_text(&inspection, None);
         assert!(text.contains("vehicle:   PX4 on PX4_SITL, software ?, airframe 10017, 4 rotors"));
         assert!(text.contains("airborne:  11.0 s (10.0-21.0 s)"));
         assert!(text.contains(
             "  actuator_motors[0]: 3100 samples, logged at 100.0 Hz; step 10.0 ms (5-95%: 9.0-11.0)\n      control[0], control[1]: held, changes at ~10.0 Hz\n"
         ));
         assert!(text.contains("absent:    wind"));
+    }
+
+    fn airframe(defaults: GeometryDefaults) -> AirframeSection {
+        AirframeSection::Read(AirframeInspection {
+            airframe: Some(4001),
+            rotor_count: 6,
+            layout: Layout::HexaPlus,
+            arm_lengths_m: vec![0.25; 6],
+            moment_ratios_m: vec![0.016; 6],
+            spins: vec![Spin::CounterClockwise, Spin::Clockwise],
+            thrust_coefficients_n: vec![6.5, 6.5, 6.5, 6.5, 6.5, 7.0],
+            thrust_model_factor: 0.3,
+            allocation_rank: 4,
+            defaults,
+        })
+    }
+
+    fn airframe_lines(section: &AirframeSection) -> String {
+        let mut out = String::new();
+        airframe_text(&mut out, section);
+        out
+    }
+
+    #[test]
+    fn the_airframe_says_what_its_parameters_are_worth() {
+        let at_defaults = airframe(GeometryDefaults {
+            declared: true,
+            set_for_vehicle: vec![],
+            builtin_coefficients: true,
+        });
+        assert_eq!(
+            airframe_lines(&at_defaults),
+            "airframe:  6 rotors, hexa +; arms 0.250 m; km 0.016 m (ccw, cw); CT 6.50, 6.50, 6.50, 6.50, 6.50, 7.00 N; THR_MDL_FAC 0.3; allocation rank 4 of 4\n           CA_ROTOR* are the airframe defaults of SYS_AUTOSTART 4001: the geometry may not be this vehicle's\n           CT and |KM| are PX4's built-in defaults: thrust and moment coefficients not measured on this vehicle\n"
+        );
+        let set = airframe(GeometryDefaults {
+            declared: true,
+            set_for_vehicle: vec!["CA_ROTOR0_PX".into(), "CA_ROTOR5_CT".into()],
+            builtin_coefficients: false,
+        });
+        let text = airframe_lines(&set);
+        assert!(
+            text.ends_with("\n           set for this vehicle: CA_ROTOR0_PX, CA_ROTOR5_CT\n"),
+            "{text}"
+        );
+        let undeclared = airframe(GeometryDefaults {
+            declared: false,
+            set_for_vehicle: vec![],
+            builtin_coefficients: false,
+        });
+        assert!(airframe_lines(&undeclared).contains("declares no parameter defaults"));
+        let unreadable = AirframeSection::Unreadable("PX4 parameter CA_ROTOR2_PY: missing".into());
+        assert_eq!(
+            airframe_lines(&unreadable),
+            "airframe:  not read: PX4 parameter CA_ROTOR2_PY: missing\n"
+        );
     }
 }

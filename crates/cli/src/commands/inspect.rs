@@ -137,16 +137,26 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A ULog: read by `ulog`, inspected by `data`, rendered by `report`. `report` depends on no crate
-/// that computes, so the inspection reaches it as JSON (whose fields it names, refusing others).
+/// A ULog: read by `ulog`, inspected by `data`, its airframe parameters read by `physics`,
+/// rendered by `report`. `report` depends on no crate that computes, so the inspection reaches it
+/// as JSON (whose fields it names, refusing others).
 fn inspect_ulog(path: &Path) -> anyhow::Result<()> {
+    use report::ulog_inspection::{AirframeSection, UlogInspection, ulog_inspection_text};
     let log = ulog::Log::read(path)?;
     let inspection = serde_json::to_value(data::ulog::inspect(&log))?;
-    let view: report::ulog_inspection::UlogInspection = serde_json::from_value(inspection)?;
+    let view: UlogInspection = serde_json::from_value(inspection)?;
+    let parameters = data::ulog::parameter_table(&log);
+    let airframe = match physics::vehicle::px4::inspect_airframe(&parameters) {
+        Ok(None) => None,
+        Ok(Some(airframe)) => Some(AirframeSection::Read(serde_json::from_value(
+            serde_json::to_value(airframe)?,
+        )?)),
+        Err(error) => Some(AirframeSection::Unreadable(error.to_string())),
+    };
     say!("file:      {}", path.display());
     say!(
         "{}",
-        report::ulog_inspection::ulog_inspection_text(&view).trim_end()
+        ulog_inspection_text(&view, airframe.as_ref()).trim_end()
     );
     Ok(())
 }

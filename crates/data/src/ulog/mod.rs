@@ -1,12 +1,15 @@
 //! PX4 ULog flight logs (read by the `ulog` crate): what a log holds for a flight analysis
 //! ([`inspect`]: vehicle, duration, airborne time, and per topic its rates, time-stamp jitter,
-//! gaps and the rate at which each key column really changes).
+//! gaps and the rate at which each key column really changes) and its parameters as plain numbers
+//! ([`parameter_table`]).
 
 mod inspect;
+mod parameters;
 mod rates;
 
 pub use inspect::{
     Airborne, ColumnRate, DropoutSummary, Gaps, RatesOver, StepSpread, TopicInspection,
     UlogInspection, VehicleInfo, inspect,
 };
+pub use parameters::{ParameterTable, parameter_table};
 pub use rates::{ColumnPattern, NewSamples, column_pattern};

@@ -26,8 +26,8 @@ use std::path::Path;
 pub use error::{FormatFault, ParseError, Problem, UlogError};
 pub use format::{Field, FieldType, MAX_FIELDS, MAX_NESTING};
 pub use log::{
-    Column, Dropout, Log, LogLevel, LoggedMessage, ParamValue, ParameterChange, Parameters, Topic,
-    Truncation, Value,
+    Column, Dropout, Log, LogLevel, LoggedMessage, ParameterChange, ParameterNumber, Parameters,
+    Topic, Truncation, Value,
 };
 
 impl Log {

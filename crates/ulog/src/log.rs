@@ -44,12 +44,12 @@ impl Value {
 
 /// A parameter's value: PX4 parameters are `int32_t` or `float`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ParamValue {
+pub enum ParameterNumber {
     Int(i32),
     Float(f32),
 }
 
-impl ParamValue {
+impl ParameterNumber {
     pub fn as_f64(self) -> f64 {
         match self {
             Self::Int(v) => f64::from(v),
@@ -63,22 +63,22 @@ impl ParamValue {
 pub struct ParameterChange {
     pub time_us: u64,
     pub name: String,
-    pub value: ParamValue,
+    pub value: ParameterNumber,
 }
 
 /// The log's parameters: their values when logging started, changes during it, and the defaults
 /// the log declares (system defaults and the airframe configuration's defaults).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Parameters {
-    pub initial: BTreeMap<String, ParamValue>,
+    pub initial: BTreeMap<String, ParameterNumber>,
     pub changes: Vec<ParameterChange>,
-    pub system_defaults: BTreeMap<String, ParamValue>,
-    pub configuration_defaults: BTreeMap<String, ParamValue>,
+    pub system_defaults: BTreeMap<String, ParameterNumber>,
+    pub configuration_defaults: BTreeMap<String, ParameterNumber>,
 }
 
 impl Parameters {
     /// The value of `name` at the end of the log (its last change, else its initial value).
-    pub fn value(&self, name: &str) -> Option<ParamValue> {
+    pub fn value(&self, name: &str) -> Option<ParameterNumber> {
         self.changes
             .iter()
             .rev()

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use crate::error::{ParseError, Problem};
 use crate::format::{FieldType, Formats, parse_format};
 use crate::log::{
-    Dropout, Log, LogLevel, LoggedMessage, ParamValue, ParameterChange, Parameters, Topic,
+    Dropout, Log, LogLevel, LoggedMessage, ParameterChange, ParameterNumber, Parameters, Topic,
     Truncation, Value,
 };
 
@@ -374,11 +374,11 @@ fn scalar(field_type: FieldType, bytes: &[u8]) -> Option<Value> {
 }
 
 /// A parameter's name and value: an info-like payload of type `int32_t` or `float`.
-fn parameter(payload: &[u8], kind: char) -> Result<(String, ParamValue), Problem> {
+fn parameter(payload: &[u8], kind: char) -> Result<(String, ParameterNumber), Problem> {
     let (name, type_name, value) = typed_key_value(payload, kind)?;
     let value = match (type_name.as_str(), value) {
-        ("int32_t", Value::Int(v)) => i32::try_from(v).ok().map(ParamValue::Int),
-        ("float", Value::Float(v)) => Some(ParamValue::Float(v as f32)),
+        ("int32_t", Value::Int(v)) => i32::try_from(v).ok().map(ParameterNumber::Int),
+        ("float", Value::Float(v)) => Some(ParameterNumber::Float(v as f32)),
         _ => None,
     };
     let value = value.ok_or(Problem::ParameterType {

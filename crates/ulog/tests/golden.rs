@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
-use ulog::{Log, ParamValue};
+use ulog::{Log, ParameterNumber};
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -101,8 +101,10 @@ fn parameters_agree_with_pyulog() {
         for (name, value) in expected["parameters"].as_object().unwrap() {
             let read = parameters.value(name).unwrap_or_else(|| panic!("{name}"));
             match read {
-                ParamValue::Int(v) => assert_eq!(Some(i64::from(v)), value.as_i64(), "{name}"),
-                ParamValue::Float(v) => assert_eq!(Some(f64::from(v)), value.as_f64(), "{name}"),
+                ParameterNumber::Int(v) => assert_eq!(Some(i64::from(v)), value.as_i64(), "{name}"),
+                ParameterNumber::Float(v) => {
+                    assert_eq!(Some(f64::from(v)), value.as_f64(), "{name}")
+                }
             }
         }
         let count = |key: &str| expected[key].as_u64().unwrap() as usize;

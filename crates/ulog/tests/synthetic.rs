@@ -3,7 +3,7 @@
 //! and random bytes or mutations of a valid stream, which must never make it panic.
 
 use proptest::prelude::*;
-use ulog::{Column, Dropout, Log, LogLevel, ParamValue, Problem, Truncation, Value};
+use ulog::{Column, Dropout, Log, LogLevel, ParameterNumber, Problem, Truncation, Value};
 
 /// A ULog stream under construction.
 #[derive(Clone)]
@@ -167,18 +167,24 @@ fn a_flight_is_read_whole() {
         ]
     );
     let parameters = &log.parameters;
-    assert_eq!(parameters.initial["MPC_THR_HOVER"], ParamValue::Float(0.42));
+    assert_eq!(
+        parameters.initial["MPC_THR_HOVER"],
+        ParameterNumber::Float(0.42)
+    );
     assert_eq!(
         parameters.value("MPC_THR_HOVER"),
-        Some(ParamValue::Float(0.45))
+        Some(ParameterNumber::Float(0.45))
     );
-    assert_eq!(parameters.value("CA_ROTOR_COUNT"), Some(ParamValue::Int(4)));
+    assert_eq!(
+        parameters.value("CA_ROTOR_COUNT"),
+        Some(ParameterNumber::Int(4))
+    );
     assert_eq!(parameters.changes.len(), 1);
     assert_eq!(parameters.changes[0].time_us, 3_000);
     assert_eq!(parameters.system_defaults.len(), 1);
     assert_eq!(
         parameters.configuration_defaults["CA_ROTOR_COUNT"],
-        ParamValue::Int(6)
+        ParameterNumber::Int(6)
     );
     assert_eq!(
         log.dropouts,

@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use ulog::{Log, ParamValue};
+use ulog::{Log, ParameterNumber};
 
 /// The parameters a log holds, as numbers.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -21,7 +21,7 @@ pub struct ParameterTable {
 /// The parameters of `log` ([`ParameterTable`]).
 pub fn parameter_table(log: &Log) -> ParameterTable {
     let parameters = &log.parameters;
-    let numbers = |map: &BTreeMap<String, ParamValue>| -> BTreeMap<String, f64> {
+    let numbers = |map: &BTreeMap<String, ParameterNumber>| -> BTreeMap<String, f64> {
         map.iter().map(|(k, v)| (k.clone(), v.as_f64())).collect()
     };
     let mut values = numbers(&parameters.initial);

@@ -120,3 +120,54 @@ fn a_corrupt_log_is_a_one_line_error_naming_file_and_offset() {
     learn_in(&dir, &["data", "inspect", "short.ulg"])
         .one_line_error(&["short.ulg: byte 0: the file ends inside its 16-byte header"]);
 }
+
+/// `learn sindy` reads a ULog's columns on one topic's clock and says which were held, and how
+/// long; a field the log lacks is a one-line error naming the file and the column.
+#[test]
+fn sindy_fits_ulog_columns_on_one_clock() {
+    let Some(path) = log_file("sample_px4_events.ulg") else {
+        return;
+    };
+    let dir = scratch("ulog-sindy");
+    let log = path.to_str().unwrap();
+    let rates = "vehicle_angular_velocity.xyz[0],vehicle_angular_velocity.xyz[1]";
+    let controls = "vehicle_torque_setpoint.xyz[0],actuator_motors.control[0]";
+    let run = learn_in(
+        &dir,
+        &[
+            "sindy",
+            "--csv",
+            log,
+            "--state",
+            rates,
+            "--control",
+            controls,
+        ],
+    );
+    let text = run.success();
+    assert_lines(
+        text,
+        &[
+            &format!("{log}: 1558 rows on the clock of vehicle_angular_velocity[0]"),
+            "  vehicle_torque_setpoint.xyz[0] held from its 50.0 Hz samples (at most 0.004 s)",
+            "  actuator_motors.control[0] held from its 10.0 Hz samples (at most 0.080 s)",
+        ],
+    );
+    assert!(
+        text.contains("vehicle_angular_velocity.xyz[1]' = "),
+        "{text}"
+    );
+    let run = learn_in(
+        &dir,
+        &[
+            "sindy",
+            "--csv",
+            log,
+            "--state",
+            "vehicle_angular_velocity.rate",
+        ],
+    );
+    run.one_line_error(&[&format!(
+        "{log}: vehicle_angular_velocity.rate: topic vehicle_angular_velocity has no field 'rate'"
+    )]);
+}

@@ -65,6 +65,21 @@ impl NumericTable {
         })
     }
 
+    /// A table of columns already read elsewhere (a ULog's), each row's "line" given.
+    pub(crate) fn from_columns(
+        path: &Path,
+        names: Vec<String>,
+        columns: Vec<Vec<f64>>,
+        lines: Vec<usize>,
+    ) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            names,
+            columns,
+            lines,
+        }
+    }
+
     /// The rows `rows` of every column, each keeping its line of the file.
     pub fn rows_subset(&self, rows: std::ops::Range<usize>) -> Self {
         Self {

@@ -100,3 +100,69 @@ fn held_and_interpolated_columns_are_recognised_while_airborne() {
             .contains(&"vehicle_local_position".to_string())
     );
 }
+
+/// Columns of three topics on one clock: a topic's value is its latest sample at or before each
+/// row (held, never interpolated), and how long the slowest was held is reported.
+#[test]
+fn columns_of_other_topics_are_held_as_of_the_base_clock() {
+    let log = ulog::Log::parse(&synthetic_log()).unwrap();
+    let path = std::path::Path::new("synthetic.ulg");
+    let columns = [
+        "vehicle_angular_velocity.xyz[2]",
+        "actuator_motors.control[1]",
+        "vehicle_land_detected.landed",
+    ];
+    let aligned = data::ulog::aligned_table(&log, path, None, &columns).unwrap();
+    assert_eq!(aligned.base, "vehicle_angular_velocity[0]");
+    assert_eq!(aligned.time.len(), 1000);
+    assert!((aligned.time[1] - aligned.time[0] - 0.01).abs() < 1e-12);
+    let landed = aligned
+        .table
+        .column("vehicle_land_detected.landed")
+        .unwrap();
+    // Landed until 2 s, held between its samples every second.
+    assert_eq!(
+        (landed[199], landed[200], landed[799], landed[800]),
+        (1.0, 0.0, 0.0, 1.0)
+    );
+    let held: Vec<(&str, f64, f64)> = aligned
+        .held
+        .iter()
+        .map(|h| (h.column.as_str(), h.median_rate_hz, h.longest_hold_s))
+        .collect();
+    assert_eq!(held[0].0, "actuator_motors.control[1]");
+    assert!(
+        (held[0].1 - 100.0).abs() < 1e-6 && held[0].2 == 0.0,
+        "{held:?}"
+    );
+    assert!(
+        (held[1].1 - 1.0).abs() < 1e-6 && (held[1].2 - 0.99).abs() < 1e-9,
+        "{held:?}"
+    );
+    // On the land detector's clock: ten rows, each the other topics' sample of the same time.
+    let slow =
+        data::ulog::aligned_table(&log, path, Some("vehicle_land_detected"), &columns).unwrap();
+    assert_eq!(slow.time.len(), 10);
+    let motors = slow.table.column("actuator_motors.control[1]").unwrap();
+    let first = log
+        .topic("actuator_motors", 0)
+        .unwrap()
+        .column_f64("control[1]")
+        .unwrap();
+    assert_eq!(motors[3], first[300]);
+    // A field or topic the log lacks is named with the column.
+    let error = data::ulog::aligned_table(&log, path, None, &["actuator_motors.control[7]"])
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        error,
+        "synthetic.ulg: actuator_motors.control[7]: topic actuator_motors has no field 'control[7]'"
+    );
+    let error = data::ulog::aligned_table(&log, path, None, &["wind.windspeed_north"])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("the log has no samples of topic wind[0]"),
+        "{error}"
+    );
+}

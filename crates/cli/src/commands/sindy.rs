@@ -31,8 +31,10 @@ pub enum OptimizerKind {
 pub struct Args {
     #[command(subcommand)]
     pub command: Option<ApplyCommand>,
-    /// A numeric CSV file with a header row; give --csv once per recording to fit several
-    /// trajectories together (derivatives are estimated within each).
+    /// A numeric CSV file with a header row, or a PX4 ULog (`.ulg`: columns `topic.field` on the
+    /// clock of the first column's topic, or of the topic --time names; other topics' values held
+    /// as of it); give --csv once per recording to fit several trajectories together (derivatives
+    /// are estimated within each).
     #[arg(long, required = true)]
     pub csv: Vec<PathBuf>,
     /// The time column (strictly increasing; forward and central differences use the true time
@@ -181,7 +183,11 @@ pub(super) fn read_recording(
     columns: &[&str],
     derivative: Derivative,
 ) -> anyhow::Result<Recording> {
-    let (time, table) = NumericTable::read_with_increasing_time(path, time_column, columns)?;
+    let (time, table) = if is_ulog(path) {
+        read_ulog_columns(path, time_column, columns)?
+    } else {
+        NumericTable::read_with_increasing_time(path, time_column, columns)?
+    };
     check_sampling(path, time_column, derivative, &time, |row| table.line(row))?;
     let n = table.rows();
     let states = Mat::from_fn(n, state_count, |i, j| table.columns[j][i]);
@@ -194,6 +200,39 @@ pub(super) fn read_recording(
         trajectory,
         table,
     })
+}
+
+/// Whether `path` names a PX4 ULog (by its extension).
+pub(super) fn is_ulog(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ulg"))
+}
+
+/// The columns (`topic.field`) of a ULog on the clock of `--time` when it names a topic (of the
+/// first column's topic while it is the default `t`); says which columns were held, and how long.
+fn read_ulog_columns(
+    path: &Path,
+    time_column: &str,
+    columns: &[&str],
+) -> anyhow::Result<(Vec<f64>, NumericTable)> {
+    let log = ulog::Log::read(path)?;
+    let base = (time_column != "t").then_some(time_column);
+    let aligned = data::ulog::aligned_table(&log, path, base, columns)?;
+    say!(
+        "{}: {} rows on the clock of {}",
+        path.display(),
+        aligned.time.len(),
+        aligned.base
+    );
+    for held in &aligned.held {
+        say!(
+            "  {} held from its {:.1} Hz samples (at most {:.3} s)",
+            held.column,
+            held.median_rate_hz,
+            held.longest_hold_s
+        );
+    }
+    Ok((aligned.time, aligned.table))
 }
 
 /// Refuses a time axis the derivative cannot use, naming the file's line.
@@ -508,8 +547,12 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         .library(library)
         .optimizer(optimizer)
         .derivative(derivative);
+    if args.stream && args.csv.iter().any(|path| is_ulog(path)) {
+        bail!("--stream reads a CSV; a ULog is read whole");
+    }
     let streamed = args.stream
         || (args.csv.len() == 1
+            && !is_ulog(&args.csv[0])
             && std::fs::metadata(&args.csv[0])
                 .is_ok_and(|metadata| metadata.is_file() && metadata.len() > STREAM_ABOVE_BYTES));
     let (model, score, n) = if streamed {

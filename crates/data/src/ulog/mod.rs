@@ -1,12 +1,14 @@
 //! PX4 ULog flight logs (read by the `ulog` crate): what a log holds for a flight analysis
 //! ([`inspect`]: vehicle, duration, airborne time, and per topic its rates, time-stamp jitter,
 //! gaps and the rate at which each key column really changes) and its parameters as plain numbers
-//! ([`parameter_table`]).
+//! ([`parameter_table`]); chosen columns of several topics on one clock ([`aligned_table`]).
 
+mod aligned;
 mod inspect;
 mod parameters;
 mod rates;
 
+pub use aligned::{AlignedTable, HeldColumn, aligned_table};
 pub use inspect::{
     Airborne, ColumnRate, DropoutSummary, Gaps, RatesOver, StepSpread, TopicInspection,
     UlogInspection, VehicleInfo, inspect,

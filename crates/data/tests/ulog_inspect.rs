@@ -166,3 +166,22 @@ fn columns_of_other_topics_are_held_as_of_the_base_clock() {
         "{error}"
     );
 }
+
+/// A base clock whose time stamps repeat is refused, naming the sample (a derivative over it would
+/// divide by zero).
+#[test]
+fn a_clock_that_stands_still_is_refused() {
+    let mut bytes = b"ULog\x01\x12\x35\x01".to_vec();
+    bytes.extend(0u64.to_le_bytes());
+    message(&mut bytes, b'F', b"rates:uint64_t timestamp;float x;");
+    message(&mut bytes, b'A', b"\x00\x00\x00rates");
+    for (time, x) in [(0u64, 1.0f32), (10_000, 2.0), (10_000, 3.0), (20_000, 4.0)] {
+        sample(&mut bytes, 0, time, &x.to_le_bytes());
+    }
+    let log = ulog::Log::parse(&bytes).unwrap();
+    let path = std::path::Path::new("still.ulg");
+    let error = data::ulog::aligned_table(&log, path, None, &["rates.x"])
+        .unwrap_err()
+        .to_string();
+    assert!(error.starts_with("still.ulg:3:rates[0]:"), "{error}");
+}

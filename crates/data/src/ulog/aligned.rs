@@ -12,7 +12,7 @@ use ulog::{Log, Topic};
 
 use crate::error::{DataError, Result};
 use crate::numeric::NumericTable;
-use crate::time::median_interval;
+use crate::time::{check_time_axis_at, median_interval};
 
 /// A ULog's columns on the clock of one topic.
 #[derive(Clone, Debug)]
@@ -142,11 +142,18 @@ pub fn aligned_table(
         values.push(picked.iter().map(|&sample| column_values[sample]).collect());
     }
     let names = columns.iter().map(|c| c.to_string()).collect();
-    let lines = rows.clone().map(|row| row + 1).collect();
+    let time: Vec<f64> = clock[rows.clone()]
+        .iter()
+        .map(|&t| t as f64 * 1e-6)
+        .collect();
+    let base = format!("{}[{}]", base_topic.name, base_topic.multi_id);
+    // A clock that stands still or runs back has no derivative: its sample is named.
+    check_time_axis_at(path, &base, &time, f64::INFINITY, &|k| start + k + 1)?;
+    let lines = rows.map(|row| row + 1).collect();
     Ok(AlignedTable {
-        time: clock[rows].iter().map(|&t| t as f64 * 1e-6).collect(),
+        time,
         table: NumericTable::from_columns(path, names, values, lines),
-        base: format!("{}[{}]", base_topic.name, base_topic.multi_id),
+        base,
         held,
     })
 }

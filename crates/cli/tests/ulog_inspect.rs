@@ -64,6 +64,7 @@ fn the_simulated_flight_is_described() {
             // The simulated battery discharges linearly: a line between rare knots.
             "      voltage_v: interpolated, knots at ~0.1 Hz",
             "absent:    wind",
+            "limits:    motor commands new at ~10.0 Hz (actuator_motors[0]): delays and motor lags shorter than ~0.100 s cannot be identified from this log (PX4's high-rate SDLOG_PROFILE logs actuator topics faster)",
         ],
     );
 }
@@ -84,6 +85,7 @@ fn the_real_flight_is_described() {
             "  vehicle_local_position[0]: 926 samples, logged at 10.1 Hz; step 98.9 ms (5-95%: 94.4-107.9)",
             "      x, y, z, vx, vy, vz, ax, ay, az: new every sample (~10.0 Hz)",
             "  actuator_outputs[1]: 1 samples, logged at ? Hz",
+            "limits:    motor commands new at ~10.0 Hz (actuator_motors[0]): delays and motor lags shorter than ~0.100 s cannot be identified from this log (PX4's high-rate SDLOG_PROFILE logs actuator topics faster)",
         ],
     );
 }

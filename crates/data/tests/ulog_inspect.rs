@@ -94,6 +94,13 @@ fn held_and_interpolated_columns_are_recognised_while_airborne() {
         assert!((column.effective_rate_hz - 10.0).abs() < 1.5, "{column:?}");
     }
     assert_eq!(motors.gaps.count, 0);
+    // The motors change at 10 Hz: timing under ~0.1 s is out of this log's reach.
+    let limit = inspection.timing_limit.as_ref().unwrap();
+    assert_eq!(limit.topic, "actuator_motors[0]");
+    assert!(
+        (limit.shortest_s - 0.1).abs() < 0.002 && limit.slow,
+        "{limit:?}"
+    );
     assert!(
         inspection
             .absent_topics

@@ -102,6 +102,17 @@ pub struct UlogInspection {
     pub dropouts: DropoutSummary,
     pub truncated_at: Option<u64>,
     pub warnings: usize,
+    pub timing_limit: Option<TimingLimit>,
+}
+
+/// What the motor commands' rate leaves out of reach (see the `data` crate's `TimingLimit`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimingLimit {
+    pub topic: String,
+    pub command_rate_hz: f64,
+    pub shortest_s: f64,
+    pub slow: bool,
 }
 
 /// A rotor's spin seen from above (see the `physics` crate's `Spin`).
@@ -330,6 +341,21 @@ pub fn ulog_inspection_text(
     if !inspection.absent_topics.is_empty() {
         let _ = writeln!(out, "absent:    {}", inspection.absent_topics.join(", "));
     }
+    if let Some(limit) = &inspection.timing_limit {
+        let _ = write!(
+            out,
+            "limits:    motor commands new at ~{:.1} Hz ({}): delays and motor lags shorter than \
+             ~{:.3} s cannot be identified from this log",
+            limit.command_rate_hz, limit.topic, limit.shortest_s
+        );
+        if limit.slow {
+            let _ = write!(
+                out,
+                " (PX4's high-rate SDLOG_PROFILE logs actuator topics faster)"
+            );
+        }
+        let _ = writeln!(out);
+    }
     let _ = writeln!(
         out,
         "others:    {} more topic instances with samples",
@@ -448,6 +474,12 @@ mod tests {
             },
             truncated_at: None,
             warnings: 1,
+            timing_limit: Some(TimingLimit {
+                topic: "actuator_motors[0]".into(),
+                command_rate_hz: 10.0,
+                shortest_s: 0.1,
+                slow: true,
+            }),
         };
         let text = ulog_inspection_text(&inspection, None);
         assert!(text.contains("vehicle:   PX4 on PX4_SITL, software ?, airframe 10017, 4 rotors"));
@@ -456,6 +488,11 @@ mod tests {
             "  actuator_motors[0]: 3100 samples, logged at 100.0 Hz; step 10.0 ms (5-95%: 9.0-11.0)\n      control[0], control[1]: held, changes at ~10.0 Hz\n"
         ));
         assert!(text.contains("absent:    wind"));
+        assert!(text.contains(
+            "limits:    motor commands new at ~10.0 Hz (actuator_motors[0]): delays and motor lags \
+             shorter than ~0.100 s cannot be identified from this log (PX4's high-rate \
+             SDLOG_PROFILE logs actuator topics faster)\n"
+        ));
     }
 
     fn airframe(defaults: GeometryDefaults) -> AirframeSection {

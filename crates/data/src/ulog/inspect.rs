@@ -138,6 +138,46 @@ pub struct UlogInspection {
     pub truncated_at: Option<u64>,
     /// Messages the autopilot logged at warning level or worse.
     pub warnings: usize,
+    /// What the motor commands' rate leaves out of reach (`None` without motor commands).
+    pub timing_limit: Option<TimingLimit>,
+}
+
+/// A command's effect is seen only as often as the command changes: timing shorter than the
+/// motor commands' interval (a delay, a motor lag) cannot be identified from the log.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TimingLimit {
+    /// The topic instance the motor commands come from (`actuator_motors[0]` first).
+    pub topic: String,
+    /// The slowest effective rate of its columns that change, Hz.
+    pub command_rate_hz: f64,
+    /// One over that rate: the shortest timing the log can resolve, s.
+    pub shortest_s: f64,
+    /// Slower than [`SLOW_COMMAND_RATE_HZ`]: PX4's high-rate logging profile would do better.
+    pub slow: bool,
+}
+
+/// Below this rate of new motor commands, PX4's high-rate logging profile is worth naming.
+pub const SLOW_COMMAND_RATE_HZ: f64 = 100.0;
+
+/// The timing limit of the first motor-command topic whose columns change.
+fn timing_limit(topics: &[TopicInspection]) -> Option<TimingLimit> {
+    ["actuator_motors", "actuator_outputs"]
+        .iter()
+        .flat_map(|name| topics.iter().filter(move |t| t.name == *name))
+        .find_map(|topic| {
+            let rate = topic
+                .columns
+                .iter()
+                .filter(|c| c.pattern != ColumnPattern::Constant && c.effective_rate_hz > 0.0)
+                .map(|c| c.effective_rate_hz)
+                .min_by(f64::total_cmp)?;
+            Some(TimingLimit {
+                topic: format!("{}[{}]", topic.name, topic.multi_id),
+                command_rate_hz: rate,
+                shortest_s: 1.0 / rate,
+                slow: rate < SLOW_COMMAND_RATE_HZ,
+            })
+        })
 }
 
 /// Inspects a parsed log (see [`UlogInspection`]).
@@ -177,6 +217,7 @@ pub fn inspect(log: &Log) -> UlogInspection {
         .filter(|t| !t.is_empty() && !KEY_TOPICS.iter().any(|(name, _)| *name == t.name))
         .count();
     let durations = log.dropouts.iter().map(|d| u64::from(d.duration_ms));
+    let timing_limit = timing_limit(&topics);
     UlogInspection {
         vehicle: vehicle(log),
         start_time_us: log.start_time_us,
@@ -200,6 +241,7 @@ pub fn inspect(log: &Log) -> UlogInspection {
                 matches!(m.level, Emergency | Alert | Critical | Error | Warning)
             })
             .count(),
+        timing_limit,
     }
 }
 

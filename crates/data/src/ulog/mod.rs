@@ -10,8 +10,8 @@ mod rates;
 
 pub use aligned::{AlignedTable, HeldColumn, aligned_table};
 pub use inspect::{
-    Airborne, ColumnRate, DropoutSummary, Gaps, RatesOver, StepSpread, TopicInspection,
-    UlogInspection, VehicleInfo, inspect,
+    Airborne, ColumnRate, DropoutSummary, Gaps, RatesOver, SLOW_COMMAND_RATE_HZ, StepSpread,
+    TimingLimit, TopicInspection, UlogInspection, VehicleInfo, inspect,
 };
 pub use parameters::{ParameterTable, parameter_table};
 pub use rates::{ColumnPattern, NewSamples, column_pattern};

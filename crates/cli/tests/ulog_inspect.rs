@@ -9,22 +9,10 @@ use std::path::PathBuf;
 
 use common::{learn_in, scratch, workspace};
 
-/// The log `file` of `data/ulog`, or `None` (skipping) where the logs are absent outside CI.
+/// The log `file` of `data/ulog` (absolute), or `None` (skipping) where the logs are absent
+/// outside CI.
 fn log_file(file: &str) -> Option<PathBuf> {
-    let path = workspace().join("data/ulog").join(file);
-    if path.is_file() {
-        return Some(path.canonicalize().unwrap());
-    }
-    assert!(
-        std::env::var("CI").map_or(true, |ci| ci != "true"),
-        "CI=true but no ULog file at {} (run `make data`)",
-        path.display()
-    );
-    eprintln!(
-        "skipping: no ULog file at {} (run `make data`)",
-        path.display()
-    );
-    None
+    data::ulog_file_for_tests(&workspace(), file).map(|path| path.canonicalize().unwrap())
 }
 
 fn inspect(path: &std::path::Path) -> String {

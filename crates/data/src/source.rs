@@ -93,6 +93,30 @@ pub fn real_data_dir_for_tests(workspace_root: &Path) -> Option<PathBuf> {
     None
 }
 
+/// The public ULog `file` of `data/ulog` under `workspace_root` (a link `make data` makes), for
+/// tests, as [`real_data_dir_for_tests`] finds the flights: `None` with a note where it is absent,
+/// except under CI (`CI=true`), where a test that needs it cannot silently skip.
+///
+/// # Panics
+/// When `CI=true` and the file is absent.
+pub fn ulog_file_for_tests(workspace_root: &Path, file: &str) -> Option<PathBuf> {
+    let path = workspace_root.join("data/ulog").join(file);
+    if path.is_file() {
+        return Some(path);
+    }
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!(
+            "CI=true but no ULog file at {} (run `make data`)",
+            path.display()
+        );
+    }
+    eprintln!(
+        "skipping: no ULog file at {} (run `make data`)",
+        path.display()
+    );
+    None
+}
+
 /// SHA-256 of a file, hex encoded.
 pub fn file_sha256(path: &Path) -> Result<String> {
     let bytes = std::fs::read(path).map_err(|source| DataError::Io {

@@ -80,19 +80,10 @@ fn the_crazyflie_map_gives_the_logged_motor_forces() {
 
 #[test]
 fn the_px4_example_is_what_the_sample_log_says() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/ulog/sample_px4_events.ulg");
-    if !path.is_file() {
-        assert!(
-            std::env::var("CI").map_or(true, |ci| ci != "true"),
-            "CI=true but no ULog file at {} (run `make data`)",
-            path.display()
-        );
-        eprintln!(
-            "skipping: no ULog file at {} (run `make data`)",
-            path.display()
-        );
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let Some(path) = data::ulog_file_for_tests(&workspace, "sample_px4_events.ulg") else {
         return;
-    }
+    };
     let log = ulog::Log::read(&path).unwrap();
     let read =
         VehicleDescription::from_px4_parameters(&data::ulog::parameter_table(&log).values).unwrap();

@@ -13,19 +13,7 @@ fn workspace() -> PathBuf {
 }
 
 fn parameters(file: &str) -> Option<data::ulog::ParameterTable> {
-    let path = workspace().join("data/ulog").join(file);
-    if !path.is_file() {
-        assert!(
-            std::env::var("CI").map_or(true, |ci| ci != "true"),
-            "CI=true but no ULog file at {} (run `make data`)",
-            path.display()
-        );
-        eprintln!(
-            "skipping: no ULog file at {} (run `make data`)",
-            path.display()
-        );
-        return None;
-    }
+    let path = data::ulog_file_for_tests(&workspace(), file)?;
     let log = ulog::Log::read(&path).unwrap_or_else(|e| panic!("{e}"));
     Some(data::ulog::parameter_table(&log))
 }

@@ -67,11 +67,7 @@ fn column_summary(columns: &[String]) -> String {
 }
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
-    let is_ulog = args
-        .file
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("ulg"));
-    if is_ulog {
+    if super::sindy::is_ulog(&args.file) {
         return inspect_ulog(&args.file);
     }
     let (log, columns) = FlightLog::read_with_columns(&args.file)?;

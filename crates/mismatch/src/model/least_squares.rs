@@ -544,16 +544,7 @@ mod tests {
             residual: decay,
             bounds: vec![(0.0, 10.0), (0.0, 5.0), (0.5, 2.0)],
         };
-        let projecting = LevenbergMarquardtParams {
-            iterations: 40,
-            tries: 8,
-            initial_damping: 1e-3,
-            min_damping: 1e-9,
-            increase: 10.0,
-            decrease: 3.0,
-            tolerance: 1e-9,
-            active_bounds: ActiveBounds::Project,
-        };
+        let projecting = crate::model::refine::RECORDING_FIT;
         let projected = projecting
             .checked()
             .unwrap()

@@ -209,21 +209,24 @@ impl DenseProblem for WhitenedFit<'_> {
     }
 }
 
-/// The solver of one recording's fits: 8 damped steps an iteration, converged when a step lowers
-/// the sum of squares by at most 1e-9 of it (the values the fits were tuned with).
+/// The settings of one recording's fits: 8 damped steps an iteration, converged when a step
+/// lowers the sum of squares by at most 1e-9 of it (the values the fits were tuned with).
+pub(crate) const RECORDING_FIT: LevenbergMarquardtParams = LevenbergMarquardtParams {
+    iterations: 40,
+    tries: 8,
+    initial_damping: 1e-3,
+    min_damping: 1e-9,
+    increase: 10.0,
+    decrease: 3.0,
+    tolerance: 1e-9,
+    active_bounds: ActiveBounds::Project,
+};
+
+/// The solver of one recording's fits ([`RECORDING_FIT`]).
 static SOLVER: LazyLock<LevenbergMarquardt> = LazyLock::new(|| {
-    LevenbergMarquardtParams {
-        iterations: 40,
-        tries: 8,
-        initial_damping: 1e-3,
-        min_damping: 1e-9,
-        increase: 10.0,
-        decrease: 3.0,
-        tolerance: 1e-9,
-        active_bounds: ActiveBounds::Project,
-    }
-    .checked()
-    .expect("the single-recording solver's settings are valid")
+    RECORDING_FIT
+        .checked()
+        .expect("the single-recording solver's settings are valid")
 });
 
 /// Levenberg–Marquardt ([`crate::model::least_squares`]) on the (weighted) whitened residual of the

@@ -79,6 +79,7 @@ mod model;
 mod optimizers;
 mod persist;
 mod regression;
+pub mod sampling;
 pub mod stability;
 mod stream;
 pub mod weak_form;

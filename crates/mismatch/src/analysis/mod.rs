@@ -13,7 +13,6 @@ pub use report::mismatch::recording::{
 };
 use serde::Serialize;
 use sindy::stability::{Selection, SelectionSettings, stability_selection};
-use sindy::weak_form::white_noise_sigma;
 
 use crate::error::{MismatchError, Result};
 use crate::explain::describe::describe;
@@ -228,7 +227,7 @@ fn prediction_noise(recording: &Recording, model: &NominalModel, effects: &Effec
         forward::accelerations_at_rows(recording, &recording.commands, model, effects);
     std::array::from_fn(|a| {
         let series: Vec<f64> = accelerations.iter().map(|x| x[a]).collect();
-        recording.dt * white_noise_sigma(&series)
+        recording.dt * recording.white_noise_sigma(&series)
     })
 }
 

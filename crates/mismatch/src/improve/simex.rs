@@ -33,7 +33,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::Serialize;
-use sindy::weak_form::white_noise_sigma;
+use sindy::sampling::Sampling;
 
 use crate::explain::fit::FittedSet;
 use crate::locate::problem::Problem;
@@ -100,7 +100,7 @@ pub fn noise_bias(
     }
     let sigma: Vec3 = std::array::from_fn(|a| {
         let series: Vec<f64> = problem.recording.body_rate.iter().map(|w| w[a]).collect();
-        white_noise_sigma(&series)
+        problem.recording.white_noise_sigma(&series)
     });
     let length = problem.recording.len();
     let draw_rate = |rng: &mut ChaCha8Rng| -> Vec<Vec3> {
@@ -251,7 +251,7 @@ fn command_sample_noise(problem: &Problem) -> Option<[[f64; 4]; 4]> {
         .iter()
         .map(|c| c.map(|v| samples.domain.to_domain(v)))
         .collect();
-    let covariance = white_covariance(&in_domain);
+    let covariance = white_covariance(&in_domain, &problem.recording.sampling);
     let unfelt = 1.0 - 1.0 / steps;
     Some(std::array::from_fn(|i| {
         std::array::from_fn(|j| {
@@ -264,12 +264,12 @@ fn command_sample_noise(problem: &Problem) -> Option<[[f64; 4]; 4]> {
     }))
 }
 
-/// The covariance of the white noise on four smooth series, by polarisation of
-/// [`white_noise_sigma`]: `cov(a, b) = (σ(a + b)² − σ(a − b)²) / 4`.
-fn white_covariance(series: &[[f64; 4]]) -> [[f64; 4]; 4] {
+/// The covariance of the white noise on four smooth series sampled at `sampling`, by polarisation
+/// of [`Sampling::white_noise_sigma`]: `cov(a, b) = (σ(a + b)² − σ(a − b)²) / 4`.
+fn white_covariance(series: &[[f64; 4]], sampling: &Sampling) -> [[f64; 4]; 4] {
     let sigma2 = |f: &dyn Fn(&[f64; 4]) -> f64| {
         let values: Vec<f64> = series.iter().map(f).collect();
-        white_noise_sigma(&values).powi(2)
+        sampling.white_noise_sigma(&values).powi(2)
     };
     std::array::from_fn(|i| {
         std::array::from_fn(|j| {

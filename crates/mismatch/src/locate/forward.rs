@@ -12,6 +12,8 @@
 use physics::vector::{Mat3, Vec3};
 use physics::{CommandLogging, Effects, Logger, NominalModel};
 
+use sindy::sampling::Sampling;
+
 use crate::recording::Recording;
 use crate::recording::command_samples::CommandSamples;
 
@@ -35,7 +37,7 @@ pub fn predict_substeps(
     let n = recording.len();
     let actuators = actuator_trace(
         &recording.samples,
-        recording.dt,
+        &recording.sampling,
         &model.logger,
         effects.delay_s(),
         effects.lag_s(),
@@ -72,7 +74,7 @@ pub fn predict_substeps(
     }
     let tau = model.logger.rate_time_constant_s();
     if angular_wanted && tau > 0.0 {
-        low_pass(&mut angular, recording.dt / SUBSTEPS as f64, tau);
+        low_pass(&mut angular, &recording.sampling, tau);
     }
     SubstepPrediction {
         translational,
@@ -81,17 +83,24 @@ pub fn predict_substeps(
 }
 
 /// With a drag lag, the velocity the air terms see at every sub-interval midpoint: the linearly
-/// interpolated velocity through a first-order lag of time constant `lag` (from the first row's).
+/// interpolated velocity through a first-order lag of time constant `lag` (from the row's velocity
+/// at the first row and after every gap).
 fn air_velocity_trace(recording: &Recording, lag: f64) -> Option<Vec<Vec3>> {
     if lag <= 0.0 {
         return None;
     }
     let n = recording.len();
-    let h = recording.dt / SUBSTEPS as f64;
-    let gain = 1.0 - (-h / lag).exp();
+    let sampling = &recording.sampling;
+    let mut gain = 1.0 - (-sampling.interval() / SUBSTEPS as f64 / lag).exp();
     let mut state = recording.velocity[0];
     let mut out = Vec::with_capacity((n - 1) * SUBSTEPS);
     for k in 0..n - 1 {
+        if !sampling.is_uniform() {
+            gain = 1.0 - (-sampling.interval_at(k) / SUBSTEPS as f64 / lag).exp();
+            if segment_starts_at(sampling, k) {
+                state = recording.velocity[k];
+            }
+        }
         for j in 0..SUBSTEPS {
             let s = (j as f64 + 0.5) / SUBSTEPS as f64;
             let velocity = lerp(recording.velocity[k], recording.velocity[k + 1], s);
@@ -102,6 +111,12 @@ fn air_velocity_trace(recording: &Recording, lag: f64) -> Option<Vec<Vec3>> {
         }
     }
     Some(out)
+}
+
+/// Whether interval `k` is the first of a segment after a gap (the filters start afresh there, as
+/// at the first row).
+fn segment_starts_at(sampling: &Sampling, k: usize) -> bool {
+    k > 0 && sampling.is_gap(k - 1)
 }
 
 /// The within-row spread of the commands that reaches the actuators: a first-order lag of time
@@ -153,12 +168,19 @@ pub fn accelerations_at_rows(
     (translational, angular)
 }
 
-/// First-order low-pass of time constant `tau` over a series at spacing `h`, in place, starting
-/// at the first value.
-fn low_pass(series: &mut [Vec3], h: f64, tau: f64) {
-    let gain = 1.0 - (-h / tau).exp();
+/// First-order low-pass of time constant `tau`, in place, over a series given at the sub-interval
+/// midpoints of `sampling`, starting at the first value (and afresh after every gap).
+fn low_pass(series: &mut [Vec3], sampling: &Sampling, tau: f64) {
+    let mut gain = 1.0 - (-(sampling.interval() / SUBSTEPS as f64) / tau).exp();
     let mut state = series.first().copied().unwrap_or([0.0; 3]);
-    for value in series.iter_mut() {
+    for (index, value) in series.iter_mut().enumerate() {
+        let (k, j) = (index / SUBSTEPS, index % SUBSTEPS);
+        if !sampling.is_uniform() && j == 0 {
+            gain = 1.0 - (-(sampling.interval_at(k) / SUBSTEPS as f64) / tau).exp();
+            if segment_starts_at(sampling, k) {
+                state = *value;
+            }
+        }
         for i in 0..3 {
             state[i] += gain * (value[i] - state[i]);
         }
@@ -185,7 +207,7 @@ fn lerp_matrix(a: &Mat3, b: &Mat3, s: f64) -> Mat3 {
 /// The logged commands as a function of time (s from the first row), as the logger made them.
 struct Reconstruction<'a> {
     commands: &'a [[f64; 4]],
-    dt: f64,
+    sampling: &'a Sampling,
     count: usize,
     logging: CommandLogging,
 }
@@ -195,27 +217,52 @@ impl Reconstruction<'_> {
         self.commands[index.clamp(0, self.commands.len() as i64 - 1) as usize]
     }
 
+    /// The time of row `index` (s from the first row), at the nominal interval beyond the ends.
+    fn row_time(&self, index: i64) -> f64 {
+        let last = self.commands.len() as i64 - 1;
+        let interval = self.sampling.interval();
+        match index {
+            i if i < 0 => i as f64 * interval,
+            i if i > last => self.sampling.offset(last as usize) + (i - last) as f64 * interval,
+            i => self.sampling.offset(i as usize),
+        }
+    }
+
     /// The mean of the command over `[start, end]` (a sub-interval, shorter than a row interval).
     fn mean(&self, start: f64, end: f64) -> [f64; 4] {
         match self.logging {
             CommandLogging::Sample => self.band_limited(0.5 * (start + end)),
-            // Held over [t_j, t_{j+1}); the period mean is the same, one interval earlier.
-            CommandLogging::Held => self.steps(start, end, 0.0),
-            CommandLogging::PeriodMean => self.steps(start, end, self.dt),
+            // Held over [t_j, t_{j+1}); the period mean is the same, one row earlier.
+            CommandLogging::Held => self.steps(start, end, 0),
+            CommandLogging::PeriodMean => self.steps(start, end, 1),
         }
     }
 
-    /// A command constant over `[t_j − shift, t_{j+1} − shift)`, averaged over `[start, end]`.
-    fn steps(&self, start: f64, end: f64, shift: f64) -> [f64; 4] {
-        let (start, end) = (start + shift, end + shift);
-        let first = (start / self.dt).floor();
-        let boundary = (first + 1.0) * self.dt;
-        let a = self.at_index(first as i64);
-        if end <= boundary {
+    /// A command constant over `[t_j, t_{j+1})`, the one of row `j + rows_later`, averaged over
+    /// `[start, end]`.
+    fn steps(&self, start: f64, end: f64, rows_later: i64) -> [f64; 4] {
+        let (first, crosses, weight_first) = match self.sampling {
+            // One interval later, in seconds: the arithmetic of a fixed step.
+            Sampling::Uniform { interval: dt, .. } => {
+                let shift = rows_later as f64 * dt;
+                let (start, end) = (start + shift, end + shift);
+                let first = (start / dt).floor();
+                let boundary = (first + 1.0) * dt;
+                let weight_first = (boundary - start) / (end - start);
+                (first as i64, end > boundary, weight_first)
+            }
+            Sampling::Stamped { .. } => {
+                let first = self.sampling.position(start).floor() as i64;
+                let boundary = self.row_time(first + 1);
+                let weight_first = (boundary - start) / (end - start);
+                (first + rows_later, end > boundary, weight_first)
+            }
+        };
+        let a = self.at_index(first);
+        if !crosses {
             return a;
         }
-        let b = self.at_index(first as i64 + 1);
-        let weight_first = (boundary - start) / (end - start);
+        let b = self.at_index(first + 1);
         let mut mixed = [0.0; 4];
         for i in 0..self.count {
             mixed[i] = weight_first * a[i] + (1.0 - weight_first) * b[i];
@@ -225,9 +272,9 @@ impl Reconstruction<'_> {
 
     /// The curve through the samples at time `t`: Lanczos interpolation with [`LANCZOS_LOBES`]
     /// lobes, a windowed sinc (within 4 · 10⁻³ of a sinusoid's amplitude at a sixteenth of the log
-    /// rate).
+    /// rate), in rows (on stamps, a time between two samples is the fraction of their interval).
     fn band_limited(&self, t: f64) -> [f64; 4] {
-        let position = t / self.dt;
+        let position = self.sampling.position(t);
         let j = position.floor();
         let s = position - j;
         let j = j as i64;
@@ -290,18 +337,19 @@ fn lanczos(x: f64, a: f64) -> f64 {
 /// an input constant over each sub-interval).
 pub fn actuator_trace(
     samples: &CommandSamples,
-    dt: f64,
+    sampling: &Sampling,
     logger: &Logger,
     delay: f64,
     lag: f64,
 ) -> Vec<[f64; 4]> {
     let (commands, count) = (&samples.values[..], samples.count);
     let n = commands.len();
-    let h = dt / SUBSTEPS as f64;
+    let dt = sampling.interval();
+    let mut h = dt / SUBSTEPS as f64;
     let total = (n - 1) * SUBSTEPS;
     let reconstruction = Reconstruction {
         commands,
-        dt,
+        sampling,
         count,
         logging: logger.command,
     };
@@ -313,20 +361,34 @@ pub fn actuator_trace(
     };
     let shift = logger.command_time_offset_s + hold + delay;
     let mut state = samples.commands(reconstruction.mean(-shift, h - shift));
-    let decay_full = if lag > 0.0 { (-h / lag).exp() } else { 0.0 };
-    let decay_half = if lag > 0.0 {
-        (-h / (2.0 * lag)).exp()
-    } else {
-        0.0
+    let decays = |h: f64| {
+        if lag > 0.0 {
+            ((-h / lag).exp(), (-h / (2.0 * lag)).exp())
+        } else {
+            (0.0, 0.0)
+        }
     };
-    let phases = (logger.command == CommandLogging::Sample).then(|| lanczos_phases(dt, shift));
+    let (mut decay_full, mut decay_half) = decays(h);
+    // Evenly spaced, the Lanczos weights repeat from row to row.
+    let phases = (logger.command == CommandLogging::Sample && sampling.is_uniform())
+        .then(|| lanczos_phases(dt, shift));
     let mut out = Vec::with_capacity(total);
     for step in 0..total {
-        let start = step as f64 * h - shift;
+        let (k, j) = (step / SUBSTEPS, step % SUBSTEPS);
+        let start = match sampling {
+            Sampling::Uniform { .. } => step as f64 * h - shift,
+            Sampling::Stamped { .. } => {
+                if j == 0 {
+                    h = sampling.interval_at(k) / SUBSTEPS as f64;
+                    (decay_full, decay_half) = decays(h);
+                }
+                sampling.offset(k) + j as f64 * h - shift
+            }
+        };
         let input = match &phases {
             Some(phases) => {
-                let (base, weights) = &phases[step % SUBSTEPS];
-                let first = (step / SUBSTEPS) as i64 + base;
+                let (base, weights) = &phases[j];
+                let first = k as i64 + base;
                 let mut value = [0.0; 4];
                 for (m, w) in weights.iter().enumerate() {
                     let p = reconstruction.at_index(first + m as i64);
@@ -336,8 +398,14 @@ pub fn actuator_trace(
                 }
                 samples.commands(value)
             }
+            None if logger.command == CommandLogging::Sample => {
+                samples.commands(reconstruction.band_limited(start + 0.5 * h))
+            }
             None => reconstruction.mean(start, start + h),
         };
+        if j == 0 && segment_starts_at(sampling, k) {
+            state = input;
+        }
         if lag > 0.0 {
             let mut midpoint = [0.0; 4];
             for i in 0..count {
@@ -356,6 +424,14 @@ pub fn actuator_trace(
 mod tests {
     use super::*;
 
+    fn even(dt: f64, len: usize) -> Sampling {
+        Sampling::Uniform {
+            start: 0.0,
+            interval: dt,
+            len,
+        }
+    }
+
     fn held() -> Logger {
         Logger {
             command: CommandLogging::Held,
@@ -367,15 +443,15 @@ mod tests {
     fn delay_shifts_the_held_commands_and_lag_approaches_them() {
         let commands: Vec<[f64; 4]> = (0..6).map(|k| [k as f64, 0.0, 0.0, 0.0]).collect();
         let dt = 0.02;
-        let plain = actuator_trace(&CommandSamples::plain(&commands, 1), dt, &held(), 0.0, 0.0);
+        let plain = actuator_trace(&CommandSamples::plain(&commands, 1), &even(dt, 6), &held(), 0.0, 0.0);
         assert_eq!(plain[SUBSTEPS * 2 + 3][0], 2.0);
         // Delay of exactly one interval: interval 3 sees command 2.
-        let delayed = actuator_trace(&CommandSamples::plain(&commands, 1), dt, &held(), dt, 0.0);
+        let delayed = actuator_trace(&CommandSamples::plain(&commands, 1), &even(dt, 6), &held(), dt, 0.0);
         assert!((delayed[SUBSTEPS * 3 + 5][0] - 2.0).abs() < 1e-12);
         // Half a sub-interval of delay mixes two commands half and half at the switch.
         let half = actuator_trace(
             &CommandSamples::plain(&commands, 1),
-            dt,
+            &even(dt, commands.len()),
             &held(),
             dt / SUBSTEPS as f64 / 2.0,
             0.0,
@@ -386,13 +462,13 @@ mod tests {
             command: CommandLogging::PeriodMean,
             ..Logger::default()
         };
-        let early = actuator_trace(&CommandSamples::plain(&commands, 1), dt, &mean, 0.0, 0.0);
+        let early = actuator_trace(&CommandSamples::plain(&commands, 1), &even(dt, 6), &mean, 0.0, 0.0);
         assert!((early[SUBSTEPS * 2 + 3][0] - 3.0).abs() < 1e-12);
         // A lag follows a step monotonically, without overshoot, and reaches 1 − e^(−t/τ).
         let step: Vec<[f64; 4]> = (0..6)
             .map(|k| [if k >= 2 { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0])
             .collect();
-        let lagged = actuator_trace(&CommandSamples::plain(&step, 1), dt, &held(), 0.0, 0.05);
+        let lagged = actuator_trace(&CommandSamples::plain(&step, 1), &even(dt, 6), &held(), 0.0, 0.05);
         let response: Vec<f64> = lagged[SUBSTEPS * 2..].iter().map(|a| a[0]).collect();
         assert!(response.windows(2).all(|w| w[1] > w[0] && w[1] < 1.0));
         let midpoint = (SUBSTEPS as f64 + 0.5) * dt / SUBSTEPS as f64;
@@ -411,7 +487,7 @@ mod tests {
             .collect();
         let trace = actuator_trace(
             &CommandSamples::plain(&commands, 1),
-            dt,
+            &even(dt, commands.len()),
             &Logger::default(),
             0.0,
             0.0,
@@ -423,7 +499,7 @@ mod tests {
         }
         let delayed = actuator_trace(
             &CommandSamples::plain(&commands, 1),
-            dt,
+            &even(dt, commands.len()),
             &Logger::default(),
             0.013,
             0.0,
@@ -449,7 +525,7 @@ mod tests {
         let limits = detect_limits(&speeds, 1);
         assert_eq!(limits[0].lower, Some(0.0));
         let error = |samples: &CommandSamples| {
-            let trace = actuator_trace(samples, dt, &Logger::default(), 0.0, 0.0);
+            let trace = actuator_trace(samples, &even(dt, 100), &Logger::default(), 0.0, 0.0);
             let h = dt / SUBSTEPS as f64;
             (10 * SUBSTEPS..90 * SUBSTEPS)
                 .map(|i| (trace[i][0].powi(2) - demand((i as f64 + 0.5) * h).max(0.0)).abs())

@@ -4,7 +4,7 @@
 
 use physics::{CommandLogging, Effects, NominalModel};
 use sindy::stability::BlockDesign;
-use sindy::weak_form::{TestFunction, WeakForm, white_noise_sigma};
+use sindy::weak_form::{TestFunction, WeakForm};
 
 use crate::error::{MismatchError, Result};
 use crate::locate::forward::{
@@ -86,7 +86,7 @@ impl Problem {
             path: recording.path.clone(),
             message,
         };
-        let weak_form = test_function.at_interval(recording.dt).map_err(bad)?;
+        let weak_form = test_function.on(&recording.sampling).map_err(bad)?;
         let half = weak_form.half;
         let n = recording.len();
         // Enough rows for several windows to fit and to hold out.
@@ -95,6 +95,15 @@ impl Problem {
             return Err(bad(format!(
                 "{n} rows, the analysis needs at least {needed} ({MIN_WINDOWS} of the comparison's windows of {} rows)",
                 2 * half + 1
+            )));
+        }
+        let centres = weak_form.centres.len();
+        if centres + 2 * half < needed {
+            return Err(bad(format!(
+                "{centres} rows have a whole window of the comparison between gaps, the analysis needs at least {} ({} gaps longer than {} s)",
+                needed - 2 * half,
+                recording.sampling.gaps().len(),
+                sindy::sampling::GAP_FACTOR * recording.dt
             )));
         }
         let channels = if model.predicts_torque() { 6 } else { 3 };
@@ -125,7 +134,7 @@ impl Problem {
             } else {
                 recording.body_rate.iter().map(|w| w[c - 3]).collect()
             };
-            let measured = white_noise_sigma(&signal) * weak_form.target_noise_gain();
+            let measured = recording.white_noise_sigma(&signal) * weak_form.target_noise_gain();
             model_noise[c] = model_side_noise(&recording, &model, nominal.as_ref(), c)
                 * weak_form.model_noise_gain();
             let floor_side = match &logged {
@@ -145,7 +154,7 @@ impl Problem {
             )));
         }
         Ok(Self {
-            time: recording.time[half..n - half].to_vec(),
+            time: weak_form.centres.iter().map(|&k| recording.time[k]).collect(),
             recording,
             model,
             weak_form,
@@ -242,7 +251,7 @@ impl Problem {
 
 /// The weak-form target of the recorded velocity (translational channels) and body rate.
 fn targets(recording: &Recording, weak_form: &WeakForm, channels: usize) -> Vec<Channels> {
-    let rows = recording.len() - 2 * weak_form.half;
+    let rows = weak_form.centres.len();
     let mut target = vec![[0.0; 6]; rows];
     for c in 0..channels {
         let signal: Vec<f64> = if c < 3 {
@@ -270,7 +279,7 @@ fn model_side_noise(
 ) -> f64 {
     let attitude = if c < 3 {
         let direction: Vec<f64> = recording.rotation.iter().map(|r| r[c][2]).collect();
-        white_noise_sigma(&direction) * nominal_thrust_acceleration(recording, model)
+        recording.white_noise_sigma(&direction) * nominal_thrust_acceleration(recording, model)
     } else {
         0.0
     };
@@ -285,5 +294,5 @@ fn model_side_noise(
         };
         angular.iter().map(|a| a[c - 3]).collect()
     };
-    white_noise_sigma(&series).max(attitude)
+    recording.white_noise_sigma(&series).max(attitude)
 }

@@ -13,7 +13,7 @@ use std::path::PathBuf;
 use data::{FlightLog, RateFrame};
 use physics::vector::{Mat3, Vec3, mat_t_vec};
 use physics::{CommandLogging, NominalModel};
-use sindy::weak_form::white_noise_sigma;
+use sindy::sampling::Sampling;
 
 use crate::error::{MismatchError, Result};
 use command_samples::{ActuatorLimits, CommandSamples, SampleDomain, detect_limits};
@@ -23,9 +23,11 @@ use noise_reaction::NoiseReaction;
 #[derive(Clone, Debug)]
 pub struct Recording {
     pub path: PathBuf,
-    /// Sample interval, s.
+    /// The nominal sample interval (`sampling.interval()`), s.
     pub dt: f64,
     pub time: Vec<f64>,
+    /// When the samples were taken: evenly spaced, or the logged stamps with their gaps.
+    pub sampling: Sampling,
     pub rotation: Vec<Mat3>,
     pub velocity: Vec<Vec3>,
     /// Position, m (world frame).
@@ -108,7 +110,8 @@ impl Recording {
             })
             .collect();
         degenerate::check_thrust(&commands, model).map_err(degenerate)?;
-        let dt = log.sample_interval();
+        let sampling = Sampling::new(&log.time);
+        let dt = sampling.interval();
         let command_rate_hz = match model.logger.command {
             CommandLogging::PeriodMean => model.logger.controller_rate_hz,
             _ => None,
@@ -118,7 +121,7 @@ impl Recording {
             let per_row = (rate * dt).max(1.0);
             for i in 0..model.actuator_count() {
                 let series: Vec<f64> = commands.iter().map(|c| c[i]).collect();
-                command_spread[i] = (per_row - 1.0) * white_noise_sigma(&series).powi(2);
+                command_spread[i] = (per_row - 1.0) * sampling.white_noise_sigma(&series).powi(2);
             }
         }
         let count = model.actuator_count();
@@ -133,6 +136,7 @@ impl Recording {
             path: log.path.clone(),
             dt,
             time: log.time.clone(),
+            sampling,
             rotation: log.rotation.clone(),
             velocity: log.velocity.clone(),
             position: log.position.clone(),
@@ -154,6 +158,11 @@ impl Recording {
     pub fn set_commands(&mut self, commands: Vec<[f64; 4]>) {
         self.samples = self.samples.with_commands(&commands);
         self.commands = commands;
+    }
+
+    /// Robust standard deviation of the white noise on a smooth series given at the rows.
+    pub fn white_noise_sigma(&self, series: &[f64]) -> f64 {
+        self.sampling.white_noise_sigma(series)
     }
 
     /// Number of rows.

@@ -21,12 +21,10 @@ use physics::vector::{Mat3, Vec3, mat_mul, transpose, vee};
 use physics::{CommandLogging, Logger};
 use serde::Serialize;
 use sindy::median::robust_standard_deviation;
-use sindy::weak_form::{white_noise_sigma, white_noise_sigma_of_fourth_differences};
+use sindy::sampling::white_noise_sigma_of_fourth_differences;
 
 use crate::recording::Recording;
 
-/// Fourth-difference weights; white noise of variance σ² has fourth differences of variance 70 σ².
-const FOURTH_DIFFERENCE: [f64; 5] = [1.0, -4.0, 6.0, -4.0, 1.0];
 /// Rows beyond this many robust standard deviations are left out of the regression (command
 /// transients).
 const TRIM_SIGMAS: f64 = 4.0;
@@ -121,7 +119,7 @@ pub fn remove_velocity(
             .map(|k| velocity[k + 1][a] - velocity[k][a] - predicted_change[k][a])
             .collect();
         let logged: Vec<f64> = velocity.iter().map(|v| v[a]).collect();
-        let sigma = white_noise_sigma(&logged);
+        let sigma = recording.white_noise_sigma(&logged);
         let step = prediction_noise[a].max(VELOCITY_STEP_FLOOR * sigma);
         smooth_noise(&increments, sigma, step)
     });
@@ -210,27 +208,35 @@ fn relative_rotation(a: &Mat3, b: &Mat3) -> Vec3 {
     vee(&mat_mul(&transpose(a), b))
 }
 
+/// The fourth-difference weights centred on row `k` (white noise of variance σ² has fourth
+/// differences of variance 70 σ²); zero across a gap, where the row takes no part.
+fn fourth_difference(recording: &Recording, k: usize) -> [f64; 5] {
+    recording
+        .sampling
+        .fourth_difference_weights(k - 2)
+        .unwrap_or([0.0; 5])
+}
+
 /// Fourth differences of the twelve logged state channels, centred on rows `2..n−2`.
 fn state_fourth_differences(recording: &Recording) -> Vec<[f64; STATES]> {
-    let fourth = |series: &[Vec3], k: usize, a: usize| -> f64 {
-        (0..5)
-            .map(|j| FOURTH_DIFFERENCE[j] * series[k + j - 2][a])
-            .sum()
-    };
     (2..recording.len() - 2)
         .map(|k| {
+            let weights = fourth_difference(recording, k);
+            let fourth = |series: &[Vec3], a: usize| -> f64 {
+                (0..5).map(|j| weights[j] * series[k + j - 2][a]).sum()
+            };
             let mut row = [0.0; STATES];
             for j in 0..5 {
                 let turn =
                     relative_rotation(&recording.rotation[k], &recording.rotation[k + j - 2]);
                 for a in 0..3 {
-                    row[3 + a] += FOURTH_DIFFERENCE[j] * turn[a];
+                    row[3 + a] += weights[j] * turn[a];
                 }
             }
             for a in 0..3 {
-                row[a] = fourth(&recording.body_rate, k, a);
-                row[6 + a] = fourth(&recording.velocity, k, a);
-                row[9 + a] = fourth(&recording.position, k, a);
+                row[a] = fourth(&recording.body_rate, a);
+                row[6 + a] = fourth(&recording.velocity, a);
+                row[9 + a] = fourth(&recording.position, a);
             }
             row
         })
@@ -246,14 +252,18 @@ fn reaction_gains(
 ) -> Option<Vec<[f64; STATES]>> {
     let commands: Vec<[f64; 4]> = (2..recording.len() - 2)
         .map(|k| {
+            let weights = fourth_difference(recording, k);
             std::array::from_fn(|i| {
                 (0..5)
-                    .map(|j| FOURTH_DIFFERENCE[j] * recording.commands[k + j - 2][i])
+                    .map(|j| weights[j] * recording.commands[k + j - 2][i])
                     .sum()
             })
         })
         .collect();
-    let mut keep = vec![true; states.len()];
+    let spans_no_gap: Vec<bool> = (2..recording.len() - 2)
+        .map(|k| fourth_difference(recording, k) != [0.0; 5])
+        .collect();
+    let mut keep = spans_no_gap.clone();
     let mut gains = vec![[0.0; STATES]; actuators];
     for _ in 0..4 {
         gains = least_squares(states, &commands, &keep, actuators)?;
@@ -261,10 +271,17 @@ fn reaction_gains(
             commands[r][i] - (0..STATES).map(|s| gains[i][s] * states[r][s]).sum::<f64>()
         };
         let scales: Vec<f64> = (0..actuators)
-            .map(|i| robust_standard_deviation((0..states.len()).map(|r| residual(r, i))))
+            .map(|i| {
+                robust_standard_deviation(
+                    (0..states.len())
+                        .filter(|&r| spans_no_gap[r])
+                        .map(|r| residual(r, i)),
+                )
+            })
             .collect();
         for (r, kept) in keep.iter_mut().enumerate() {
-            *kept = (0..actuators).all(|i| residual(r, i).abs() <= TRIM_SIGMAS * scales[i]);
+            *kept = spans_no_gap[r]
+                && (0..actuators).all(|i| residual(r, i).abs() <= TRIM_SIGMAS * scales[i]);
         }
     }
     Some(gains)
@@ -334,11 +351,16 @@ fn attitude_smoothing_scales(
     states: &[[f64; STATES]],
     a: usize,
 ) -> (f64, f64) {
-    let fourth: Vec<f64> = states.iter().map(|s| s[3 + a]).collect();
+    let fourth: Vec<f64> = states
+        .iter()
+        .enumerate()
+        .filter(|(r, _)| fourth_difference(recording, r + 2) != [0.0; 5])
+        .map(|(_, s)| s[3 + a])
+        .collect();
     let rate: Vec<f64> = recording.body_rate.iter().map(|w| w[a]).collect();
     (
         white_noise_sigma_of_fourth_differences(&fourth),
-        recording.dt * white_noise_sigma(&rate),
+        recording.dt * recording.white_noise_sigma(&rate),
     )
 }
 
@@ -370,8 +392,8 @@ fn position_noise(recording: &Recording) -> Vec<Vec3> {
             .collect();
         let position: Vec<f64> = p.iter().map(|x| x[a]).collect();
         let velocity: Vec<f64> = v.iter().map(|x| x[a]).collect();
-        let step = recording.dt * white_noise_sigma(&velocity);
-        smooth_noise(&series, white_noise_sigma(&position), step)
+        let step = recording.dt * recording.white_noise_sigma(&velocity);
+        smooth_noise(&series, recording.white_noise_sigma(&position), step)
     })
 }
 

@@ -40,6 +40,11 @@ fn flight(seed: u64) -> (Recording, Commands, Commands, Vec<Vec3>) {
         path: PathBuf::from("synthetic.csv"),
         dt: DT,
         time: Vec::new(),
+        sampling: sindy::sampling::Sampling::Uniform {
+            start: 0.0,
+            interval: DT,
+            len: ROWS,
+        },
         rotation: Vec::new(),
         velocity: Vec::new(),
         position: Vec::new(),

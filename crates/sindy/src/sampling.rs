@@ -207,7 +207,10 @@ mod tests {
         let sampling = Sampling::new(&even);
         assert!(sampling.is_uniform());
         assert!((sampling.interval() - 0.02).abs() < 1e-15);
-        assert_eq!(sampling.fourth_difference_weights(7), Some(FOURTH_DIFFERENCE));
+        assert_eq!(
+            sampling.fourth_difference_weights(7),
+            Some(FOURTH_DIFFERENCE)
+        );
         let stamped = Sampling::new(&jittered(100, 0.01, 0.15));
         assert!(!stamped.is_uniform());
         assert!((stamped.interval() - 0.01).abs() < 0.003);

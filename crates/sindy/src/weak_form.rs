@@ -222,7 +222,11 @@ impl WeakForm {
         let points: Vec<(f64, [f64; 2], f64)> = (first..=last)
             .map(|j| {
                 let offset = time[j] - time[k];
-                let before = if j > first { time[j] - time[j - 1] } else { 0.0 };
+                let before = if j > first {
+                    time[j] - time[j - 1]
+                } else {
+                    0.0
+                };
                 let after = if j < last { time[j + 1] - time[j] } else { 0.0 };
                 (offset / width, [offset, 1.0], 0.5 * (before + after))
             })
@@ -266,7 +270,10 @@ impl WeakForm {
         for (w, &(s, [a, b], length)) in weights.iter_mut().zip(points) {
             let u = a * b / width;
             let taper = self.function.shape(s) * length;
-            *w += taper * (0..4).map(|m| lambda[(m, 0)] * u.powi(m as i32)).sum::<f64>();
+            *w += taper
+                * (0..4)
+                    .map(|m| lambda[(m, 0)] * u.powi(m as i32))
+                    .sum::<f64>();
         }
     }
 
@@ -372,7 +379,11 @@ impl WeakForm {
                     (Some(weights), _) => weights,
                     (None, Some(time)) => {
                         stamped = self.mean_weights((first..=last).map(|j| {
-                            let before = if j > first { time[j] - time[j - 1] } else { 0.0 };
+                            let before = if j > first {
+                                time[j] - time[j - 1]
+                            } else {
+                                0.0
+                            };
                             let after = if j < last { time[j + 1] - time[j] } else { 0.0 };
                             (time[j] - time[k], 0.5 * (before + after))
                         }));

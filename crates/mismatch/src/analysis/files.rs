@@ -63,6 +63,7 @@ impl Analysis {
             recording: &report.recording,
             model: &report.model,
             rate_frame: &report.rate_frame,
+            time_stamps: report.time_stamps.as_ref(),
             channels: &report.channels,
             translational_only: self.problem.channels == 3,
             window_factor: settings.analysis.locate.window_factor,

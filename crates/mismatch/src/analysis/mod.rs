@@ -9,7 +9,7 @@ use data::FlightLog;
 use physics::vector::Vec3;
 use physics::{EffectId, EffectParameters, Effects, Logger, NominalModel, ParameterValue};
 pub use report::mismatch::recording::{
-    ChannelReport, Fit, Heldout, Mse, RateFrame, RateFrameReport, Window,
+    ChannelReport, Fit, Heldout, Mse, RateFrame, RateFrameReport, StampedTiming, Window,
 };
 use serde::Serialize;
 use sindy::stability::{Selection, SelectionSettings, stability_selection};
@@ -106,6 +106,9 @@ pub struct Report {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub command_limits: Option<[ActuatorLimits; 4]>,
     pub rate_frame: RateFrameReport,
+    /// The time stamps, when they are not evenly spaced.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_stamps: Option<StampedTiming>,
     /// How the recording's commands and rates were logged (from the model file).
     pub logger: Logger,
     /// What was taken out of sampled commands of a faster controller: their unfelt reaction to the
@@ -485,6 +488,7 @@ fn build_report(
             body_rms: problem.recording.rate_frame_errors.0,
             world_rms: problem.recording.rate_frame_errors.1,
         },
+        time_stamps: stamped_timing(problem),
         logger: problem.model.logger,
         noise_reaction: problem.recording.noise_reaction.clone(),
         selection: SelectionReport {
@@ -506,6 +510,32 @@ fn build_report(
         },
         settings: settings.analysis_record(),
     }
+}
+
+/// What the report says of a recording's time stamps when they are not evenly spaced.
+fn stamped_timing(problem: &Problem) -> Option<StampedTiming> {
+    use statrs::statistics::{Data, OrderStatistics};
+    let sampling = &problem.recording.sampling;
+    if sampling.is_uniform() {
+        return None;
+    }
+    let median = sampling.interval();
+    let ratios: Vec<f64> = (0..sampling.len() - 1)
+        .map(|k| sampling.interval_at(k) / median)
+        .collect();
+    let longest = ratios.iter().copied().fold(0.0, f64::max) * median;
+    let mut ratios = Data::new(ratios);
+    let gaps = sampling.gaps().len();
+    Some(StampedTiming {
+        median_interval_s: median,
+        interval_ratio_percentiles: [ratios.percentile(1), ratios.percentile(99)],
+        gaps,
+        gap_factor: sindy::sampling::GAP_FACTOR,
+        longest_interval_s: longest,
+        segments: gaps + 1,
+        compared_rows: problem.rows(),
+        rows: sampling.len(),
+    })
 }
 
 #[cfg(test)]

@@ -443,10 +443,22 @@ mod tests {
     fn delay_shifts_the_held_commands_and_lag_approaches_them() {
         let commands: Vec<[f64; 4]> = (0..6).map(|k| [k as f64, 0.0, 0.0, 0.0]).collect();
         let dt = 0.02;
-        let plain = actuator_trace(&CommandSamples::plain(&commands, 1), &even(dt, 6), &held(), 0.0, 0.0);
+        let plain = actuator_trace(
+            &CommandSamples::plain(&commands, 1),
+            &even(dt, 6),
+            &held(),
+            0.0,
+            0.0,
+        );
         assert_eq!(plain[SUBSTEPS * 2 + 3][0], 2.0);
         // Delay of exactly one interval: interval 3 sees command 2.
-        let delayed = actuator_trace(&CommandSamples::plain(&commands, 1), &even(dt, 6), &held(), dt, 0.0);
+        let delayed = actuator_trace(
+            &CommandSamples::plain(&commands, 1),
+            &even(dt, 6),
+            &held(),
+            dt,
+            0.0,
+        );
         assert!((delayed[SUBSTEPS * 3 + 5][0] - 2.0).abs() < 1e-12);
         // Half a sub-interval of delay mixes two commands half and half at the switch.
         let half = actuator_trace(
@@ -462,13 +474,25 @@ mod tests {
             command: CommandLogging::PeriodMean,
             ..Logger::default()
         };
-        let early = actuator_trace(&CommandSamples::plain(&commands, 1), &even(dt, 6), &mean, 0.0, 0.0);
+        let early = actuator_trace(
+            &CommandSamples::plain(&commands, 1),
+            &even(dt, 6),
+            &mean,
+            0.0,
+            0.0,
+        );
         assert!((early[SUBSTEPS * 2 + 3][0] - 3.0).abs() < 1e-12);
         // A lag follows a step monotonically, without overshoot, and reaches 1 − e^(−t/τ).
         let step: Vec<[f64; 4]> = (0..6)
             .map(|k| [if k >= 2 { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0])
             .collect();
-        let lagged = actuator_trace(&CommandSamples::plain(&step, 1), &even(dt, 6), &held(), 0.0, 0.05);
+        let lagged = actuator_trace(
+            &CommandSamples::plain(&step, 1),
+            &even(dt, 6),
+            &held(),
+            0.0,
+            0.05,
+        );
         let response: Vec<f64> = lagged[SUBSTEPS * 2..].iter().map(|a| a[0]).collect();
         assert!(response.windows(2).all(|w| w[1] > w[0] && w[1] < 1.0));
         let midpoint = (SUBSTEPS as f64 + 0.5) * dt / SUBSTEPS as f64;

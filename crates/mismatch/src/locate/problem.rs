@@ -154,7 +154,11 @@ impl Problem {
             )));
         }
         Ok(Self {
-            time: weak_form.centres.iter().map(|&k| recording.time[k]).collect(),
+            time: weak_form
+                .centres
+                .iter()
+                .map(|&k| recording.time[k])
+                .collect(),
             recording,
             model,
             weak_form,

@@ -86,6 +86,25 @@ pub struct RateFrameReport {
     pub world_rms: f64,
 }
 
+/// The time stamps of a recording that is not evenly spaced: every operator of the comparison
+/// then works on the samples' own times, and no window spans a gap.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StampedTiming {
+    /// The median sample interval, s.
+    pub median_interval_s: f64,
+    /// The 1st and 99th percentiles of each interval divided by the median one.
+    pub interval_ratio_percentiles: [f64; 2],
+    /// Intervals longer than `gap_factor` median intervals, which split the recording.
+    pub gaps: usize,
+    pub gap_factor: f64,
+    pub longest_interval_s: f64,
+    /// Stretches between gaps.
+    pub segments: usize,
+    /// Rows with a whole window of the comparison between gaps, at which it is made.
+    pub compared_rows: usize,
+    pub rows: usize,
+}
+
 /// The thresholds an effect passes to be named.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EvidenceRule {
@@ -168,6 +187,8 @@ pub struct RecordingView<'a> {
     pub recording: &'a str,
     pub model: &'a str,
     pub rate_frame: &'a RateFrameReport,
+    /// When the recording is not evenly spaced, its time stamps.
+    pub time_stamps: Option<&'a StampedTiming>,
     pub channels: &'a [ChannelReport],
     /// Only the translational channels were compared (the model predicts no torques).
     pub translational_only: bool,
@@ -269,6 +290,20 @@ impl RecordingView<'_> {
             "The `w` column was read in {frame}: it matches the rate implied by the recorded attitude with an RMS error of {:.4} rad/s in the body frame and {:.4} rad/s in the world frame.\n",
             self.rate_frame.body_rms, self.rate_frame.world_rms
         );
+        if let Some(stamps) = self.time_stamps {
+            let [low, high] = stamps.interval_ratio_percentiles;
+            let _ = writeln!(
+                md,
+                "The time stamps are not evenly spaced: the median interval is {:.4} s and 98% of the intervals lie between {low:.2} and {high:.2} times it; {} gaps longer than {} median intervals (the longest {:.3} s) split the recording into {} segments. Every operator works on the samples' own times, and the comparison is made at the {} of the {} rows whose window spans no gap.\n",
+                stamps.median_interval_s,
+                stamps.gaps,
+                stamps.gap_factor,
+                stamps.longest_interval_s,
+                stamps.segments,
+                stamps.compared_rows,
+                stamps.rows
+            );
+        }
     }
 
     /// The channels against their noise floors and the stretches that disagree.
@@ -631,6 +666,7 @@ mod tests {
             recording: "flight.csv",
             model: "model.json",
             rate_frame: &rate_frame,
+            time_stamps: None,
             channels: &channels,
             translational_only: true,
             window_factor: 2.5,
@@ -719,6 +755,7 @@ mod tests {
             recording: "calm.csv",
             model: "model.json",
             rate_frame: &rate_frame,
+            time_stamps: None,
             channels: &channels,
             translational_only: false,
             window_factor: 2.5,

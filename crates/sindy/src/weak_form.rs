@@ -14,6 +14,10 @@
 //! bandwidth: no finite-difference or smoothing bias enters either side. The noise of the target is
 //! `σ √(Σ ψ_j²)` for white sample noise `σ` and weights `ψ_j`; neighbouring rows share samples, so
 //! their noises are correlated over the support (tests work on blocks longer than it).
+//!
+//! The operator works on a [`Sampling`]: evenly spaced samples share one set of weights; on
+//! logged stamps every window has its own (a trapezoid on the stamps made exact on cubics), and
+//! only the rows whose window spans no gap are centres ([`WeakForm::centres`]).
 
 use serde::Serialize;
 

@@ -68,8 +68,11 @@ pub struct FlightLog {
     /// `T_sp`: normalised thrust setpoint.
     pub thrust_setpoint: Vec<f64>,
     pub hover_throttle: Vec<f64>,
-    /// `pwm`: the four motor commands, about 1000 to 2000.
+    /// `pwm`: the four motor commands, about 1000 to 2000 (as logged, in another layout:
+    /// [`crate::layout`]).
     pub motor_command: Vec<[f64; 4]>,
+    /// Battery voltage, V, when the layout has it (never in the Neural-Fly layout).
+    pub battery_voltage: Option<Vec<f64>>,
     pub position_desired: Option<Vec<[f64; 3]>>,
     pub velocity_desired: Option<Vec<[f64; 3]>>,
     pub attitude_setpoint: Option<Vec<[f64; 4]>>,
@@ -290,6 +293,7 @@ impl FlightLog {
             thrust_setpoint: scalars("T_sp")?,
             hover_throttle: scalars("hover_throttle")?,
             motor_command: arrays4("pwm")?,
+            battery_voltage: None,
             position_desired: optional3("p_d")?,
             velocity_desired: optional3("v_d")?,
             attitude_setpoint: if table.has_column("q_sp") {
@@ -334,6 +338,10 @@ impl FlightLog {
             thrust_setpoint: self.thrust_setpoint[rows.clone()].to_vec(),
             hover_throttle: self.hover_throttle[rows.clone()].to_vec(),
             motor_command: self.motor_command[rows.clone()].to_vec(),
+            battery_voltage: self
+                .battery_voltage
+                .as_ref()
+                .map(|v| v[rows.clone()].to_vec()),
             position_desired: part(&self.position_desired),
             velocity_desired: part(&self.velocity_desired),
             attitude_setpoint: self

@@ -19,6 +19,7 @@ mod cells;
 mod conditions;
 mod error;
 mod flight_log;
+pub mod layout;
 mod numeric;
 mod records;
 mod source;

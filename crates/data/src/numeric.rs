@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::cells::NumericColumn;
-use crate::error::Result;
+use crate::error::{DataError, Result};
 use crate::records::CsvRecords;
 use crate::stream::NumericRows;
 use crate::table::TextTable;
@@ -28,6 +28,39 @@ impl NumericTable {
     /// same first error in file order.
     pub fn read(path: &Path, columns: &[&str]) -> Result<Self> {
         let records = CsvRecords::open(path)?;
+        let mut rows = NumericRows::new(path, records, columns)?;
+        let block = rows
+            .next_block(usize::MAX)?
+            .expect("a file without rows is an error");
+        Ok(Self {
+            path: path.to_path_buf(),
+            names: columns.iter().map(|s| s.to_string()).collect(),
+            columns: block.columns,
+            lines: block.lines,
+        })
+    }
+
+    /// [`NumericTable::read`] of a file whose header line begins with `prefix`, which is not part
+    /// of the first column's name (a header written as a comment, `# a,b,c`, as numpy's `savetxt`
+    /// writes it); the error names the file when its first line does not begin so.
+    pub fn read_after_header_prefix(path: &Path, prefix: &str, columns: &[&str]) -> Result<Self> {
+        use std::io::BufRead;
+        let io = |source| DataError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file = bounded_read::open(path, bounded_read::InputKind::Csv).map_err(io)?;
+        let mut input = std::io::BufReader::with_capacity(1 << 16, file);
+        let start = input.fill_buf().map_err(io)?;
+        if !start.starts_with(prefix.as_bytes()) {
+            return Err(DataError::Config {
+                path: path.to_path_buf(),
+                field: "header_prefix".into(),
+                message: format!("the file's first line does not begin with {prefix:?}"),
+            });
+        }
+        input.consume(prefix.len());
+        let records = CsvRecords::new(path, input);
         let mut rows = NumericRows::new(path, records, columns)?;
         let block = rows
             .next_block(usize::MAX)?

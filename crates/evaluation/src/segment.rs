@@ -236,6 +236,7 @@ mod tests {
             thrust_setpoint: vec![0.5; n],
             hover_throttle: vec![0.5; n],
             motor_command: vec![[1500.0; 4]; n],
+            battery_voltage: None,
             position_desired: None,
             velocity_desired: None,
             attitude_setpoint: None,

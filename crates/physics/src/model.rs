@@ -5,6 +5,9 @@
 //! `m v̇ = m [0, 0, −g] + R [0, 0, T]` and `J ω̇ = −ω × (J ω) + τ`.
 //! With `"thrust_source": "T_sp"`, `T = m g T_sp / hover_throttle` and the torques are unknown;
 //! with `"mixer"`, `[T, τx, τy, τz] = b0 · s²` where `s_i = (pwm_i − pwm_offset) / pwm_scale`.
+//! A `"vehicle"` description of four rotors (a file beside the model, or inline) gives the mixer
+//! instead: `s_i² = n_i` the rotor's thrust in units of its coefficient, from its logged command
+//! (and the battery voltage) through the vehicle's command map.
 
 use std::path::{Path, PathBuf};
 
@@ -15,6 +18,7 @@ use crate::error::{PhysicsError, Result};
 use crate::logger::Logger;
 use crate::ranges::{self, PhysicalRange};
 use crate::vector::{E3, Vec3, add, cross, hadamard, mat_vec, scale};
+use crate::vehicle::{CommandMap, VehicleDescription};
 
 /// Where the collective thrust comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -36,6 +40,9 @@ pub struct Mixer {
     pub b0: [[f64; 4]; 4],
     #[serde(skip)]
     inverse: [[f64; 4]; 4],
+    /// With a vehicle description: its command map, through which `s² = n(u, V)`.
+    #[serde(skip)]
+    command_map: Option<CommandMap>,
 }
 
 /// Thrust (N) and, when the model knows them, body torques (N·m).
@@ -60,6 +67,9 @@ pub struct NominalModel {
     /// command sampled at each row's time, no rate filter).
     #[serde(skip_serializing_if = "Logger::is_default")]
     pub logger: Logger,
+    /// The vehicle the mixer was derived from, when the model file gave one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vehicle: Option<VehicleDescription>,
 }
 
 impl Mixer {
@@ -71,12 +81,50 @@ impl Mixer {
             pwm_scale,
             b0,
             inverse,
+            command_map: None,
         })
     }
 
-    /// Normalised motor speeds `s_i = (pwm_i − pwm_offset) / pwm_scale`, clipped at 0.
-    pub fn speeds(&self, pwm: &[f64; 4]) -> [f64; 4] {
-        pwm.map(|p| ((p - self.pwm_offset) / self.pwm_scale).max(0.0))
+    /// The mixer of a vehicle of four rotors: `b0`'s columns are the allocation's times each
+    /// rotor's thrust coefficient, and `s_i² = n_i(u_i, V)`.
+    pub fn from_vehicle(vehicle: &VehicleDescription) -> Option<Self> {
+        if vehicle.rotors.len() != 4 {
+            return None;
+        }
+        let rows = vehicle.allocation().rows();
+        let b0 = std::array::from_fn(|r| {
+            std::array::from_fn(|i| rows[r][i] * vehicle.rotors[i].thrust_coefficient_n)
+        });
+        let mut mixer = Self::new(0.0, 1.0, b0)?;
+        mixer.command_map = Some(vehicle.command_map.clone());
+        Some(mixer)
+    }
+
+    /// Whether the speeds need the battery voltage.
+    pub fn needs_battery_voltage(&self) -> bool {
+        self.command_map
+            .as_ref()
+            .is_some_and(|map| map.thrust.needs_voltage())
+    }
+
+    /// Normalised motor speeds `s_i = (pwm_i − pwm_offset) / pwm_scale`, clipped at 0 (through the
+    /// command map with a vehicle: `s_i = √n_i(u_i, V)`, NaN without a voltage it needs).
+    pub fn speeds(&self, pwm: &[f64; 4], battery_v: Option<f64>) -> [f64; 4] {
+        match &self.command_map {
+            Some(map) => pwm.map(|command| {
+                let u = map.command.scaled(command);
+                map.thrust
+                    .relative_thrust(u, battery_v)
+                    .map_or(f64::NAN, f64::sqrt)
+            }),
+            None => pwm.map(|p| ((p - self.pwm_offset) / self.pwm_scale).max(0.0)),
+        }
+    }
+
+    /// Whether motor commands are written through `pwm_offset` and `pwm_scale` (not a vehicle's
+    /// command map, which the simulator cannot invert).
+    pub fn writes_pwm(&self) -> bool {
+        self.command_map.is_none()
     }
 
     /// The motor commands of normalised speeds.
@@ -158,17 +206,31 @@ impl NominalModel {
                 ));
             }
         };
-        let mixer = match object.get("mixer") {
+        let vehicle = match object.get("vehicle") {
             None | Some(Value::Null) => None,
-            Some(Value::Object(mixer)) => Some(fields.mixer(mixer)?),
-            Some(other) => {
+            Some(value) => Some(fields.vehicle(value)?),
+        };
+        let mixer = match (object.get("mixer"), &vehicle) {
+            (None | Some(Value::Null), None) => None,
+            (None | Some(Value::Null), Some(vehicle)) => Some(fields.vehicle_mixer(vehicle)?),
+            (Some(_), Some(_)) => {
+                return Err(fields.error(
+                    "mixer",
+                    "give a mixer or a vehicle, not both (the vehicle's gives the mixer)",
+                ));
+            }
+            (Some(Value::Object(mixer)), None) => Some(fields.mixer(mixer)?),
+            (Some(other), None) => {
                 return Err(fields.error("mixer", &format!("expected an object, found {other}")));
             }
         };
         if thrust_source == ThrustSource::Mixer && mixer.is_none() {
-            return Err(fields.error("mixer", "missing, but thrust_source is \"mixer\""));
+            return Err(fields.error(
+                "mixer",
+                "missing, but thrust_source is \"mixer\" (give a mixer or a vehicle)",
+            ));
         }
-        if let Some(mixer) = &mixer {
+        if let (Some(mixer), None) = (&mixer, &vehicle) {
             fields.check_lift(mixer, mass_kg * gravity_m_s2)?;
         }
         let ground_height_m = match object.get("ground_height_m") {
@@ -187,12 +249,29 @@ impl NominalModel {
             mixer,
             ground_height_m,
             logger,
+            vehicle,
         })
     }
 
-    /// Serialises the model in the documented JSON schema.
+    /// Serialises the model in the documented JSON schema (with a vehicle, the vehicle inline
+    /// instead of the mixer derived from it).
     pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).expect("a model serialises")
+        let mut value = serde_json::to_value(self).expect("a model serialises");
+        if self.vehicle.is_some()
+            && let Some(object) = value.as_object_mut()
+        {
+            object.remove("mixer");
+        }
+        serde_json::to_string_pretty(&value).expect("a model serialises")
+    }
+
+    /// Whether the motor commands need the battery voltage to give thrust.
+    pub fn needs_battery_voltage(&self) -> bool {
+        self.thrust_source == ThrustSource::Mixer
+            && self
+                .mixer
+                .as_ref()
+                .is_some_and(Mixer::needs_battery_voltage)
     }
 
     /// Whether the model predicts body torques (it has a mixer and uses it).
@@ -207,13 +286,14 @@ impl NominalModel {
         thrust_setpoint: f64,
         hover_throttle: f64,
         pwm: &[f64; 4],
+        battery_v: Option<f64>,
     ) -> [f64; 4] {
         match self.thrust_source {
             ThrustSource::Mixer => self
                 .mixer
                 .as_ref()
                 .expect("validated: a mixer model has a mixer")
-                .speeds(pwm),
+                .speeds(pwm, battery_v),
             ThrustSource::ThrustSetpoint => [
                 self.mass_kg * self.gravity_m_s2 * thrust_setpoint / hover_throttle,
                 0.0,
@@ -307,7 +387,7 @@ pub fn angular_acceleration_with_inertia(inertia: Vec3, rate: Vec3, torque: Vec3
 }
 
 /// The fields of a model file; any other is an error (as `deny_unknown_fields` elsewhere).
-const MODEL_KEYS: [&str; 7] = [
+const MODEL_KEYS: [&str; 8] = [
     "mass_kg",
     "gravity_m_s2",
     "inertia_kg_m2",
@@ -315,6 +395,7 @@ const MODEL_KEYS: [&str; 7] = [
     "mixer",
     "ground_height_m",
     "logger",
+    "vehicle",
 ];
 /// The fields of the `mixer` object.
 const MIXER_KEYS: [&str; 3] = ["pwm_offset", "pwm_scale", "b0"];
@@ -439,6 +520,35 @@ impl FieldReader {
             .validate()
             .map_err(|(field, message)| self.error(&format!("logger.{field}"), &message))?;
         Ok(logger)
+    }
+
+    /// The `vehicle` field: a vehicle description file's path (relative to the model file) or the
+    /// description itself.
+    fn vehicle(&self, value: &Value) -> Result<VehicleDescription> {
+        match value {
+            Value::String(relative) => {
+                let path = self.path.parent().unwrap_or(Path::new(".")).join(relative);
+                VehicleDescription::load(&path)
+            }
+            Value::Object(_) => VehicleDescription::from_json(&value.to_string(), &self.path),
+            other => Err(self.error(
+                "vehicle",
+                &format!("expected a file name or an object, found {other}"),
+            )),
+        }
+    }
+
+    /// The mixer of a vehicle of four rotors.
+    fn vehicle_mixer(&self, vehicle: &VehicleDescription) -> Result<Mixer> {
+        Mixer::from_vehicle(vehicle).ok_or_else(|| {
+            self.error(
+                "vehicle",
+                &format!(
+                    "the model takes a vehicle of 4 rotors whose allocation is invertible; this one has {} rotors",
+                    vehicle.rotors.len()
+                ),
+            )
+        })
     }
 
     fn mixer(&self, mixer: &Map<String, Value>) -> Result<Mixer> {
@@ -625,7 +735,7 @@ mod tests {
             r#"{"mass_kg": 2.644, "gravity_m_s2": 9.81, "inertia_kg_m2": [0.03, 0.03, 0.05], "thrust_source": "T_sp"}"#,
         )
         .unwrap();
-        let command = model.actuator_command(0.5, 0.5, &[0.0; 4]);
+        let command = model.actuator_command(0.5, 0.5, &[0.0; 4], None);
         assert!((model.wrench(&command).thrust - 2.644 * 9.81).abs() < 1e-12);
         let level = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
         let a = model.translational_acceleration(&level, 2.644 * 9.81);

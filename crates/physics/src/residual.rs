@@ -33,6 +33,7 @@ pub fn residual_force(model: &NominalModel, log: &FlightLog) -> Vec<Vec3> {
                 log.thrust_setpoint[k],
                 log.hover_throttle[k],
                 &log.motor_command[k],
+                log.battery_voltage.as_ref().map(|v| v[k]),
             );
             let thrust = model.wrench(&command).thrust;
             let acceleration = [derivatives[0][k], derivatives[1][k], derivatives[2][k]];

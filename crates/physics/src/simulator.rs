@@ -212,6 +212,11 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
             "the simulator needs a model with a mixer (thrust_source \"mixer\")".into(),
         )
     })?;
+    if !mixer.writes_pwm() {
+        return Err(PhysicsError::Simulation(
+            "the simulator writes motor commands through a mixer's pwm_offset and pwm_scale; a model with a vehicle's command map is for analysing recordings".into(),
+        ));
+    }
     let mut flight = Flight::new(model, mixer, scenario);
     let per_row = scenario.controller_steps_per_row();
     let warmup_steps = scenario.warmup_rows() * per_row;
@@ -606,6 +611,7 @@ fn empty_log(name: &str, rows: usize) -> FlightLog {
         thrust_setpoint: Vec::with_capacity(rows),
         hover_throttle: Vec::with_capacity(rows),
         motor_command: Vec::with_capacity(rows),
+        battery_voltage: None,
         position_desired: Some(Vec::with_capacity(rows)),
         velocity_desired: Some(Vec::with_capacity(rows)),
         attitude_setpoint: Some(Vec::with_capacity(rows)),

@@ -21,6 +21,8 @@
 
 use serde::Serialize;
 
+use std::sync::OnceLock;
+
 use faer::Mat;
 
 use crate::sampling::Sampling;
@@ -102,6 +104,8 @@ impl TestFunction {
             centres: Vec::new(),
             windows: Vec::new(),
             even_weights: None,
+            stamped_target: OnceLock::new(),
+            stamped_model: OnceLock::new(),
         };
         match sampling {
             Sampling::Uniform { len, .. } => {
@@ -159,6 +163,31 @@ fn stamped_windows(
     (centres, windows)
 }
 
+/// Per-centre weights end to end, with where each centre's start (one more entry: the end).
+#[derive(Clone, Debug, Default)]
+struct Packed {
+    values: Vec<f64>,
+    starts: Vec<usize>,
+}
+
+impl Packed {
+    fn of(parts: impl Iterator<Item = Vec<f64>>) -> Self {
+        let mut packed = Self {
+            values: Vec::new(),
+            starts: vec![0],
+        };
+        for part in parts {
+            packed.values.extend(part);
+            packed.starts.push(packed.values.len());
+        }
+        packed
+    }
+
+    fn part(&self, index: usize) -> &[f64] {
+        &self.values[self.starts[index]..self.starts[index + 1]]
+    }
+}
+
 /// The test function on a recording's samples: the target's sample weights and the model side's
 /// weight at any time, at the rows whose window fits ([`WeakForm::centres`]).
 #[derive(Clone, Debug)]
@@ -178,6 +207,11 @@ pub struct WeakForm {
     windows: Vec<(usize, usize)>,
     /// When evenly spaced, the weights every centre shares: `ψ_j = −φ'(j dt) dt`, `j = −half … half`.
     even_weights: Option<Vec<f64>>,
+    /// When stamped, each centre's target weights end to end, made at the first use.
+    stamped_target: OnceLock<Packed>,
+    /// When stamped, the number of points per interval and each centre's model-side weights end
+    /// to end, made at the first use.
+    stamped_model: OnceLock<(usize, Packed)>,
 }
 
 impl WeakForm {
@@ -217,10 +251,20 @@ impl WeakForm {
     }
 
     /// The target's sample weights at the `index`-th centre, from its window's first sample.
-    fn target_weights(&self, index: usize) -> std::borrow::Cow<'_, [f64]> {
-        let Some(time) = self.stamps() else {
-            return std::borrow::Cow::Borrowed(self.even_weights.as_deref().expect("even"));
-        };
+    fn target_weights(&self, index: usize) -> &[f64] {
+        if let Some(weights) = &self.even_weights {
+            return weights;
+        }
+        self.stamped_target
+            .get_or_init(|| {
+                Packed::of((0..self.centres.len()).map(|i| self.stamped_target_weights(i)))
+            })
+            .part(index)
+    }
+
+    /// [`Self::target_weights`] of a stamped form, computed.
+    fn stamped_target_weights(&self, index: usize) -> Vec<f64> {
+        let time = self.stamps().expect("stamped");
         let (k, (first, last)) = (self.centres[index], self.windows[index]);
         let width = self.half as f64 * self.dt;
         let points: Vec<(f64, [f64; 2], f64)> = (first..=last)
@@ -237,7 +281,7 @@ impl WeakForm {
             .collect();
         let mut weights = self.derivative_weights(&points);
         self.exact_on_cubics(&mut weights, &points);
-        std::borrow::Cow::Owned(weights)
+        weights
     }
 
     /// Corrects stamped weights so that the target is exact on every cubic in time, as the
@@ -342,20 +386,13 @@ impl WeakForm {
                 (0..2 * self.half * substeps).map(|i| ((i as f64 + 0.5) * h - offset, h)),
             )
         });
+        let stamped = even.is_none().then(|| self.stamped_model_weights(substeps));
         (0..self.centres.len())
             .map(|index| {
-                let (k, (first, last)) = (self.centres[index], self.windows[index]);
-                let stamped;
-                let weights = match (&even, self.stamps()) {
-                    (Some(weights), _) => weights,
-                    (None, Some(time)) => {
-                        stamped = self.mean_weights((first..last).flat_map(|i| {
-                            let h = (time[i + 1] - time[i]) / parts;
-                            let start = time[i] - time[k];
-                            (0..substeps).map(move |s| (start + (s as f64 + 0.5) * h, h))
-                        }));
-                        &stamped
-                    }
+                let first = self.windows[index].0;
+                let weights = match (&even, stamped) {
+                    (Some(weights), _) => weights.as_slice(),
+                    (None, Some(packed)) => packed.part(index),
                     (None, None) => unreachable!("a form is even or stamped"),
                 };
                 weights
@@ -365,6 +402,29 @@ impl WeakForm {
                     .sum()
             })
             .collect()
+    }
+
+    /// Each centre's model-side weights on stamps at `substeps` points per interval (made once).
+    fn stamped_model_weights(&self, substeps: usize) -> &Packed {
+        let (made_for, packed) = self.stamped_model.get_or_init(|| {
+            let time = self.stamps().expect("stamped");
+            let parts = substeps as f64;
+            let packed = Packed::of(self.centres.iter().zip(&self.windows).map(
+                |(&k, &(first, last))| {
+                    self.mean_weights((first..last).flat_map(|i| {
+                        let h = (time[i + 1] - time[i]) / parts;
+                        let start = time[i] - time[k];
+                        (0..substeps).map(move |s| (start + (s as f64 + 0.5) * h, h))
+                    }))
+                },
+            ));
+            (substeps, packed)
+        });
+        assert_eq!(
+            *made_for, substeps,
+            "a stamped weak form integrates at one number of points per interval"
+        );
+        packed
     }
 
     /// `∫ φ x dt` at the centres of a signal given at the rows themselves.

@@ -29,9 +29,14 @@ use super::Global;
         .args(["recording", "demo", "flights"])
 ))]
 pub struct Args {
-    /// A recording in the Neural-Fly CSV layout.
+    /// A recording: in the Neural-Fly CSV layout, or a CSV file or PX4 ULog that --layout describes.
     #[arg(long, conflicts_with_all = ["demo", "flights"])]
     pub recording: Option<PathBuf>,
+    /// With --recording: a layout description (JSON) saying which columns or ULog topics hold the
+    /// recording's time, position, velocity, attitude, body rate, motor commands and battery
+    /// voltage, and in which units and frames (docs/layouts.md).
+    #[arg(long, requires = "recording")]
+    pub layout: Option<PathBuf>,
     /// The nominal model JSON (with --recording or --flights; not with --demo: each scenario names
     /// its own model).
     #[arg(long, conflicts_with = "demo", required_unless_present = "demo")]
@@ -194,12 +199,19 @@ fn run_flights(
     Ok(())
 }
 
-/// The recording, or the rows of it that `--rows` asks for.
+/// The recording (through its layout, when given), or the rows of it that `--rows` asks for.
 fn read_recording(
     recording: &Path,
+    layout: Option<&Path>,
     rows: Option<&std::ops::Range<usize>>,
 ) -> anyhow::Result<data::FlightLog> {
-    let log = data::FlightLog::read(recording)?;
+    let log = match layout {
+        Some(layout) => {
+            let layout = data::layout::RecordingLayout::load(layout)?;
+            data::layout::read_with_layout(recording, &layout)?
+        }
+        None => data::FlightLog::read(recording)?,
+    };
     let Some(rows) = rows else {
         return Ok(log);
     };
@@ -224,6 +236,9 @@ fn run_recording(
     let mut set = OutputSet::new("mismatch --recording");
     set.input("the --model file", model_path);
     set.input("the --recording", recording);
+    if let Some(layout) = &args.layout {
+        set.input("the --layout file", layout);
+    }
     let out = set.folder(&args.out, "--out", Existing::from_force(args.force));
     for name in ANALYSIS_FILES {
         set.file_in(out, name);
@@ -231,7 +246,7 @@ fn run_recording(
     set.check()?;
     let model = load_model(model_path)?;
     let staged = set.prepare()?;
-    let log = read_recording(recording, args.rows.as_ref())?;
+    let log = read_recording(recording, args.layout.as_deref(), args.rows.as_ref())?;
     let spinner = super::progress::spinner(global.show_progress(), "preparing the recording");
     let analysis = mismatch::analyze_observed(
         &log,

@@ -130,6 +130,7 @@ pub fn flight(wind: f64) -> FlightLog {
             })
             .collect(),
         position_desired: None,
+        battery_voltage: None,
         velocity_desired: None,
         attitude_setpoint: None,
         residual_force: None,

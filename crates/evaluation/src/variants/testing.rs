@@ -68,6 +68,7 @@ pub(super) fn cell(support: Segment, query: Segment) -> EvaluationCell {
         thrust_setpoint: Vec::new(),
         hover_throttle: Vec::new(),
         motor_command: Vec::new(),
+        battery_voltage: None,
         position_desired: None,
         velocity_desired: None,
         attitude_setpoint: None,

@@ -100,12 +100,18 @@ impl Recording {
                 .map(|(r, w)| mat_t_vec(r, *w))
                 .collect(),
         };
+        if model.needs_battery_voltage() && log.battery_voltage.is_none() {
+            return Err(bad(
+                "the model's thrust map depends on the battery voltage, and the recording has none (map a battery_voltage column in its layout)".into(),
+            ));
+        }
         let commands: Vec<[f64; 4]> = (0..log.len())
             .map(|k| {
                 model.actuator_command(
                     log.thrust_setpoint[k],
                     log.hover_throttle[k],
                     &log.motor_command[k],
+                    log.battery_voltage.as_ref().map(|v| v[k]),
                 )
             })
             .collect();

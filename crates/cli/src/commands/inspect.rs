@@ -70,7 +70,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     if super::sindy::is_ulog(&args.file) {
         return inspect_ulog(&args.file);
     }
-    let (log, columns) = FlightLog::read_with_columns(&args.file)?;
+    let (log, columns) = FlightLog::read_with_columns(&args.file, data::Spacing::Uniform)?;
     let n = log.len();
     let dt = log.sample_interval();
     say!("file:      {}", args.file.display());

@@ -30,11 +30,15 @@ pub struct SampleTiming {
     /// The 1st and the 99th percentile of the intervals, relative to the median (the jitter).
     pub p01_ratio: f64,
     pub p99_ratio: f64,
-    /// Whether every interval lies within [`DEFAULT_UNIFORM_TOLERANCE`] of the median (what
+    /// Whether every interval lies within `uniform_tolerance` of the median (what
     /// [`Spacing::Uniform`] accepts).
     pub uniform: bool,
-    /// Intervals longer than [`GAP_INTERVALS`] median intervals.
+    /// [`DEFAULT_UNIFORM_TOLERANCE`], relative to the median.
+    pub uniform_tolerance: f64,
+    /// Intervals longer than `gap_intervals` median intervals.
     pub gaps: usize,
+    /// [`GAP_INTERVALS`].
+    pub gap_intervals: f64,
     /// The longest interval, and the time of the sample it starts at.
     pub longest_s: f64,
     pub longest_at_s: f64,
@@ -55,10 +59,12 @@ impl SampleTiming {
             uniform: intervals
                 .iter()
                 .all(|i| (i - median).abs() <= DEFAULT_UNIFORM_TOLERANCE * median),
+            uniform_tolerance: DEFAULT_UNIFORM_TOLERANCE,
             gaps: intervals
                 .iter()
                 .filter(|&&i| i > GAP_INTERVALS * median)
                 .count(),
+            gap_intervals: GAP_INTERVALS,
             longest_s: intervals[longest],
             longest_at_s: time[longest],
         })

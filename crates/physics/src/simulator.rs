@@ -7,8 +7,8 @@
 //! [`crate::LogTiming`] draws: jittered, dropped, gaps): the measured state at that instant and the
 //! command as the scenario's [`crate::Logger`] records it (the instantaneous command, the mean over
 //! the log period, either shifted by whole control steps; each command held to the next row when
-//! the controller runs at the log rate). The rigid body is integrated with RK4
-//! at `physics_rate_hz`; with a motor lag the four motor speeds are part of the state. Measurement
+//! the controller runs at the log rate). The rigid body is integrated with RK4 at
+//! `physics_rate_hz`; with a motor lag the four motor speeds are part of the state. Measurement
 //! noise (Gaussian, from the scenario's seed) is added to position, velocity, attitude and body
 //! rate, the rate after the logger's optional first-order filter; the controller sees the noisy
 //! values, as on a real vehicle. An optional band-limited [`crate::Jitter`] is added to the

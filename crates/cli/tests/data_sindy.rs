@@ -146,6 +146,12 @@ fn a_pipe_is_read_like_a_file() {
 
 /// A 5-row flight log with the given columns (`q` and/or `R`).
 fn flight(with_q: bool, with_r: bool) -> String {
+    let times: Vec<String> = (0..5).map(|k| format!("{:.2}", k as f64 * 0.02)).collect();
+    flight_at(with_q, with_r, &times)
+}
+
+/// A flight log with the given columns, a row at each of `times`.
+fn flight_at(with_q: bool, with_r: bool, times: &[String]) -> String {
     let mut header = vec!["t", "p", "v"];
     if with_q {
         header.push("q");
@@ -155,9 +161,9 @@ fn flight(with_q: bool, with_r: bool) -> String {
     }
     header.extend(["w", "T_sp", "hover_throttle", "pwm", "battery"]);
     let mut text = header.join(",") + "\n";
-    for k in 0..5 {
+    for time in times {
         let mut cells = vec![
-            format!("{:.2}", k as f64 * 0.02),
+            time.clone(),
             "\"[0.0, 0.0, 1.0]\"".to_string(),
             "\"[0.0, 0.0, 0.0]\"".to_string(),
         ];
@@ -209,6 +215,55 @@ fn inspect_lists_the_columns_the_file_has() {
     .unwrap();
     learn_in(&dir, &["data", "inspect", "dup.csv"])
         .one_line_error(&["dup.csv:1:pwm:", "appears twice"]);
+}
+
+/// A deterministic pseudo-random offset in [−1, 1] for sample `k` (a SplitMix64 hash).
+fn offset(k: usize) -> f64 {
+    let mut z = (k as u64)
+        .wrapping_add(1)
+        .wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^= z >> 31;
+    2.0 * (z >> 11) as f64 / (1u64 << 53) as f64 - 1.0
+}
+
+/// `learn data inspect` reads a log however its samples are spaced and says how: one line for
+/// uniform samples; the median, the jitter and the gaps of a real logger's time stamps.
+#[test]
+fn inspect_reports_how_the_samples_are_spaced() {
+    let dir = scratch("inspect-spacing");
+    let uniform: Vec<String> = (0..400)
+        .map(|k| format!("{:.2}", k as f64 * 0.02))
+        .collect();
+    std::fs::write(dir.join("uniform.csv"), flight_at(true, false, &uniform)).unwrap();
+    let run = learn_in(&dir, &["data", "inspect", "uniform.csv"]);
+    let out = run.success();
+    assert!(
+        out.contains("\nspacing:   uniform, every interval within 1 % of the median 0.020000 s\n"),
+        "{out}"
+    );
+    assert!(!out.contains("gaps:"), "{out}");
+    // Each stamp moved by up to ±20 % of the interval, every tenth row dropped, and no row from
+    // t = 4 s to 5 s: refused as not uniform before.
+    let uneven: Vec<String> = (0..400)
+        .filter(|k| k % 10 != 7)
+        .map(|k| k as f64 * 0.02 + 0.004 * offset(k))
+        .filter(|t| !(4.0..5.0).contains(t))
+        .map(|t| format!("{t}"))
+        .collect();
+    std::fs::write(dir.join("uneven.csv"), flight_at(true, false, &uneven)).unwrap();
+    let run = learn_in(&dir, &["data", "inspect", "uneven.csv"]);
+    let out = run.success();
+    // The drops double a tenth of the intervals: the 99th percentile is above 2.
+    assert!(
+        out.contains(
+            "\nspacing:   uneven (readers of uniform samples, as the paper's pipelines, refuse it): median interval 0.020390 s (49.043 Hz), 1st to 99th percentile 0.663 to 2.248 × the median\n\
+             gaps:      1 interval over 3 × the median; the longest interval 1.003893 s (49.2 × the median) from t = 3.999 s\n"
+        ),
+        "{out}"
+    );
+    assert!(out.contains("\nsamples:   316\n"), "{out}");
 }
 
 fn conditions(pattern: &str, conditions: &str) -> String {

@@ -10,7 +10,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{DataError, Result};
 use crate::table::TextTable;
-use crate::time::{check_interval_range, check_time_axis_at};
+use crate::time::{
+    SampleTiming, Spacing, check_interval_range, check_time_axis_at, median_interval,
+};
 
 /// `<vehicle>_<trajectory>_<method>_<condition>.csv`, as the Neural-Fly data names its files.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -56,7 +58,7 @@ impl FlightMeta {
 pub struct FlightLog {
     pub path: PathBuf,
     pub meta: Option<FlightMeta>,
-    /// Time in seconds, strictly increasing at a uniform rate.
+    /// Time in seconds, strictly increasing (at a uniform rate when read with [`Spacing::Uniform`]).
     pub time: Vec<f64>,
     pub position: Vec<[f64; 3]>,
     pub velocity: Vec<[f64; 3]>,
@@ -201,25 +203,26 @@ pub enum RateFrame {
 }
 
 impl FlightLog {
-    /// Reads and validates a log. Errors name the file, row and column. Besides the layout and the
-    /// attitude, the values must be physically plausible: every sample interval in
+    /// Reads and validates a uniformly sampled log ([`Spacing::Uniform`]: the paper's pipelines
+    /// difference at a fixed step). Errors name the file, row and column. Besides the layout and
+    /// the attitude, the values must be physically plausible: every sample interval in
     /// `SAMPLE_INTERVAL_RANGE_S` and every quantity in its `PLAUSIBLE_RANGES` (see this module).
     pub fn read(path: &Path) -> Result<Self> {
-        Self::read_with_columns(path).map(|(log, _)| log)
+        Self::read_spaced(path, Spacing::Uniform)
     }
 
-    /// [`FlightLog::read`], also returning the names of the file's columns in file order (what a
-    /// log does not keep: which of `q` and `R` were recorded, and columns it does not use).
-    pub fn read_with_columns(path: &Path) -> Result<(Self, Vec<String>)> {
+    /// [`FlightLog::read`] with the samples spaced as `spacing` allows ([`Spacing::Any`]: a real
+    /// logger's jitter, dropped samples and gaps).
+    pub fn read_spaced(path: &Path, spacing: Spacing) -> Result<Self> {
+        Self::read_with_columns(path, spacing).map(|(log, _)| log)
+    }
+
+    /// [`FlightLog::read_spaced`], also returning the names of the file's columns in file order
+    /// (what a log does not keep: which of `q` and `R` were recorded, and columns it does not use).
+    pub fn read_with_columns(path: &Path, spacing: Spacing) -> Result<(Self, Vec<String>)> {
         let table = TextTable::read(path)?;
         let time = table.scalars("t")?;
-        check_time_axis_at(
-            path,
-            "t",
-            &time,
-            crate::time::DEFAULT_UNIFORM_TOLERANCE,
-            &|k| table.line(k),
-        )?;
+        check_time_axis_at(path, "t", &time, spacing.tolerance(), &|k| table.line(k))?;
         check_interval_range(path, "t", &time, SAMPLE_INTERVAL_RANGE_S, &|k| {
             table.line(k)
         })?;
@@ -355,6 +358,16 @@ impl FlightLog {
     /// The mean sample interval, s.
     pub fn sample_interval(&self) -> f64 {
         (self.time[self.len() - 1] - self.time[0]) / (self.len() - 1) as f64
+    }
+
+    /// The median sample interval, s (of an even count of intervals the larger middle one).
+    pub fn median_interval(&self) -> f64 {
+        median_interval(&self.time)
+    }
+
+    /// How the samples are spaced: median interval, jitter, gaps (`None` under two samples).
+    pub fn sample_timing(&self) -> Option<SampleTiming> {
+        SampleTiming::of(&self.time)
     }
 
     /// The wind condition from the file name, or `"unknown"`.

@@ -1,6 +1,8 @@
 //! Flight data for learned-library system identification.
 //!
-//! What it is for: reading Neural-Fly flight logs into a typed, validated [`FlightLog`]; reading plain
+//! What it is for: reading Neural-Fly flight logs into a typed, validated [`FlightLog`] (uniformly
+//! sampled, or with [`Spacing::Any`] as a real logger spaces them: jitter, dropped rows, gaps;
+//! [`SampleTiming`] says which); reading plain
 //! numeric CSVs by column name ([`NumericTable`], [`ColumnRef`] for `v[k]`); several CSV
 //! recordings of one system as the tasks of meta-learning ([`read_file_tasks`],
 //! [`read_column_tasks`]); support/query splits ([`SplitSpec`]); the experiment's wind conditions
@@ -33,7 +35,7 @@ mod write;
 
 pub use conditions::{Condition, ExperimentConditions, FlightFile, PaperTraining, Role};
 pub use error::{DataError, Result};
-pub use flight_log::{FlightLog, FlightMeta, REQUIRED_COLUMNS, RateFrame};
+pub use flight_log::{FlightLog, FlightMeta, REQUIRED_COLUMNS, RateFrame, SAMPLE_INTERVAL_RANGE_S};
 pub use numeric::NumericTable;
 pub use records::LayoutFault;
 pub use source::{
@@ -44,5 +46,8 @@ pub use split::{Split, SplitSpec};
 pub use stream::{NumericBlock, NumericStream};
 pub use table::ColumnRef;
 pub use tasks::{MAX_TASKS, TaskTable, interval_text, read_column_tasks, read_file_tasks};
-pub use time::{DEFAULT_UNIFORM_TOLERANCE, StreamedTimeAxis, check_time_axis};
+pub use time::{
+    DEFAULT_UNIFORM_TOLERANCE, GAP_INTERVALS, SampleTiming, Spacing, StreamedTimeAxis,
+    check_time_axis,
+};
 pub use write::write_numeric_csv;

@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use serde::Serialize;
 use statrs::statistics::{Data, OrderStatistics};
 
 use crate::error::{DataError, Result};
@@ -19,9 +20,81 @@ fn upper_median(values: Vec<f64>) -> f64 {
     Data::new(values).order_statistic(order)
 }
 
+/// An interval longer than this many median intervals is a gap.
+pub const GAP_INTERVALS: f64 = 3.0;
+
+/// How the samples of a time column are spaced: what a reader of [`Spacing::Any`] lets through.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SampleTiming {
+    pub median_interval_s: f64,
+    /// The 1st and the 99th percentile of the intervals, relative to the median (the jitter).
+    pub p01_ratio: f64,
+    pub p99_ratio: f64,
+    /// Whether every interval lies within `uniform_tolerance` of the median (what
+    /// [`Spacing::Uniform`] accepts).
+    pub uniform: bool,
+    /// [`DEFAULT_UNIFORM_TOLERANCE`], relative to the median.
+    pub uniform_tolerance: f64,
+    /// Intervals longer than `gap_intervals` median intervals.
+    pub gaps: usize,
+    /// [`GAP_INTERVALS`].
+    pub gap_intervals: f64,
+    /// The longest interval, and the time of the sample it starts at.
+    pub longest_s: f64,
+    pub longest_at_s: f64,
+}
+
+impl SampleTiming {
+    /// The timing of a strictly increasing `time`; `None` under two samples.
+    pub(crate) fn of(time: &[f64]) -> Option<Self> {
+        let intervals: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+        let longest =
+            (0..intervals.len()).max_by(|&a, &b| intervals[a].total_cmp(&intervals[b]))?;
+        let median = median_interval(time);
+        let mut ratios = Data::new(intervals.iter().map(|i| i / median).collect::<Vec<_>>());
+        Some(Self {
+            median_interval_s: median,
+            p01_ratio: ratios.quantile(0.01),
+            p99_ratio: ratios.quantile(0.99),
+            uniform: intervals
+                .iter()
+                .all(|i| (i - median).abs() <= DEFAULT_UNIFORM_TOLERANCE * median),
+            uniform_tolerance: DEFAULT_UNIFORM_TOLERANCE,
+            gaps: intervals
+                .iter()
+                .filter(|&&i| i > GAP_INTERVALS * median)
+                .count(),
+            gap_intervals: GAP_INTERVALS,
+            longest_s: intervals[longest],
+            longest_at_s: time[longest],
+        })
+    }
+}
+
 /// Largest relative deviation of a sample interval from the median interval that still counts as
 /// uniform sampling (the Neural-Fly logs deviate by ~1e-12).
 pub const DEFAULT_UNIFORM_TOLERANCE: f64 = 0.01;
+
+/// The spacing of the samples a reader requires of a time column.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Spacing {
+    /// Uniform sampling: every interval within [`DEFAULT_UNIFORM_TOLERANCE`] of the median (what
+    /// a pipeline that differences at a fixed step needs).
+    Uniform,
+    /// Any spacing: strictly increasing and every interval within `SAMPLE_INTERVAL_RANGE_S`, with
+    /// jitter, dropped samples and gaps allowed (a real logger's time stamps).
+    Any,
+}
+
+impl Spacing {
+    /// The largest relative deviation of an interval from the median that this spacing accepts.
+    pub(crate) fn tolerance(self) -> f64 {
+        match self {
+            Self::Uniform => DEFAULT_UNIFORM_TOLERANCE,
+            Self::Any => f64::INFINITY,
+        }
+    }
+}
 
 /// Fails unless `time` (a column named `t`) has at least two samples, is strictly increasing and
 /// uniformly sampled within `tolerance` (relative to the median interval); the error reports the

@@ -6,7 +6,8 @@
 //! registry; a set of them is [`Effects`], each named by an [`EffectId`]; ids and parameter names
 //! are an output contract); a
 //! closed-loop simulator ([`simulate`]: RK4 rigid body, geometric tracking controller that knows
-//! only the nominal model, figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`]; a
+//! only the nominal model, figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`], rows
+//! jittered, dropped or missing over gaps as a real logger writes them ([`LogTiming`]); a
 //! [`Scenario`] is read from JSON or, for examples and tests, built by [`Scenario::figure_eight`])
 //! that writes Neural-Fly logs the data tools read back ([`write_readable`]); and the residual
 //! force of a recorded flight ([`residual_force`], the `fa` column); descriptions of any multirotor
@@ -25,6 +26,7 @@ mod effect_id;
 pub mod effects;
 mod error;
 mod jitter;
+mod log_timing;
 mod logger;
 mod model;
 pub mod ranges;
@@ -41,6 +43,7 @@ pub use effect_id::UnknownEffectId;
 pub use effects::*;
 pub use error::{PhysicsError, Result};
 pub use jitter::{Jitter, JitterSignal, MAX_JITTER};
+pub use log_timing::{LogTiming, MAX_DROPPED_FRACTION};
 pub use logger::{
     CommandLogging, Logger, MAX_COMMAND_OFFSET_S, MAX_RATE_LOW_PASS_HZ, MIN_RATE_LOW_PASS_HZ,
 };

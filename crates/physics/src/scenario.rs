@@ -9,6 +9,7 @@ use crate::controller::Gains;
 use crate::effects::Effects;
 use crate::error::{PhysicsError, Result, readable};
 use crate::jitter::Jitter;
+use crate::log_timing::LogTiming;
 use crate::logger::{CommandLogging, Logger};
 use crate::model::NominalModel;
 use crate::trajectory::{MAX_POSITION_M, Trajectory};
@@ -60,6 +61,10 @@ pub struct Scenario {
     /// Band-limited jitter added to the controller's commands (none by default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub jitter: Option<Jitter>,
+    /// A real logger's timing: rows jittered, dropped, or missing over gaps (none by default:
+    /// every row on time). Needs a `sample` logger of a controller faster than the log.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log_timing: Option<LogTiming>,
 }
 
 fn default_physics_rate() -> f64 {
@@ -150,6 +155,7 @@ impl Scenario {
             controller_rate_hz: None,
             logger: None,
             jitter: None,
+            log_timing: None,
         }
     }
 
@@ -190,8 +196,10 @@ impl Scenario {
     /// [[`MIN_HOVER_THROTTLE`], 1]; noise standard deviations in [0, [`MAX_NOISE`]]; gains, effects
     /// and trajectory as their own checks say, a delay of at most [`MAX_DELAY_S`], and a reference
     /// that stays within [`MAX_POSITION_M`] of the origin (per coordinate) and accelerates at most
-    /// at [`MAX_REFERENCE_ACCELERATION_M_S2`]. Together these keep every value of the simulated log
-    /// inside the ranges the data tools accept (`PLAUSIBLE_RANGES` of the data crate).
+    /// at [`MAX_REFERENCE_ACCELERATION_M_S2`]; a log timing as [`LogTiming::validate`] says, with
+    /// a `sample` logger, a controller at least twice the log rate, and at least [`MIN_LOG_ROWS`]
+    /// rows left. Together these keep every value of the simulated log inside the ranges the data
+    /// tools accept (`PLAUSIBLE_RANGES` and `SAMPLE_INTERVAL_RANGE_S` of the data crate).
     pub fn validate(&self, origin: &Path) -> Result<()> {
         self.validate_rates(origin)?;
         self.validate_timing(origin)?;
@@ -205,6 +213,7 @@ impl Scenario {
                 ),
             ));
         }
+        self.validate_logged_rows(origin)?;
         self.validate_vehicle(origin)?;
         self.validate_reference(origin)
     }
@@ -441,6 +450,47 @@ impl Scenario {
                 .validate()
                 .map_err(|(f, m)| field(&format!("jitter.{f}"), m))?;
         }
+        if let Some(timing) = &self.log_timing {
+            if logger.command != CommandLogging::Sample || self.controller_steps_per_row() < 2 {
+                return Err(field(
+                    "log_timing",
+                    "needs a \"sample\" logger of a controller at least twice the log rate (a held or period-mean command is defined relative to evenly spaced rows)".to_string(),
+                ));
+            }
+            timing
+                .validate(self.log_rate_hz, self.duration_s)
+                .map_err(|(f, m)| field(&format!("log_timing.{f}"), m))?;
+        }
+        Ok(())
+    }
+
+    /// With a log timing: rows enough left after the drops and gaps, and no interval between
+    /// rows longer than a flight log's reader accepts.
+    fn validate_logged_rows(&self, origin: &Path) -> Result<()> {
+        if self.log_timing.is_none() {
+            return Ok(());
+        }
+        let field = |message: String| field_error(origin, "log_timing".into(), message);
+        let steps = self.row_steps();
+        if steps.len() < MIN_LOG_ROWS {
+            return Err(field(format!(
+                "the drops and gaps leave {} of the {} rows, a log needs at least {MIN_LOG_ROWS}",
+                steps.len(),
+                self.rows()
+            )));
+        }
+        let control_dt = 1.0 / self.controller_rate();
+        let longest = data::SAMPLE_INTERVAL_RANGE_S.1;
+        if let Some(w) = steps
+            .windows(2)
+            .find(|w| (w[1] - w[0]) as f64 * control_dt > longest)
+        {
+            return Err(field(format!(
+                "no row between t = {:.3} s and {:.3} s, longer than the {longest} s between samples a flight log's reader accepts",
+                w[0] as f64 * control_dt,
+                w[1] as f64 * control_dt
+            )));
+        }
         Ok(())
     }
 
@@ -477,9 +527,21 @@ impl Scenario {
         Ok(())
     }
 
-    /// Number of logged rows.
+    /// Number of rows due (`⌊duration_s · log_rate_hz⌋ + 1`; the log timing may drop some).
     pub(crate) fn rows(&self) -> usize {
         (self.duration_s * self.log_rate_hz).floor() as usize + 1
+    }
+
+    /// The control step of each logged row, counted from the first row's, strictly increasing:
+    /// every `controller_steps_per_row()` steps, or as the log timing spaces them.
+    pub(crate) fn row_steps(&self) -> Vec<usize> {
+        let per_row = self.controller_steps_per_row();
+        match &self.log_timing {
+            None => (0..self.rows()).map(|k| k * per_row).collect(),
+            Some(timing) => {
+                timing.row_steps(self.rows(), per_row, self.controller_rate(), self.seed)
+            }
+        }
     }
 
     /// Number of control steps flown before the recording starts.

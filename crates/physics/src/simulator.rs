@@ -3,11 +3,12 @@
 //!
 //! Timing: the controller runs at `controller_rate_hz` (by default the log rate) and each command
 //! is held by the actuators (after any delay, exact even between physics steps) until the next one.
-//! Every `controller_rate_hz / log_rate_hz` control steps a row is logged: the measured state at
-//! that instant and the command as the scenario's [`crate::Logger`] records it (the instantaneous
-//! command, the mean over the log period, either shifted by whole control steps; each command held
-//! to the next row when the controller runs at the log rate). The rigid body is integrated with RK4
-//! at `physics_rate_hz`; with a motor lag the four motor speeds are part of the state. Measurement
+//! Every `controller_rate_hz / log_rate_hz` control steps a row is logged (or at the steps a
+//! [`crate::LogTiming`] draws: jittered, dropped, gaps): the measured state at that instant and the
+//! command as the scenario's [`crate::Logger`] records it (the instantaneous command, the mean over
+//! the log period, either shifted by whole control steps; each command held to the next row when
+//! the controller runs at the log rate). The rigid body is integrated with RK4 at
+//! `physics_rate_hz`; with a motor lag the four motor speeds are part of the state. Measurement
 //! noise (Gaussian, from the scenario's seed) is added to position, velocity, attitude and body
 //! rate, the rate after the logger's optional first-order filter; the controller sees the noisy
 //! values, as on a real vehicle. An optional band-limited [`crate::Jitter`] is added to the
@@ -218,14 +219,16 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
         ));
     }
     let mut flight = Flight::new(model, mixer, scenario);
-    let per_row = scenario.controller_steps_per_row();
-    let warmup_steps = scenario.warmup_rows() * per_row;
-    let rows = scenario.rows();
-    let last_row_step = warmup_steps + (rows - 1) * per_row;
+    let warmup_steps = scenario.warmup_rows() * scenario.controller_steps_per_row();
+    // The control step of each row, from the first row's (validated: at least two rows).
+    let row_steps = scenario.row_steps();
+    let rows = row_steps.len();
+    let last_row_step = warmup_steps + row_steps[rows - 1];
     // Run on after the last row until the commands a look-ahead logger records exist.
     let last_step = last_row_step + flight.look_ahead_steps();
     let mut log = empty_log(name, rows);
     let mut commands = CommandLog::new(scenario, rows);
+    let mut next_row = row_steps.iter().map(|s| s + warmup_steps).peekable();
     for step in 0..=last_step {
         let t = (step as f64 - warmup_steps as f64) * flight.control_dt;
         let reference = flight.generator.at(t);
@@ -235,10 +238,7 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
             .update(&measured, &reference, flight.control_dt);
         let speeds = flight.speeds_for(&output, t);
         commands.issue(step, speeds, mixer.wrench(&speeds)[0]);
-        if step >= warmup_steps
-            && (step - warmup_steps).is_multiple_of(per_row)
-            && step <= last_row_step
-        {
+        if next_row.next_if_eq(&step).is_some() {
             record_row(&mut log, &measured, &reference, &output, t);
             commands.add_row(step - warmup_steps);
         }
@@ -621,3 +621,5 @@ fn empty_log(name: &str, rows: usize) -> FlightLog {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod timing_tests;

@@ -2,13 +2,13 @@
 
 use std::path::Path;
 
-use data::{DataError, FlightLog};
+use data::{DataError, FlightLog, Spacing};
 
 use crate::error::{PhysicsError, Result};
 
 /// Writes the simulated `log` to `out` only if the data tools read it back: it is written next to
-/// `out`, read with [`FlightLog::read`] (the checks of `learn data inspect` and `learn mismatch`:
-/// layout, plausible ranges) and moved into place. Otherwise nothing is left behind and the error
+/// `out`, read with [`FlightLog::read_spaced`] (layout, plausible ranges; any spacing, as a
+/// scenario's `log_timing` may space the rows) and moved into place. Otherwise nothing is left behind and the error
 /// ([`PhysicsError::UnusableLog`]) names the `scenario` file it was simulated from, the refused
 /// column and the scenario and model settings likely responsible.
 pub fn write_readable(log: &FlightLog, out: &Path, scenario: &Path) -> Result<()> {
@@ -18,7 +18,7 @@ pub fn write_readable(log: &FlightLog, out: &Path, scenario: &Path) -> Result<()
         .unwrap_or_else(|| "flight.csv".to_string());
     let staging = out.with_file_name(format!(".{file_name}.{}.partial", std::process::id()));
     log.write_csv(&staging)?;
-    if let Err(error) = FlightLog::read(&staging) {
+    if let Err(error) = FlightLog::read_spaced(&staging, Spacing::Any) {
         let _ = std::fs::remove_file(&staging);
         let cause = match &error {
             DataError::Implausible {

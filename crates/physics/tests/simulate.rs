@@ -119,3 +119,61 @@ fn a_scenario_at_its_bounds_gives_a_log_the_data_tools_accept() {
         "{farthest}"
     );
 }
+
+/// A flight logged as a real logger logs it (jittered, with drops and a gap) is written: the
+/// writer reads it back with any spacing, though a reader of uniform samples refuses it.
+#[test]
+fn a_jittered_log_with_drops_and_a_gap_is_written() {
+    let scenario = Scenario {
+        duration_s: 12.0,
+        controller_rate_hz: Some(500.0),
+        log_timing: Some(physics::LogTiming {
+            jitter_s: 0.006,
+            dropped_fraction: 0.1,
+            gaps: vec![[4.0, 0.5]],
+        }),
+        ..scenario(Effects::default(), 5)
+    };
+    scenario
+        .validate(std::path::Path::new("timed.json"))
+        .unwrap();
+    let log = simulate(&demo_model(), &scenario, "timed").unwrap();
+    let dir = common::temp_dir("timed");
+    let path = dir.path().join("timed.csv");
+    physics::write_readable(&log, &path, std::path::Path::new("timed.json")).unwrap();
+    let back = data::FlightLog::read_spaced(&path, data::Spacing::Any).unwrap();
+    assert_eq!(back.time, log.time);
+    assert_eq!(back.motor_command, log.motor_command);
+    let message = data::FlightLog::read(&path).unwrap_err().to_string();
+    assert!(
+        message.contains("sample interval is not uniform"),
+        "{message}"
+    );
+}
+
+/// `log_timing` is read from a scenario file with the other fields, each error naming its field;
+/// a scenario without one is written as before (no `log_timing` key).
+#[test]
+fn a_scenario_file_names_its_log_timing() {
+    let base = serde_json::to_value(Scenario::figure_eight("quad-a.json", 1)).unwrap();
+    assert!(base.get("log_timing").is_none(), "{base}");
+    let with = |timing: serde_json::Value| {
+        let mut value = base.clone();
+        value["controller_rate_hz"] = 500.0.into();
+        value["log_timing"] = timing;
+        bounded_read::json::from_str::<Scenario>(&value.to_string())
+    };
+    let scenario = with(serde_json::json!({"jitter_s": 0.004, "gaps": [[1.0, 0.5]]})).unwrap();
+    assert_eq!(
+        scenario.log_timing,
+        Some(physics::LogTiming {
+            jitter_s: 0.004,
+            dropped_fraction: 0.0,
+            gaps: vec![[1.0, 0.5]],
+        })
+    );
+    scenario.validate(std::path::Path::new("s.json")).unwrap();
+    let error = with(serde_json::json!({"jitter": 0.004})).unwrap_err();
+    assert!(error.field.starts_with("log_timing"), "{error:?}");
+    assert!(error.message.contains("jitter"), "{error:?}");
+}

@@ -20,8 +20,9 @@
 //! terminal text and the SVG figures of one recording, of several flights analysed together and
 //! of the demo matrix), from plain result types and views that the `mismatch` crate fills.
 //!
-//! What `learn data inspect` says of a PX4 ULog is rendered here too ([`ulog_inspection`]), from the
-//! `data` crate's inspection as its JSON hands it over.
+//! What `learn data inspect` says of a PX4 ULog is rendered here too ([`ulog_inspection`]), and of
+//! a CSV flight log's time stamps ([`sample_timing`]), from the `data` crate's inspection as its
+//! JSON hands it over.
 
 mod ablations;
 mod compare;
@@ -32,6 +33,7 @@ mod figure;
 pub mod mismatch;
 mod published;
 mod render;
+pub mod sample_timing;
 mod table;
 pub mod ulog_inspection;
 

@@ -70,7 +70,8 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     if super::sindy::is_ulog(&args.file) {
         return inspect_ulog(&args.file);
     }
-    let (log, columns) = FlightLog::read_with_columns(&args.file)?;
+    // Any spacing: a real logger's jitter, drops and gaps are reported, not refused.
+    let (log, columns) = FlightLog::read_with_columns(&args.file, data::Spacing::Any)?;
     let n = log.len();
     let dt = log.sample_interval();
     say!("file:      {}", args.file.display());
@@ -85,7 +86,16 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     }
     say!("samples:   {n}");
     say!("duration:  {:.3} s", log.time[n - 1] - log.time[0]);
-    say!("rate:      {:.3} Hz (dt = {dt:.6} s)", 1.0 / dt);
+    say!("rate:      {:.3} Hz (mean dt = {dt:.6} s)", 1.0 / dt);
+    if let Some(timing) = log.sample_timing() {
+        // `report` depends on no crate that computes: the timing reaches it as JSON.
+        let view: report::sample_timing::SampleTiming =
+            serde_json::from_value(serde_json::to_value(timing)?)?;
+        say!(
+            "{}",
+            report::sample_timing::sample_timing_text(&view).trim_end()
+        );
+    }
     say!("columns:   {}", column_summary(&columns));
     say!("ranges:");
     say!("{}", range3("p [m]", &log.position));

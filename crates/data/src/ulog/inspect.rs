@@ -5,6 +5,7 @@ use statrs::statistics::{Data, OrderStatistics};
 use ulog::{Column, Log, Topic};
 
 use super::rates::{ColumnPattern, NewSamples};
+use crate::time::GAP_INTERVALS;
 
 /// The topics a flight analysis reads and their key columns; `{rotor}` stands for each motor
 /// index below the rotor count (`CA_ROTOR_COUNT`, else 4).
@@ -29,9 +30,6 @@ const KEY_TOPICS: &[(&str, &[&str])] = &[
     // Its `landed` field gives the airborne time; its rate is that of its events.
     ("vehicle_land_detected", &[]),
 ];
-
-/// A sample step longer than this many median steps is a gap.
-const GAP_STEPS: f64 = 3.0;
 
 /// The vehicle and autopilot the log names (info fields and parameters).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -63,7 +61,7 @@ pub struct StepSpread {
     pub p95_ms: f64,
 }
 
-/// Steps longer than [`GAP_STEPS`] median steps, and steps that do not move forward.
+/// Steps longer than [`GAP_INTERVALS`] median steps, and steps that do not move forward.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Gaps {
     pub count: usize,
@@ -416,7 +414,7 @@ fn column_rates(
 
 fn gaps(steps_ms: &[f64], median_ms: f64, times: &[f64]) -> Gaps {
     let long: Vec<usize> = (0..steps_ms.len())
-        .filter(|&k| steps_ms[k] > GAP_STEPS * median_ms)
+        .filter(|&k| steps_ms[k] > GAP_INTERVALS * median_ms)
         .collect();
     let longest = (0..steps_ms.len()).max_by(|&a, &b| steps_ms[a].total_cmp(&steps_ms[b]));
     Gaps {

@@ -64,5 +64,6 @@ pub fn scenario(effects: Effects, seed: u64) -> Scenario {
         controller_rate_hz: None,
         logger: None,
         jitter: None,
+        log_timing: None,
     }
 }

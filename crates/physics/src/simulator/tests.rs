@@ -11,11 +11,11 @@ const MODEL: &str = r#"{"mass_kg": 1.8, "gravity_m_s2": 9.81, "inertia_kg_m2": [
     "mixer": {"pwm_offset": 1000.0, "pwm_scale": 1000.0,
               "b0": [[9.0, 9.0, 9.0, 9.0], [-1.08, 1.08, 1.08, -1.08], [1.08, -1.08, 1.08, -1.08], [0.144, 0.144, -0.144, -0.144]]}}"#;
 
-fn model() -> NominalModel {
+pub(super) fn model() -> NominalModel {
     NominalModel::from_json(MODEL, Path::new("quad.json")).unwrap()
 }
 
-fn scenario() -> Scenario {
+pub(super) fn scenario() -> Scenario {
     Scenario::figure_eight("quad.json", 1)
 }
 
@@ -47,7 +47,7 @@ fn random_waypoints(s: &mut Scenario, count: usize, box_max: [f64; 3]) {
     };
 }
 
-fn rejected_field(change: impl FnOnce(&mut Scenario)) -> String {
+pub(super) fn rejected_field(change: impl FnOnce(&mut Scenario)) -> String {
     let mut s = scenario();
     change(&mut s);
     let error = s

@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
 # Fills data/neural-fly: a link to ../shared/data/neural-fly when it exists, otherwise a shallow
 # clone of the upstream public repository (its data/ folder has the same layout). Links
-# data/ulog to ../shared/data/ulog (the public PX4 logs the ulog crate's tests read) when it exists.
+# data/ulog and data/crazyflie to ../shared/data (the public PX4 logs and the Crazyflie flight the
+# tests of other layouts read) when they exist.
 # Never copies flight logs into the project: data/ is git-ignored.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mkdir -p data
-if [ ! -e data/ulog ] && [ -d ../shared/data/ulog ]; then
-  ln -s "$(cd ../shared/data/ulog && pwd)" data/ulog
-  echo "data: linked data/ulog -> ../shared/data/ulog"
-fi
+for folder in ulog crazyflie; do
+  if [ ! -e "data/$folder" ] && [ -d "../shared/data/$folder" ]; then
+    ln -s "$(cd "../shared/data/$folder" && pwd)" "data/$folder"
+    echo "data: linked data/$folder -> ../shared/data/$folder"
+  fi
+done
 target=data/neural-fly
 if [ -e "$target" ]; then
   echo "data: $target already present"

@@ -40,7 +40,7 @@ pub use numeric::NumericTable;
 pub use records::LayoutFault;
 pub use source::{
     DATA_DIR_VARIABLE, DEFAULT_DATA_DIR, bytes_sha256, file_sha256, find_data_dir,
-    real_data_dir_for_tests, resolve_data_dir, ulog_file_for_tests,
+    real_data_dir_for_tests, resolve_data_dir, shared_file_for_tests, ulog_file_for_tests,
 };
 pub use split::{Split, SplitSpec};
 pub use stream::{NumericBlock, NumericStream};

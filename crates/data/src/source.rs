@@ -94,24 +94,34 @@ pub fn real_data_dir_for_tests(workspace_root: &Path) -> Option<PathBuf> {
 }
 
 /// The public ULog `file` of `data/ulog` under `workspace_root` (a link `make data` makes), for
-/// tests, as [`real_data_dir_for_tests`] finds the flights: `None` with a note where it is absent,
-/// except under CI (`CI=true`), where a test that needs it cannot silently skip.
+/// tests: [`shared_file_for_tests`] of folder `ulog`.
 ///
 /// # Panics
 /// When `CI=true` and the file is absent.
 pub fn ulog_file_for_tests(workspace_root: &Path, file: &str) -> Option<PathBuf> {
-    let path = workspace_root.join("data/ulog").join(file);
+    shared_file_for_tests(workspace_root, "ulog", file)
+}
+
+/// A public recording `file` of `data/FOLDER` under `workspace_root` (a link to
+/// `../shared/data/FOLDER` that `make data` makes), for tests, as [`real_data_dir_for_tests`] finds
+/// the flights: `None` with a note where it is absent, except under CI (`CI=true`), where a test
+/// that needs it cannot silently skip.
+///
+/// # Panics
+/// When `CI=true` and the file is absent.
+pub fn shared_file_for_tests(workspace_root: &Path, folder: &str, file: &str) -> Option<PathBuf> {
+    let path = workspace_root.join("data").join(folder).join(file);
     if path.is_file() {
         return Some(path);
     }
     if std::env::var("CI").is_ok_and(|v| v == "true") {
         panic!(
-            "CI=true but no ULog file at {} (run `make data`)",
+            "CI=true but no recording at {} (run `make data`)",
             path.display()
         );
     }
     eprintln!(
-        "skipping: no ULog file at {} (run `make data`)",
+        "skipping: no recording at {} (run `make data`)",
         path.display()
     );
     None

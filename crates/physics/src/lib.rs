@@ -47,7 +47,9 @@ pub use log_timing::{LogTiming, MAX_DROPPED_FRACTION};
 pub use logger::{
     CommandLogging, Logger, MAX_COMMAND_OFFSET_S, MAX_RATE_LOW_PASS_HZ, MIN_RATE_LOW_PASS_HZ,
 };
-pub use model::{Mixer, NominalModel, ThrustSource, Wrench, angular_acceleration_with_inertia};
+pub use model::{
+    ComparedChannels, Mixer, NominalModel, ThrustSource, Wrench, angular_acceleration_with_inertia,
+};
 pub use residual::{five_point_derivative, residual_force};
 pub use scenario::{
     MAX_DELAY_S, MAX_DURATION_S, MAX_LOG_ROWS, MAX_NOISE, MAX_PHYSICS_RATE_HZ,

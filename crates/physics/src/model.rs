@@ -31,6 +31,24 @@ pub enum ThrustSource {
     ThrustSetpoint,
 }
 
+/// Which of the recording's channels the model is compared on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ComparedChannels {
+    /// Translational and, with a mixer, angular accelerations.
+    #[default]
+    All,
+    /// The translational accelerations only: the model's torques are not trusted (an inertia or
+    /// rotor geometry that is not known).
+    Translational,
+}
+
+impl ComparedChannels {
+    fn is_all(&self) -> bool {
+        *self == Self::All
+    }
+}
+
 /// The map from motor commands to thrust and torques.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Mixer {
@@ -70,6 +88,9 @@ pub struct NominalModel {
     /// The vehicle the mixer was derived from, when the model file gave one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub vehicle: Option<VehicleDescription>,
+    /// The channels compared (optional field; default all).
+    #[serde(skip_serializing_if = "ComparedChannels::is_all")]
+    pub compared_channels: ComparedChannels,
 }
 
 impl Mixer {
@@ -237,6 +258,17 @@ impl NominalModel {
             None => 0.0,
             Some(_) => fields.in_range(object, &ranges::GROUND_HEIGHT_M)?,
         };
+        let compared_channels = match object.get("compared_channels") {
+            None | Some(Value::Null) => ComparedChannels::All,
+            Some(Value::String(s)) if s == "all" => ComparedChannels::All,
+            Some(Value::String(s)) if s == "translational" => ComparedChannels::Translational,
+            Some(other) => {
+                return Err(fields.error(
+                    "compared_channels",
+                    &format!("expected \"all\" or \"translational\", found {other}"),
+                ));
+            }
+        };
         let logger = match object.get("logger") {
             None | Some(Value::Null) => Logger::default(),
             Some(value) => fields.logger(value)?,
@@ -250,6 +282,7 @@ impl NominalModel {
             ground_height_m,
             logger,
             vehicle,
+            compared_channels,
         })
     }
 
@@ -274,9 +307,10 @@ impl NominalModel {
                 .is_some_and(Mixer::needs_battery_voltage)
     }
 
-    /// Whether the model predicts body torques (it has a mixer and uses it).
+    /// Whether the model predicts body torques (it has a mixer and uses it, and its angular
+    /// channels are compared).
     pub fn predicts_torque(&self) -> bool {
-        self.thrust_source == ThrustSource::Mixer
+        self.thrust_source == ThrustSource::Mixer && self.compared_channels == ComparedChannels::All
     }
 
     /// The actuator states the recorded command asks for: the four normalised motor speeds with a
@@ -387,7 +421,7 @@ pub fn angular_acceleration_with_inertia(inertia: Vec3, rate: Vec3, torque: Vec3
 }
 
 /// The fields of a model file; any other is an error (as `deny_unknown_fields` elsewhere).
-const MODEL_KEYS: [&str; 8] = [
+const MODEL_KEYS: [&str; 9] = [
     "mass_kg",
     "gravity_m_s2",
     "inertia_kg_m2",
@@ -396,6 +430,7 @@ const MODEL_KEYS: [&str; 8] = [
     "ground_height_m",
     "logger",
     "vehicle",
+    "compared_channels",
 ];
 /// The fields of the `mixer` object.
 const MIXER_KEYS: [&str; 3] = ["pwm_offset", "pwm_scale", "b0"];

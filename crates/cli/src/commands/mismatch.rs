@@ -210,7 +210,7 @@ fn read_recording(
             let layout = data::layout::RecordingLayout::load(layout)?;
             data::layout::read_with_layout(recording, &layout)?
         }
-        None => data::FlightLog::read(recording)?,
+        None => data::FlightLog::read_spaced(recording, data::Spacing::Any)?,
     };
     let Some(rows) = rows else {
         return Ok(log);

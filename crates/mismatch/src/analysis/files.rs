@@ -66,6 +66,8 @@ impl Analysis {
             time_stamps: report.time_stamps.as_ref(),
             channels: &report.channels,
             translational_only: self.problem.channels == 3,
+            angular_left_out: self.problem.model.compared_channels
+                == physics::ComparedChannels::Translational,
             window_factor: settings.analysis.locate.window_factor,
             windows: &report.windows,
             rule: EvidenceRule {

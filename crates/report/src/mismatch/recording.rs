@@ -192,6 +192,9 @@ pub struct RecordingView<'a> {
     pub channels: &'a [ChannelReport],
     /// Only the translational channels were compared (the model predicts no torques).
     pub translational_only: bool,
+    /// The model has a mixer, but its angular channels were left out by choice
+    /// (`compared_channels`).
+    pub angular_left_out: bool,
     /// A window is located where the moving RMS exceeds this multiple of the noise floor.
     pub window_factor: f64,
     /// Where the nominal model disagrees with the recording.
@@ -323,7 +326,12 @@ impl RecordingView<'_> {
                 if c.significant { "yes" } else { "no" }
             );
         }
-        if self.translational_only {
+        if self.angular_left_out {
+            let _ = writeln!(
+                md,
+                "\nThe model's `compared_channels` is \"translational\": its torques are not compared, only the translational channels."
+            );
+        } else if self.translational_only {
             let _ = writeln!(
                 md,
                 "\nThe model has no mixer, so it predicts no torques: only the translational channels are compared."
@@ -669,6 +677,7 @@ mod tests {
             time_stamps: None,
             channels: &channels,
             translational_only: true,
+            angular_left_out: false,
             window_factor: 2.5,
             windows: &windows,
             rule: EvidenceRule {
@@ -758,6 +767,7 @@ mod tests {
             time_stamps: None,
             channels: &channels,
             translational_only: false,
+            angular_left_out: false,
             window_factor: 2.5,
             windows: &[],
             rule: EvidenceRule {

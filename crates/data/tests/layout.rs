@@ -1,0 +1,155 @@
+//! Recordings read through a layout description: units and frames converted, a header written as a
+//! comment, bad layouts and files refused with the file and field named, and the public Crazyflie
+//! flight read as its README describes it.
+
+use std::path::Path;
+
+use data::layout::{Frames, RecordingLayout, read_with_layout};
+
+fn layout(json: &str) -> RecordingLayout {
+    serde_json::from_str(json).unwrap()
+}
+
+const PX4_LIKE: &str = r#"{
+  "time": {"column": "timestamp", "unit": "ms"},
+  "frames": "ned_frd",
+  "position": ["x", "y", "z"],
+  "velocity": ["vx", "vy", "vz"],
+  "quaternion": {"w": "q0", "x": "q1", "y": "q2", "z": "q3"},
+  "body_rate": ["p", "q", "r"],
+  "motor_commands": ["m1", "m2", "m3", "m4"],
+  "battery_voltage": "volts"
+}"#;
+
+/// A row of a NED/FRD log: yaw `psi` about the down axis, level, at height `h`, climbing.
+fn ned_row(k: usize, psi: f64, h: f64) -> String {
+    let (w, z) = ((psi / 2.0).cos(), (psi / 2.0).sin());
+    let t = 1000.0 + 10.0 * k as f64 + if k % 2 == 1 { 1.5 } else { 0.0 };
+    format!(
+        "{t},1.0,2.0,{},0.5,-0.25,-1.0,{w},0.0,0.0,{z},0.1,0.2,0.3,1500,1510,1490,1505,11.1\n",
+        -h
+    )
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn a_ned_frd_log_reads_z_up_in_seconds_on_its_own_stamps() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("timestamp,x,y,z,vx,vy,vz,q0,q1,q2,q3,p,q,r,m1,m2,m3,m4,volts\n");
+    for k in 0..6 {
+        text.push_str(&ned_row(k, 0.4, 2.0));
+    }
+    let path = write(dir.path(), "px4.csv", &text);
+    let log = read_with_layout(&path, &layout(PX4_LIKE)).unwrap();
+    assert_eq!(log.len(), 6);
+    assert!((log.time[1] - log.time[0] - 0.0115).abs() < 1e-12);
+    // Height up, climbing: z and vz change sign; the second axes too (north-west-up).
+    assert_eq!(log.position[0], [1.0, -2.0, 2.0]);
+    assert_eq!(log.velocity[0], [0.5, 0.25, 1.0]);
+    assert_eq!(log.body_rate[0], [0.1, -0.2, -0.3]);
+    // Level: the body's third axis (the thrust) points up; a yaw to the east in NED (clockwise
+    // from above) is a yaw to the west in NWU (counter-clockwise from above, negative angle).
+    let r = log.rotation[0];
+    assert!((r[2][2] - 1.0).abs() < 1e-12);
+    assert!((r[1][0] - (-0.4f64).sin()).abs() < 1e-12, "{r:?}");
+    assert_eq!(log.motor_command[0], [1500.0, 1510.0, 1490.0, 1505.0]);
+    assert_eq!(log.battery_voltage.as_ref().unwrap()[0], 11.1);
+    assert_eq!(layout(PX4_LIKE).frames, Frames::NedFrd);
+}
+
+#[test]
+fn a_header_written_as_a_comment_needs_its_prefix_declared() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("# timestamp,x,y,z,vx,vy,vz,q0,q1,q2,q3,p,q,r,m1,m2,m3,m4,volts\n");
+    for k in 0..6 {
+        text.push_str(&ned_row(k, 0.0, 1.0));
+    }
+    let path = write(dir.path(), "commented.csv", &text);
+    let plain = read_with_layout(&path, &layout(PX4_LIKE))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        plain.contains("commented.csv:1") && plain.contains("comment"),
+        "{plain}"
+    );
+    let with_prefix = PX4_LIKE.replacen('{', "{\"header_prefix\": \"# \",", 1);
+    assert_eq!(
+        read_with_layout(&path, &layout(&with_prefix))
+            .unwrap()
+            .len(),
+        6
+    );
+    let wrong = PX4_LIKE.replacen('{', "{\"header_prefix\": \"% \",", 1);
+    let message = read_with_layout(&path, &layout(&wrong))
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("header_prefix"), "{message}");
+}
+
+#[test]
+fn bad_layouts_and_cells_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let unknown = write(
+        dir.path(),
+        "layout.json",
+        &PX4_LIKE.replacen('{', "{\"colour\": 1,", 1),
+    );
+    let message = RecordingLayout::load(&unknown).unwrap_err().to_string();
+    assert!(
+        message.contains("layout.json") && message.contains("colour"),
+        "{message}"
+    );
+    let mut text = String::from("timestamp,x,y,z,vx,vy,vz,q0,q1,q2,q3,p,q,r,m1,m2,m3,m4,volts\n");
+    for k in 0..6 {
+        text.push_str(&ned_row(k, 0.0, 1.0));
+    }
+    let half_quaternion = text.replacen(",1,0.0,0.0,0,", ",0.5,0.0,0.0,0,", 1);
+    let path = write(dir.path(), "bad.csv", &half_quaternion);
+    let message = read_with_layout(&path, &layout(PX4_LIKE))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("bad.csv:2") && message.contains("q0"),
+        "{message}"
+    );
+    let missing = PX4_LIKE.replace("\"volts\"", "\"vbat\"");
+    let path = write(dir.path(), "ok.csv", &text);
+    let message = read_with_layout(&path, &layout(&missing))
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("vbat"), "{message}");
+}
+
+/// The public Crazyflie flight through the layout in `experiments/layouts/`: its README's time unit
+/// (µs), its jitter (9–11 ms) and its command range (a fraction of 65536, times the scale).
+#[test]
+fn the_crazyflie_flight_reads_as_its_readme_describes() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let Some(path) = data::shared_file_for_tests(&root, "crazyflie", "randomwalk_l_cf102_01.csv")
+    else {
+        return;
+    };
+    let layout =
+        RecordingLayout::load(&root.join("experiments/layouts/crazyflie-neural-swarm.json"))
+            .unwrap();
+    let log = read_with_layout(&path, &layout).unwrap();
+    let intervals: Vec<f64> = log.time.windows(2).map(|w| w[1] - w[0]).collect();
+    let mut sorted = intervals.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    assert!((0.0095..0.0105).contains(&median), "{median}");
+    let duration = log.time[log.len() - 1] - log.time[0];
+    assert!((55.0..70.0).contains(&duration), "{duration}");
+    let commands = log.motor_command.iter().flatten();
+    assert!(commands.clone().all(|c| (0.0..=65536.0).contains(c)));
+    assert!(commands.clone().any(|c| *c > 30000.0));
+    let heights = log.position.iter().map(|p| p[2]);
+    assert!(heights.clone().all(|z| (0.0..0.5).contains(&z)));
+    let volts = log.battery_voltage.unwrap();
+    assert!(volts.iter().all(|v| (3.0..4.3).contains(v)));
+}

@@ -75,6 +75,10 @@ pub struct FlightLog {
     pub motor_command: Vec<[f64; 4]>,
     /// Battery voltage, V, when the layout has it (never in the Neural-Fly layout).
     pub battery_voltage: Option<Vec<f64>>,
+    /// The frame of `body_rate` when the file's layout declares it (a layout description's body
+    /// rate is in the body frame); `None` for the Neural-Fly layout, whose `w` column's frame
+    /// [`FlightLog::rate_frame`] finds.
+    pub declared_rate_frame: Option<RateFrame>,
     pub position_desired: Option<Vec<[f64; 3]>>,
     pub velocity_desired: Option<Vec<[f64; 3]>>,
     pub attitude_setpoint: Option<Vec<[f64; 4]>>,
@@ -297,6 +301,7 @@ impl FlightLog {
             hover_throttle: scalars("hover_throttle")?,
             motor_command: arrays4("pwm")?,
             battery_voltage: None,
+            declared_rate_frame: None,
             position_desired: optional3("p_d")?,
             velocity_desired: optional3("v_d")?,
             attitude_setpoint: if table.has_column("q_sp") {
@@ -345,6 +350,7 @@ impl FlightLog {
                 .battery_voltage
                 .as_ref()
                 .map(|v| v[rows.clone()].to_vec()),
+            declared_rate_frame: self.declared_rate_frame,
             position_desired: part(&self.position_desired),
             velocity_desired: part(&self.velocity_desired),
             attitude_setpoint: self

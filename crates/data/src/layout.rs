@@ -154,7 +154,10 @@ pub fn read_with_layout(path: &Path, layout: &RecordingLayout) -> Result<FlightL
             message: error.to_string(),
         })?;
         let aligned = crate::ulog::aligned_table(&log, path, Some(&layout.time.column), &columns)?;
-        (aligned.time, aligned.table)
+        // Seconds since the log started, as the ULog inspection counts them.
+        let start = log.start_time_us as f64 * 1e-6;
+        let time: Vec<f64> = aligned.time.iter().map(|t| t - start).collect();
+        (time, aligned.table)
     } else {
         let mut names = vec![layout.time.column.as_str()];
         names.extend(&columns);
@@ -204,6 +207,7 @@ pub fn read_with_layout(path: &Path, layout: &RecordingLayout) -> Result<FlightL
         hover_throttle: vec![f64::NAN; time.len()],
         motor_command,
         battery_voltage: layout.battery_voltage.as_ref().map(|_| column(17).clone()),
+        declared_rate_frame: Some(crate::RateFrame::Body),
         position_desired: None,
         velocity_desired: None,
         attitude_setpoint: None,

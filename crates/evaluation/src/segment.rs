@@ -237,6 +237,7 @@ mod tests {
             hover_throttle: vec![0.5; n],
             motor_command: vec![[1500.0; 4]; n],
             battery_voltage: None,
+            declared_rate_frame: None,
             position_desired: None,
             velocity_desired: None,
             attitude_setpoint: None,

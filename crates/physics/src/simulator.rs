@@ -612,6 +612,7 @@ fn empty_log(name: &str, rows: usize) -> FlightLog {
         hover_throttle: Vec::with_capacity(rows),
         motor_command: Vec::with_capacity(rows),
         battery_voltage: None,
+        declared_rate_frame: None,
         position_desired: Some(Vec::with_capacity(rows)),
         velocity_desired: Some(Vec::with_capacity(rows)),
         attitude_setpoint: Some(Vec::with_capacity(rows)),

@@ -60,6 +60,10 @@ pub struct Args {
     /// recording longer than one analysis accepts.
     #[arg(long, value_parser = super::evaluate::parse_rows, requires = "recording")]
     pub rows: Option<std::ops::Range<usize>>,
+    /// With --recording: half the support of the comparison's test function, s (default 0.2); it
+    /// must span at least three sample intervals, so a log sampled slower than 15 Hz needs more.
+    #[arg(long, requires = "recording")]
+    pub half_width: Option<f64>,
     /// Overwrite existing output files (never one of the run's inputs).
     #[arg(long)]
     pub force: bool,
@@ -68,7 +72,11 @@ pub struct Args {
 pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
     // clap's "mode" group gives exactly one of --recording, --demo and --flights, and --model
     // with the two that need it; the last arm only keeps the match total.
-    let settings = mismatch::Settings::default().checked()?;
+    let mut settings = mismatch::Settings::default();
+    if let Some(half_width) = args.half_width {
+        settings.comparison.test_function.half_width_s = half_width;
+    }
+    let settings = settings.checked()?;
     match (&args.recording, &args.demo, &args.flights, &args.model) {
         (None, Some(manifest), None, None) => run_demo(manifest, &args, &settings),
         (None, None, Some(conditions), Some(model)) => {

@@ -131,6 +131,7 @@ pub fn flight(wind: f64) -> FlightLog {
             .collect(),
         position_desired: None,
         battery_voltage: None,
+        declared_rate_frame: None,
         velocity_desired: None,
         attitude_setpoint: None,
         residual_force: None,

@@ -48,6 +48,7 @@ pub fn synthetic_log(n: usize) -> FlightLog {
             .collect(),
         position_desired: Some(vec![[0.0; 3]; n]),
         battery_voltage: None,
+        declared_rate_frame: None,
         velocity_desired: Some(vec![[0.0; 3]; n]),
         attitude_setpoint: Some(vec![[0.0, 0.0, 0.0, 1.0]; n]),
         residual_force: Some(vec![[0.1, -0.2, 0.3]; n]),

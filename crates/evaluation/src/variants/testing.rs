@@ -69,6 +69,7 @@ pub(super) fn cell(support: Segment, query: Segment) -> EvaluationCell {
         hover_throttle: Vec::new(),
         motor_command: Vec::new(),
         battery_voltage: None,
+        declared_rate_frame: None,
         position_desired: None,
         velocity_desired: None,
         attitude_setpoint: None,

@@ -382,7 +382,7 @@ impl DemoPlan {
         let log = simulate(&loaded.model, &scenario, name)?;
         write(&csv, &log.csv_text())?;
         // Blind: the analysis sees only the CSV as written and the model file's contents.
-        let recording = data::FlightLog::read(&csv)?;
+        let recording = data::FlightLog::read_spaced(&csv, data::Spacing::Any)?;
         let model_name = self.configuration_dir(configuration).join("model.json");
         let analysis = analyze(
             &recording,

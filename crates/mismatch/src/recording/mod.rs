@@ -90,7 +90,8 @@ impl Recording {
             degeneracy,
         };
         degenerate::check_excitation(log, model).map_err(degenerate)?;
-        let (frame, body_rms, world_rms) = log.rate_frame();
+        let (detected, body_rms, world_rms) = log.rate_frame();
+        let frame = log.declared_rate_frame.unwrap_or(detected);
         let body_rate = match frame {
             RateFrame::Body => log.body_rate.clone(),
             RateFrame::World => log

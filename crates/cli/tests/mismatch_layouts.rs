@@ -1,0 +1,150 @@
+//! `learn mismatch --layout`: recordings of other loggers (the public Crazyflie flight and PX4 log)
+//! through the layouts and models in `experiments/`, their time stamps as logged; bad layouts and
+//! models refused with one line naming the file and field.
+
+mod common;
+
+use common::{learn_in, scratch, workspace};
+
+fn root(path: &str) -> String {
+    workspace().join(path).display().to_string()
+}
+
+/// Seven seconds of the Crazyflie flight near the floor: read with its layout, compared on its
+/// jittering stamps with a model built from its vehicle description (voltage-dependent thrust).
+#[test]
+fn the_crazyflie_flight_is_analysed_through_its_layout() {
+    let Some(flight) =
+        data::shared_file_for_tests(&workspace(), "crazyflie", "randomwalk_l_cf102_01.csv")
+    else {
+        return;
+    };
+    let dir = scratch("crazyflie");
+    let out = dir.join("out");
+    let run = learn_in(
+        &dir,
+        &[
+            "mismatch",
+            "--recording",
+            &flight.display().to_string(),
+            "--layout",
+            &root("experiments/layouts/crazyflie-neural-swarm.json"),
+            "--model",
+            &root("experiments/mismatch/vehicles/crazyflie-parrot.json"),
+            "--rows",
+            "0:700",
+            "--out",
+            &out.display().to_string(),
+            "--quiet",
+        ],
+    );
+    run.success();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("mismatch.json")).unwrap()).unwrap();
+    let stamps = &report["time_stamps"];
+    let median = stamps["median_interval_s"].as_f64().unwrap();
+    assert!((0.0095..0.0105).contains(&median), "{stamps}");
+    assert_eq!(report["channels"].as_array().unwrap().len(), 3);
+    let text = std::fs::read_to_string(out.join("mismatch.md")).unwrap();
+    assert!(
+        text.contains("`compared_channels` is \"translational\""),
+        "{text}"
+    );
+    assert!(
+        text.contains("The time stamps are not evenly spaced"),
+        "{text}"
+    );
+}
+
+/// The PX4 log's positions come at ~10 Hz: the default ±0.2 s window is refused with what to do.
+#[test]
+fn a_slow_ulog_needs_a_wider_window() {
+    let Some(log) = data::ulog_file_for_tests(&workspace(), "sample_px4_events.ulg") else {
+        return;
+    };
+    let dir = scratch("slow-ulog");
+    let args = |extra: &[&str]| {
+        let mut args = vec![
+            "mismatch".to_string(),
+            "--recording".into(),
+            log.display().to_string(),
+            "--layout".into(),
+            root("experiments/layouts/px4-ulog.json"),
+            "--model".into(),
+            root("experiments/mismatch/vehicles/jmavsim-iris.json"),
+            "--out".into(),
+            dir.join("out").display().to_string(),
+            "--quiet".into(),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        args
+    };
+    let strings = args(&[]);
+    let refused = learn_in(
+        &dir,
+        &strings.iter().map(String::as_str).collect::<Vec<_>>(),
+    );
+    refused.one_line_error(&["sample_px4_events.ulg", "±0.2 s", "it needs 3"]);
+    let strings = args(&["--half-width", "0.4", "--rows", "160:280"]);
+    let run = learn_in(
+        &dir,
+        &strings.iter().map(String::as_str).collect::<Vec<_>>(),
+    );
+    run.success();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/mismatch.json")).unwrap())
+            .unwrap();
+    // Times since the log's start, as `learn data inspect` counts them (airborne 16.7–28.1 s).
+    let start = report["fit"]["t_start"].as_f64().unwrap();
+    assert!((15.0..20.0).contains(&start), "{start}");
+}
+
+#[test]
+fn a_bad_layout_or_vehicle_model_is_named() {
+    let dir = scratch("bad-layout");
+    std::fs::write(dir.join("flight.csv"), "t,x\n0,1\n").unwrap();
+    std::fs::write(
+        dir.join("layout.json"),
+        r#"{"time": {"column": "t", "unit": "fortnights"}}"#,
+    )
+    .unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "mismatch",
+            "--recording",
+            "flight.csv",
+            "--layout",
+            "layout.json",
+            "--model",
+            &root("experiments/mismatch/vehicles/crazyflie-parrot.json"),
+            "--out",
+            "out",
+        ],
+    );
+    run.one_line_error(&["layout.json", "fortnights"]);
+    std::fs::write(
+        dir.join("model.json"),
+        r#"{"mass_kg": 1.0, "gravity_m_s2": 9.81, "inertia_kg_m2": [0.01, 0.01, 0.02],
+            "thrust_source": "mixer", "vehicle": "hexa.json"}"#,
+    )
+    .unwrap();
+    std::fs::copy(
+        workspace().join("experiments/vehicles/hexa-plus.json"),
+        dir.join("hexa.json"),
+    )
+    .unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "mismatch",
+            "--recording",
+            "flight.csv",
+            "--model",
+            "model.json",
+            "--out",
+            "out",
+        ],
+    );
+    run.one_line_error(&["model.json", "vehicle", "6 rotors"]);
+}

@@ -27,7 +27,15 @@ impl NumericTable {
     /// read once (a file or a pipe, at most [`bounded_read::MAX_CSV_BYTES`]): the same values, or the
     /// same first error in file order.
     pub fn read(path: &Path, columns: &[&str]) -> Result<Self> {
-        let records = CsvRecords::open(path)?;
+        Self::from_records(path, CsvRecords::open(path)?, columns)
+    }
+
+    /// The named columns of every row `records` (of `path`) holds.
+    fn from_records<R: std::io::BufRead>(
+        path: &Path,
+        records: CsvRecords<R>,
+        columns: &[&str],
+    ) -> Result<Self> {
         let mut rows = NumericRows::new(path, records, columns)?;
         let block = rows
             .next_block(usize::MAX)?
@@ -60,17 +68,7 @@ impl NumericTable {
             });
         }
         input.consume(prefix.len());
-        let records = CsvRecords::new(path, input);
-        let mut rows = NumericRows::new(path, records, columns)?;
-        let block = rows
-            .next_block(usize::MAX)?
-            .expect("a file without rows is an error");
-        Ok(Self {
-            path: path.to_path_buf(),
-            names: columns.iter().map(|s| s.to_string()).collect(),
-            columns: block.columns,
-            lines: block.lines,
-        })
+        Self::from_records(path, CsvRecords::new(path, input), columns)
     }
 
     /// The named columns of a table already read, parsed row by row (as [`crate::NumericStream`]

@@ -347,7 +347,7 @@ impl WeakForm {
             Some(weights) => square(weights).sqrt(),
             None => {
                 let total: f64 = (0..self.centres.len())
-                    .map(|index| square(&self.target_weights(index)))
+                    .map(|index| square(self.target_weights(index)))
                     .sum();
                 (total / self.centres.len().max(1) as f64).sqrt()
             }

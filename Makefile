@@ -76,4 +76,5 @@ bench: data build
 # Takes about 10 minutes on 2 cores (the matrix about 6, the joint analysis about 4).
 mismatch-demo: data build
 	$(LEARN) mismatch --demo experiments/mismatch/demo.json --work target/mismatch-demo --out results/mismatch --force
+	$(LEARN) mismatch --demo experiments/mismatch/demo-timing.json --work target/mismatch-demo-timing --out results/mismatch/timing --force
 	$(LEARN) mismatch --flights experiments/conditions.json --model experiments/mismatch/neural-fly.json --out results/mismatch --force

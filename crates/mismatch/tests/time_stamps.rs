@@ -147,3 +147,10 @@ fn a_concealed_thrust_loss_is_fitted_across_the_gap() {
         "{fit:?}"
     );
 }
+
+/// What `learn data inspect` calls a gap is what splits the comparison (the readers cannot depend on
+/// the analysis, so each crate names the threshold; they must agree).
+#[test]
+fn the_inspection_and_the_comparison_split_at_the_same_gaps() {
+    assert_eq!(data::GAP_INTERVALS, sindy::sampling::GAP_FACTOR);
+}

@@ -157,11 +157,11 @@ fn run_demo(
     super::staged_write(&staged, || {
         write_files(
             staged.dir(out),
-            SUMMARY_FILES.into_iter().zip(summary.render()),
+            SUMMARY_FILES.into_iter().zip(summary.render(manifest)),
         )
     })?;
     staged.commit()?;
-    say_part!("{}", summary.view().table_text());
+    say_part!("{}", summary.view(manifest).table_text());
     say!("wrote {}", args.out.join(SUMMARY_FILES[0]).display());
     Ok(())
 }

@@ -2,6 +2,8 @@
 //! Markdown and the terminal table are rendered by the `report` crate, [`report::mismatch::demo`],
 //! from the view [`DemoSummary::view`] fills).
 
+use std::path::Path;
+
 use physics::{
     ChannelGroup, EffectId, Effects, NominalModel, ParameterValue, Scenario, Trajectory,
 };
@@ -368,9 +370,10 @@ impl DemoSummary {
     }
 
     /// What the Markdown and the terminal table say: the configurations and the cells with the
-    /// effects by their names, the rest borrowed.
-    pub fn view(&self) -> DemoView<'_> {
+    /// effects by their names, the rest borrowed; `manifest` names the manifest read.
+    pub fn view(&self, manifest: &Path) -> DemoView<'_> {
         DemoView {
+            manifest: manifest.display().to_string(),
             targets: &self.targets,
             configurations: self.configurations.iter().map(configuration_line).collect(),
             cases: &self.cases,
@@ -378,10 +381,11 @@ impl DemoSummary {
         }
     }
 
-    /// The contents of the files [`super::SUMMARY_FILES`] names: the Markdown and the JSON.
-    pub fn render(&self) -> [String; 2] {
+    /// The contents of the files [`super::SUMMARY_FILES`] names: the Markdown and the JSON, of a
+    /// run of `manifest`.
+    pub fn render(&self, manifest: &Path) -> [String; 2] {
         let json = serde_json::to_string_pretty(self).expect("serialises");
-        [self.view().markdown(), json + "\n"]
+        [self.view(manifest).markdown(), json + "\n"]
     }
 }
 

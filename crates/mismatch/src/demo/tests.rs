@@ -71,7 +71,12 @@ fn cell(c: &Value) -> CellOutcome {
 
 /// The summary as the committed JSON records it (the cells as judged then: not judged again).
 fn committed_summary() -> DemoSummary {
-    let json: Value = serde_json::from_str(&read("summary.json")).unwrap();
+    committed_summary_of("summary.json")
+}
+
+/// [`committed_summary`] of the JSON file `name` in `results/mismatch`.
+fn committed_summary_of(name: &str) -> DemoSummary {
+    let json: Value = serde_json::from_str(&read(name)).unwrap();
     let targets = &json["targets"];
     DemoSummary {
         targets: Targets {
@@ -90,10 +95,23 @@ fn committed_summary() -> DemoSummary {
     }
 }
 
+/// The timing matrix (`make mismatch-demo`'s second run) renders its Markdown as committed.
+#[test]
+fn the_committed_timing_summary_renders_its_committed_markdown() {
+    let summary = committed_summary_of("timing/summary.json");
+    let manifest = Path::new("experiments/mismatch/demo-timing.json");
+    assert_eq!(summary.view(manifest).markdown(), read("timing/summary.md"));
+}
+
 #[test]
 fn the_committed_summary_renders_its_committed_markdown() {
     let summary = committed_summary();
-    assert_eq!(summary.view().markdown(), read("summary.md"));
+    assert_eq!(
+        summary
+            .view(Path::new("experiments/mismatch/demo.json"))
+            .markdown(),
+        read("summary.md")
+    );
 }
 
 #[test]
@@ -107,7 +125,9 @@ fn the_committed_summary_is_read_back_whole() {
 
 #[test]
 fn the_committed_summary_prints_one_line_per_cell_and_the_total() {
-    let text = committed_summary().view().table_text();
+    let text = committed_summary()
+        .view(Path::new("experiments/mismatch/demo.json"))
+        .table_text();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 185);
     assert_eq!(
@@ -131,7 +151,9 @@ fn a_cell_that_misses_prints_why_and_counts_against_the_total() {
     let cell = &mut summary.cells[17];
     cell.passed = false;
     cell.failures = vec!["inertia_scale.k off by 11% (2.3 standard errors)".to_string()];
-    let text = summary.view().table_text();
+    let text = summary
+        .view(Path::new("experiments/mismatch/demo.json"))
+        .table_text();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(
         lines[17],

@@ -19,7 +19,8 @@
 //! Beyond PySINDy: regularised regressions of targets on any feature matrix with the penalty
 //! chosen by blocked cross-validation, and bagged ensembles with a predictive band
 //! ([`RegressionSpec`]); the weak form of an equation through a smooth test function
-//! ([`weak_form`], as PySINDy's weak libraries); forward stepwise selection of column groups
+//! ([`weak_form`], as PySINDy's weak libraries), on evenly spaced or logged time stamps
+//! ([`sampling`]); forward stepwise selection of column groups
 //! with time-blocked cross-validation and stability selection over block-bootstrap resamples
 //! ([`stability`]).
 //!

@@ -147,4 +147,24 @@ fn a_bad_layout_or_vehicle_model_is_named() {
         ],
     );
     run.one_line_error(&["model.json", "vehicle", "6 rotors"]);
+    let Some(flight) =
+        data::shared_file_for_tests(&workspace(), "crazyflie", "randomwalk_l_cf102_01.csv")
+    else {
+        return;
+    };
+    let run = learn_in(
+        &dir,
+        &[
+            "mismatch",
+            "--recording",
+            &flight.display().to_string(),
+            "--layout",
+            &root("experiments/layouts/crazyflie-neural-swarm.json"),
+            "--model",
+            &root("experiments/mismatch/neural-fly.json"),
+            "--out",
+            "out",
+        ],
+    );
+    run.one_line_error(&["randomwalk_l_cf102_01.csv", "T_sp", "no thrust setpoint"]);
 }

@@ -192,6 +192,13 @@ pub fn read_with_layout(path: &Path, layout: &RecordingLayout) -> Result<FlightL
             })
             .collect()
     };
+    for (first, range, names) in [
+        (0, "p", &layout.position),
+        (3, "v", &layout.velocity),
+        (10, "w", &layout.body_rate),
+    ] {
+        check_plausible(&table, first, range, names)?;
+    }
     let quaternion = quaternions(&table, layout)?;
     let rotation = quaternion.iter().map(rotation_from_quaternion).collect();
     let motor_command = (0..time.len())
@@ -216,6 +223,36 @@ pub fn read_with_layout(path: &Path, layout: &RecordingLayout) -> Result<FlightL
         rotation,
         time,
     })
+}
+
+/// Fails on the first value of the three columns from `first` outside the plausible range of the
+/// Neural-Fly column `range` (as [`FlightLog::read`] checks it), naming the layout's column.
+fn check_plausible(
+    table: &NumericTable,
+    first: usize,
+    range: &str,
+    names: &[String; 3],
+) -> Result<()> {
+    let range = crate::flight_log::plausible_range(range).expect("a checked column");
+    for (axis, name) in names.iter().enumerate() {
+        let values = &table.columns[first + axis];
+        if let Some(k) = values
+            .iter()
+            .position(|v| !(range.min..=range.max).contains(v))
+        {
+            return Err(DataError::Implausible {
+                path: table.path.clone(),
+                row: table.line(k),
+                column: name.clone(),
+                value: values[k],
+                min: range.min,
+                max: range.max,
+                unit: range.unit,
+                quantity: range.quantity,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The attitude as `[x, y, z, w]` quaternions in the z-up frames, each checked to be a unit one.

@@ -117,6 +117,15 @@ fn bad_layouts_and_cells_are_named() {
         message.contains("bad.csv:2") && message.contains("q0"),
         "{message}"
     );
+    let runaway = text.replacen(",0.5,-0.25,-1.0,", ",5e9,-0.25,-1.0,", 1);
+    let path = write(dir.path(), "runaway.csv", &runaway);
+    let message = read_with_layout(&path, &layout(PX4_LIKE))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("runaway.csv:2") && message.contains("vx"),
+        "{message}"
+    );
     let missing = PX4_LIKE.replace("\"volts\"", "\"vbat\"");
     let path = write(dir.path(), "ok.csv", &text);
     let message = read_with_layout(&path, &layout(&missing))

@@ -71,6 +71,13 @@ impl Recording {
             )));
         }
         if model.thrust_source == physics::ThrustSource::ThrustSetpoint
+            && log.thrust_setpoint.iter().all(|t| t.is_nan())
+        {
+            return Err(bad(
+                "the model's thrust_source is \"T_sp\", and the recording has no thrust setpoint (a layout description maps none: give the model a vehicle or a mixer)".into(),
+            ));
+        }
+        if model.thrust_source == physics::ThrustSource::ThrustSetpoint
             && let Some(row) = log
                 .hover_throttle
                 .iter()

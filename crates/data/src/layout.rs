@@ -16,7 +16,7 @@ use serde::Deserialize;
 use crate::error::{DataError, Result};
 use crate::flight_log::{FlightLog, FlightMeta, SAMPLE_INTERVAL_RANGE_S};
 use crate::numeric::NumericTable;
-use crate::time::{check_interval_range, check_time_axis_at};
+use crate::time::check_interval_range;
 
 /// The unit of a time column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -161,15 +161,11 @@ pub fn read_with_layout(path: &Path, layout: &RecordingLayout) -> Result<FlightL
     } else {
         let mut names = vec![layout.time.column.as_str()];
         names.extend(&columns);
-        let mut table = match &layout.header_prefix {
+        let table = match &layout.header_prefix {
             Some(prefix) => NumericTable::read_after_header_prefix(path, prefix, &names)?,
             None => NumericTable::read(path, &names)?,
         };
-        let time = table.columns.remove(0);
-        table.names.remove(0);
-        check_time_axis_at(path, &layout.time.column, &time, f64::INFINITY, &|k| {
-            table.line(k)
-        })?;
+        let (time, table) = table.split_increasing_time()?;
         let unit = layout.time.unit.seconds();
         (time.into_iter().map(|t| t * unit).collect(), table)
     };

@@ -151,11 +151,16 @@ impl NumericTable {
     ) -> Result<(Vec<f64>, Self)> {
         let mut names = vec![time];
         names.extend_from_slice(columns);
-        let mut table = Self::read(path, &names)?;
-        let time_values = table.columns.remove(0);
-        table.names.remove(0);
-        check_time_axis_at(path, time, &time_values, f64::INFINITY, &|k| table.line(k))?;
-        Ok((time_values, table))
+        Self::read(path, &names)?.split_increasing_time()
+    }
+
+    /// The first column, checked as a strictly increasing time axis (its steps may vary), and the
+    /// table of the others.
+    pub(crate) fn split_increasing_time(mut self) -> Result<(Vec<f64>, Self)> {
+        let time = self.columns.remove(0);
+        let name = self.names.remove(0);
+        check_time_axis_at(&self.path, &name, &time, f64::INFINITY, &|k| self.line(k))?;
+        Ok((time, self))
     }
 
     /// Number of rows.

@@ -26,7 +26,7 @@ use std::sync::OnceLock;
 use faer::Mat;
 
 use crate::sampling::Sampling;
-pub use crate::sampling::white_noise_sigma_of_fourth_differences;
+use crate::sampling::white_noise_sigma_of_fourth_differences;
 
 /// The test function's settings.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

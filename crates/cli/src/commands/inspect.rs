@@ -67,7 +67,7 @@ fn column_summary(columns: &[String]) -> String {
 }
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
-    if super::sindy::is_ulog(&args.file) {
+    if data::layout::is_ulog(&args.file) {
         return inspect_ulog(&args.file);
     }
     // Any spacing: a real logger's jitter, drops and gaps are reported, not refused.

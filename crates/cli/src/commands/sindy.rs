@@ -183,7 +183,7 @@ pub(super) fn read_recording(
     columns: &[&str],
     derivative: Derivative,
 ) -> anyhow::Result<Recording> {
-    let (time, table) = if is_ulog(path) {
+    let (time, table) = if data::layout::is_ulog(path) {
         read_ulog_columns(path, time_column, columns)?
     } else {
         NumericTable::read_with_increasing_time(path, time_column, columns)?
@@ -200,12 +200,6 @@ pub(super) fn read_recording(
         trajectory,
         table,
     })
-}
-
-/// Whether `path` names a PX4 ULog (by its extension).
-pub(super) fn is_ulog(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("ulg"))
 }
 
 /// The columns (`topic.field`) of a ULog on the clock of `--time` when it names a topic (of the
@@ -547,12 +541,12 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         .library(library)
         .optimizer(optimizer)
         .derivative(derivative);
-    if args.stream && args.csv.iter().any(|path| is_ulog(path)) {
+    if args.stream && args.csv.iter().any(|path| data::layout::is_ulog(path)) {
         bail!("--stream reads a CSV; a ULog is read whole");
     }
     let streamed = args.stream
         || (args.csv.len() == 1
-            && !is_ulog(&args.csv[0])
+            && !data::layout::is_ulog(&args.csv[0])
             && std::fs::metadata(&args.csv[0])
                 .is_ok_and(|metadata| metadata.is_file() && metadata.len() > STREAM_ABOVE_BYTES));
     let (model, score, n) = if streamed {

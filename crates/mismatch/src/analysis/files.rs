@@ -140,7 +140,7 @@ impl Analysis {
         let logger = &self.problem.model.logger;
         let steps_per_row = logger
             .controller_rate_hz
-            .map(|rate| rate * self.problem.recording.dt);
+            .map(|rate| rate * self.problem.recording.dt());
         match (logger.command, steps_per_row) {
             (CommandLogging::Sample, None) => CommandSampling::RateUnknown,
             (CommandLogging::Sample, Some(steps_per_row))

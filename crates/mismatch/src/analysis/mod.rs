@@ -230,7 +230,7 @@ fn prediction_noise(recording: &Recording, model: &NominalModel, effects: &Effec
         forward::accelerations_at_rows(recording, &recording.commands, model, effects);
     std::array::from_fn(|a| {
         let series: Vec<f64> = accelerations.iter().map(|x| x[a]).collect();
-        recording.dt * recording.white_noise_sigma(&series)
+        recording.dt() * recording.white_noise_sigma(&series)
     })
 }
 
@@ -255,7 +255,7 @@ fn analyze_recording(
             degeneracy,
         })?;
     }
-    let block_rows = ((settings.analysis.block_s / problem.recording.dt).round() as usize).max(1);
+    let block_rows = ((settings.analysis.block_s / problem.recording.dt()).round() as usize).max(1);
     let before = problem.residual(&Effects::default());
     observe(Stage::Candidates);
     let (candidates, mut columns) = build_library(&problem);

@@ -101,7 +101,7 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
         if effect.acts_on() == ChannelGroup::Angular && problem.channels != 6 {
             continue;
         }
-        let Some((terms, perturbed)) = effect.screening(problem.recording.dt) else {
+        let Some((terms, perturbed)) = effect.screening(problem.recording.dt()) else {
             continue;
         };
         let start = columns.len();

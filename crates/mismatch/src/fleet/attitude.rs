@@ -185,7 +185,7 @@ pub fn check(flights: &[FleetFlight]) -> Option<AttitudeCheck> {
         mean_pwm_offset: offset,
         mean_pwm_slope: slope,
         mean_pwm_lag_rows: pwm_lag,
-        mean_pwm_lag_s: pwm_lag as f64 * flights[0].problem.recording.dt,
+        mean_pwm_lag_s: pwm_lag as f64 * flights[0].problem.recording.dt(),
         mean_pwm_residual_rms: pwm_rms,
         torque_map_lag_rows: lag,
         explained_calm_heldout: calm_heldout,

@@ -236,7 +236,7 @@ fn with_noise(
 /// vehicle felt: not an error of the inputs.
 fn command_sample_noise(problem: &Problem) -> Option<[[f64; 4]; 4]> {
     let logger = &problem.model.logger;
-    let steps = logger.controller_rate_hz? * problem.recording.dt;
+    let steps = logger.controller_rate_hz? * problem.recording.dt();
     let sampled = logger.command == physics::CommandLogging::Sample;
     if !sampled
         || steps < noise_reaction::MIN_STEPS_PER_ROW

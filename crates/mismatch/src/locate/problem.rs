@@ -103,7 +103,7 @@ impl Problem {
                 "{centres} rows have a whole window of the comparison between gaps, the analysis needs at least {} ({} gaps longer than {} s)",
                 needed - 2 * half,
                 recording.sampling.gaps().len(),
-                sindy::sampling::GAP_FACTOR * recording.dt
+                sindy::sampling::GAP_FACTOR * recording.dt()
             )));
         }
         let channels = if model.predicts_torque() { 6 } else { 3 };

@@ -78,7 +78,7 @@ pub(crate) fn locate_windows(
     settings: &LocateSettings,
 ) -> Vec<Window> {
     let rows = residual.len();
-    let half = half_window_rows(settings.window_s, problem.recording.dt, rows);
+    let half = half_window_rows(settings.window_s, problem.recording.dt(), rows);
     let mut windows = Vec::new();
     for c in 0..problem.channels {
         let threshold = (settings.window_factor * problem.noise_floor[c]).powi(2);

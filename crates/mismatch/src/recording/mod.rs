@@ -23,8 +23,6 @@ use noise_reaction::NoiseReaction;
 #[derive(Clone, Debug)]
 pub struct Recording {
     pub path: PathBuf,
-    /// The nominal sample interval (`sampling.interval()`), s.
-    pub dt: f64,
     pub time: Vec<f64>,
     /// When the samples were taken: evenly spaced, or the logged stamps with their gaps.
     pub sampling: Sampling,
@@ -148,7 +146,6 @@ impl Recording {
         };
         let mut recording = Self {
             path: log.path.clone(),
-            dt,
             time: log.time.clone(),
             sampling,
             rotation: log.rotation.clone(),
@@ -172,6 +169,11 @@ impl Recording {
     pub fn set_commands(&mut self, commands: Vec<[f64; 4]>) {
         self.samples = self.samples.with_commands(&commands);
         self.commands = commands;
+    }
+
+    /// The nominal sample interval (`sampling.interval()`), s.
+    pub fn dt(&self) -> f64 {
+        self.sampling.interval()
     }
 
     /// Robust standard deviation of the white noise on a smooth series given at the rows.

@@ -71,7 +71,7 @@ pub fn steps_per_row(logger: &Logger, dt: f64) -> Option<f64> {
 /// Removes the unfelt reaction to the logged attitude and position noise from the commands, and
 /// records it in `recording.noise_reaction`; returns whether it did.
 pub fn remove(recording: &mut Recording, logger: &Logger, actuators: usize) -> bool {
-    let Some(steps) = steps_per_row(logger, recording.dt) else {
+    let Some(steps) = steps_per_row(logger, recording.dt()) else {
         return false;
     };
     if recording.len() < MIN_ROWS {
@@ -360,7 +360,7 @@ fn attitude_smoothing_scales(
     let rate: Vec<f64> = recording.body_rate.iter().map(|w| w[a]).collect();
     (
         white_noise_sigma_of_fourth_differences(&fourth),
-        recording.dt * recording.white_noise_sigma(&rate),
+        recording.dt() * recording.white_noise_sigma(&rate),
     )
 }
 
@@ -392,7 +392,7 @@ fn position_noise(recording: &Recording) -> Vec<Vec3> {
             .collect();
         let position: Vec<f64> = p.iter().map(|x| x[a]).collect();
         let velocity: Vec<f64> = v.iter().map(|x| x[a]).collect();
-        let step = recording.dt * recording.white_noise_sigma(&velocity);
+        let step = recording.dt() * recording.white_noise_sigma(&velocity);
         smooth_noise(&series, recording.white_noise_sigma(&position), step)
     })
 }

@@ -38,7 +38,6 @@ fn flight(seed: u64) -> (Recording, Commands, Commands, Vec<Vec3>) {
     ];
     let mut recording = Recording {
         path: PathBuf::from("synthetic.csv"),
-        dt: DT,
         time: Vec::new(),
         sampling: sindy::sampling::Sampling::Uniform {
             start: 0.0,

@@ -1,26 +1,30 @@
 //! The evidence rule: an effect is named only when it buys an improvement clearly beyond noise.
 //!
 //! For every effect of the jointly fitted set, the set without it is refitted, and the effect
-//! passes when all of these hold:
-//! - **significance** (fit part): the likelihood ratio `Λ = ΔSSE / (κ s²)` is at least the
-//!   `significance` quantile of χ² with as many degrees of freedom as the effect has parameters.
-//!   `ΔSSE` is the noise-normalised sum of squares the effect removes, `s²` the full model's
-//!   residual variance per row and channel (noise-normalised, ≈ 1 when the model is right), and `κ`
-//!   the integrated autocorrelation of that residual over the test function's support: the weak
-//!   form's rows share samples, so `κ` neighbouring rows carry about one row's worth of
-//!   independent noise, and `ΔSSE` of a noise-only term is about `κ s² χ²_p`;
-//! - **size** (fit part): the mean gain per row and channel is at least `min_gain` noise variances;
+//! passes when all of these hold, each on the channels the effect acts on (its channel group:
+//! translational, angular or both), so that a residual the vocabulary cannot explain in one group
+//! does not hide an effect of the other:
+//! - **significance** (fit part): the likelihood ratio `Λ = Σ_g ΔSSE_g / (κ_g s²_g)` over the
+//!   effect's groups `g` is at least the `significance` quantile of χ² with as many degrees of
+//!   freedom as the effect has parameters. `ΔSSE_g` is the noise-normalised sum of squares the
+//!   effect removes from group `g`, `s²_g` the full model's residual variance per row and channel
+//!   of that group (noise-normalised, ≈ 1 when the model is right), and `κ_g` the integrated
+//!   autocorrelation of that residual over the test function's support: the weak form's rows share
+//!   samples, so `κ` neighbouring rows carry about one row's worth of independent noise, and
+//!   `ΔSSE` of a noise-only term is about `κ s² χ²_p`;
+//! - **size** (fit part): the mean gain per row and channel of its groups is at least `min_gain`
+//!   noise variances;
 //! - **consistency** (fit part): the mean gain is still at least `min_trimmed_gain` when the two
 //!   blocks (of about a second) that gain most are left out ([`sindy::stability::trimmed_gain`]):
 //!   not one transient;
 //! - **held out**: on the held-out part, which no fit or choice has seen, the noise-normalised
-//!   residual sum of squares falls by at least `min_heldout_reduction` of its value without the
-//!   effect.
+//!   residual sum of squares of its groups (each divided by its `s²_g`) falls by at least
+//!   `min_heldout_reduction` of its value without the effect.
 //!
 //! While an effect fails, the weakest failing one (smallest fit gain) is dropped and the rest
 //! refitted; the rule is then applied again to every effect left.
 
-use physics::EffectId;
+use physics::{ChannelGroup, EffectId};
 use rayon::prelude::*;
 use serde::Serialize;
 use sindy::stability::trimmed_gain;
@@ -54,6 +58,8 @@ impl Default for EvidenceSettings {
 #[derive(Clone, Debug, Serialize)]
 pub struct Evidence {
     pub id: EffectId,
+    /// The channels the effect was judged on (those it acts on, of those compared).
+    pub judged_on: ChannelGroup,
     /// Parameters of the effect (the degrees of freedom of the test).
     pub parameters: usize,
     /// `Λ = ΔSSE / (κ s²)` and the χ² quantile it is compared with.
@@ -73,36 +79,71 @@ pub struct Evidence {
     pub passes: bool,
 }
 
-/// Noise-normalised sums of squares of a set's residual: per fit block, and over the held-out part.
+/// Noise-normalised sums of squares of a set's residual, per compared channel group (in the order
+/// of [`Problem::channel_groups`]): per fit block, and over the held-out part.
 struct Scores {
-    blocks: Vec<f64>,
-    counts: Vec<f64>,
-    heldout: f64,
+    /// `blocks[b][g]`: block `b`, group `g`.
+    blocks: Vec<Vec<f64>>,
+    /// Rows times channels of each block, per group.
+    counts: Vec<Vec<f64>>,
+    heldout: Vec<f64>,
+}
+
+impl Scores {
+    /// The sum over the fit blocks of group `g`.
+    fn fit(&self, g: usize) -> f64 {
+        self.blocks.iter().map(|b| b[g]).sum()
+    }
+
+    fn count(&self, g: usize) -> f64 {
+        self.counts.iter().map(|b| b[g]).sum()
+    }
 }
 
 fn scores(problem: &Problem, set: &FittedSet, block_rows: usize) -> Scores {
     let residual = problem.residual(&set.effects());
+    let groups = problem.channel_groups();
     let mut blocks = Vec::new();
     let mut counts = Vec::new();
     let mut start = 0;
     while start < problem.split {
         let end = (start + block_rows).min(problem.split);
-        blocks.push(problem.whitened_sse(&residual, start..end));
-        counts.push(((end - start) * problem.channels) as f64);
+        let of_group = |(_, channels): &(ChannelGroup, std::ops::Range<usize>)| {
+            problem.whitened_sse_of(&residual, start..end, channels.clone())
+        };
+        blocks.push(groups.iter().map(of_group).collect());
+        counts.push(
+            groups
+                .iter()
+                .map(|(_, channels)| ((end - start) * channels.len()) as f64)
+                .collect(),
+        );
         start = end;
     }
+    let heldout = groups
+        .iter()
+        .map(|(_, channels)| {
+            problem.whitened_sse_of(&residual, problem.split..problem.rows(), channels.clone())
+        })
+        .collect();
     Scores {
         blocks,
         counts,
-        heldout: problem.whitened_sse(&residual, problem.split..problem.rows()),
+        heldout,
     }
 }
 
-/// The integrated autocorrelation of a residual over lags up to `lags`, averaged over channels
-/// (at least 1).
+/// The integrated autocorrelation of a residual over lags up to `lags`, averaged over all compared
+/// channels (at least 1).
 pub(crate) fn autocorrelation_factor(problem: &Problem, residual: &[Channels], lags: usize) -> f64 {
+    autocorrelation_of(residual, 0..problem.channels, lags)
+}
+
+/// [`autocorrelation_factor`] over the channels `channels`.
+fn autocorrelation_of(residual: &[Channels], channels: std::ops::Range<usize>, lags: usize) -> f64 {
+    let count = channels.len();
     let mut total = 0.0;
-    for c in 0..problem.channels {
+    for c in channels {
         let r: Vec<f64> = residual.iter().map(|x| x[c]).collect();
         let variance: f64 = r.iter().map(|v| v * v).sum();
         if variance <= 0.0 {
@@ -115,7 +156,7 @@ pub(crate) fn autocorrelation_factor(problem: &Problem, residual: &[Channels], l
         }
         total += factor;
     }
-    (total / problem.channels as f64).max(1.0)
+    (total / count as f64).max(1.0)
 }
 
 /// The `q` quantile of χ² with `p` degrees of freedom (at least 1), exact (statrs).
@@ -126,10 +167,31 @@ pub fn chi_square_quantile(p: usize, q: f64) -> f64 {
         .unwrap_or(f64::NAN)
 }
 
-/// What the full set's residual says about the noise: `κ` and `s²` on the fit part.
+/// What the full set's residual says about the noise of one channel group: `κ` and `s²` on the
+/// fit part.
+#[derive(Clone, Copy, Debug)]
 struct NoiseScale {
     autocorrelation: f64,
     variance: f64,
+}
+
+impl NoiseScale {
+    fn of(problem: &Problem, whitened: &[Channels], channels: std::ops::Range<usize>) -> Self {
+        let count = (whitened.len() * channels.len()).max(1) as f64;
+        let variance = whitened
+            .iter()
+            .map(|r| channels.clone().map(|c| r[c] * r[c]).sum::<f64>())
+            .sum::<f64>()
+            / count;
+        Self {
+            autocorrelation: autocorrelation_of(whitened, channels, 2 * problem.weak_form.half),
+            variance,
+        }
+    }
+
+    fn scale(&self) -> f64 {
+        (self.autocorrelation * self.variance).max(1e-300)
+    }
 }
 
 /// What every effect of one set is judged against.
@@ -137,10 +199,26 @@ struct Judge<'a> {
     problem: &'a Problem,
     set: &'a FittedSet,
     full: Scores,
-    noise: NoiseScale,
+    /// Per compared channel group.
+    noise: Vec<NoiseScale>,
     settings: &'a EvidenceSettings,
     iterations: usize,
     block_rows: usize,
+}
+
+/// The compared groups (indices into [`Problem::channel_groups`]) an effect is judged on, and
+/// the group it is reported as judged on.
+fn judged_groups(problem: &Problem, id: EffectId) -> (Vec<usize>, ChannelGroup) {
+    let groups = problem.channel_groups();
+    let acts_on = id.acts_on();
+    let judged: Vec<usize> = (0..groups.len())
+        .filter(|&g| acts_on == ChannelGroup::Both || groups[g].0 == acts_on)
+        .collect();
+    match judged.as_slice() {
+        [] => ((0..groups.len()).collect(), acts_on),
+        [g] => (judged.clone(), groups[*g].0),
+        _ => (judged, ChannelGroup::Both),
+    }
 }
 
 /// The evidence for effect `id` of the judged set; returns it with the refitted set without the
@@ -159,22 +237,32 @@ fn evidence_for(judge: &Judge, id: EffectId) -> (Evidence, FittedSet) {
     let mut reduced = set.without(id);
     reduced.refit(problem, iterations);
     let without = scores(problem, &reduced, block_rows);
-    let gains: Vec<f64> = without
+    let (groups, judged_on) = judged_groups(problem, id);
+    let sum_over = |values: &[f64]| groups.iter().map(|&g| values[g]).sum::<f64>();
+    let gains: Vec<(f64, f64)> = without
         .blocks
         .iter()
         .zip(&full.blocks)
         .zip(&full.counts)
-        .map(|((w, f), n)| (w - f) / n)
+        .map(|((w, f), n)| (1.0, (sum_over(w) - sum_over(f)) / sum_over(n)))
         .collect();
-    let rows: f64 = full.counts.iter().sum();
-    let removed: f64 = without.blocks.iter().sum::<f64>() - full.blocks.iter().sum::<f64>();
-    let mean = removed / rows;
-    let weighted: Vec<(f64, f64)> = gains.iter().map(|g| (1.0, *g)).collect();
-    let trimmed = trimmed_gain(&weighted);
+    let removed_in = |g: usize| without.fit(g) - full.fit(g);
+    let removed: f64 = groups.iter().map(|&g| removed_in(g)).sum();
+    let mean = removed / groups.iter().map(|&g| full.count(g)).sum::<f64>();
+    let trimmed = trimmed_gain(&gains);
     let parameters = set.parameters.len() - reduced.parameters.len();
-    let likelihood_ratio = removed / (noise.autocorrelation * noise.variance).max(1e-300);
+    let likelihood_ratio: f64 = groups
+        .iter()
+        .map(|&g| removed_in(g) / noise[g].scale())
+        .sum();
     let threshold = chi_square_quantile(parameters, settings.significance);
-    let reduction = 1.0 - full.heldout / without.heldout.max(1e-300);
+    let heldout_of = |scores: &Scores| -> f64 {
+        groups
+            .iter()
+            .map(|&g| scores.heldout[g] / noise[g].variance.max(1e-300))
+            .sum()
+    };
+    let reduction = 1.0 - heldout_of(full) / heldout_of(&without).max(1e-300);
     let passes = likelihood_ratio >= threshold
         && mean >= settings.min_gain
         && trimmed >= settings.min_trimmed_gain
@@ -182,13 +270,14 @@ fn evidence_for(judge: &Judge, id: EffectId) -> (Evidence, FittedSet) {
     (
         Evidence {
             id,
+            judged_on,
             parameters,
             likelihood_ratio,
             likelihood_ratio_threshold: threshold,
             fit_gain: mean,
             trimmed_gain: trimmed,
-            heldout_without: without.heldout,
-            heldout_with: full.heldout,
+            heldout_without: sum_over(&without.heldout),
+            heldout_with: sum_over(&full.heldout),
             heldout_reduction: reduction,
             fit_sse_removed: removed,
             passes,
@@ -242,14 +331,12 @@ pub fn apply(
                 w
             })
             .collect();
-        let noise = NoiseScale {
-            autocorrelation: autocorrelation_factor(
-                problem,
-                &fit_residual,
-                2 * problem.weak_form.half,
-            ),
-            variance: full.blocks.iter().sum::<f64>() / full.counts.iter().sum::<f64>(),
-        };
+        let noise: Vec<NoiseScale> = problem
+            .channel_groups()
+            .into_iter()
+            .map(|(_, channels)| NoiseScale::of(problem, &fit_residual, channels))
+            .collect();
+        let all_channels = NoiseScale::of(problem, &fit_residual, 0..problem.channels);
         let judge = Judge {
             problem,
             set: &set,
@@ -276,7 +363,7 @@ pub fn apply(
                     &set.parameters,
                     &set.values,
                     &FitRows::plain(0..problem.split),
-                    judge.noise.autocorrelation * judge.noise.variance,
+                    all_channels.autocorrelation * all_channels.variance,
                 );
                 return Judgement {
                     evidence: outcomes.into_iter().map(|(e, _)| e).collect(),
@@ -319,6 +406,7 @@ mod tests {
     fn evidence(removed: f64) -> Evidence {
         Evidence {
             id: EffectId::ThrustScale,
+            judged_on: ChannelGroup::Translational,
             parameters: 1,
             likelihood_ratio: 100.0,
             likelihood_ratio_threshold: 10.0,

@@ -2,7 +2,7 @@
 //! acceleration of the recorded velocity and body rate), the model's value of the same functional,
 //! the residual and its noise floor, per channel.
 
-use physics::{CommandLogging, Effects, NominalModel};
+use physics::{ChannelGroup, CommandLogging, Effects, NominalModel};
 use sindy::stability::BlockDesign;
 use sindy::weak_form::{TestFunction, WeakForm};
 
@@ -242,14 +242,35 @@ impl Problem {
 
     /// Sum of squares of a residual over rows `range`, each channel divided by its noise floor.
     pub fn whitened_sse(&self, residual: &[Channels], range: std::ops::Range<usize>) -> f64 {
+        self.whitened_sse_of(residual, range, 0..self.channels)
+    }
+
+    /// [`Self::whitened_sse`] over the channels `channels` only.
+    pub fn whitened_sse_of(
+        &self,
+        residual: &[Channels],
+        range: std::ops::Range<usize>,
+        channels: std::ops::Range<usize>,
+    ) -> f64 {
         residual[range]
             .iter()
             .map(|r| {
-                (0..self.channels)
+                channels
+                    .clone()
                     .map(|c| (r[c] / self.noise_floor[c]).powi(2))
                     .sum::<f64>()
             })
             .sum()
+    }
+
+    /// The channel groups the problem compares, each with its channels: the translational
+    /// accelerations, and the angular ones when the model predicts torques.
+    pub fn channel_groups(&self) -> Vec<(ChannelGroup, std::ops::Range<usize>)> {
+        let mut groups = vec![(ChannelGroup::Translational, 0..3)];
+        if self.channels == 6 {
+            groups.push((ChannelGroup::Angular, 3..6));
+        }
+        groups
     }
 }
 

@@ -189,7 +189,8 @@ pub struct Needs {
 }
 
 /// The channels an effect acts on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ChannelGroup {
     Translational,
     Angular,

@@ -1,0 +1,58 @@
+//! The evidence rule on recordings the vocabulary cannot wholly explain: each effect is judged on
+//! the channels it acts on, so a residual left in one channel group does not hide an effect of the
+//! other.
+
+use mismatch::{CheckedSettings, Settings, analyze};
+use physics::{EffectId, Effects, NominalModel, ThrustScale, simulate};
+
+mod common;
+
+use common::scenario;
+
+fn model() -> NominalModel {
+    common::model_for_scenario()
+}
+
+fn settings() -> CheckedSettings {
+    let mut settings = Settings::default();
+    settings.analysis.block_s = 0.5;
+    settings.analysis.selection.resamples = 20;
+    settings.checked().unwrap()
+}
+
+/// Adds to the logged body rate a smooth wobble no effect of the vocabulary describes: two
+/// incommensurate sines per axis, so the angular channels keep a residual far above their noise.
+fn with_rate_wobble(mut log: data::FlightLog) -> data::FlightLog {
+    let t0 = log.time[0];
+    for (t, w) in log.time.iter().zip(log.body_rate.iter_mut()) {
+        let s = t - t0;
+        let tau = std::f64::consts::TAU;
+        w[0] += 0.3 * (tau * 0.7 * s).sin() + 0.2 * (tau * 1.3 * s + 1.0).sin();
+        w[1] += 0.25 * (tau * 0.9 * s + 2.0).sin() + 0.2 * (tau * 1.7 * s).sin();
+        w[2] += 0.2 * (tau * 0.5 * s + 0.5).sin();
+    }
+    log
+}
+
+#[test]
+fn an_unexplained_angular_residual_does_not_hide_a_translational_effect() {
+    let effects = Effects {
+        thrust_scale: Some(ThrustScale { k: 0.99 }),
+        ..Effects::default()
+    };
+    let log = with_rate_wobble(simulate(&model(), &scenario(effects, 5), "wobble.csv").unwrap());
+    let analysis = analyze(&log, &model(), "demo", &settings()).unwrap();
+    let report = &analysis.report;
+    assert!(report.channels[3].residual_rms > 20.0 * report.channels[3].noise_floor);
+    let thrust = report
+        .effects
+        .iter()
+        .find(|e| e.id == EffectId::ThrustScale)
+        .unwrap_or_else(|| panic!("thrust_scale not named: {:?}", report.selection.dropped));
+    assert_eq!(
+        thrust.evidence.judged_on,
+        physics::ChannelGroup::Translational
+    );
+    let k = analysis.fitted.thrust_scale.unwrap().k;
+    assert!((k - 0.99).abs() < 0.003, "{k}");
+}

@@ -272,8 +272,13 @@ fn run_recording(
     staged.commit()?;
     let report = &analysis.report;
     let names: Vec<&str> = report.effects.iter().map(|e| e.id.name()).collect();
+    let inseparable: String = report
+        .not_separable
+        .iter()
+        .map(|n| format!(" ({} not separable from a stand-in)", n.effect.id.name()))
+        .collect();
     say!(
-        "effects: {}; held-out MSE {:.5} -> {:.5}; wrote {}",
+        "effects: {}{inseparable}; held-out MSE {:.5} -> {:.5}; wrote {}",
         if names.is_empty() {
             "none".to_string()
         } else {

@@ -8,12 +8,13 @@ use std::path::Path;
 
 use physics::CommandLogging;
 use report::mismatch::recording::{
-    CandidateLine, CommandSampling, EstimateLine, EvidenceLine, EvidenceRule, NamedEffect,
-    NoiseBiasLine, RecordingView, ResidualFigure, TermLine,
+    CandidateLine, CommandSampling, EstimateLine, EvidenceLine, EvidenceRule, Inseparable,
+    NamedEffect, NoiseBiasLine, RecordingView, ResidualFigure, StandInLine, TermLine,
 };
 
 use crate::analysis::{Analysis, check_finite};
 use crate::error::Result;
+use crate::explain::confounds::StandIn;
 use crate::explain::evidence::Evidence;
 use crate::locate::problem::CHANNEL_NAMES;
 use crate::recording::noise_reaction;
@@ -50,6 +51,31 @@ fn evidence_line(evidence: &Evidence) -> EvidenceLine<'static> {
         heldout_without: evidence.heldout_without,
         heldout_with: evidence.heldout_with,
         heldout_reduction: evidence.heldout_reduction,
+    }
+}
+
+/// A stand-in as the report prints it.
+fn stand_in_line(stand_in: &StandIn) -> StandInLine<'static> {
+    let parameters = stand_in
+        .parameters
+        .values()
+        .into_iter()
+        .map(|(name, value)| {
+            let numbers: Vec<String> = value.numbers().iter().map(|v| format!("{v:.3}")).collect();
+            match numbers.as_slice() {
+                [one] => format!("{name} = {one}"),
+                many => format!("{name} = [{}]", many.join(", ")),
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    StandInLine {
+        id: stand_in.id.name(),
+        parameters,
+        likelihood_ratio: stand_in.likelihood_ratio,
+        likelihood_ratio_threshold: stand_in.likelihood_ratio_threshold,
+        heldout_increase: stand_in.heldout_increase,
+        explains_as_well: stand_in.explains_as_well,
     }
 }
 
@@ -92,6 +118,24 @@ impl Analysis {
                     explained_fraction: e.explained_fraction,
                 })
                 .collect(),
+            not_separable: report
+                .not_separable
+                .iter()
+                .map(|n| Inseparable {
+                    id: n.effect.id.name(),
+                    description: &n.effect.description,
+                    stand_ins: n.stand_ins.iter().map(stand_in_line).collect(),
+                })
+                .collect(),
+            wind_replaced: report
+                .selection
+                .wind_replaced
+                .as_ref()
+                .map(|w| Inseparable {
+                    id: w.id.name(),
+                    description: "",
+                    stand_ins: w.stand_ins.iter().map(stand_in_line).collect(),
+                }),
             dropped: report.selection.dropped.iter().map(evidence_line).collect(),
             unexplained: &report.unexplained,
             resamples: report.selection.settings.resamples,

@@ -15,6 +15,7 @@ use serde::Serialize;
 use sindy::stability::{Selection, SelectionSettings, stability_selection};
 
 use crate::error::{MismatchError, Result};
+use crate::explain::confounds::{self, Confound, Separate, Separation, StandIn};
 use crate::explain::describe::describe;
 use crate::explain::evidence::{self, Evidence, explained_fractions};
 use crate::explain::fit::{FitAlternatives, Screened, fit_parameters, profile_nonlinear};
@@ -58,6 +59,16 @@ pub struct EffectReport {
     pub evidence: Evidence,
 }
 
+/// A named effect that a stand-in explains as well on this recording
+/// ([`crate::explain::confounds`]): kept in the fitted model, not named.
+#[derive(Clone, Debug, Serialize)]
+pub struct NotSeparableReport {
+    #[serde(flatten)]
+    pub effect: EffectReport,
+    /// The effects fitted in its place, each with how much worse it explains the recording.
+    pub stand_ins: Vec<StandIn>,
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct CandidateReport {
     #[serde(flatten)]
@@ -76,6 +87,14 @@ pub struct SelectionReport {
     pub alternatives: FitAlternatives,
     /// The effects the evidence rule dropped, with their evidence when dropped.
     pub dropped: Vec<Evidence>,
+    /// A wind the evidence rule named that a vehicle effect explains as well: not named, the
+    /// vehicle effect fitted in its place ([`crate::explain::confounds`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wind_replaced: Option<Confound>,
+    /// Every named effect that has stand-ins, tested against each of them
+    /// ([`crate::explain::confounds`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub separation_tests: Vec<Confound>,
 }
 
 /// Everything written to `mismatch.json`.
@@ -86,7 +105,12 @@ pub struct Report {
     pub channels: Vec<ChannelReport>,
     /// Where the nominal model disagrees with the recording.
     pub windows: Vec<Window>,
+    /// The effects named.
     pub effects: Vec<EffectReport>,
+    /// Effects that explain the residual but that another effect explains as well on this
+    /// recording: fitted, not named.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub not_separable: Vec<NotSeparableReport>,
     /// Where a significant residual remains that the effects found do not explain.
     pub unexplained: Vec<Window>,
     pub fit: Fit,
@@ -126,7 +150,19 @@ pub struct Analysis {
     pub problem: Problem,
     pub before: Vec<Channels>,
     pub after: Vec<Channels>,
+    /// The fitted model: the effects named and those not separable from a stand-in.
     pub fitted: Effects,
+}
+
+impl Analysis {
+    /// The fitted effects that are named (the fitted model without the effects not separable
+    /// from a stand-in).
+    pub fn named(&self) -> Effects {
+        self.report
+            .not_separable
+            .iter()
+            .fold(self.fitted.clone(), |named, n| named.without(n.effect.id))
+    }
 }
 
 /// The stages of an analysis, in order (each pass goes through all of them).
@@ -286,6 +322,16 @@ fn analyze_recording(
         settings.analysis.iterations / 2,
         block_rows,
     );
+    let separation = confounds::separate(
+        &problem,
+        judgement,
+        &Separate {
+            settings: &settings.analysis.evidence,
+            iterations: settings.analysis.iterations / 2,
+            block_rows,
+        },
+    );
+    let judgement = &separation.judgement;
     // The model the evidence rule judged (fitted on the fit part) is the one the residuals and the
     // held-out check describe; the parameters reported are estimated again on all rows.
     let after = problem.residual(&judgement.set.effects());
@@ -307,7 +353,7 @@ fn analyze_recording(
             after: &after,
         },
         Named {
-            judgement: &judgement,
+            separation: &separation,
             estimate: &estimate,
         },
         Screen {
@@ -384,7 +430,7 @@ fn first_null(value: &serde_json::Value, path: String) -> Option<String> {
 
 /// The effects named: as the evidence rule judged them (fit part) and as finally estimated.
 struct Named<'a> {
-    judgement: &'a evidence::Judgement,
+    separation: &'a Separation,
     estimate: &'a Estimate,
 }
 
@@ -405,9 +451,10 @@ fn build_report(
     screen: Screen,
 ) -> Report {
     let Named {
-        judgement,
+        separation,
         estimate,
     } = named;
+    let judgement = &separation.judgement;
     let fit_rows = 0..problem.split;
     let heldout_rows = problem.split..problem.rows();
     let effects = estimate.set.effects();
@@ -420,7 +467,7 @@ fn build_report(
         .noise_bias
         .as_ref()
         .map(|b| effects_from(&estimate.set.parameters, &b.bias));
-    let effect_reports = judgement
+    let mut effect_reports: Vec<EffectReport> = judgement
         .evidence
         .iter()
         .zip(shares)
@@ -445,6 +492,17 @@ fn build_report(
             evidence: evidence.clone(),
         })
         .collect();
+    let not_separable = separation
+        .not_separable
+        .iter()
+        .filter_map(|confound| {
+            let at = effect_reports.iter().position(|e| e.id == confound.id)?;
+            Some(NotSeparableReport {
+                effect: effect_reports.remove(at),
+                stand_ins: confound.stand_ins.clone(),
+            })
+        })
+        .collect();
     let t = |row: usize| problem.time[row.min(problem.rows() - 1)];
     let form = &problem.weak_form;
     Report {
@@ -453,6 +511,7 @@ fn build_report(
         channels: channel_reports(problem, &settings.analysis.locate, &residuals),
         windows: locate_windows(problem, residuals.before, &settings.analysis.locate),
         effects: effect_reports,
+        not_separable,
         unexplained: locate_windows(
             problem,
             &without_steps(problem, residuals.after, &estimate.step_times),
@@ -507,6 +566,8 @@ fn build_report(
                 .collect(),
             alternatives: screen.alternatives,
             dropped: judgement.dropped.clone(),
+            wind_replaced: separation.wind_replaced.clone(),
+            separation_tests: separation.tests.clone(),
         },
         settings: settings.analysis_record(),
     }

@@ -77,7 +77,9 @@ impl CellOutcome {
     ) -> Self {
         let report = &analysis.report;
         let true_effects = truth.ids();
-        let found_effects = analysis.fitted.ids();
+        // Effects not separable from a stand-in are fitted but not named: not found.
+        let named = analysis.named();
+        let found_effects = named.ids();
         let standard_error = |id: EffectId, name: &str| {
             report
                 .effects
@@ -85,7 +87,7 @@ impl CellOutcome {
                 .find(|e| e.id == id)
                 .and_then(|e| e.standard_errors.as_ref()?.get(name).cloned())
         };
-        let parameters = compare_parameters(truth, &analysis.fitted, &standard_error);
+        let parameters = compare_parameters(truth, &named, &standard_error);
         let (before, after) = (report.fit.heldout.before.mse, report.fit.heldout.after.mse);
         let ratio = after / before.max(1e-300);
         let mut failures = Vec::new();

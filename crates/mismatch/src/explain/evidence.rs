@@ -194,6 +194,74 @@ impl NoiseScale {
     }
 }
 
+/// The noise scale of `set`'s fit-part residual per compared channel group, and over all channels.
+fn noise_scales(problem: &Problem, set: &FittedSet) -> (Vec<NoiseScale>, NoiseScale) {
+    let residual = problem.residual(&set.effects());
+    let whitened: Vec<Channels> = residual[..problem.split]
+        .iter()
+        .map(|r| {
+            let mut w = [0.0; 6];
+            for c in 0..problem.channels {
+                w[c] = r[c] / problem.noise_floor[c];
+            }
+            w
+        })
+        .collect();
+    let groups = problem
+        .channel_groups()
+        .into_iter()
+        .map(|(_, channels)| NoiseScale::of(problem, &whitened, channels))
+        .collect();
+    (
+        groups,
+        NoiseScale::of(problem, &whitened, 0..problem.channels),
+    )
+}
+
+/// How much worse `other` explains the recording than `set`, on the channel groups the effects
+/// `ids` act on, in the evidence rule's terms (the noise scale of `set`'s residual).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Worse {
+    /// `Σ_g (SSE_g(other) − SSE_g(set)) / (κ_g s²_g)` on the fit part.
+    pub likelihood_ratio: f64,
+    /// `1 − SSE(set) / SSE(other)` on the held-out part, each group divided by its `s²_g`.
+    pub heldout_increase: f64,
+}
+
+pub(crate) fn worse_by(
+    problem: &Problem,
+    set: &FittedSet,
+    other: &FittedSet,
+    ids: &[EffectId],
+    block_rows: usize,
+) -> Worse {
+    let mut groups: Vec<usize> = ids
+        .iter()
+        .flat_map(|id| judged_groups(problem, *id).0)
+        .collect();
+    groups.sort_unstable();
+    groups.dedup();
+    let (noise, _) = noise_scales(problem, set);
+    let (full, swapped) = (
+        scores(problem, set, block_rows),
+        scores(problem, other, block_rows),
+    );
+    let likelihood_ratio = groups
+        .iter()
+        .map(|&g| (swapped.fit(g) - full.fit(g)) / noise[g].scale())
+        .sum();
+    let heldout_of = |scores: &Scores| -> f64 {
+        groups
+            .iter()
+            .map(|&g| scores.heldout[g] / noise[g].variance.max(1e-300))
+            .sum()
+    };
+    Worse {
+        likelihood_ratio,
+        heldout_increase: 1.0 - heldout_of(&full) / heldout_of(&swapped).max(1e-300),
+    }
+}
+
 /// What every effect of one set is judged against.
 struct Judge<'a> {
     problem: &'a Problem,
@@ -320,23 +388,7 @@ pub fn apply(
             };
         }
         let full = scores(problem, &set, block_rows);
-        let residual = problem.residual(&set.effects());
-        let fit_residual: Vec<Channels> = residual[..problem.split]
-            .iter()
-            .map(|r| {
-                let mut w = [0.0; 6];
-                for c in 0..problem.channels {
-                    w[c] = r[c] / problem.noise_floor[c];
-                }
-                w
-            })
-            .collect();
-        let noise: Vec<NoiseScale> = problem
-            .channel_groups()
-            .into_iter()
-            .map(|(_, channels)| NoiseScale::of(problem, &fit_residual, channels))
-            .collect();
-        let all_channels = NoiseScale::of(problem, &fit_residual, 0..problem.channels);
+        let (noise, all_channels) = noise_scales(problem, &set);
         let judge = Judge {
             problem,
             set: &set,

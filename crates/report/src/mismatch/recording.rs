@@ -145,6 +145,49 @@ pub struct NamedEffect<'a> {
     pub explained_fraction: f64,
 }
 
+/// An effect that other effects of the vocabulary explain as well on this recording (the
+/// separation test of each named effect against its stand-ins).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Inseparable<'a> {
+    /// The effect's id as the outputs spell it.
+    pub id: &'a str,
+    /// Its sentence with its fitted values.
+    pub description: &'a str,
+    pub stand_ins: Vec<StandInLine<'a>>,
+}
+
+/// One effect fitted in place of another, and how much worse it explains the recording.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StandInLine<'a> {
+    pub id: &'a str,
+    /// Its fitted parameters (`tau_s = 0.031`).
+    pub parameters: String,
+    pub likelihood_ratio: f64,
+    pub likelihood_ratio_threshold: f64,
+    /// `1 − SSE(named) / SSE(stand-in)` on the held-out part.
+    pub heldout_increase: f64,
+    pub explains_as_well: bool,
+}
+
+impl StandInLine<'_> {
+    /// `motor_lag (tau_s = 0.031): fit-part likelihood ratio 3.2 against 10.8, held-out residual 2% higher`.
+    fn text(&self) -> String {
+        format!(
+            "{} ({}): fit-part likelihood ratio {:.1} against {:.1}, held-out residual {:.0}% {}",
+            self.id,
+            self.parameters,
+            self.likelihood_ratio,
+            self.likelihood_ratio_threshold,
+            100.0 * self.heldout_increase.abs(),
+            if self.heldout_increase >= 0.0 {
+                "higher"
+            } else {
+                "lower"
+            }
+        )
+    }
+}
+
 /// `name ± error` for each parameter, the errors to two significant digits: `k ± [0.0061, 0.016]`.
 fn standard_errors_text(errors: &[(&str, Vec<f64>)]) -> String {
     errors
@@ -201,6 +244,11 @@ pub struct RecordingView<'a> {
     pub windows: &'a [Window],
     pub rule: EvidenceRule,
     pub effects: Vec<NamedEffect<'a>>,
+    /// Effects that passed the evidence rule but that a stand-in explains as well: fitted, not
+    /// named.
+    pub not_separable: Vec<Inseparable<'a>>,
+    /// A wind that passed the evidence rule but that a vehicle effect explains as well.
+    pub wind_replaced: Option<Inseparable<'a>>,
     /// The effects the evidence rule dropped.
     pub dropped: Vec<EvidenceLine<'a>>,
     /// Where a significant residual remains with the effects found.
@@ -421,7 +469,7 @@ impl RecordingView<'_> {
         let rule = self.rule;
         let _ = writeln!(
             md,
-            "An effect is named only when, with the others refitted without it, it passes four tests: on the fit part, its likelihood ratio (corrected for the correlation of neighbouring rows) exceeds the {} quantile of χ², it lowers the noise-normalised residual by at least {} per row and channel, and by at least {} when the two {} s blocks that gain most are left out (not one transient); and it lowers the held-out residual by at least {:.0}%.\n",
+            "An effect is named only when, with the others refitted without it, it passes four tests on the channels it acts on: on the fit part, its likelihood ratio (corrected for the correlation of neighbouring rows) exceeds the {} quantile of χ², it lowers the noise-normalised residual by at least {} per row and channel, and by at least {} when the two {} s blocks that gain most are left out (not one transient); and it lowers the held-out residual by at least {:.0}%.\n",
             rule.significance,
             rule.min_gain,
             rule.min_trimmed_gain,
@@ -459,6 +507,7 @@ impl RecordingView<'_> {
                 );
             }
         }
+        self.confounds_markdown(md);
         for d in &self.dropped {
             let _ = writeln!(
                 md,
@@ -472,6 +521,34 @@ impl RecordingView<'_> {
             );
         }
         self.unexplained_markdown(md);
+    }
+
+    /// The effects a stand-in explains as well, and a wind a vehicle effect replaced.
+    fn confounds_markdown(&self, md: &mut String) {
+        let as_well = |e: &Inseparable| -> String {
+            e.stand_ins
+                .iter()
+                .filter(|s| s.explains_as_well)
+                .map(|s| s.text())
+                .collect::<Vec<_>>()
+                .join("; ")
+        };
+        for e in &self.not_separable {
+            let _ = writeln!(
+                md,
+                "- **not separable from this recording: {}** — {} Fitted in its place, with the others refitted, these explain the recording as well: {}. It stays in the fitted model; which of them is the physics, this recording cannot tell.",
+                e.id,
+                e.description,
+                as_well(e)
+            );
+        }
+        if let Some(wind) = &self.wind_replaced {
+            let _ = writeln!(
+                md,
+                "- not named: wind — a vehicle effect explains the recording as well ({}). A flight's air is the weaker explanation of a residual the vehicle's own physics explains, so that effect was fitted in its place and judged by the evidence rule.",
+                as_well(wind)
+            );
+        }
     }
 
     /// What remains unexplained with the effects named.
@@ -693,6 +770,19 @@ mod tests {
                 standard_errors: vec![("d", vec![0.0123, 0.25, 3.0])],
                 explained_fraction: 0.625,
             }],
+            not_separable: vec![Inseparable {
+                id: "delay",
+                description: "A delay of 30 ms.",
+                stand_ins: vec![StandInLine {
+                    id: "motor_lag",
+                    parameters: "tau_s = 0.031".to_string(),
+                    likelihood_ratio: 3.21,
+                    likelihood_ratio_threshold: 10.83,
+                    heldout_increase: -0.02,
+                    explains_as_well: true,
+                }],
+            }],
+            wind_replaced: None,
             dropped: vec![evidence("wind", 3.25)],
             unexplained: &unexplained,
             resamples: 40,
@@ -734,6 +824,7 @@ mod tests {
             "\nThe model has no mixer, so it predicts no torques: only the translational channels are compared.\n",
             "(1 s moving RMS):\n\n- vdot_x from 1.2 s to 7.5 s\n",
             "- **linear_drag** — Drag. Standard errors: d ± [0.012, 0.25, 3.0]. It accounts for 62% of the nominal model's (noise-normalised) residual; without it the held-out residual is 50% higher (likelihood ratio 120 against 16.3, gain 0.75 per row and channel, 0.50 without its two largest blocks).\n",
+            "- **not separable from this recording: delay** — A delay of 30 ms. Fitted in its place, with the others refitted, these explain the recording as well: motor_lag (tau_s = 0.031): fit-part likelihood ratio 3.2 against 10.8, held-out residual 2% lower. It stays",
             "- not named: wind (likelihood ratio 3.2 against 16.3, gain 0.750, 0.500 without its two largest blocks, held-out reduction 33.3%): below the evidence rule.\n",
             "- unexplained residual on vdot_x, 2.0–2.8 s\n",
             "- linear_drag (`drag_x` = −v_x [m/s]): 88%, kept\n",
@@ -778,6 +869,8 @@ mod tests {
                 block_s: 1.0,
             },
             effects: Vec::new(),
+            not_separable: Vec::new(),
+            wind_replaced: None,
             dropped: Vec::new(),
             unexplained: &[],
             resamples: 40,

@@ -1,0 +1,335 @@
+//! Effects one recording cannot tell apart. Some effects of the vocabulary leave nearly the same
+//! signature on a flight: a pure delay and a first-order motor lag (both a first-order lateness of
+//! the commands); a wind through a drag, a thrust scale and a drag along the body axes (each can
+//! be a steady force along the thrust); a wind and a tilted thrust axis (a steady sideways force,
+//! as an uncalibrated attitude gives); a thrust scale and a ground effect at a nearly constant
+//! height. The evidence rule tests each named effect against nothing; here each named effect that
+//! has such stand-ins is tested against each of them:
+//!
+//! the effect is replaced by the stand-in, every other parameter refitted, and the stand-in
+//! **explains as well** unless the named set is better by the evidence rule's own margins — the
+//! fit-part likelihood ratio of the difference at least the χ² quantile of the rule's
+//! significance (with as many degrees of freedom as the effect has parameters beyond the
+//! stand-in's, at least 1), or the held-out residual at least `min_heldout_reduction` lower.
+//!
+//! - A **wind** that a vehicle effect explains as well is not named: the stand-in takes its place
+//!   (and must then pass the evidence rule itself). A flight's air is the weaker explanation of a
+//!   residual the vehicle's own physics explains.
+//! - Any other effect that a stand-in explains as well stays in the fitted model (it explains the
+//!   residual either way) but is reported as **not separable from this recording**, with the
+//!   stand-ins and their fitted values, instead of being named.
+
+use physics::{EffectId, EffectNumber, EffectParameters};
+use serde::Serialize;
+
+use crate::explain::evidence::{self, EvidenceSettings, Judgement, chi_square_quantile, worse_by};
+use crate::explain::fit::FittedSet;
+use crate::locate::problem::Problem;
+use crate::model::refine::effects_from;
+
+/// The stand-ins of an effect, in the order they are tried (declared with the rule, before any
+/// evaluation data was seen).
+pub fn stand_ins(id: EffectId) -> &'static [EffectId] {
+    use EffectId::*;
+    match id {
+        Delay => &[MotorLag],
+        MotorLag => &[Delay],
+        Wind => &[ThrustScale, LinearDrag, ThrustTilt],
+        ThrustScale => &[LinearDrag, GroundEffect],
+        LinearDrag => &[ThrustScale],
+        GroundEffect => &[ThrustScale],
+        _ => &[],
+    }
+}
+
+/// One stand-in fitted in place of a named effect.
+#[derive(Clone, Debug, Serialize)]
+pub struct StandIn {
+    pub id: EffectId,
+    /// Its parameters fitted in the effect's place (fit part), with the others refitted.
+    pub parameters: EffectParameters,
+    /// How much worse the fit part is with the stand-in, `ΔSSE / (κ s²)` per channel group as in
+    /// the evidence rule (negative: better), and the χ² quantile it is compared with.
+    pub likelihood_ratio: f64,
+    pub likelihood_ratio_threshold: f64,
+    /// `1 − SSE(named) / SSE(stand-in)` on the held-out part (negative: the stand-in is better).
+    pub heldout_increase: f64,
+    /// Neither margin separates it from the named effect.
+    pub explains_as_well: bool,
+}
+
+/// A named effect that stand-ins were fitted in place of.
+#[derive(Clone, Debug, Serialize)]
+pub struct Confound {
+    pub id: EffectId,
+    pub stand_ins: Vec<StandIn>,
+}
+
+impl Confound {
+    /// Whether some stand-in explains the recording as well.
+    pub fn inseparable(&self) -> bool {
+        self.stand_ins.iter().any(|s| s.explains_as_well)
+    }
+}
+
+/// What the separation left: the judgement (re-judged when a wind was replaced), the winds
+/// replaced by a vehicle effect, the effects not separable from a stand-in, and every test made.
+#[derive(Clone, Debug)]
+pub struct Separation {
+    pub judgement: Judgement,
+    pub wind_replaced: Option<Confound>,
+    pub not_separable: Vec<Confound>,
+    /// Every named effect tested against its stand-ins, in order (the wind's first).
+    pub tests: Vec<Confound>,
+}
+
+/// The settings of one separation: the evidence rule's, and the fit's.
+pub struct Separate<'a> {
+    pub settings: &'a EvidenceSettings,
+    pub iterations: usize,
+    pub block_rows: usize,
+}
+
+/// Tests every named effect of `judgement` against its stand-ins (see the module).
+pub fn separate(problem: &Problem, judgement: Judgement, how: &Separate) -> Separation {
+    let mut judgement = judgement;
+    let mut wind_replaced = None;
+    let mut tests = Vec::new();
+    if judgement.set.ids().contains(&EffectId::Wind) {
+        let confound = test(problem, &judgement.set, EffectId::Wind, how);
+        if let Some(best) = best_stand_in(&confound) {
+            let replaced = replace(problem, &judgement.set, EffectId::Wind, best, how);
+            judgement = evidence::apply(
+                problem,
+                replaced,
+                how.settings,
+                how.iterations,
+                how.block_rows,
+            );
+            wind_replaced = Some(confound.clone());
+        }
+        tests.push(confound);
+    }
+    let vehicle: Vec<Confound> = judgement
+        .set
+        .ids()
+        .into_iter()
+        .filter(|id| *id != EffectId::Wind && !stand_ins(*id).is_empty())
+        .map(|id| test(problem, &judgement.set, id, how))
+        .filter(|confound| !confound.stand_ins.is_empty())
+        .collect();
+    let not_separable = vehicle
+        .iter()
+        .filter(|c| c.inseparable())
+        .cloned()
+        .collect();
+    tests.extend(vehicle);
+    Separation {
+        judgement,
+        wind_replaced,
+        not_separable,
+        tests,
+    }
+}
+
+/// The stand-in that explains the recording as well with the smallest fit-part loss.
+fn best_stand_in(confound: &Confound) -> Option<EffectId> {
+    confound
+        .stand_ins
+        .iter()
+        .filter(|s| s.explains_as_well)
+        .min_by(|a, b| a.likelihood_ratio.total_cmp(&b.likelihood_ratio))
+        .map(|s| s.id)
+}
+
+/// Fits each stand-in of `id` that `set` does not already hold in `id`'s place and compares.
+fn test(problem: &Problem, set: &FittedSet, id: EffectId, how: &Separate) -> Confound {
+    let present = set.ids();
+    let stand_ins = stand_ins(id)
+        .iter()
+        .filter(|a| !present.contains(a))
+        .filter_map(|&a| {
+            let swapped = replace(problem, set, id, a, how);
+            // A stand-in the set cannot hold (a wind without a drag) is not a stand-in.
+            if !swapped.ids().contains(&a) {
+                return None;
+            }
+            let extra = set
+                .parameters
+                .len()
+                .saturating_sub(swapped.parameters.len());
+            let worse = worse_by(problem, set, &swapped, &[id, a], how.block_rows);
+            let threshold = chi_square_quantile(extra.max(1), how.settings.significance);
+            Some(StandIn {
+                id: a,
+                parameters: swapped
+                    .effects()
+                    .parameters(a)
+                    .expect("the stand-in is in the swapped set"),
+                likelihood_ratio: worse.likelihood_ratio,
+                likelihood_ratio_threshold: threshold,
+                heldout_increase: worse.heldout_increase,
+                explains_as_well: worse.likelihood_ratio < threshold
+                    && worse.heldout_increase < how.settings.min_heldout_reduction,
+            })
+        })
+        .collect();
+    Confound { id, stand_ins }
+}
+
+/// `set` with effect `id` replaced by `stand_in`, refitted: the stand-in started from the best
+/// value of its profile grid (others held) when it has one number that is profiled, else
+/// neutral.
+fn replace(
+    problem: &Problem,
+    set: &FittedSet,
+    id: EffectId,
+    stand_in: EffectId,
+    how: &Separate,
+) -> FittedSet {
+    let mut swapped = set.without(id);
+    let numbers = EffectNumber::all_of(stand_in);
+    let start: Vec<f64> = match numbers.as_slice() {
+        [one] if !one.profile_grid().is_empty() => {
+            vec![best_on_grid(problem, &swapped, *one)]
+        }
+        _ => numbers.iter().map(|n| n.neutral()).collect(),
+    };
+    swapped.parameters.extend(numbers);
+    swapped.values.extend(start);
+    // Only parameters the set can hold (a wind needs a drag).
+    let held = swapped.effects();
+    let (parameters, values) = swapped
+        .parameters
+        .iter()
+        .zip(&swapped.values)
+        .filter(|(p, _)| held.contains(p.effect))
+        .map(|(p, v)| (*p, *v))
+        .unzip();
+    let mut swapped = FittedSet { parameters, values };
+    swapped.refit(problem, how.iterations);
+    swapped
+}
+
+/// The value of `number`'s profile grid (its neutral value left out) that best explains the fit
+/// rows with `set`'s values held.
+fn best_on_grid(problem: &Problem, set: &FittedSet, number: EffectNumber) -> f64 {
+    let neutral = number.neutral();
+    let grid: Vec<f64> = number
+        .profile_grid()
+        .into_iter()
+        .filter(|v| *v != neutral)
+        .collect();
+    let sse = |value: f64| {
+        let mut parameters = set.parameters.clone();
+        let mut values = set.values.clone();
+        parameters.push(number);
+        values.push(value);
+        let residual = problem.residual(&effects_from(&parameters, &values));
+        problem.whitened_sse(&residual, 0..problem.split)
+    };
+    grid.into_iter()
+        .map(|v| (v, sse(v)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(neutral, |(v, _)| v)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use physics::{
+        Effects, LinearDrag, Noise, NominalModel, Scenario, ThrustScale, Trajectory, simulate,
+    };
+
+    use super::*;
+    use crate::Settings;
+    use crate::recording::Recording;
+
+    /// A 14 s figure-8 of the demo vehicle with a thrust loss and a drag along the body axes.
+    fn problem() -> Problem {
+        let scenario = Scenario {
+            model: "quad-a.json".into(),
+            duration_s: 14.0,
+            warmup_s: 3.0,
+            seed: 11,
+            physics_rate_hz: 500.0,
+            log_rate_hz: 50.0,
+            hover_throttle: 0.5,
+            trajectory: Trajectory::Figure8 {
+                center: [0.0, 0.0, 1.5],
+                first: [1.8, 0.0, 0.0],
+                second: [0.0, 0.9, 0.4],
+                period_s: 6.0,
+                low_passes: Vec::new(),
+                yaw_amplitude_rad: 0.3,
+                yaw_period_s: 9.0,
+            },
+            effects: Effects {
+                thrust_scale: Some(ThrustScale { k: 0.95 }),
+                linear_drag: Some(LinearDrag { d: [0.3, 0.3, 0.4] }),
+                ..Effects::default()
+            },
+            noise: Noise {
+                position_m: 0.002,
+                velocity_m_s: 0.005,
+                attitude_rad: 0.002,
+                rate_rad_s: 0.008,
+            },
+            gains: Default::default(),
+            controller_rate_hz: None,
+            logger: None,
+            jitter: None,
+            log_timing: None,
+        };
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../experiments/mismatch/vehicles/quad-a.json");
+        let model = NominalModel {
+            logger: scenario.logger(),
+            ..NominalModel::load(&path).unwrap()
+        };
+        let log = simulate(&model, &scenario, "confounded.csv").unwrap();
+        let settings = Settings::default().checked().unwrap();
+        let recording = Recording::new(&log, &model, 40).unwrap();
+        Problem::new(
+            recording,
+            model,
+            settings.comparison.test_function,
+            settings.comparison.heldout_fraction,
+        )
+        .unwrap()
+    }
+
+    /// A thrust loss taken for a vertical wind through the drag: the evidence rule alone names the
+    /// wind (nothing else in the set explains the steady vertical force), the separation puts the
+    /// thrust scale in its place.
+    #[test]
+    fn a_wind_a_vehicle_effect_explains_as_well_is_not_named() {
+        let problem = problem();
+        let evidence = EvidenceSettings::default();
+        let block_rows = 25;
+        let mut set = FittedSet {
+            parameters: [EffectId::LinearDrag, EffectId::Wind]
+                .into_iter()
+                .flat_map(EffectNumber::all_of)
+                .collect(),
+            values: vec![0.3, 0.3, 0.4, 0.0, 0.0, 0.0],
+        };
+        set.refit(&problem, 40);
+        let judged = evidence::apply(&problem, set, &evidence, 20, block_rows);
+        assert_eq!(judged.set.ids(), [EffectId::LinearDrag, EffectId::Wind]);
+        let how = Separate {
+            settings: &evidence,
+            iterations: 20,
+            block_rows,
+        };
+        let separation = separate(&problem, judged, &how);
+        let replaced = separation.wind_replaced.expect("the wind replaced");
+        assert!(replaced.inseparable(), "{replaced:?}");
+        let mut ids = separation.judgement.set.ids();
+        ids.sort_by_key(|id| id.name());
+        assert_eq!(ids, [EffectId::LinearDrag, EffectId::ThrustScale]);
+        let k = separation.judgement.set.effects().thrust_scale.unwrap().k;
+        assert!((k - 0.95).abs() < 0.01, "{k}");
+    }
+}

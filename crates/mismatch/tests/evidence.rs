@@ -1,9 +1,9 @@
-//! The evidence rule on recordings the vocabulary cannot wholly explain: each effect is judged on
-//! the channels it acts on, so a residual left in one channel group does not hide an effect of the
-//! other.
+//! What is named on recordings the vocabulary or the log cannot wholly support: each effect is
+//! judged on the channels it acts on, so a residual left in one channel group does not hide an
+//! effect of the other; timing shorter than the log's commands resolve is not named.
 
 use mismatch::{CheckedSettings, Settings, analyze};
-use physics::{EffectId, Effects, NominalModel, ThrustScale, simulate};
+use physics::{Delay, EffectId, Effects, NominalModel, ThrustScale, simulate};
 
 mod common;
 
@@ -55,4 +55,40 @@ fn an_unexplained_angular_residual_does_not_hide_a_translational_effect() {
     );
     let k = analysis.fitted.thrust_scale.unwrap().k;
     assert!((k - 0.99).abs() < 0.003, "{k}");
+}
+
+/// The motor commands of a 50 Hz log held for three rows (16.7 new values per second, as a logger
+/// that writes its motor topic slowly does): a concealed 50 ms delay, less the held commands' mean
+/// age of one row, is shorter than the 60 ms the commands resolve, and is reported as such
+/// instead of named.
+#[test]
+fn a_delay_shorter_than_the_commands_resolve_is_not_named() {
+    let effects = Effects {
+        delay: Some(Delay { delay_s: 0.05 }),
+        ..Effects::default()
+    };
+    let mut log = simulate(&model(), &scenario(effects, 6), "held.csv").unwrap();
+    let held: Vec<[f64; 4]> = (0..log.len())
+        .map(|k| log.motor_command[k - k % 3])
+        .collect();
+    log.motor_command = held;
+    let analysis = analyze(&log, &model(), "demo", &settings()).unwrap();
+    let report = &analysis.report;
+    let content = report.log_content.as_ref().expect("held commands");
+    let limit = content.timing_limit_s.unwrap();
+    assert!((limit - 0.06).abs() < 0.002, "{limit}");
+    assert!(
+        report
+            .effects
+            .iter()
+            .all(|e| !matches!(e.id, EffectId::Delay | EffectId::MotorLag)),
+        "{:?}",
+        report.effects.iter().map(|e| e.id).collect::<Vec<_>>()
+    );
+    let below = &report.selection.below_resolution;
+    assert_eq!(below.len(), 1, "{below:?}");
+    assert!(
+        below[0].id == EffectId::Delay && below[0].value_s < limit,
+        "{below:?}"
+    );
 }

@@ -8,8 +8,9 @@ use std::path::Path;
 
 use physics::CommandLogging;
 use report::mismatch::recording::{
-    CandidateLine, CommandSampling, EstimateLine, EvidenceLine, EvidenceRule, Inseparable,
-    NamedEffect, NoiseBiasLine, RecordingView, ResidualFigure, StandInLine, TermLine,
+    BelowResolutionLine, CandidateLine, CommandSampling, EstimateLine, EvidenceLine, EvidenceRule,
+    Inseparable, LogContentView, NamedEffect, NoiseBiasLine, RecordingView, ResidualFigure,
+    StandInLine, TermLine,
 };
 
 use crate::analysis::{Analysis, check_finite};
@@ -17,6 +18,7 @@ use crate::error::Result;
 use crate::explain::confounds::StandIn;
 use crate::explain::evidence::Evidence;
 use crate::locate::problem::CHANNEL_NAMES;
+use crate::recording::content::LogContent;
 use crate::recording::noise_reaction;
 
 /// The names of an analysis's files in its folder, in the order of [`Analysis::render`].
@@ -79,6 +81,28 @@ fn stand_in_line(stand_in: &StandIn) -> StandInLine<'static> {
     }
 }
 
+/// What the log holds as the report prints it.
+fn log_content_view(content: &LogContent) -> LogContentView<'static> {
+    use data::ulog::ColumnPattern;
+    LogContentView {
+        row_rate_hz: content.row_rate_hz,
+        signals: content
+            .signals
+            .iter()
+            .map(|s| {
+                let pattern = match s.pattern {
+                    ColumnPattern::Fresh => "fresh",
+                    ColumnPattern::Held => "held",
+                    ColumnPattern::Interpolated => "interpolated",
+                    ColumnPattern::Constant => "constant",
+                };
+                (s.signal.name(), pattern, s.effective_rate_hz)
+            })
+            .collect(),
+        timing_limit_s: content.timing_limit_s,
+    }
+}
+
 impl Analysis {
     /// What `mismatch.md` says: the report's plain parts borrowed, its effects, evidence and
     /// candidates by their names.
@@ -90,6 +114,17 @@ impl Analysis {
             model: &report.model,
             rate_frame: &report.rate_frame,
             time_stamps: report.time_stamps.as_ref(),
+            log_content: report.log_content.as_ref().map(log_content_view),
+            below_resolution: report
+                .selection
+                .below_resolution
+                .iter()
+                .map(|b| BelowResolutionLine {
+                    id: b.id.name(),
+                    value_s: b.value_s,
+                    limit_s: b.limit_s,
+                })
+                .collect(),
             channels: &report.channels,
             translational_only: self.problem.channels == 3,
             angular_left_out: self.problem.model.compared_channels

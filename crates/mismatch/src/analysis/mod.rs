@@ -18,7 +18,10 @@ use crate::error::{MismatchError, Result};
 use crate::explain::confounds::{self, Confound, Separate, Separation, StandIn};
 use crate::explain::describe::describe;
 use crate::explain::evidence::{self, Evidence, explained_fractions};
-use crate::explain::fit::{FitAlternatives, Screened, fit_parameters, profile_nonlinear};
+use crate::explain::fit::{
+    BelowResolution, FitAlternatives, Screened, fit_parameters, leave_out_below_resolution,
+    profile_nonlinear,
+};
 use crate::explain::library::{Candidate, build_library};
 use crate::improve::estimate::{self, Estimate};
 use crate::improve::simex::NoiseSources;
@@ -29,6 +32,7 @@ use crate::model::least_squares::Termination;
 use crate::model::refine::effects_from;
 use crate::recording::Recording;
 use crate::recording::command_samples::ActuatorLimits;
+use crate::recording::content::{self, LogContent};
 use crate::recording::degenerate;
 use crate::recording::noise_reaction::{self, NoiseReaction};
 use crate::settings::{AnalysisRecord, CheckedSettings, NoiseFree};
@@ -95,6 +99,9 @@ pub struct SelectionReport {
     /// ([`crate::explain::confounds`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub separation_tests: Vec<Confound>,
+    /// Delays and motor lags the fit found shorter than the log resolves: left out.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub below_resolution: Vec<BelowResolution>,
 }
 
 /// Everything written to `mismatch.json`.
@@ -133,6 +140,10 @@ pub struct Report {
     /// The time stamps, when they are not evenly spaced.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_stamps: Option<StampedTiming>,
+    /// How often each signal brings a new value, when some signal is held or interpolated
+    /// between slower updates ([`crate::recording::content`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub log_content: Option<LogContent>,
     /// How the recording's commands and rates were logged (from the model file).
     pub logger: Logger,
     /// What was taken out of sampled commands of a faster controller: their unfelt reaction to the
@@ -307,13 +318,20 @@ fn analyze_recording(
         selection: &selection,
     };
     observe(Stage::Fitting);
-    let (set, alternatives) = fit_parameters(
+    let (mut set, alternatives) = fit_parameters(
         &problem,
         &screened,
         settings.analysis.iterations,
         block_rows,
         wind_start,
     );
+    let log_content = content::measure(log);
+    let below_resolution = match log_content.as_ref().and_then(|c| c.timing_limit_s) {
+        Some(limit) => {
+            leave_out_below_resolution(&problem, &mut set, limit, settings.analysis.iterations)
+        }
+        None => Vec::new(),
+    };
     observe(Stage::Judging);
     let judgement = evidence::apply(
         &problem,
@@ -360,6 +378,8 @@ fn analyze_recording(
             candidates: &candidates,
             selection: &selection,
             alternatives,
+            below_resolution,
+            log_content,
         },
     );
     let analysis = Analysis {
@@ -439,6 +459,9 @@ struct Screen<'a> {
     candidates: &'a [Candidate],
     selection: &'a Selection,
     alternatives: FitAlternatives,
+    below_resolution: Vec<BelowResolution>,
+    /// What the log holds, which bounds what the fit may name.
+    log_content: Option<LogContent>,
 }
 
 fn build_report(
@@ -548,6 +571,7 @@ fn build_report(
             world_rms: problem.recording.rate_frame_errors.1,
         },
         time_stamps: stamped_timing(problem),
+        log_content: screen.log_content,
         logger: problem.model.logger,
         noise_reaction: problem.recording.noise_reaction.clone(),
         selection: SelectionReport {
@@ -568,6 +592,7 @@ fn build_report(
             dropped: judgement.dropped.clone(),
             wind_replaced: separation.wind_replaced.clone(),
             separation_tests: separation.tests.clone(),
+            below_resolution: screen.below_resolution,
         },
         settings: settings.analysis_record(),
     }

@@ -308,6 +308,50 @@ pub fn fit_parameters(
     (set, alternatives)
 }
 
+/// A delay or motor lag the fit found shorter than the log resolves, left out of the fitted set.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct BelowResolution {
+    pub id: EffectId,
+    /// Its fitted value, s.
+    pub value_s: f64,
+    /// The motor commands' effective interval, s ([`crate::recording::content`]).
+    pub limit_s: f64,
+}
+
+/// Leaves out of `set` every delay and motor lag shorter than `limit_s` (a command's effect is
+/// seen only as often as the command changes) and refits the rest; returns what was left out.
+pub fn leave_out_below_resolution(
+    problem: &Problem,
+    set: &mut FittedSet,
+    limit_s: f64,
+    iterations: usize,
+) -> Vec<BelowResolution> {
+    let short: Vec<(EffectId, f64)> = set
+        .parameters
+        .iter()
+        .zip(&set.values)
+        .filter(|(p, v)| (**p == DELAY || **p == MOTOR_LAG) && **v < limit_s)
+        .map(|(p, v)| (p.effect, *v))
+        .collect();
+    if short.is_empty() {
+        return Vec::new();
+    }
+    for (id, _) in &short {
+        *set = set.without(*id);
+    }
+    set.refit(problem, iterations);
+    // A timing at zero is no timing: left out without a word.
+    short
+        .into_iter()
+        .filter(|(_, value)| *value > 0.0)
+        .map(|(id, value_s)| BelowResolution {
+            id,
+            value_s,
+            limit_s,
+        })
+        .collect()
+}
+
 /// Resolves the timing term: a delay, a motor lag, or both, each started from its profile (both
 /// from each single solution), fitted with the linear effects; returns the best fit and every
 /// alternative's whitened error.

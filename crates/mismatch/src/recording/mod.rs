@@ -2,9 +2,11 @@
 //! actuator commands the nominal model reads from the recorded command columns (step 0 of the
 //! method): the actuator limits and the samples a command is reconstructed through
 //! ([`command_samples`]), the reaction of sampled commands to logged noise removed
-//! ([`noise_reaction`]), and recordings no analysis can use refused ([`degenerate`]).
+//! ([`noise_reaction`]), what the log really holds ([`content`]), and recordings no analysis can
+//! use refused ([`degenerate`]).
 
 pub mod command_samples;
+pub mod content;
 pub mod degenerate;
 pub mod noise_reaction;
 

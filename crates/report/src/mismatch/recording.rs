@@ -105,6 +105,27 @@ pub struct StampedTiming {
     pub rows: usize,
 }
 
+/// What a recording holds when some signal is held or interpolated between slower updates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LogContentView<'a> {
+    /// One over the median row interval, Hz.
+    pub row_rate_hz: f64,
+    /// Each signal's name, how its rows relate (`held`, `interpolated`, `fresh`, `constant`) and
+    /// its new values per second.
+    pub signals: Vec<(&'a str, &'a str, f64)>,
+    /// The shortest delay or motor lag the log resolves, s (when the commands are slower than
+    /// the rows).
+    pub timing_limit_s: Option<f64>,
+}
+
+/// A delay or motor lag fitted shorter than the log resolves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BelowResolutionLine<'a> {
+    pub id: &'a str,
+    pub value_s: f64,
+    pub limit_s: f64,
+}
+
 /// The thresholds an effect passes to be named.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EvidenceRule {
@@ -232,6 +253,10 @@ pub struct RecordingView<'a> {
     pub rate_frame: &'a RateFrameReport,
     /// When the recording is not evenly spaced, its time stamps.
     pub time_stamps: Option<&'a StampedTiming>,
+    /// What the log holds, when some signal is slower than the rows.
+    pub log_content: Option<LogContentView<'a>>,
+    /// Delays and motor lags fitted shorter than the log resolves (left out).
+    pub below_resolution: Vec<BelowResolutionLine<'a>>,
     pub channels: &'a [ChannelReport],
     /// Only the translational channels were compared (the model predicts no torques).
     pub translational_only: bool,
@@ -354,6 +379,30 @@ impl RecordingView<'_> {
                 stamps.compared_rows,
                 stamps.rows
             );
+        }
+        if let Some(content) = &self.log_content {
+            let slow: Vec<String> = content
+                .signals
+                .iter()
+                .filter(|(_, pattern, _)| *pattern != "fresh")
+                .map(|(name, pattern, rate)| {
+                    format!("{name} {pattern} ({rate:.1} new values per second)")
+                })
+                .collect();
+            let _ = write!(
+                md,
+                "**What the log holds.** The rows come at {:.1} Hz, but not every signal is new at every row: {}.",
+                content.row_rate_hz,
+                slow.join(", ")
+            );
+            if let Some(limit) = content.timing_limit_s {
+                let _ = write!(
+                    md,
+                    " A command's effect is seen only as often as the command changes: a delay or a motor lag shorter than {:.0} ms cannot be identified from this log, and none shorter is named (logging the motor commands at the controller's rate, as PX4's high-rate logging profile does, would resolve them).",
+                    1000.0 * limit
+                );
+            }
+            let _ = writeln!(md, "\n");
         }
     }
 
@@ -508,6 +557,15 @@ impl RecordingView<'_> {
             }
         }
         self.confounds_markdown(md);
+        for b in &self.below_resolution {
+            let _ = writeln!(
+                md,
+                "- not named: {} of {:.0} ms, shorter than the {:.0} ms between the motor commands' new values: below what the log resolves (left out of the fit).",
+                b.id,
+                1000.0 * b.value_s,
+                1000.0 * b.limit_s
+            );
+        }
         for d in &self.dropped {
             let _ = writeln!(
                 md,
@@ -752,6 +810,19 @@ mod tests {
             model: "model.json",
             rate_frame: &rate_frame,
             time_stamps: None,
+            log_content: Some(LogContentView {
+                row_rate_hz: 50.0,
+                signals: vec![
+                    ("velocity", "fresh", 50.0),
+                    ("motor commands", "held", 12.5),
+                ],
+                timing_limit_s: Some(0.08),
+            }),
+            below_resolution: vec![BelowResolutionLine {
+                id: "delay",
+                value_s: 0.03,
+                limit_s: 0.08,
+            }],
             channels: &channels,
             translational_only: true,
             angular_left_out: false,
@@ -825,6 +896,8 @@ mod tests {
             "(1 s moving RMS):\n\n- vdot_x from 1.2 s to 7.5 s\n",
             "- **linear_drag** — Drag. Standard errors: d ± [0.012, 0.25, 3.0]. It accounts for 62% of the nominal model's (noise-normalised) residual; without it the held-out residual is 50% higher (likelihood ratio 120 against 16.3, gain 0.75 per row and channel, 0.50 without its two largest blocks).\n",
             "- **not separable from this recording: delay** — A delay of 30 ms. Fitted in its place, with the others refitted, these explain the recording as well: motor_lag (tau_s = 0.031): fit-part likelihood ratio 3.2 against 10.8, held-out residual 2% lower. It stays",
+            "**What the log holds.** The rows come at 50.0 Hz, but not every signal is new at every row: motor commands held (12.5 new values per second). A command's effect is seen only as often as the command changes: a delay or a motor lag shorter than 80 ms cannot be identified from this log",
+            "- not named: delay of 30 ms, shorter than the 80 ms between the motor commands' new values: below what the log resolves (left out of the fit).\n",
             "- not named: wind (likelihood ratio 3.2 against 16.3, gain 0.750, 0.500 without its two largest blocks, held-out reduction 33.3%): below the evidence rule.\n",
             "- unexplained residual on vdot_x, 2.0–2.8 s\n",
             "- linear_drag (`drag_x` = −v_x [m/s]): 88%, kept\n",
@@ -856,6 +929,8 @@ mod tests {
             model: "model.json",
             rate_frame: &rate_frame,
             time_stamps: None,
+            log_content: None,
+            below_resolution: Vec::new(),
             channels: &channels,
             translational_only: false,
             angular_left_out: false,

@@ -92,3 +92,27 @@ fn a_delay_shorter_than_the_commands_resolve_is_not_named() {
         "{below:?}"
     );
 }
+
+/// The motor commands logged in another order than the model numbers its rotors (each shifted by
+/// one): the model's torques are then unrelated to the recorded angular accelerations, the
+/// angular channels are left out with the response that shows it, and no angular effect is named.
+#[test]
+fn torques_unrelated_to_the_recording_are_not_compared() {
+    let mut log = simulate(&model(), &scenario(Effects::default(), 7), "shifted.csv").unwrap();
+    for u in &mut log.motor_command {
+        u.rotate_left(1);
+    }
+    let analysis = analyze(&log, &model(), "demo", &settings()).unwrap();
+    let report = &analysis.report;
+    let response = report.uninformative_torques.expect("the torques left out");
+    assert!(!response.informative(), "{response:?}");
+    assert_eq!(report.channels.len(), 3);
+    assert!(
+        report
+            .effects
+            .iter()
+            .all(|e| e.id.acts_on() != physics::ChannelGroup::Angular),
+        "{:?}",
+        report.effects.iter().map(|e| e.id).collect::<Vec<_>>()
+    );
+}

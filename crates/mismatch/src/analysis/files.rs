@@ -128,7 +128,11 @@ impl Analysis {
             channels: &report.channels,
             translational_only: self.problem.channels == 3,
             angular_left_out: self.problem.model.compared_channels
-                == physics::ComparedChannels::Translational,
+                == physics::ComparedChannels::Translational
+                && report.uninformative_torques.is_none(),
+            uninformative_torques: report
+                .uninformative_torques
+                .map(|r| (r.response, r.standard_error)),
             window_factor: settings.analysis.locate.window_factor,
             windows: &report.windows,
             rule: EvidenceRule {

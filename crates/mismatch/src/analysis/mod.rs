@@ -27,6 +27,7 @@ use crate::improve::estimate::{self, Estimate};
 use crate::improve::simex::NoiseSources;
 use crate::locate::forward;
 use crate::locate::problem::{CHANNEL_NAMES, Channels, Problem};
+use crate::locate::response::{AngularResponse, angular_response};
 use crate::locate::windows::{Residuals, channel_reports, locate_windows, without_steps};
 use crate::model::least_squares::Termination;
 use crate::model::refine::effects_from;
@@ -140,6 +141,11 @@ pub struct Report {
     /// The time stamps, when they are not evenly spaced.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_stamps: Option<StampedTiming>,
+    /// The response of the angular channels to the model's torques, when it showed they say
+    /// nothing about the recording and only the translational channels were compared
+    /// ([`crate::locate::response`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uninformative_torques: Option<AngularResponse>,
     /// How often each signal brings a new value, when some signal is held or interpolated
     /// between slower updates ([`crate::recording::content`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -296,6 +302,7 @@ fn analyze_recording(
         settings.comparison.test_function,
         settings.comparison.heldout_fraction,
     )?;
+    let (problem, uninformative_torques) = compared_where_informative(problem, settings)?;
     if settings.analysis.noise_free == NoiseFree::Refuse {
         degenerate::check_noise(&problem).map_err(|degeneracy| MismatchError::Degenerate {
             path: problem.recording.path.clone(),
@@ -380,6 +387,7 @@ fn analyze_recording(
             alternatives,
             below_resolution,
             log_content,
+            uninformative_torques,
         },
     );
     let analysis = Analysis {
@@ -391,6 +399,31 @@ fn analyze_recording(
     };
     check_finite(&analysis)?;
     Ok(analysis)
+}
+
+/// The problem as compared: without its angular channels when the model's torques say nothing
+/// about the recorded angular accelerations ([`crate::locate::response`]), with the response that
+/// showed it.
+fn compared_where_informative(
+    problem: Problem,
+    settings: &CheckedSettings,
+) -> Result<(Problem, Option<AngularResponse>)> {
+    match angular_response(&problem, settings.analysis.evidence.significance) {
+        Some(response) if !response.informative() => {
+            let model = physics::NominalModel {
+                compared_channels: physics::ComparedChannels::Translational,
+                ..problem.model
+            };
+            let translational = Problem::new(
+                problem.recording,
+                model,
+                settings.comparison.test_function,
+                settings.comparison.heldout_fraction,
+            )?;
+            Ok((translational, Some(response)))
+        }
+        _ => Ok((problem, None)),
+    }
 }
 
 /// Fails, naming the recording and the first offending quantity, unless every number of an analysis
@@ -462,6 +495,8 @@ struct Screen<'a> {
     below_resolution: Vec<BelowResolution>,
     /// What the log holds, which bounds what the fit may name.
     log_content: Option<LogContent>,
+    /// The angular channels' response, when it left them out.
+    uninformative_torques: Option<AngularResponse>,
 }
 
 fn build_report(
@@ -572,6 +607,7 @@ fn build_report(
         },
         time_stamps: stamped_timing(problem),
         log_content: screen.log_content,
+        uninformative_torques: screen.uninformative_torques,
         logger: problem.model.logger,
         noise_reaction: problem.recording.noise_reaction.clone(),
         selection: SelectionReport {

@@ -142,21 +142,27 @@ pub(crate) fn autocorrelation_factor(problem: &Problem, residual: &[Channels], l
 /// [`autocorrelation_factor`] over the channels `channels`.
 fn autocorrelation_of(residual: &[Channels], channels: std::ops::Range<usize>, lags: usize) -> f64 {
     let count = channels.len();
-    let mut total = 0.0;
-    for c in channels {
-        let r: Vec<f64> = residual.iter().map(|x| x[c]).collect();
-        let variance: f64 = r.iter().map(|v| v * v).sum();
-        if variance <= 0.0 {
-            continue;
-        }
-        let mut factor = 1.0;
-        for lag in 1..=lags.min(r.len().saturating_sub(1)) {
-            let covariance: f64 = r[lag..].iter().zip(&r).map(|(a, b)| a * b).sum();
-            factor += 2.0 * covariance / variance;
-        }
-        total += factor;
-    }
+    let total: f64 = channels
+        .map(|c| {
+            let r: Vec<f64> = residual.iter().map(|x| x[c]).collect();
+            integrated_autocorrelation(&r, lags).unwrap_or(0.0)
+        })
+        .sum();
     (total / count as f64).max(1.0)
+}
+
+/// `1 + 2 Σ ρ(lag)` of one series over lags up to `lags` (none for a series of zeros).
+pub(crate) fn integrated_autocorrelation(r: &[f64], lags: usize) -> Option<f64> {
+    let variance: f64 = r.iter().map(|v| v * v).sum();
+    if variance <= 0.0 {
+        return None;
+    }
+    let mut factor = 1.0;
+    for lag in 1..=lags.min(r.len().saturating_sub(1)) {
+        let covariance: f64 = r[lag..].iter().zip(r).map(|(a, b)| a * b).sum();
+        factor += 2.0 * covariance / variance;
+    }
+    Some(factor)
 }
 
 /// The `q` quantile of χ² with `p` degrees of freedom (at least 1), exact (statrs).

@@ -209,6 +209,12 @@ impl StandInLine<'_> {
     }
 }
 
+/// `[0.00, -0.12, 0.85]`: values to two decimals.
+fn fixed_list(values: &[f64]) -> String {
+    let texts: Vec<String> = values.iter().map(|v| format!("{v:.2}")).collect();
+    format!("[{}]", texts.join(", "))
+}
+
 /// `name ± error` for each parameter, the errors to two significant digits: `k ± [0.0061, 0.016]`.
 fn standard_errors_text(errors: &[(&str, Vec<f64>)]) -> String {
     errors
@@ -263,6 +269,9 @@ pub struct RecordingView<'a> {
     /// The model has a mixer, but its angular channels were left out by choice
     /// (`compared_channels`).
     pub angular_left_out: bool,
+    /// The response (and its standard error) of each angular channel to the model's torques, when
+    /// it showed they say nothing about the recording and the angular channels were left out.
+    pub uninformative_torques: Option<([f64; 3], [f64; 3])>,
     /// A window is located where the moving RMS exceeds this multiple of the noise floor.
     pub window_factor: f64,
     /// Where the nominal model disagrees with the recording.
@@ -427,6 +436,13 @@ impl RecordingView<'_> {
             let _ = writeln!(
                 md,
                 "\nThe model's `compared_channels` is \"translational\": its torques are not compared, only the translational channels."
+            );
+        } else if let Some((response, error)) = self.uninformative_torques {
+            let _ = writeln!(
+                md,
+                "\nThe model's torques say nothing about the recorded angular accelerations: each angular channel's response to the model's prediction (1 when the torques are right, 0 when they are unrelated) is {} ± {} (x, y, z), not clearly positive on every axis. Commands that do not resolve the attitude loop (see what the log holds) or a wrong rotor geometry do this; any angular effect fitted there would only fit noise, so only the translational channels are compared.",
+                fixed_list(&response),
+                fixed_list(&error)
             );
         } else if self.translational_only {
             let _ = writeln!(
@@ -826,6 +842,7 @@ mod tests {
             channels: &channels,
             translational_only: true,
             angular_left_out: false,
+            uninformative_torques: Some(([0.0006, -0.02, 0.23], [0.23, 0.24, 0.05])),
             window_factor: 2.5,
             windows: &windows,
             rule: EvidenceRule {
@@ -892,7 +909,7 @@ mod tests {
             "# Sim-to-real mismatch: flight.csv\n",
             "The `w` column was read in the world frame (converted to body rates): it matches the rate implied by the recorded attitude with an RMS error of 0.0123 rad/s in the body frame and 0.0046 rad/s in the world frame.\n",
             "| vdot_x | 0.2500 | 0.0100 | yes |\n| vdot_y | 0.0050 | 0.0100 | no |\n",
-            "\nThe model has no mixer, so it predicts no torques: only the translational channels are compared.\n",
+            "\nThe model's torques say nothing about the recorded angular accelerations: each angular channel's response to the model's prediction (1 when the torques are right, 0 when they are unrelated) is [0.00, -0.02, 0.23] ± [0.23, 0.24, 0.05] (x, y, z), not clearly positive on every axis.",
             "(1 s moving RMS):\n\n- vdot_x from 1.2 s to 7.5 s\n",
             "- **linear_drag** — Drag. Standard errors: d ± [0.012, 0.25, 3.0]. It accounts for 62% of the nominal model's (noise-normalised) residual; without it the held-out residual is 50% higher (likelihood ratio 120 against 16.3, gain 0.75 per row and channel, 0.50 without its two largest blocks).\n",
             "- **not separable from this recording: delay** — A delay of 30 ms. Fitted in its place, with the others refitted, these explain the recording as well: motor_lag (tau_s = 0.031): fit-part likelihood ratio 3.2 against 10.8, held-out residual 2% lower. It stays",
@@ -934,6 +951,7 @@ mod tests {
             channels: &channels,
             translational_only: false,
             angular_left_out: false,
+            uninformative_torques: None,
             window_factor: 2.5,
             windows: &[],
             rule: EvidenceRule {

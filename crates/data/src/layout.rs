@@ -68,6 +68,15 @@ pub struct QuaternionColumns {
     pub z: String,
 }
 
+/// A column and the factor its values are multiplied by.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScaledColumn {
+    pub column: String,
+    #[serde(default = "unit_scale")]
+    pub scale: f64,
+}
+
 /// Where a recording's quantities are, in a CSV file or a ULog.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -95,6 +104,15 @@ pub struct RecordingLayout {
     /// Battery voltage, V (for a thrust map that depends on it).
     #[serde(default)]
     pub battery_voltage: Option<String>,
+    /// The normalised collective thrust setpoint, for a model whose thrust is `T_sp` (`T = m g
+    /// T_sp / hover_throttle`: no rotor or mass parameters needed), times `scale` (−1 for PX4's
+    /// `vehicle_thrust_setpoint.xyz[2]`, which points down the body's z axis).
+    #[serde(default)]
+    pub thrust_setpoint: Option<ScaledColumn>,
+    /// The thrust setpoint that hovers, with `thrust_setpoint`: a column (PX4's
+    /// `hover_thrust_estimate.hover_thrust`).
+    #[serde(default)]
+    pub hover_throttle: Option<String>,
     /// A CSV header line that begins with this text, not part of the first name (`"# "` for a
     /// header written as a comment).
     #[serde(default)]
@@ -117,15 +135,23 @@ impl RecordingLayout {
             field: error.field,
             message: error.message,
         })?;
-        serde_json::from_str(text).map_err(|error| DataError::Config {
+        let layout: Self = serde_json::from_str(text).map_err(|error| DataError::Config {
             path: path.to_path_buf(),
             field: "(layout)".into(),
             message: error.to_string(),
-        })
+        })?;
+        if layout.thrust_setpoint.is_some() != layout.hover_throttle.is_some() {
+            return Err(DataError::Config {
+                path: path.to_path_buf(),
+                field: "thrust_setpoint".into(),
+                message: "a thrust setpoint needs the hover throttle it is divided by: give both `thrust_setpoint` and `hover_throttle`, or neither".into(),
+            });
+        }
+        Ok(layout)
     }
 
     /// The data columns in reading order: position, velocity, quaternion (w, x, y, z), body rate,
-    /// motor commands, battery voltage.
+    /// motor commands, then the optional ones present ([`Self::optional_columns`]).
     fn columns(&self) -> Vec<&str> {
         let q = &self.quaternion;
         let mut columns: Vec<&str> = self
@@ -138,14 +164,47 @@ impl RecordingLayout {
             .map(String::as_str)
             .collect();
         columns.extend(self.battery_voltage.as_deref());
+        columns.extend(self.thrust_setpoint.as_ref().map(|c| c.column.as_str()));
+        columns.extend(self.hover_throttle.as_deref());
         columns
     }
+
+    /// Where the optional columns are among [`Self::columns`]: battery voltage, thrust setpoint,
+    /// hover throttle.
+    fn optional_columns(&self) -> [Option<usize>; 3] {
+        let mut next = REQUIRED_LAYOUT_COLUMNS;
+        let mut place = |present: bool| {
+            present.then(|| {
+                next += 1;
+                next - 1
+            })
+        };
+        [
+            place(self.battery_voltage.is_some()),
+            place(self.thrust_setpoint.is_some()),
+            place(self.hover_throttle.is_some()),
+        ]
+    }
 }
+
+/// Position, velocity, quaternion, body rate and motor commands: 3 + 3 + 4 + 3 + 4 columns.
+const REQUIRED_LAYOUT_COLUMNS: usize = 17;
 
 /// Reads `path` (a CSV file, or a PX4 ULog when its extension is `.ulg`) as `layout` says. The
 /// time stamps are kept as logged (strictly increasing, every interval within
 /// [`SAMPLE_INTERVAL_RANGE_S`]); errors name the file, line and column.
 pub fn read_with_layout(path: &Path, layout: &RecordingLayout) -> Result<FlightLog> {
+    read_rows_with_layout(path, layout, None)
+}
+
+/// [`read_with_layout`] of the data rows `rows` only (counted from 0, the end excluded): the
+/// checks see only those rows, so a stretch a log fills with NaN (PX4's estimates after landing)
+/// can be left out.
+pub fn read_rows_with_layout(
+    path: &Path,
+    layout: &RecordingLayout,
+    rows: Option<std::ops::Range<usize>>,
+) -> Result<FlightLog> {
     let columns = layout.columns();
     let (time, table) = if is_ulog(path) {
         let log = ulog::Log::read(path).map_err(|error| DataError::Config {
@@ -168,6 +227,23 @@ pub fn read_with_layout(path: &Path, layout: &RecordingLayout) -> Result<FlightL
         let (time, table) = table.split_increasing_time()?;
         let unit = layout.time.unit.seconds();
         (time.into_iter().map(|t| t * unit).collect(), table)
+    };
+    let (time, table) = match rows {
+        None => (time, table),
+        Some(rows) => {
+            let count = table.rows();
+            let sliced = table
+                .rows_in(rows.clone())
+                .ok_or_else(|| DataError::Config {
+                    path: path.to_path_buf(),
+                    field: "rows".into(),
+                    message: format!(
+                        "rows {}:{} reach past its {count} data rows",
+                        rows.start, rows.end
+                    ),
+                })?;
+            (time[rows].to_vec(), sliced)
+        }
     };
     let line = |k: usize| table.line(k);
     check_interval_range(
@@ -200,16 +276,38 @@ pub fn read_with_layout(path: &Path, layout: &RecordingLayout) -> Result<FlightL
     let motor_command = (0..time.len())
         .map(|k| std::array::from_fn(|i| column(13 + i)[k] * layout.motor_command_scale))
         .collect();
+    let [battery, thrust_setpoint, hover_throttle] = layout.optional_columns();
+    let scale = layout.thrust_setpoint.as_ref().map_or(1.0, |c| c.scale);
+    let scaled = |index: Option<usize>, factor: f64, range: &str, name: Option<&String>| {
+        let Some(i) = index else {
+            return Ok(vec![f64::NAN; time.len()]);
+        };
+        let values: Vec<f64> = column(i).iter().map(|v| v * factor).collect();
+        check_plausible_values(&table, &values, range, name.expect("a present column"))?;
+        Ok::<_, DataError>(values)
+    };
+    let thrust_setpoint = scaled(
+        thrust_setpoint,
+        scale,
+        "T_sp",
+        layout.thrust_setpoint.as_ref().map(|c| &c.column),
+    )?;
+    let hover_throttle = scaled(
+        hover_throttle,
+        1.0,
+        "hover_throttle",
+        layout.hover_throttle.as_ref(),
+    )?;
     Ok(FlightLog {
         path: path.to_path_buf(),
         meta: FlightMeta::from_file_name(path),
         position: vector(0),
         velocity: vector(3),
         body_rate: vector(10),
-        thrust_setpoint: vec![f64::NAN; time.len()],
-        hover_throttle: vec![f64::NAN; time.len()],
+        thrust_setpoint,
+        hover_throttle,
         motor_command,
-        battery_voltage: layout.battery_voltage.as_ref().map(|_| column(17).clone()),
+        battery_voltage: battery.map(|i| column(i).clone()),
         declared_rate_frame: Some(crate::RateFrame::Body),
         position_desired: None,
         velocity_desired: None,
@@ -229,26 +327,37 @@ fn check_plausible(
     range: &str,
     names: &[String; 3],
 ) -> Result<()> {
-    let range = crate::flight_log::plausible_range(range).expect("a checked column");
     for (axis, name) in names.iter().enumerate() {
-        let values = &table.columns[first + axis];
-        if let Some(k) = values
-            .iter()
-            .position(|v| !(range.min..=range.max).contains(v))
-        {
-            return Err(DataError::Implausible {
-                path: table.path.clone(),
-                row: table.line(k),
-                column: name.clone(),
-                value: values[k],
-                min: range.min,
-                max: range.max,
-                unit: range.unit,
-                quantity: range.quantity,
-            });
-        }
+        check_plausible_values(table, &table.columns[first + axis], range, name)?;
     }
     Ok(())
+}
+
+/// Fails on the first of `values` (one per row of `table`, as scaled by the layout) outside the
+/// plausible range of the Neural-Fly column `range`, naming the layout's column `name`.
+fn check_plausible_values(
+    table: &NumericTable,
+    values: &[f64],
+    range: &str,
+    name: &str,
+) -> Result<()> {
+    let range = crate::flight_log::plausible_range(range).expect("a checked column");
+    match values
+        .iter()
+        .position(|v| !(range.min..=range.max).contains(v))
+    {
+        Some(k) => Err(DataError::Implausible {
+            path: table.path.clone(),
+            row: table.line(k),
+            column: name.to_string(),
+            value: values[k],
+            min: range.min,
+            max: range.max,
+            unit: range.unit,
+            quantity: range.quantity,
+        }),
+        None => Ok(()),
+    }
 }
 
 /// The attitude as `[x, y, z, w]` quaternions in the z-up frames, each checked to be a unit one.

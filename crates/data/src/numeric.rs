@@ -176,6 +176,23 @@ impl NumericTable {
             .unwrap_or(crate::table::file_row(index))
     }
 
+    /// Rows `range` only, each keeping its line (`None` when the range reaches past the rows).
+    pub fn rows_in(&self, range: std::ops::Range<usize>) -> Option<Self> {
+        if range.start > range.end || range.end > self.rows() {
+            return None;
+        }
+        Some(Self {
+            path: self.path.clone(),
+            names: self.names.clone(),
+            columns: self
+                .columns
+                .iter()
+                .map(|c| c[range.clone()].to_vec())
+                .collect(),
+            lines: range.map(|k| self.line(k)).collect(),
+        })
+    }
+
     /// A column by name.
     pub fn column(&self, name: &str) -> Option<&[f64]> {
         self.names

@@ -162,3 +162,59 @@ fn the_crazyflie_flight_reads_as_its_readme_describes() {
     let volts = log.battery_voltage.unwrap();
     assert!(volts.iter().all(|v| (3.0..4.3).contains(v)));
 }
+
+/// A thrust setpoint logged down the FRD body axis reads scaled to the upward `T_sp`, with its
+/// hover throttle; the rows asked for are taken before the checks, so an implausible hover estimate
+/// after them (a ULog's NaN after landing, here a zero) is left out, and one inside them is named
+/// with its line.
+#[test]
+fn a_thrust_setpoint_is_scaled_and_the_rows_are_taken_before_the_checks() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = "timestamp,x,y,z,vx,vy,vz,q0,q1,q2,q3,p,q,r,m1,m2,m3,m4,volts,tz,hover\n";
+    let mut text = String::from(header);
+    for k in 0..8 {
+        let row = ned_row(k, 0.0, 1.0);
+        let hover = if k == 7 { "0" } else { "0.42" };
+        text.push_str(&format!("{},-0.45,{hover}\n", row.trim_end()));
+    }
+    let path = write(dir.path(), "thrust.csv", &text);
+    let with_setpoint = PX4_LIKE.replacen(
+        '{',
+        r#"{"thrust_setpoint": {"column": "tz", "scale": -1.0}, "hover_throttle": "hover","#,
+        1,
+    );
+    let layout = layout(&with_setpoint);
+    let log = data::layout::read_rows_with_layout(&path, &layout, Some(0..7)).unwrap();
+    assert_eq!(log.len(), 7);
+    assert_eq!(log.thrust_setpoint[0], 0.45);
+    assert_eq!(log.hover_throttle[6], 0.42);
+    let whole = read_with_layout(&path, &layout).unwrap_err().to_string();
+    assert!(
+        whole.contains("thrust.csv:9")
+            && whole.contains("hover")
+            && whole.contains("hover throttle"),
+        "{whole}"
+    );
+    let past = data::layout::read_rows_with_layout(&path, &layout, Some(2..9))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        past.contains("rows 2:9 reach past its 8 data rows"),
+        "{past}"
+    );
+}
+
+/// A thrust setpoint without the hover throttle it is divided by is refused when the layout loads.
+#[test]
+fn a_thrust_setpoint_needs_its_hover_throttle() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = PX4_LIKE.replacen('{', r#"{"thrust_setpoint": {"column": "tz"},"#, 1);
+    let path = write(dir.path(), "layout.json", &text);
+    let error = RecordingLayout::load(&path).unwrap_err().to_string();
+    assert!(
+        error.contains("layout.json")
+            && error.contains("thrust_setpoint")
+            && error.contains("hover_throttle"),
+        "{error}"
+    );
+}

@@ -215,8 +215,13 @@ fn read_recording(
 ) -> anyhow::Result<data::FlightLog> {
     let log = match layout {
         Some(layout) => {
+            // The rows are taken before the layout's checks, which then see only them.
             let layout = data::layout::RecordingLayout::load(layout)?;
-            data::layout::read_with_layout(recording, &layout)?
+            return Ok(data::layout::read_rows_with_layout(
+                recording,
+                &layout,
+                rows.cloned(),
+            )?);
         }
         None => data::FlightLog::read_spaced(recording, data::Spacing::Any)?,
     };

@@ -57,7 +57,7 @@ impl Signal {
     }
 }
 
-/// How often one signal brings a new value: that of its slowest component that changes.
+/// How often one signal brings a new value: that of its component that brings the most.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct SignalContent {
     pub signal: Signal,
@@ -109,14 +109,16 @@ pub fn measure(log: &FlightLog) -> Option<LogContent> {
     })
 }
 
-/// The content of the slowest component of `signal` that changes (none when none does).
+/// The content of the component of `signal` that brings the most new values (none when none
+/// changes): a held signal repeats all its components together, while a slow component of a fresh
+/// one (a yaw that barely moves, printed to a few digits) repeats by rounding alone.
 fn content_of(signal: Signal, log: &FlightLog, duration: f64) -> Option<SignalContent> {
     signal
         .components(log)
         .iter()
         .map(|values| NewSamples::count(&log.time, values, PRECISION).pattern())
         .filter(|(pattern, new)| *pattern != ColumnPattern::Constant && *new > 0)
-        .min_by_key(|(_, new)| *new)
+        .max_by_key(|(_, new)| *new)
         .map(|(pattern, new)| SignalContent {
             signal,
             pattern,
@@ -170,14 +172,17 @@ mod tests {
         assert_eq!(measure(&fresh_log(200)), None);
     }
 
-    /// Motor commands held for five rows of a 100 Hz log: the timing limit is their 50 ms.
+    /// Motor commands held for five rows of a 100 Hz log: the timing limit is their 50 ms, not the
+    /// 0.4 s of a motor that barely moves.
     #[test]
     fn held_commands_set_the_timing_limit() {
         let n = 400;
         let mut log = fresh_log(n);
         for (k, u) in log.motor_command.iter_mut().enumerate() {
             let held = (k / 5) as f64;
-            *u = [0.5 + 0.01 * held.sin(), 0.5, 0.5 + 0.01 * held.cos(), 0.5];
+            // The second motor barely moves: rounded, it changes every 40 rows only.
+            let slow = 0.5 + 1e-3 * (k / 40) as f64;
+            *u = [0.5 + 0.01 * held.sin(), slow, 0.5 + 0.01 * held.cos(), 0.5];
         }
         let content = measure(&log).expect("held commands");
         let commands = content

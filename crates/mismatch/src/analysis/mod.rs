@@ -178,7 +178,7 @@ impl Analysis {
         self.report
             .not_separable
             .iter()
-            .fold(self.fitted.clone(), |named, n| named.without(n.effect.id))
+            .fold(self.fitted, |named, n| named.without(n.effect.id))
     }
 }
 

@@ -1,6 +1,6 @@
-//! `learn mismatch --layout`: recordings of other loggers (the public Crazyflie flight and PX4 log)
-//! through the layouts and models in `experiments/`, their time stamps as logged; bad layouts and
-//! models refused with one line naming the file and field.
+//! `learn mismatch --layout`: recordings of other loggers (the public Crazyflie flight and PX4 logs)
+//! through the layouts and models in `experiments/`, their time stamps as logged, with what each
+//! log allows; bad layouts and models refused with one line naming the file and field.
 
 mod common;
 
@@ -97,6 +97,77 @@ fn a_slow_ulog_needs_a_wider_window() {
     // Times since the log's start, as `learn data inspect` counts them (airborne 16.7–28.1 s).
     let start = report["fit"]["t_start"].as_f64().unwrap();
     assert!((15.0..20.0).contains(&start), "{start}");
+    // What the log allows: motor commands held over two rows put timing under ~0.2 s out of
+    // reach; torques computed from them say nothing about the body rate, so only the
+    // translational channels are compared; jMAVSim has no wind, and none is named.
+    let limit = report["log_content"]["timing_limit_s"].as_f64().unwrap();
+    assert!((0.15..0.25).contains(&limit), "{limit}");
+    assert!(report["uninformative_torques"].is_object(), "{report}");
+    assert_eq!(report["channels"].as_array().unwrap().len(), 3);
+    let named: Vec<&str> = report["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["id"].as_str().unwrap())
+        .collect();
+    assert!(!named.contains(&"wind"), "{named:?}");
+}
+
+/// A real flight of a vehicle whose rotors and mass are not known, compared through its thrust
+/// setpoint and PX4's hover-thrust estimate: the estimate's NaN after landing is named unless the
+/// rows stop before it; on the rows in the air a large residual remains and nothing the
+/// vocabulary holds explains it on the held-out part, so nothing is named.
+#[test]
+fn an_unknown_vehicle_is_compared_through_its_thrust_setpoint() {
+    let Some(log) = data::ulog_file_for_tests(&workspace(), "quadrotor_local.ulg") else {
+        return;
+    };
+    let dir = scratch("thrust-setpoint");
+    let args = |extra: &[&str]| {
+        let mut args = vec![
+            "mismatch".to_string(),
+            "--recording".into(),
+            log.display().to_string(),
+            "--layout".into(),
+            root("experiments/layouts/px4-ulog-thrust-setpoint.json"),
+            "--model".into(),
+            root("experiments/mismatch/vehicles/px4-thrust-setpoint.json"),
+            "--half-width".into(),
+            "0.4".into(),
+            "--out".into(),
+            dir.join("out").display().to_string(),
+            "--quiet".into(),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        args
+    };
+    let strings = args(&[]);
+    let refused = learn_in(
+        &dir,
+        &strings.iter().map(String::as_str).collect::<Vec<_>>(),
+    );
+    refused.one_line_error(&[
+        "quadrotor_local.ulg",
+        "hover_thrust_estimate.hover_thrust",
+        "NaN",
+    ]);
+    let strings = args(&["--rows", "0:720"]);
+    let run = learn_in(
+        &dir,
+        &strings.iter().map(String::as_str).collect::<Vec<_>>(),
+    );
+    run.success();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/mismatch.json")).unwrap())
+            .unwrap();
+    assert_eq!(report["channels"].as_array().unwrap().len(), 3);
+    assert!(report["channels"][0]["significant"].as_bool().unwrap());
+    assert_eq!(
+        report["effects"].as_array().unwrap().len(),
+        0,
+        "{}",
+        report["effects"]
+    );
 }
 
 #[test]

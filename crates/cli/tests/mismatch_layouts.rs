@@ -10,6 +10,30 @@ fn root(path: &str) -> String {
     workspace().join(path).display().to_string()
 }
 
+/// `learn mismatch` on `log` through a layout and model of `experiments/`, into `dir/out`, quiet,
+/// with `extra` arguments.
+fn ulog_args(
+    log: &std::path::Path,
+    (layout, model): (&str, &str),
+    dir: &std::path::Path,
+    extra: &[&str],
+) -> Vec<String> {
+    let mut args = vec![
+        "mismatch".to_string(),
+        "--recording".into(),
+        log.display().to_string(),
+        "--layout".into(),
+        root(layout),
+        "--model".into(),
+        root(model),
+        "--out".into(),
+        dir.join("out").display().to_string(),
+        "--quiet".into(),
+    ];
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args
+}
+
 /// Seven seconds of the Crazyflie flight near the floor: read with its layout, compared on its
 /// jittering stamps with a model built from its vehicle description (voltage-dependent thrust).
 #[test]
@@ -63,22 +87,11 @@ fn a_slow_ulog_needs_a_wider_window() {
         return;
     };
     let dir = scratch("slow-ulog");
-    let args = |extra: &[&str]| {
-        let mut args = vec![
-            "mismatch".to_string(),
-            "--recording".into(),
-            log.display().to_string(),
-            "--layout".into(),
-            root("experiments/layouts/px4-ulog.json"),
-            "--model".into(),
-            root("experiments/mismatch/vehicles/jmavsim-iris.json"),
-            "--out".into(),
-            dir.join("out").display().to_string(),
-            "--quiet".into(),
-        ];
-        args.extend(extra.iter().map(|s| s.to_string()));
-        args
-    };
+    let files = (
+        "experiments/layouts/px4-ulog.json",
+        "experiments/mismatch/vehicles/jmavsim-iris.json",
+    );
+    let args = |extra: &[&str]| ulog_args(&log, files, &dir, extra);
     let strings = args(&[]);
     let refused = learn_in(
         &dir,
@@ -123,23 +136,14 @@ fn an_unknown_vehicle_is_compared_through_its_thrust_setpoint() {
         return;
     };
     let dir = scratch("thrust-setpoint");
+    let files = (
+        "experiments/layouts/px4-ulog-thrust-setpoint.json",
+        "experiments/mismatch/vehicles/px4-thrust-setpoint.json",
+    );
     let args = |extra: &[&str]| {
-        let mut args = vec![
-            "mismatch".to_string(),
-            "--recording".into(),
-            log.display().to_string(),
-            "--layout".into(),
-            root("experiments/layouts/px4-ulog-thrust-setpoint.json"),
-            "--model".into(),
-            root("experiments/mismatch/vehicles/px4-thrust-setpoint.json"),
-            "--half-width".into(),
-            "0.4".into(),
-            "--out".into(),
-            dir.join("out").display().to_string(),
-            "--quiet".into(),
-        ];
-        args.extend(extra.iter().map(|s| s.to_string()));
-        args
+        let mut all = vec!["--half-width", "0.4"];
+        all.extend(extra);
+        ulog_args(&log, files, &dir, &all)
     };
     let strings = args(&[]);
     let refused = learn_in(

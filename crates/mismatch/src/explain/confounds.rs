@@ -27,8 +27,9 @@ use crate::explain::fit::FittedSet;
 use crate::locate::problem::Problem;
 use crate::model::refine::effects_from;
 
-/// The stand-ins of an effect, in the order they are tried (declared with the rule, before any
-/// evaluation data was seen).
+/// The stand-ins of an effect, in the order they are tried (each needs no other effect to act
+/// through). Declared with the rule, before any evaluation data was seen, except the wind's thrust
+/// tilt (docs/mismatch.md).
 pub fn stand_ins(id: EffectId) -> &'static [EffectId] {
     use EffectId::*;
     match id {
@@ -148,19 +149,15 @@ fn test(problem: &Problem, set: &FittedSet, id: EffectId, how: &Separate) -> Con
     let stand_ins = stand_ins(id)
         .iter()
         .filter(|a| !present.contains(a))
-        .filter_map(|&a| {
+        .map(|&a| {
             let swapped = replace(problem, set, id, a, how);
-            // A stand-in the set cannot hold (a wind without a drag) is not a stand-in.
-            if !swapped.ids().contains(&a) {
-                return None;
-            }
             let extra = set
                 .parameters
                 .len()
                 .saturating_sub(swapped.parameters.len());
             let worse = worse_by(problem, set, &swapped, &[id, a], how.block_rows);
             let threshold = chi_square_quantile(extra.max(1), how.settings.significance);
-            Some(StandIn {
+            StandIn {
                 id: a,
                 parameters: swapped
                     .effects()
@@ -171,7 +168,7 @@ fn test(problem: &Problem, set: &FittedSet, id: EffectId, how: &Separate) -> Con
                 heldout_increase: worse.heldout_increase,
                 explains_as_well: worse.likelihood_ratio < threshold
                     && worse.heldout_increase < how.settings.min_heldout_reduction,
-            })
+            }
         })
         .collect();
     Confound { id, stand_ins }
@@ -197,16 +194,6 @@ fn replace(
     };
     swapped.parameters.extend(numbers);
     swapped.values.extend(start);
-    // Only parameters the set can hold (a wind needs a drag).
-    let held = swapped.effects();
-    let (parameters, values) = swapped
-        .parameters
-        .iter()
-        .zip(&swapped.values)
-        .filter(|(p, _)| held.contains(p.effect))
-        .map(|(p, v)| (*p, *v))
-        .unzip();
-    let mut swapped = FittedSet { parameters, values };
     swapped.refit(problem, how.iterations);
     swapped
 }

@@ -10,8 +10,11 @@
 //! fields they flatten to. The format is PX4's "ULog File Format"; pyulog is the reference
 //! (`docs/ulog.md`).
 //!
+//! It also writes the part of the format a simulator needs ([`writer::write`]: `float` topics, no
+//! parameters), so that a log of known physics takes the whole ULog path.
+//!
 //! What it is not for: resampling topics onto a common time axis, naming what a topic means for a
-//! flight analysis or judging a log's rates (the `data` crate's), nor writing ULog.
+//! flight analysis or judging a log's rates (the `data` crate's).
 //!
 //! Errors are one line: the file, the byte offset of the offending message and what is wrong
 //! ([`UlogError`]); no input makes the reader panic.
@@ -20,6 +23,7 @@ mod error;
 mod format;
 mod log;
 mod reader;
+pub mod writer;
 
 use std::path::Path;
 

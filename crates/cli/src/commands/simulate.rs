@@ -1,5 +1,6 @@
 //! `learn simulate --scenario FILE --out FILE.csv`: a closed-loop flight of the simulated plant,
-//! written as a Neural-Fly log.
+//! written as a Neural-Fly log, or as a PX4 ULog when the output ends in `.ulg`
+//! (`data::ulog::flight_log_as_ulog`; read back with `experiments/layouts/simulator-ulog.json`).
 
 use std::path::PathBuf;
 
@@ -13,7 +14,8 @@ pub struct Args {
     /// Scenario JSON (model, trajectory, effects, noise, seed).
     #[arg(long)]
     pub scenario: PathBuf,
-    /// Output CSV (never the scenario or the model it names, even with --force).
+    /// Output CSV, or ULog when it ends in .ulg (never the scenario or the model it names, even
+    /// with --force).
     #[arg(long)]
     pub out: PathBuf,
     /// Overwrite an existing output file.
@@ -47,9 +49,16 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         .unwrap_or_else(|| "flight".to_string());
     let log = physics::simulate(&model, &scenario, &name)
         .with_context(|| format!("{}", args.scenario.display()))?;
-    super::staged_write(&staged, || {
-        physics::write_readable(&log, staged.path(file), &args.scenario)
-    })?;
+    if data::layout::is_ulog(&args.out) {
+        super::staged_write(&staged, || {
+            let bytes = data::ulog::flight_log_as_ulog(&log)?;
+            std::fs::write(staged.path(file), bytes).map_err(|e| e.to_string())
+        })?;
+    } else {
+        super::staged_write(&staged, || {
+            physics::write_readable(&log, staged.path(file), &args.scenario)
+        })?;
+    }
     staged.commit()?;
     let effects: Vec<&str> = scenario
         .effects

@@ -51,7 +51,7 @@ pub fn angular_response(problem: &Problem, significance: f64) -> Option<AngularR
         let p: Vec<f64> = predicted[rows.clone()].iter().map(|t| t[c]).collect();
         let pp: f64 = p.iter().map(|v| v * v).sum();
         if pp <= 0.0 {
-            standard_error[a] = f64::INFINITY;
+            // The model predicts no angular acceleration on this axis: a response of 0.
             continue;
         }
         let beta = y.iter().zip(&p).map(|(y, p)| y * p).sum::<f64>() / pp;

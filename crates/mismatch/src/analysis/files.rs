@@ -78,6 +78,7 @@ fn stand_in_line(stand_in: &StandIn) -> StandInLine<'static> {
         likelihood_ratio_threshold: stand_in.likelihood_ratio_threshold,
         heldout_increase: stand_in.heldout_increase,
         explains_as_well: stand_in.explains_as_well,
+        explains_better: stand_in.explains_better,
     }
 }
 
@@ -166,15 +167,16 @@ impl Analysis {
                     stand_ins: n.stand_ins.iter().map(stand_in_line).collect(),
                 })
                 .collect(),
-            wind_replaced: report
+            replaced: report
                 .selection
-                .wind_replaced
-                .as_ref()
+                .replaced
+                .iter()
                 .map(|w| Inseparable {
                     id: w.id.name(),
                     description: "",
                     stand_ins: w.stand_ins.iter().map(stand_in_line).collect(),
-                }),
+                })
+                .collect(),
             dropped: report.selection.dropped.iter().map(evidence_line).collect(),
             unexplained: &report.unexplained,
             resamples: report.selection.settings.resamples,

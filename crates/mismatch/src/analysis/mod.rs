@@ -92,10 +92,11 @@ pub struct SelectionReport {
     pub alternatives: FitAlternatives,
     /// The effects the evidence rule dropped, with their evidence when dropped.
     pub dropped: Vec<Evidence>,
-    /// A wind the evidence rule named that a vehicle effect explains as well: not named, the
-    /// vehicle effect fitted in its place ([`crate::explain::confounds`]).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub wind_replaced: Option<Confound>,
+    /// Effects the evidence rule named that a stand-in replaced (a wind a vehicle effect explains
+    /// as well, any effect one explains better): not named, the stand-in fitted in its place
+    /// ([`crate::explain::confounds`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub replaced: Vec<Confound>,
     /// Every named effect that has stand-ins, tested against each of them
     /// ([`crate::explain::confounds`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -626,7 +627,7 @@ fn build_report(
                 .collect(),
             alternatives: screen.alternatives,
             dropped: judgement.dropped.clone(),
-            wind_replaced: separation.wind_replaced.clone(),
+            replaced: separation.replaced.clone(),
             separation_tests: separation.tests.clone(),
             below_resolution: screen.below_resolution,
         },

@@ -12,9 +12,10 @@
 //! significance (with as many degrees of freedom as the effect has parameters beyond the
 //! stand-in's, at least 1), or the held-out residual at least `min_heldout_reduction` lower.
 //!
-//! - A **wind** that a vehicle effect explains as well is not named: the stand-in takes its place
-//!   (and must then pass the evidence rule itself). A flight's air is the weaker explanation of a
-//!   residual the vehicle's own physics explains.
+//! - An effect that a stand-in explains **better** (the fit part better by the χ² margin, the
+//!   held-out residual no higher), and a **wind** that a vehicle effect explains as well, is not
+//!   named: the stand-in takes its place (and must then pass the evidence rule itself). A flight's
+//!   air is the weaker explanation of a residual the vehicle's own physics explains.
 //! - Any other effect that a stand-in explains as well stays in the fitted model (it explains the
 //!   residual either way) but is reported as **not separable from this recording**, with the
 //!   stand-ins and their fitted values, instead of being named.
@@ -29,7 +30,7 @@ use crate::model::refine::effects_from;
 
 /// The stand-ins of an effect, in the order they are tried (each needs no other effect to act
 /// through). Declared with the rule, before any evaluation data was seen, except the wind's thrust
-/// tilt (docs/mismatch.md).
+/// tilt and the linear drag's rotor drag (docs/mismatch.md).
 pub fn stand_ins(id: EffectId) -> &'static [EffectId] {
     use EffectId::*;
     match id {
@@ -37,7 +38,7 @@ pub fn stand_ins(id: EffectId) -> &'static [EffectId] {
         MotorLag => &[Delay],
         Wind => &[ThrustScale, LinearDrag, ThrustTilt],
         ThrustScale => &[LinearDrag, GroundEffect],
-        LinearDrag => &[ThrustScale],
+        LinearDrag => &[ThrustScale, RotorDrag],
         GroundEffect => &[ThrustScale],
         _ => &[],
     }
@@ -57,6 +58,9 @@ pub struct StandIn {
     pub heldout_increase: f64,
     /// Neither margin separates it from the named effect.
     pub explains_as_well: bool,
+    /// It is better than the named effect by the fit-part margin (with a held-out residual no
+    /// higher): the named effect is replaced by it.
+    pub explains_better: bool,
 }
 
 /// A named effect that stand-ins were fitted in place of.
@@ -73,12 +77,14 @@ impl Confound {
     }
 }
 
-/// What the separation left: the judgement (re-judged when a wind was replaced), the winds
-/// replaced by a vehicle effect, the effects not separable from a stand-in, and every test made.
+/// What the separation left: the judgement (re-judged when a stand-in replaced an effect), the
+/// effects replaced by a stand-in, the effects not separable from a stand-in, and every test made.
 #[derive(Clone, Debug)]
 pub struct Separation {
     pub judgement: Judgement,
-    pub wind_replaced: Option<Confound>,
+    /// Each effect a stand-in replaced: a wind one explains as well, or any effect one explains
+    /// better.
+    pub replaced: Vec<Confound>,
     pub not_separable: Vec<Confound>,
     /// Every named effect tested against its stand-ins, in order (the wind's first).
     pub tests: Vec<Confound>,
@@ -94,53 +100,61 @@ pub struct Separate<'a> {
 /// Tests every named effect of `judgement` against its stand-ins (see the module).
 pub fn separate(problem: &Problem, judgement: Judgement, how: &Separate) -> Separation {
     let mut judgement = judgement;
-    let mut wind_replaced = None;
+    let mut replaced = Vec::new();
     let mut tests = Vec::new();
-    if judgement.set.ids().contains(&EffectId::Wind) {
-        let confound = test(problem, &judgement.set, EffectId::Wind, how);
-        if let Some(best) = best_stand_in(&confound) {
-            let replaced = replace(problem, &judgement.set, EffectId::Wind, best, how);
+    // Each named effect with stand-ins, the wind first, is tested once; one a stand-in replaces
+    // leaves a set judged anew.
+    let mut order = judgement.set.ids();
+    order.sort_by_key(|id| *id != EffectId::Wind);
+    for id in order {
+        if !judgement.set.ids().contains(&id) || stand_ins(id).is_empty() {
+            continue;
+        }
+        let confound = test(problem, &judgement.set, id, how);
+        let wins = |s: &StandIn| s.explains_better || (id == EffectId::Wind && s.explains_as_well);
+        let best = confound
+            .stand_ins
+            .iter()
+            .filter(|s| wins(s))
+            .min_by(|a, b| a.likelihood_ratio.total_cmp(&b.likelihood_ratio))
+            .map(|s| s.id);
+        if let Some(best) = best {
+            let swapped = replace(problem, &judgement.set, id, best, how);
             judgement = evidence::apply(
                 problem,
-                replaced,
+                swapped,
                 how.settings,
                 how.iterations,
                 how.block_rows,
             );
-            wind_replaced = Some(confound.clone());
+            replaced.push(confound.clone());
         }
-        tests.push(confound);
+        if !confound.stand_ins.is_empty() {
+            tests.push(confound);
+        }
     }
-    let vehicle: Vec<Confound> = judgement
-        .set
-        .ids()
+    // What is left, tested against its stand-ins as the set now stands.
+    let standing: Vec<Confound> = if replaced.is_empty() {
+        tests.clone()
+    } else {
+        judgement
+            .set
+            .ids()
+            .into_iter()
+            .filter(|id| !stand_ins(*id).is_empty())
+            .map(|id| test(problem, &judgement.set, id, how))
+            .collect()
+    };
+    let not_separable = standing
         .into_iter()
-        .filter(|id| *id != EffectId::Wind && !stand_ins(*id).is_empty())
-        .map(|id| test(problem, &judgement.set, id, how))
-        .filter(|confound| !confound.stand_ins.is_empty())
+        .filter(|c| c.id != EffectId::Wind && c.inseparable())
         .collect();
-    let not_separable = vehicle
-        .iter()
-        .filter(|c| c.inseparable())
-        .cloned()
-        .collect();
-    tests.extend(vehicle);
     Separation {
         judgement,
-        wind_replaced,
+        replaced,
         not_separable,
         tests,
     }
-}
-
-/// The stand-in that explains the recording as well with the smallest fit-part loss.
-fn best_stand_in(confound: &Confound) -> Option<EffectId> {
-    confound
-        .stand_ins
-        .iter()
-        .filter(|s| s.explains_as_well)
-        .min_by(|a, b| a.likelihood_ratio.total_cmp(&b.likelihood_ratio))
-        .map(|s| s.id)
 }
 
 /// Fits each stand-in of `id` that `set` does not already hold in `id`'s place and compares.
@@ -156,7 +170,12 @@ fn test(problem: &Problem, set: &FittedSet, id: EffectId, how: &Separate) -> Con
                 .len()
                 .saturating_sub(swapped.parameters.len());
             let worse = worse_by(problem, set, &swapped, &[id, a], how.block_rows);
+            let fewer = swapped
+                .parameters
+                .len()
+                .saturating_sub(set.parameters.len());
             let threshold = chi_square_quantile(extra.max(1), how.settings.significance);
+            let better_threshold = chi_square_quantile(fewer.max(1), how.settings.significance);
             StandIn {
                 id: a,
                 parameters: swapped
@@ -168,6 +187,8 @@ fn test(problem: &Problem, set: &FittedSet, id: EffectId, how: &Separate) -> Con
                 heldout_increase: worse.heldout_increase,
                 explains_as_well: worse.likelihood_ratio < threshold
                     && worse.heldout_increase < how.settings.min_heldout_reduction,
+                explains_better: -worse.likelihood_ratio >= better_threshold
+                    && worse.heldout_increase <= 0.0,
             }
         })
         .collect();

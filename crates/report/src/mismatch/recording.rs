@@ -188,6 +188,7 @@ pub struct StandInLine<'a> {
     /// `1 − SSE(named) / SSE(stand-in)` on the held-out part.
     pub heldout_increase: f64,
     pub explains_as_well: bool,
+    pub explains_better: bool,
 }
 
 impl StandInLine<'_> {
@@ -281,8 +282,9 @@ pub struct RecordingView<'a> {
     /// Effects that passed the evidence rule but that a stand-in explains as well: fitted, not
     /// named.
     pub not_separable: Vec<Inseparable<'a>>,
-    /// A wind that passed the evidence rule but that a vehicle effect explains as well.
-    pub wind_replaced: Option<Inseparable<'a>>,
+    /// Effects that passed the evidence rule but that a stand-in replaced: a wind a vehicle effect
+    /// explains as well, any effect one explains better.
+    pub replaced: Vec<Inseparable<'a>>,
     /// The effects the evidence rule dropped.
     pub dropped: Vec<EvidenceLine<'a>>,
     /// Where a significant residual remains with the effects found.
@@ -616,12 +618,27 @@ impl RecordingView<'_> {
                 as_well(e)
             );
         }
-        if let Some(wind) = &self.wind_replaced {
-            let _ = writeln!(
-                md,
-                "- not named: wind — a vehicle effect explains the recording as well ({}). A flight's air is the weaker explanation of a residual the vehicle's own physics explains, so that effect was fitted in its place and judged by the evidence rule.",
-                as_well(wind)
-            );
+        for named in &self.replaced {
+            let better: Vec<String> = named
+                .stand_ins
+                .iter()
+                .filter(|s| s.explains_better)
+                .map(|s| s.text())
+                .collect();
+            if named.id == "wind" && better.is_empty() {
+                let _ = writeln!(
+                    md,
+                    "- not named: wind — a vehicle effect explains the recording as well ({}). A flight's air is the weaker explanation of a residual the vehicle's own physics explains, so that effect was fitted in its place and judged by the evidence rule.",
+                    as_well(named)
+                );
+            } else {
+                let _ = writeln!(
+                    md,
+                    "- not named: {} — an effect that could stand in for it explains the recording better ({}), so it was fitted in its place and judged by the evidence rule.",
+                    named.id,
+                    better.join("; ")
+                );
+            }
         }
     }
 
@@ -868,9 +885,10 @@ mod tests {
                     likelihood_ratio_threshold: 10.83,
                     heldout_increase: -0.02,
                     explains_as_well: true,
+                    explains_better: false,
                 }],
             }],
-            wind_replaced: None,
+            replaced: Vec::new(),
             dropped: vec![evidence("wind", 3.25)],
             unexplained: &unexplained,
             resamples: 40,
@@ -963,7 +981,7 @@ mod tests {
             },
             effects: Vec::new(),
             not_separable: Vec::new(),
-            wind_replaced: None,
+            replaced: Vec::new(),
             dropped: Vec::new(),
             unexplained: &[],
             resamples: 40,

@@ -3,7 +3,8 @@
 //! the commands); a wind through a drag, a thrust scale and a drag along the body axes (each can
 //! be a steady force along the thrust); a wind and a tilted thrust axis (a steady sideways force,
 //! as an uncalibrated attitude gives); a thrust scale and a ground effect at a nearly constant
-//! height. The evidence rule tests each named effect against nothing; here each named effect that
+//! height; a drag along the body axes and a rotor drag proportional to the thrust (one force near
+//! hover). The evidence rule tests each named effect against nothing; here each named effect that
 //! has such stand-ins is tested against each of them:
 //!
 //! the effect is replaced by the stand-in, every other parameter refitted, and the stand-in
@@ -13,7 +14,7 @@
 //! stand-in's, at least 1), or the held-out residual at least `min_heldout_reduction` lower.
 //!
 //! - An effect that a stand-in explains **better** (the fit part better by the χ² margin, the
-//!   held-out residual no higher), and a **wind** that a vehicle effect explains as well, is not
+//!   held-out residual no higher), and a **wind** that a vehicle effect explains as well, are not
 //!   named: the stand-in takes its place (and must then pass the evidence rule itself). A flight's
 //!   air is the weaker explanation of a residual the vehicle's own physics explains.
 //! - Any other effect that a stand-in explains as well stays in the fitted model (it explains the
@@ -110,7 +111,7 @@ pub fn separate(problem: &Problem, judgement: Judgement, how: &Separate) -> Sepa
         if !judgement.set.ids().contains(&id) || stand_ins(id).is_empty() {
             continue;
         }
-        let confound = test(problem, &judgement.set, id, how);
+        let confound = weigh_against_stand_ins(problem, &judgement.set, id, how);
         let wins = |s: &StandIn| s.explains_better || (id == EffectId::Wind && s.explains_as_well);
         let best = confound
             .stand_ins
@@ -142,7 +143,7 @@ pub fn separate(problem: &Problem, judgement: Judgement, how: &Separate) -> Sepa
             .ids()
             .into_iter()
             .filter(|id| !stand_ins(*id).is_empty())
-            .map(|id| test(problem, &judgement.set, id, how))
+            .map(|id| weigh_against_stand_ins(problem, &judgement.set, id, how))
             .collect()
     };
     let not_separable = standing
@@ -158,7 +159,12 @@ pub fn separate(problem: &Problem, judgement: Judgement, how: &Separate) -> Sepa
 }
 
 /// Fits each stand-in of `id` that `set` does not already hold in `id`'s place and compares.
-fn test(problem: &Problem, set: &FittedSet, id: EffectId, how: &Separate) -> Confound {
+fn weigh_against_stand_ins(
+    problem: &Problem,
+    set: &FittedSet,
+    id: EffectId,
+    how: &Separate,
+) -> Confound {
     let present = set.ids();
     let stand_ins = stand_ins(id)
         .iter()

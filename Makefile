@@ -77,6 +77,7 @@ bench: data build
 mismatch-demo: data build
 	$(LEARN) mismatch --demo experiments/mismatch/demo.json --work target/mismatch-demo --out results/mismatch --force
 	$(LEARN) mismatch --demo experiments/mismatch/demo-timing.json --work target/mismatch-demo-timing --out results/mismatch/timing --force
+	$(LEARN) mismatch --demo experiments/mismatch/demo-vehicles.json --work target/mismatch-demo-vehicles --out results/mismatch/vehicles --force
 	$(LEARN) mismatch --flights experiments/conditions.json --model experiments/mismatch/neural-fly.json --out results/mismatch --force
 	$(LEARN) mismatch --recording data/crazyflie/randomwalk_l_cf102_01.csv --layout experiments/layouts/crazyflie-neural-swarm.json --model experiments/mismatch/vehicles/crazyflie-parrot.json --out results/mismatch/shared/crazyflie --force
 	$(LEARN) mismatch --recording data/ulog/sample_px4_events.ulg --layout experiments/layouts/px4-ulog.json --model experiments/mismatch/vehicles/jmavsim-iris.json --half-width 0.4 --rows 160:280 --out results/mismatch/shared/jmavsim --force

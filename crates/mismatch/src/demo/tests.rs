@@ -103,6 +103,17 @@ fn the_committed_timing_summary_renders_its_committed_markdown() {
     assert_eq!(summary.view(manifest).markdown(), read("timing/summary.md"));
 }
 
+/// The '+' quadrotor's matrix (`make mismatch-demo`'s third run) renders its Markdown as committed.
+#[test]
+fn the_committed_vehicles_summary_renders_its_committed_markdown() {
+    let summary = committed_summary_of("vehicles/summary.json");
+    let manifest = Path::new("experiments/mismatch/demo-vehicles.json");
+    assert_eq!(
+        summary.view(manifest).markdown(),
+        read("vehicles/summary.md")
+    );
+}
+
 #[test]
 fn the_committed_summary_renders_its_committed_markdown() {
     let summary = committed_summary();

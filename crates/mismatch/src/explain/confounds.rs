@@ -24,7 +24,7 @@
 use physics::{EffectId, EffectNumber, EffectParameters};
 use serde::Serialize;
 
-use crate::explain::evidence::{self, EvidenceSettings, Judgement, chi_square_quantile, worse_by};
+use crate::explain::evidence::{self, Baseline, EvidenceSettings, Judgement, chi_square_quantile};
 use crate::explain::fit::FittedSet;
 use crate::locate::problem::Problem;
 use crate::model::refine::effects_from;
@@ -111,16 +111,15 @@ pub fn separate(problem: &Problem, judgement: Judgement, how: &Separate) -> Sepa
         if !judgement.set.ids().contains(&id) || stand_ins(id).is_empty() {
             continue;
         }
-        let confound = weigh_against_stand_ins(problem, &judgement.set, id, how);
+        let (confound, swapped) = weigh_against_stand_ins(problem, &judgement.set, id, how);
         let wins = |s: &StandIn| s.explains_better || (id == EffectId::Wind && s.explains_as_well);
         let best = confound
             .stand_ins
             .iter()
-            .filter(|s| wins(s))
-            .min_by(|a, b| a.likelihood_ratio.total_cmp(&b.likelihood_ratio))
-            .map(|s| s.id);
-        if let Some(best) = best {
-            let swapped = replace(problem, &judgement.set, id, best, how);
+            .zip(swapped)
+            .filter(|(s, _)| wins(s))
+            .min_by(|a, b| a.0.likelihood_ratio.total_cmp(&b.0.likelihood_ratio));
+        if let Some((_, swapped)) = best {
             judgement = evidence::apply(
                 problem,
                 swapped,
@@ -143,7 +142,7 @@ pub fn separate(problem: &Problem, judgement: Judgement, how: &Separate) -> Sepa
             .ids()
             .into_iter()
             .filter(|id| !stand_ins(*id).is_empty())
-            .map(|id| weigh_against_stand_ins(problem, &judgement.set, id, how))
+            .map(|id| weigh_against_stand_ins(problem, &judgement.set, id, how).0)
             .collect()
     };
     let not_separable = standing
@@ -158,15 +157,17 @@ pub fn separate(problem: &Problem, judgement: Judgement, how: &Separate) -> Sepa
     }
 }
 
-/// Fits each stand-in of `id` that `set` does not already hold in `id`'s place and compares.
+/// Fits each stand-in of `id` that `set` does not already hold in `id`'s place and compares;
+/// returns the comparison with each swapped set, in the same order.
 fn weigh_against_stand_ins(
     problem: &Problem,
     set: &FittedSet,
     id: EffectId,
     how: &Separate,
-) -> Confound {
+) -> (Confound, Vec<FittedSet>) {
     let present = set.ids();
-    let stand_ins = stand_ins(id)
+    let baseline = Baseline::of(problem, set, how.block_rows);
+    let (stand_ins, swapped): (Vec<StandIn>, Vec<FittedSet>) = stand_ins(id)
         .iter()
         .filter(|a| !present.contains(a))
         .map(|&a| {
@@ -175,14 +176,14 @@ fn weigh_against_stand_ins(
                 .parameters
                 .len()
                 .saturating_sub(swapped.parameters.len());
-            let worse = worse_by(problem, set, &swapped, &[id, a], how.block_rows);
+            let worse = baseline.worse(problem, &swapped, &[id, a]);
             let fewer = swapped
                 .parameters
                 .len()
                 .saturating_sub(set.parameters.len());
             let threshold = chi_square_quantile(extra.max(1), how.settings.significance);
             let better_threshold = chi_square_quantile(fewer.max(1), how.settings.significance);
-            StandIn {
+            let stand_in = StandIn {
                 id: a,
                 parameters: swapped
                     .effects()
@@ -195,10 +196,11 @@ fn weigh_against_stand_ins(
                     && worse.heldout_increase < how.settings.min_heldout_reduction,
                 explains_better: -worse.likelihood_ratio >= better_threshold
                     && worse.heldout_increase <= 0.0,
-            }
+            };
+            (stand_in, swapped)
         })
-        .collect();
-    Confound { id, stand_ins }
+        .unzip();
+    (Confound { id, stand_ins }, swapped)
 }
 
 /// `set` with effect `id` replaced by `stand_in`, refitted: the stand-in started from the best

@@ -98,10 +98,31 @@ impl Scores {
     fn count(&self, g: usize) -> f64 {
         self.counts.iter().map(|b| b[g]).sum()
     }
+
+    /// How much more these scores leave than `base` on the fit part of groups `groups`, each in
+    /// units of its noise scale `κ_g s²_g`: a likelihood ratio.
+    fn excess_over(&self, base: &Scores, groups: &[usize], noise: &[NoiseScale]) -> f64 {
+        groups
+            .iter()
+            .map(|&g| (self.fit(g) - base.fit(g)) / noise[g].scale())
+            .sum()
+    }
+
+    /// The held-out sum of groups `groups`, each divided by its `s²_g`.
+    fn heldout_in(&self, groups: &[usize], noise: &[NoiseScale]) -> f64 {
+        groups
+            .iter()
+            .map(|&g| self.heldout[g] / noise[g].variance.max(1e-300))
+            .sum()
+    }
 }
 
 fn scores(problem: &Problem, set: &FittedSet, block_rows: usize) -> Scores {
-    let residual = problem.residual(&set.effects());
+    scores_of(problem, &problem.residual(&set.effects()), block_rows)
+}
+
+/// The scores of a residual.
+fn scores_of(problem: &Problem, residual: &[Channels], block_rows: usize) -> Scores {
     let groups = problem.channel_groups();
     let mut blocks = Vec::new();
     let mut counts = Vec::new();
@@ -109,7 +130,7 @@ fn scores(problem: &Problem, set: &FittedSet, block_rows: usize) -> Scores {
     while start < problem.split {
         let end = (start + block_rows).min(problem.split);
         let of_group = |(_, channels): &(ChannelGroup, std::ops::Range<usize>)| {
-            problem.whitened_sse_of(&residual, start..end, channels.clone())
+            problem.whitened_sse_of(residual, start..end, channels.clone())
         };
         blocks.push(groups.iter().map(of_group).collect());
         counts.push(
@@ -123,7 +144,7 @@ fn scores(problem: &Problem, set: &FittedSet, block_rows: usize) -> Scores {
     let heldout = groups
         .iter()
         .map(|(_, channels)| {
-            problem.whitened_sse_of(&residual, problem.split..problem.rows(), channels.clone())
+            problem.whitened_sse_of(residual, problem.split..problem.rows(), channels.clone())
         })
         .collect();
     Scores {
@@ -200,9 +221,8 @@ impl NoiseScale {
     }
 }
 
-/// The noise scale of `set`'s fit-part residual per compared channel group, and over all channels.
-fn noise_scales(problem: &Problem, set: &FittedSet) -> (Vec<NoiseScale>, NoiseScale) {
-    let residual = problem.residual(&set.effects());
+/// The noise scale of a fit-part residual per compared channel group, and over all channels.
+fn noise_scales(problem: &Problem, residual: &[Channels]) -> (Vec<NoiseScale>, NoiseScale) {
     let whitened: Vec<Channels> = residual[..problem.split]
         .iter()
         .map(|r| {
@@ -224,8 +244,8 @@ fn noise_scales(problem: &Problem, set: &FittedSet) -> (Vec<NoiseScale>, NoiseSc
     )
 }
 
-/// How much worse `other` explains the recording than `set`, on the channel groups the effects
-/// `ids` act on, in the evidence rule's terms (the noise scale of `set`'s residual).
+/// How much worse another set explains the recording than a baseline set, on the channel groups
+/// of the effects compared, in the evidence rule's terms.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Worse {
     /// `Σ_g (SSE_g(other) − SSE_g(set)) / (κ_g s²_g)` on the fit part.
@@ -234,37 +254,39 @@ pub(crate) struct Worse {
     pub heldout_increase: f64,
 }
 
-pub(crate) fn worse_by(
-    problem: &Problem,
-    set: &FittedSet,
-    other: &FittedSet,
-    ids: &[EffectId],
+/// A set other sets are weighed against: its scores and its residual's noise scale per channel
+/// group, from one evaluation of its residual.
+pub(crate) struct Baseline {
+    scores: Scores,
+    noise: Vec<NoiseScale>,
     block_rows: usize,
-) -> Worse {
-    let mut groups: Vec<usize> = ids
-        .iter()
-        .flat_map(|id| judged_groups(problem, *id).0)
-        .collect();
-    groups.sort_unstable();
-    groups.dedup();
-    let (noise, _) = noise_scales(problem, set);
-    let (full, swapped) = (
-        scores(problem, set, block_rows),
-        scores(problem, other, block_rows),
-    );
-    let likelihood_ratio = groups
-        .iter()
-        .map(|&g| (swapped.fit(g) - full.fit(g)) / noise[g].scale())
-        .sum();
-    let heldout_of = |scores: &Scores| -> f64 {
-        groups
+}
+
+impl Baseline {
+    pub(crate) fn of(problem: &Problem, set: &FittedSet, block_rows: usize) -> Self {
+        let residual = problem.residual(&set.effects());
+        Self {
+            scores: scores_of(problem, &residual, block_rows),
+            noise: noise_scales(problem, &residual).0,
+            block_rows,
+        }
+    }
+
+    /// How much worse `other` does, on the groups the effects `ids` act on.
+    pub(crate) fn worse(&self, problem: &Problem, other: &FittedSet, ids: &[EffectId]) -> Worse {
+        let mut groups: Vec<usize> = ids
             .iter()
-            .map(|&g| scores.heldout[g] / noise[g].variance.max(1e-300))
-            .sum()
-    };
-    Worse {
-        likelihood_ratio,
-        heldout_increase: 1.0 - heldout_of(&full) / heldout_of(&swapped).max(1e-300),
+            .flat_map(|id| judged_groups(problem, *id).0)
+            .collect();
+        groups.sort_unstable();
+        groups.dedup();
+        let other = scores(problem, other, self.block_rows);
+        let (full, noise) = (&self.scores, &self.noise);
+        Worse {
+            likelihood_ratio: other.excess_over(full, &groups, noise),
+            heldout_increase: 1.0
+                - full.heldout_in(&groups, noise) / other.heldout_in(&groups, noise).max(1e-300),
+        }
     }
 }
 
@@ -325,18 +347,10 @@ fn evidence_for(judge: &Judge, id: EffectId) -> (Evidence, FittedSet) {
     let mean = removed / groups.iter().map(|&g| full.count(g)).sum::<f64>();
     let trimmed = trimmed_gain(&gains);
     let parameters = set.parameters.len() - reduced.parameters.len();
-    let likelihood_ratio: f64 = groups
-        .iter()
-        .map(|&g| removed_in(g) / noise[g].scale())
-        .sum();
+    let likelihood_ratio = without.excess_over(full, &groups, noise);
     let threshold = chi_square_quantile(parameters, settings.significance);
-    let heldout_of = |scores: &Scores| -> f64 {
-        groups
-            .iter()
-            .map(|&g| scores.heldout[g] / noise[g].variance.max(1e-300))
-            .sum()
-    };
-    let reduction = 1.0 - heldout_of(full) / heldout_of(&without).max(1e-300);
+    let reduction =
+        1.0 - full.heldout_in(&groups, noise) / without.heldout_in(&groups, noise).max(1e-300);
     let passes = likelihood_ratio >= threshold
         && mean >= settings.min_gain
         && trimmed >= settings.min_trimmed_gain
@@ -393,8 +407,9 @@ pub fn apply(
                 standard_errors: Vec::new(),
             };
         }
-        let full = scores(problem, &set, block_rows);
-        let (noise, all_channels) = noise_scales(problem, &set);
+        let residual = problem.residual(&set.effects());
+        let full = scores_of(problem, &residual, block_rows);
+        let (noise, all_channels) = noise_scales(problem, &residual);
         let judge = Judge {
             problem,
             set: &set,

@@ -26,7 +26,7 @@ use crate::locate::problem::{CHANNEL_NAMES, Channels, Problem};
 use crate::locate::response::{AngularResponse, angular_response};
 use crate::locate::windows::Residuals;
 use crate::recording::Recording;
-use crate::recording::content;
+use crate::recording::content::{self, LogContent};
 use crate::recording::degenerate;
 use crate::recording::noise_reaction;
 use crate::settings::{CheckedSettings, NoiseFree};
@@ -109,8 +109,14 @@ pub fn analyze_observed(
             rows: log.len(),
         });
     }
+    // What the log holds is the same for both passes.
+    let log_content = content::measure(log);
+    let logged = Logged {
+        log,
+        content: log_content.as_ref(),
+    };
     let recording = Recording::new(log, model, 40)?;
-    let first = analyze_recording(recording, log, model, model_name, settings, &|stage| {
+    let first = analyze_recording(recording, &logged, model, model_name, settings, &|stage| {
         observe(1, stage)
     })?;
     if first.problem.recording.noise_reaction.is_none() {
@@ -124,9 +130,15 @@ pub fn analyze_observed(
     if !noise_reaction::remove_velocity(&mut recording, &predicted, prediction_noise) {
         return Ok(first);
     }
-    analyze_recording(recording, log, model, model_name, settings, &|stage| {
+    analyze_recording(recording, &logged, model, model_name, settings, &|stage| {
         observe(2, stage)
     })
+}
+
+/// A log and what it holds ([`content::measure`]).
+struct Logged<'a> {
+    log: &'a FlightLog,
+    content: Option<&'a LogContent>,
 }
 
 /// The model's velocity change over every row interval.
@@ -160,7 +172,7 @@ fn prediction_noise(recording: &Recording, model: &NominalModel, effects: &Effec
 
 fn analyze_recording(
     recording: Recording,
-    log: &FlightLog,
+    logged: &Logged,
     model: &NominalModel,
     model_name: &str,
     settings: &CheckedSettings,
@@ -203,8 +215,7 @@ fn analyze_recording(
         block_rows,
         wind_start,
     );
-    let log_content = content::measure(log);
-    let below_resolution = match log_content.as_ref().and_then(|c| c.timing_limit_s) {
+    let below_resolution = match logged.content.and_then(|c| c.timing_limit_s) {
         Some(limit) => {
             leave_out_below_resolution(&problem, &mut set, limit, settings.analysis.iterations)
         }
@@ -241,7 +252,7 @@ fn analyze_recording(
     let effects = estimate.set.effects();
     let report = build_report(
         &problem,
-        log,
+        logged.log,
         model_name,
         settings,
         Residuals {
@@ -257,7 +268,7 @@ fn analyze_recording(
             selection: &selection,
             alternatives,
             below_resolution,
-            log_content,
+            log_content: logged.content.cloned(),
             uninformative_torques,
         },
     );

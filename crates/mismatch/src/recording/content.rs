@@ -70,7 +70,7 @@ pub struct SignalContent {
 /// slower updates (absent from the report when every signal is new at every row).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LogContent {
-    /// One over the median interval of the rows, Hz.
+    /// Rows per second over the log (the mean rate), Hz.
     pub row_rate_hz: f64,
     pub signals: Vec<SignalContent>,
     /// The shortest delay or motor lag the log can resolve: the motor commands' effective

@@ -108,7 +108,7 @@ pub struct StampedTiming {
 /// What a recording holds when some signal is held or interpolated between slower updates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LogContentView<'a> {
-    /// One over the median row interval, Hz.
+    /// Rows per second over the log (the mean rate), Hz.
     pub row_rate_hz: f64,
     /// Each signal's name, how its rows relate (`held`, `interpolated`, `fresh`, `constant`) and
     /// its new values per second.

@@ -12,12 +12,12 @@ fn root(path: &str) -> String {
 
 /// `learn mismatch` on `log` through a layout and model of `experiments/`, into `dir/out`, quiet,
 /// with `extra` arguments.
-fn ulog_args(
+fn learn_through_layout(
     log: &std::path::Path,
     (layout, model): (&str, &str),
     dir: &std::path::Path,
     extra: &[&str],
-) -> Vec<String> {
+) -> common::Run {
     let mut args = vec![
         "mismatch".to_string(),
         "--recording".into(),
@@ -31,7 +31,13 @@ fn ulog_args(
         "--quiet".into(),
     ];
     args.extend(extra.iter().map(|s| s.to_string()));
-    args
+    learn_in(dir, &args.iter().map(String::as_str).collect::<Vec<_>>())
+}
+
+/// The report `learn mismatch` wrote in `dir/out`.
+fn report_in(dir: &std::path::Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("out/mismatch.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
 }
 
 /// Seven seconds of the Crazyflie flight near the floor: read with its layout, compared on its
@@ -44,32 +50,17 @@ fn the_crazyflie_flight_is_analysed_through_its_layout() {
         return;
     };
     let dir = scratch("crazyflie");
-    let out = dir.join("out");
-    let run = learn_in(
-        &dir,
-        &[
-            "mismatch",
-            "--recording",
-            &flight.display().to_string(),
-            "--layout",
-            &root("experiments/layouts/crazyflie-neural-swarm.json"),
-            "--model",
-            &root("experiments/mismatch/vehicles/crazyflie-parrot.json"),
-            "--rows",
-            "0:700",
-            "--out",
-            &out.display().to_string(),
-            "--quiet",
-        ],
+    let files = (
+        "experiments/layouts/crazyflie-neural-swarm.json",
+        "experiments/mismatch/vehicles/crazyflie-parrot.json",
     );
-    run.success();
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("mismatch.json")).unwrap()).unwrap();
+    learn_through_layout(&flight, files, &dir, &["--rows", "0:700"]).success();
+    let report = report_in(&dir);
     let stamps = &report["time_stamps"];
     let median = stamps["median_interval_s"].as_f64().unwrap();
     assert!((0.0095..0.0105).contains(&median), "{stamps}");
     assert_eq!(report["channels"].as_array().unwrap().len(), 3);
-    let text = std::fs::read_to_string(out.join("mismatch.md")).unwrap();
+    let text = std::fs::read_to_string(dir.join("out/mismatch.md")).unwrap();
     assert!(
         text.contains("`compared_channels` is \"translational\""),
         "{text}"
@@ -91,22 +82,11 @@ fn a_slow_ulog_needs_a_wider_window() {
         "experiments/layouts/px4-ulog.json",
         "experiments/mismatch/vehicles/jmavsim-iris.json",
     );
-    let args = |extra: &[&str]| ulog_args(&log, files, &dir, extra);
-    let strings = args(&[]);
-    let refused = learn_in(
-        &dir,
-        &strings.iter().map(String::as_str).collect::<Vec<_>>(),
-    );
+    let refused = learn_through_layout(&log, files, &dir, &[]);
     refused.one_line_error(&["sample_px4_events.ulg", "±0.2 s", "it needs 3"]);
-    let strings = args(&["--half-width", "0.4", "--rows", "160:280"]);
-    let run = learn_in(
-        &dir,
-        &strings.iter().map(String::as_str).collect::<Vec<_>>(),
-    );
-    run.success();
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("out/mismatch.json")).unwrap())
-            .unwrap();
+    let window = ["--half-width", "0.4", "--rows", "160:280"];
+    learn_through_layout(&log, files, &dir, &window).success();
+    let report = report_in(&dir);
     // Times since the log's start, as `learn data inspect` counts them (airborne 16.7–28.1 s).
     let start = report["fit"]["t_start"].as_f64().unwrap();
     assert!((15.0..20.0).contains(&start), "{start}");
@@ -140,30 +120,15 @@ fn an_unknown_vehicle_is_compared_through_its_thrust_setpoint() {
         "experiments/layouts/px4-ulog-thrust-setpoint.json",
         "experiments/mismatch/vehicles/px4-thrust-setpoint.json",
     );
-    let args = |extra: &[&str]| {
-        let mut all = vec!["--half-width", "0.4"];
-        all.extend(extra);
-        ulog_args(&log, files, &dir, &all)
-    };
-    let strings = args(&[]);
-    let refused = learn_in(
-        &dir,
-        &strings.iter().map(String::as_str).collect::<Vec<_>>(),
-    );
+    let refused = learn_through_layout(&log, files, &dir, &["--half-width", "0.4"]);
     refused.one_line_error(&[
         "quadrotor_local.ulg",
         "hover_thrust_estimate.hover_thrust",
         "NaN",
     ]);
-    let strings = args(&["--rows", "0:720"]);
-    let run = learn_in(
-        &dir,
-        &strings.iter().map(String::as_str).collect::<Vec<_>>(),
-    );
-    run.success();
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("out/mismatch.json")).unwrap())
-            .unwrap();
+    let window = ["--half-width", "0.4", "--rows", "0:720"];
+    learn_through_layout(&log, files, &dir, &window).success();
+    let report = report_in(&dir);
     assert_eq!(report["channels"].as_array().unwrap().len(), 3);
     assert!(report["channels"][0]["significant"].as_bool().unwrap());
     assert_eq!(

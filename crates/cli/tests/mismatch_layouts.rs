@@ -166,14 +166,15 @@ fn a_bad_layout_or_vehicle_model_is_named() {
     std::fs::write(
         dir.join("model.json"),
         r#"{"mass_kg": 1.0, "gravity_m_s2": 9.81, "inertia_kg_m2": [0.01, 0.01, 0.02],
-            "thrust_source": "mixer", "vehicle": "hexa.json"}"#,
+            "thrust_source": "mixer", "vehicle": "tri.json"}"#,
     )
     .unwrap();
-    std::fs::copy(
-        workspace().join("experiments/vehicles/hexa-plus.json"),
-        dir.join("hexa.json"),
-    )
-    .unwrap();
+    // Three of a hexarotor's rotors: no yaw torque of their own (allocation rank 3).
+    let hexa =
+        std::fs::read_to_string(workspace().join("experiments/vehicles/hexa-plus.json")).unwrap();
+    let mut three: serde_json::Value = serde_json::from_str(&hexa).unwrap();
+    three["rotors"].as_array_mut().unwrap().truncate(3);
+    std::fs::write(dir.join("tri.json"), three.to_string()).unwrap();
     let run = learn_in(
         &dir,
         &[
@@ -186,7 +187,7 @@ fn a_bad_layout_or_vehicle_model_is_named() {
             "out",
         ],
     );
-    run.one_line_error(&["model.json", "vehicle", "6 rotors"]);
+    run.one_line_error(&["model.json", "vehicle", "3 rotors and rank 3"]);
     let Some(flight) =
         data::shared_file_for_tests(&workspace(), "crazyflie", "randomwalk_l_cf102_01.csv")
     else {

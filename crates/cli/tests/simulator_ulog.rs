@@ -69,3 +69,100 @@ fn a_simulated_ulog_is_analysed_through_its_layout_as_its_csv_is() {
         "{from_ulog} {from_csv}"
     );
 }
+
+/// A hexarotor's simulated ULog: its six `actuator_outputs` read through a layout that names six,
+/// and the concealed thrust scale found from them.
+#[test]
+fn a_hexarotor_ulog_is_analysed_through_its_six_motor_outputs() {
+    let dir = scratch("simulator-ulog-hexa");
+    std::fs::copy(
+        workspace().join("experiments/mismatch/vehicles/hexa-x.json"),
+        dir.join("hexa.json"),
+    )
+    .unwrap();
+    let text =
+        std::fs::read_to_string(workspace().join("experiments/mismatch/configurations/g.json"))
+            .unwrap();
+    let mut scenario: Value = serde_json::from_str(&text).unwrap();
+    scenario["model"] = json!("hexa.json");
+    scenario["duration_s"] = json!(16.0);
+    scenario["effects"] = json!({"thrust_scale": {"k": 0.9}});
+    std::fs::write(dir.join("s.json"), scenario.to_string()).unwrap();
+    learn_in(
+        &dir,
+        &["simulate", "--scenario", "s.json", "--out", "hexa.ulg"],
+    )
+    .success();
+    let layout =
+        std::fs::read_to_string(workspace().join("experiments/layouts/simulator-ulog.json"))
+            .unwrap();
+    let mut layout: Value = serde_json::from_str(&layout).unwrap();
+    layout["motor_commands"] = json!(
+        (0..6)
+            .map(|i| format!("actuator_outputs.output[{i}]"))
+            .collect::<Vec<_>>()
+    );
+    std::fs::write(dir.join("hexa-layout.json"), layout.to_string()).unwrap();
+    let args = [
+        "mismatch",
+        "--model",
+        "hexa.json",
+        "--quiet",
+        "--recording",
+        "hexa.ulg",
+        "--layout",
+        "hexa-layout.json",
+        "--out",
+        "ulog",
+    ];
+    learn_in(&dir, &args).success();
+    let k = thrust_scale(&dir, "ulog");
+    assert!((k - 0.9).abs() < 0.01, "{k}");
+}
+
+/// A vehicle whose thrust map reads the battery voltage, simulated on a draining battery and
+/// written as a ULog: the layout maps `battery_status.voltage_v`, and the concealed thrust scale
+/// is found through the vehicle's map at the logged voltage.
+#[test]
+fn a_voltage_map_vehicle_ulog_is_analysed_through_its_logged_battery() {
+    let dir = scratch("simulator-ulog-voltage");
+    std::fs::copy(
+        workspace().join("experiments/mismatch/vehicles/quad-voltage.json"),
+        dir.join("quad.json"),
+    )
+    .unwrap();
+    let text =
+        std::fs::read_to_string(workspace().join("experiments/mismatch/configurations/h.json"))
+            .unwrap();
+    let mut scenario: Value = serde_json::from_str(&text).unwrap();
+    scenario["model"] = json!("quad.json");
+    scenario["duration_s"] = json!(16.0);
+    scenario["effects"] = json!({"thrust_scale": {"k": 0.9}});
+    std::fs::write(dir.join("s.json"), scenario.to_string()).unwrap();
+    learn_in(
+        &dir,
+        &["simulate", "--scenario", "s.json", "--out", "v.ulg"],
+    )
+    .success();
+    let layout =
+        std::fs::read_to_string(workspace().join("experiments/layouts/simulator-ulog.json"))
+            .unwrap();
+    let mut layout: Value = serde_json::from_str(&layout).unwrap();
+    layout["battery_voltage"] = json!("battery_status.voltage_v");
+    std::fs::write(dir.join("v-layout.json"), layout.to_string()).unwrap();
+    let args = [
+        "mismatch",
+        "--model",
+        "quad.json",
+        "--quiet",
+        "--recording",
+        "v.ulg",
+        "--layout",
+        "v-layout.json",
+        "--out",
+        "ulog",
+    ];
+    learn_in(&dir, &args).success();
+    let k = thrust_scale(&dir, "ulog");
+    assert!((k - 0.9).abs() < 0.01, "{k}");
+}

@@ -9,6 +9,7 @@ use rotation::{
 use serde::{Deserialize, Serialize};
 
 use crate::error::{DataError, Result};
+use crate::motors::MotorCommands;
 use crate::table::TextTable;
 use crate::time::{
     SampleTiming, Spacing, check_interval_range, check_time_axis_at, median_interval,
@@ -70,10 +71,11 @@ pub struct FlightLog {
     /// `T_sp`: normalised thrust setpoint.
     pub thrust_setpoint: Vec<f64>,
     pub hover_throttle: Vec<f64>,
-    /// `pwm`: the four motor commands, about 1000 to 2000 (as logged, in another layout:
-    /// [`crate::layout`]).
-    pub motor_command: Vec<[f64; 4]>,
-    /// Battery voltage, V, when the layout has it (never in the Neural-Fly layout).
+    /// `pwm`: the motor commands, one per rotor (four in the Neural-Fly logs, about 1000 to 2000;
+    /// as logged in another layout: [`crate::layout`]).
+    pub motor_command: MotorCommands,
+    /// Battery voltage, V, when the file has it (the optional `battery_voltage` column of the
+    /// Neural-Fly layout, which the upstream logs never have; a layout's `battery_voltage`).
     pub battery_voltage: Option<Vec<f64>>,
     /// The frame of `body_rate` when the file's layout declares it (a layout description's body
     /// rate is in the body frame); `None` for the Neural-Fly layout, whose `w` column's frame
@@ -122,7 +124,7 @@ impl PlausibleRange {
 /// units), and would only reach the analyses as overflowing or meaningless numbers. The ranges are
 /// orders of magnitude wider than anything in the 30 Neural-Fly flights, whose observed extremes
 /// are given for each. Checked per component on every row; optional columns when present.
-pub const PLAUSIBLE_RANGES: [PlausibleRange; 10] = [
+pub const PLAUSIBLE_RANGES: [PlausibleRange; 11] = [
     // Observed: −1.58 to 3.09 m (a motion-capture room).
     PlausibleRange::symmetric("p", 1e4, " m", "a position component"),
     // Observed: −1.00 to 2.90 m.
@@ -156,6 +158,15 @@ pub const PLAUSIBLE_RANGES: [PlausibleRange; 10] = [
         max: 1e5,
         unit: "",
         quantity: "a motor command",
+    },
+    // Not in the Neural-Fly logs; written by the simulator with a battery (a 24-cell pack is
+    // about 100 V).
+    PlausibleRange {
+        column: "battery_voltage",
+        min: 0.0,
+        max: 1000.0,
+        unit: " V",
+        quantity: "a battery voltage",
     },
     // Observed: −27.7 to 14.2 N (a 2.6 kg vehicle weighs 26 N).
     PlausibleRange::symmetric("fa", 1e5, " N", "a residual force component"),
@@ -299,8 +310,16 @@ impl FlightLog {
             body_rate: arrays3("w")?,
             thrust_setpoint: scalars("T_sp")?,
             hover_throttle: scalars("hover_throttle")?,
-            motor_command: arrays4("pwm")?,
-            battery_voltage: None,
+            motor_command: {
+                let commands = table.motor_commands("pwm")?;
+                check_plausible(&table, "pwm", commands.rows())?;
+                commands
+            },
+            battery_voltage: if table.has_column("battery_voltage") {
+                Some(scalars("battery_voltage")?)
+            } else {
+                None
+            },
             declared_rate_frame: None,
             position_desired: optional3("p_d")?,
             velocity_desired: optional3("v_d")?,
@@ -345,7 +364,7 @@ impl FlightLog {
             body_rate: self.body_rate[rows.clone()].to_vec(),
             thrust_setpoint: self.thrust_setpoint[rows.clone()].to_vec(),
             hover_throttle: self.hover_throttle[rows.clone()].to_vec(),
-            motor_command: self.motor_command[rows.clone()].to_vec(),
+            motor_command: self.motor_command.range(rows.clone()),
             battery_voltage: self
                 .battery_voltage
                 .as_ref()

@@ -15,6 +15,7 @@ use serde::Deserialize;
 
 use crate::error::{DataError, Result};
 use crate::flight_log::{FlightLog, FlightMeta, SAMPLE_INTERVAL_RANGE_S};
+use crate::motors::{MAX_MOTORS, MotorCommands};
 use crate::numeric::NumericTable;
 use crate::time::check_interval_range;
 
@@ -95,8 +96,9 @@ pub struct RecordingLayout {
     pub quaternion: QuaternionColumns,
     /// Body rate in the body frame, rad/s.
     pub body_rate: [String; 3],
-    /// The four motor commands as logged, in the order of the vehicle description's rotors.
-    pub motor_commands: [String; 4],
+    /// The motor commands as logged (1 to [`MAX_MOTORS`]), in the order of the vehicle
+    /// description's rotors.
+    pub motor_commands: Vec<String>,
     /// Multiplies the logged motor commands into the unit the vehicle's command map reads (e.g.
     /// 65536 for a log that writes a Crazyflie's command as a fraction of 65536); 1 unless given.
     #[serde(default = "unit_scale")]
@@ -119,6 +121,10 @@ pub struct RecordingLayout {
     pub header_prefix: Option<String>,
 }
 
+/// Where the motor commands begin among the layout's columns (after position, velocity,
+/// quaternion and body rate).
+const FIRST_MOTOR_COLUMN: usize = 13;
+
 fn unit_scale() -> f64 {
     1.0
 }
@@ -140,6 +146,7 @@ impl RecordingLayout {
             field: "(layout)".into(),
             message: error.to_string(),
         })?;
+        layout.check_motor_count(path)?;
         if layout.thrust_setpoint.is_some() != layout.hover_throttle.is_some() {
             return Err(DataError::Config {
                 path: path.to_path_buf(),
@@ -169,10 +176,28 @@ impl RecordingLayout {
         columns
     }
 
+    /// Fails unless the layout names 1 to [`MAX_MOTORS`] motor commands (`origin` names the file).
+    fn check_motor_count(&self, origin: &Path) -> Result<()> {
+        let count = self.motor_commands.len();
+        if (1..=MAX_MOTORS).contains(&count) {
+            return Ok(());
+        }
+        Err(DataError::Config {
+            path: origin.to_path_buf(),
+            field: "motor_commands".into(),
+            message: format!("{count} columns; expected 1 to {MAX_MOTORS}, one per rotor"),
+        })
+    }
+
+    /// Position, velocity, quaternion, body rate and motor commands: 3 + 3 + 4 + 3 + N columns.
+    fn required_columns(&self) -> usize {
+        FIRST_MOTOR_COLUMN + self.motor_commands.len()
+    }
+
     /// Where the optional columns are among [`Self::columns`]: battery voltage, thrust setpoint,
     /// hover throttle.
     fn optional_columns(&self) -> [Option<usize>; 3] {
-        let mut next = REQUIRED_LAYOUT_COLUMNS;
+        let mut next = self.required_columns();
         let mut place = |present: bool| {
             present.then(|| {
                 next += 1;
@@ -186,9 +211,6 @@ impl RecordingLayout {
         ]
     }
 }
-
-/// Position, velocity, quaternion, body rate and motor commands: 3 + 3 + 4 + 3 + 4 columns.
-const REQUIRED_LAYOUT_COLUMNS: usize = 17;
 
 /// Reads `path` (a CSV file, or a PX4 ULog when its extension is `.ulg`) as `layout` says. The
 /// time stamps are kept as logged (strictly increasing, every interval within
@@ -205,6 +227,7 @@ pub fn read_rows_with_layout(
     layout: &RecordingLayout,
     rows: Option<std::ops::Range<usize>>,
 ) -> Result<FlightLog> {
+    layout.check_motor_count(path)?;
     let columns = layout.columns();
     let (time, table) = if is_ulog(path) {
         let log = ulog::Log::read(path).map_err(|error| DataError::Config {
@@ -273,9 +296,15 @@ pub fn read_rows_with_layout(
     }
     let quaternion = quaternions(&table, layout)?;
     let rotation = quaternion.iter().map(rotation_from_quaternion).collect();
-    let motor_command = (0..time.len())
-        .map(|k| std::array::from_fn(|i| column(13 + i)[k] * layout.motor_command_scale))
-        .collect();
+    let motors = layout.motor_commands.len();
+    let mut motor_command = MotorCommands::with_capacity(motors, time.len());
+    let mut row = vec![0.0; motors];
+    for k in 0..time.len() {
+        for (i, value) in row.iter_mut().enumerate() {
+            *value = column(FIRST_MOTOR_COLUMN + i)[k] * layout.motor_command_scale;
+        }
+        motor_command.push(&row);
+    }
     let [battery, thrust_setpoint, hover_throttle] = layout.optional_columns();
     let scale = layout.thrust_setpoint.as_ref().map_or(1.0, |c| c.scale);
     let scaled = |index: Option<usize>, factor: f64, range: &str, name: Option<&String>| {

@@ -22,6 +22,7 @@ mod conditions;
 mod error;
 mod flight_log;
 pub mod layout;
+mod motors;
 mod numeric;
 mod records;
 mod source;
@@ -36,6 +37,7 @@ mod write;
 pub use conditions::{Condition, ExperimentConditions, FlightFile, PaperTraining, Role};
 pub use error::{DataError, Result};
 pub use flight_log::{FlightLog, FlightMeta, REQUIRED_COLUMNS, RateFrame, SAMPLE_INTERVAL_RANGE_S};
+pub use motors::{MAX_MOTORS, MotorCommands};
 pub use numeric::NumericTable;
 pub use records::LayoutFault;
 pub use source::{

@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use crate::cells::{bad_cell, cell_numbers, check_finite, column_list};
 use crate::error::{DataError, Result};
+use crate::motors::{MAX_MOTORS, MotorCommands};
 use crate::records::{CsvRecords, Record};
 
 /// Rows of a CSV file, every column kept as text, in file order.
@@ -189,6 +190,39 @@ impl TextTable {
             out.push(array);
         }
         Ok(out)
+    }
+    /// Parses a column of motor commands, `[a, b, ...]`: as many values on every row as on the
+    /// first, 1 to [`MAX_MOTORS`].
+    pub fn motor_commands(&self, name: &str) -> Result<MotorCommands> {
+        let column = self.text_column(name)?;
+        let mut buffer = Vec::with_capacity(MAX_MOTORS);
+        let mut out: Option<MotorCommands> = None;
+        for (index, cell) in column.cells().enumerate() {
+            let row = self.line(index);
+            cell_numbers(&self.path, row, name, cell, &mut buffer)?;
+            let commands = match &mut out {
+                Some(commands) => commands,
+                None if (1..=MAX_MOTORS).contains(&buffer.len()) => out.insert(
+                    MotorCommands::with_capacity(buffer.len(), column.ends.len()),
+                ),
+                None => {
+                    let reason = format!("{} motors; expected 1 to {MAX_MOTORS}", buffer.len());
+                    return Err(bad_cell(&self.path, row, name, cell, reason));
+                }
+            };
+            if buffer.len() != commands.count() {
+                return Err(DataError::WrongLength {
+                    path: self.path.clone(),
+                    row,
+                    column: name.to_string(),
+                    expected: commands.count(),
+                    found: buffer.len(),
+                });
+            }
+            check_finite(&self.path, row, name, &buffer)?;
+            commands.push(&buffer);
+        }
+        Ok(out.unwrap_or_default())
     }
 }
 

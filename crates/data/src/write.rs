@@ -42,7 +42,7 @@ impl FlightLog {
     }
 
     /// The log as a Neural-Fly CSV (unnamed index column first; optional columns only when
-    /// present). Numbers are written with full precision, so reading the file back is lossless.
+    /// present, the battery voltage last). Numbers are written with full precision, so reading the file back is lossless.
     pub fn csv_text(&self) -> String {
         let mut header = String::from(",t,p");
         let optional = [
@@ -66,7 +66,11 @@ impl FlightLog {
         if optional[3].1 {
             header.push_str(",fa");
         }
-        header.push_str(",pwm\n");
+        header.push_str(",pwm");
+        if self.battery_voltage.is_some() {
+            header.push_str(",battery_voltage");
+        }
+        header.push('\n');
         let mut text = header;
         for k in 0..self.len() {
             let _ = write!(text, "{k},{:?},{}", self.time[k], list(&self.position[k]));
@@ -92,7 +96,11 @@ impl FlightLog {
             if let Some(fa) = &self.residual_force {
                 let _ = write!(text, ",{}", list(&fa[k]));
             }
-            let _ = writeln!(text, ",{}", list(&self.motor_command[k]));
+            let _ = write!(text, ",{}", list(self.motor_command.row(k)));
+            if let Some(volts) = &self.battery_voltage {
+                let _ = write!(text, ",{}", list(&[volts[k]]));
+            }
+            text.push('\n');
         }
         text
     }

@@ -81,6 +81,39 @@ fn unparseable_cell() {
     assert!(message.contains("'zero' is not a number"), "{message}");
 }
 
+/// The `pwm` lists hold a command per rotor: six read as a hexarotor's, nine are refused.
+#[test]
+fn pwm_lists_hold_one_command_per_rotor() {
+    let (_, text) = synthetic_csv(&temp_dir("six-src"), 20);
+    let column = column_index(&text, "pwm");
+    let mut six = text.clone();
+    for row in 0..20 {
+        six = replace_cell(
+            &six,
+            row,
+            column,
+            "\"[1000.0, 1100.0, 1200.0, 1300.0, 1400.0, 1500.0]\"",
+        );
+    }
+    let dir = temp_dir("six");
+    let path = dir.join("six.csv");
+    std::fs::write(&path, &six).unwrap();
+    let log = FlightLog::read(&path).unwrap();
+    assert_eq!(log.motor_command.count(), 6);
+    assert_eq!(log.motor_command.row(19)[5], 1500.0);
+    let nine = replace_cell(
+        &text,
+        0,
+        column,
+        &format!("\"[{}]\"", ["1000.0"; 9].join(", ")),
+    );
+    let message = error_of(&nine, "nine");
+    assert!(
+        message.contains("bad.csv:2:pwm") && message.contains("9 motors; expected 1 to 8"),
+        "{message}"
+    );
+}
+
 #[test]
 fn array_of_the_wrong_length() {
     let (_, text) = synthetic_csv(&temp_dir("len-src"), 20);
@@ -331,7 +364,7 @@ fn values_inside_the_plausible_ranges_still_load() {
     let log = FlightLog::read(&path).unwrap();
     assert_eq!(log.velocity[100], [999.0, -999.0, 0.0]);
     assert_eq!(log.hover_throttle[100], 0.001);
-    assert_eq!(log.motor_command[100], [0.0, 99999.0, 1000.0, 2000.0]);
+    assert_eq!(log.motor_command.row(100), [0.0, 99999.0, 1000.0, 2000.0]);
 }
 
 /// The synthetic log with every time multiplied by `factor` (written with full precision).
@@ -422,7 +455,7 @@ fn a_row_range_cuts_every_column_alike() {
     let part = log.row_range(10..40).unwrap();
     assert_eq!(part.len(), 30);
     assert_eq!(part.time[0], log.time[10]);
-    assert_eq!(part.motor_command[29], log.motor_command[39]);
+    assert_eq!(part.motor_command.row(29), log.motor_command.row(39));
     assert_eq!(part.residual_force.as_ref().unwrap().len(), 30);
     assert_eq!(part.attitude_setpoint.as_ref().unwrap().len(), 30);
     assert_eq!(part.path, log.path);

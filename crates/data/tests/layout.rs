@@ -57,7 +57,7 @@ fn a_ned_frd_log_reads_z_up_in_seconds_on_its_own_stamps() {
     let r = log.rotation[0];
     assert!((r[2][2] - 1.0).abs() < 1e-12);
     assert!((r[1][0] - (-0.4f64).sin()).abs() < 1e-12, "{r:?}");
-    assert_eq!(log.motor_command[0], [1500.0, 1510.0, 1490.0, 1505.0]);
+    assert_eq!(log.motor_command.row(0), [1500.0, 1510.0, 1490.0, 1505.0]);
     assert_eq!(log.battery_voltage.as_ref().unwrap()[0], 11.1);
     assert_eq!(layout(PX4_LIKE).frames, Frames::NedFrd);
 }
@@ -154,7 +154,7 @@ fn the_crazyflie_flight_reads_as_its_readme_describes() {
     assert!((0.0095..0.0105).contains(&median), "{median}");
     let duration = log.time[log.len() - 1] - log.time[0];
     assert!((55.0..70.0).contains(&duration), "{duration}");
-    let commands = log.motor_command.iter().flatten();
+    let commands = log.motor_command.rows().flatten();
     assert!(commands.clone().all(|c| (0.0..=65536.0).contains(c)));
     assert!(commands.clone().any(|c| *c > 30000.0));
     let heights = log.position.iter().map(|p| p[2]);
@@ -217,4 +217,41 @@ fn a_thrust_setpoint_needs_its_hover_throttle() {
             && error.contains("hover_throttle"),
         "{error}"
     );
+}
+
+/// A hexarotor's log: six motor command columns read in the layout's order; a layout of nine (or
+/// none) is refused naming its field.
+#[test]
+fn a_hexarotor_log_reads_its_six_motor_commands() {
+    let dir = tempfile::tempdir().unwrap();
+    let six = PX4_LIKE.replace(
+        r#"["m1", "m2", "m3", "m4"]"#,
+        r#"["m1", "m2", "m3", "m4", "m5", "m6"]"#,
+    );
+    let mut text =
+        String::from("timestamp,x,y,z,vx,vy,vz,q0,q1,q2,q3,p,q,r,m1,m2,m3,m4,volts,m5,m6\n");
+    for k in 0..6 {
+        text.push_str(&ned_row(k, 0.0, 1.0).replace('\n', ",1400,1600\n"));
+    }
+    let path = write(dir.path(), "hexa.csv", &text);
+    let log = read_with_layout(&path, &layout(&six)).unwrap();
+    assert_eq!(log.motor_command.count(), 6);
+    assert_eq!(
+        log.motor_command.row(5),
+        [1500.0, 1510.0, 1490.0, 1505.0, 1400.0, 1600.0]
+    );
+    let nine = six.replace(r#""m6"]"#, r#""m6", "m7", "m8", "m9"]"#);
+    let file = write(dir.path(), "nine.json", &nine);
+    let message = RecordingLayout::load(&file).unwrap_err().to_string();
+    assert!(
+        message.contains("nine.json")
+            && message.contains("motor_commands")
+            && message.contains("9 columns; expected 1 to 8"),
+        "{message}"
+    );
+    let none = six.replace(r#"["m1", "m2", "m3", "m4", "m5", "m6"]"#, "[]");
+    let message = read_with_layout(&path, &layout(&none))
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("motor_commands"), "{message}");
 }

@@ -64,7 +64,7 @@ fn known_values_of_one_row() {
     assert_eq!(log.thrust_setpoint[0], 0.6249672087747932);
     assert_eq!(log.hover_throttle[0], 0.46920177902800003);
     assert_eq!(
-        log.motor_command[0],
+        log.motor_command.row(0),
         [
             1132.8906071381034,
             1247.0587696335963,

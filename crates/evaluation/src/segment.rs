@@ -125,8 +125,13 @@ fn control(formulation: Formulation, log: &FlightLog, k: usize, out: &mut Vec<f6
             let thrust = log.thrust_setpoint[k];
             out.extend(log.rotation[k].iter().map(|row| row[2] * thrust));
         }
-        Formulation::Attitude => out.extend(log.motor_command[k].iter().map(|p| p / 1000.0)),
-        Formulation::Full => out.extend(log.motor_command[k].iter().map(|p| (p / 1000.0).powi(2))),
+        Formulation::Attitude => out.extend(log.motor_command.row(k).iter().map(|p| p / 1000.0)),
+        Formulation::Full => out.extend(
+            log.motor_command
+                .row(k)
+                .iter()
+                .map(|p| (p / 1000.0).powi(2)),
+        ),
     }
 }
 
@@ -235,7 +240,7 @@ mod tests {
             body_rate: vec![[0.0; 3]; n],
             thrust_setpoint: vec![0.5; n],
             hover_throttle: vec![0.5; n],
-            motor_command: vec![[1500.0; 4]; n],
+            motor_command: vec![[1500.0; 4]; n].into_iter().collect(),
             battery_voltage: None,
             declared_rate_frame: None,
             position_desired: None,

@@ -381,7 +381,7 @@ fn formulations_build_paper_segments() {
     assert_eq!(segment.len(), 1256);
     assert_eq!(segment.inputs().ncols(), 10);
     let k = split.query.start;
-    let n1 = log.motor_command[k][0] / 1000.0;
+    let n1 = log.motor_command.row(k)[0] / 1000.0;
     assert!((segment.controls[(0, 0)] - n1 * n1).abs() < 1e-15);
     // target = forward difference on the segment alone
     let expected = (log.velocity[k + 1][0] - log.velocity[k][0]) / log.sample_interval();

@@ -106,7 +106,7 @@ fn a_too_short_recording_is_a_one_line_error() {
     log.body_rate.truncate(50);
     log.thrust_setpoint.truncate(50);
     log.hover_throttle.truncate(50);
-    log.motor_command.truncate(50);
+    log.motor_command = log.motor_command.range(0..50);
     let error = analyze(&log, &model(), "demo", &settings())
         .unwrap_err()
         .to_string();

@@ -105,7 +105,9 @@ fn a_constant_recording_is_refused_naming_the_constant_columns() {
         log.rotation[k] = first.rotation[0];
         log.body_rate[k] = first.body_rate[0];
         log.thrust_setpoint[k] = first.thrust_setpoint[0];
-        log.motor_command[k] = first.motor_command[0];
+        log.motor_command
+            .row_mut(k)
+            .copy_from_slice(first.motor_command.row(0));
     }
     for model_name in ["neural-fly.json", "vehicles/quad-a.json"] {
         let message = refusal(&log, &model(model_name));
@@ -150,8 +152,8 @@ fn a_recording_without_thrust_is_refused_naming_the_column() {
     );
     // The motors at their zero-speed command, for a mixer model.
     let mut log = flight(noisy());
-    for pwm in &mut log.motor_command {
-        *pwm = [1000.0; 4];
+    for pwm in log.motor_command.rows_mut() {
+        pwm.fill(1000.0);
     }
     let message = refusal(&log, &model_for_scenario());
     assert!(message.contains("reads from pwm"), "{message}");

@@ -85,9 +85,9 @@ fn a_delay_shorter_than_the_commands_resolve_is_not_named() {
     };
     let mut log = simulate(&model(), &scenario(effects, 6), "held.csv").unwrap();
     let held: Vec<[f64; 4]> = (0..log.len())
-        .map(|k| log.motor_command[k - k % 3])
+        .map(|k| log.motor_command.row(k - k % 3).try_into().unwrap())
         .collect();
-    log.motor_command = held;
+    log.motor_command = held.into_iter().collect();
     let analysis = analyze(&log, &model(), "demo", &settings()).unwrap();
     let report = &analysis.report;
     let content = report.log_content.as_ref().expect("held commands");
@@ -115,7 +115,7 @@ fn a_delay_shorter_than_the_commands_resolve_is_not_named() {
 #[test]
 fn torques_unrelated_to_the_recording_are_not_compared() {
     let mut log = simulate(&model(), &scenario(Effects::default(), 7), "shifted.csv").unwrap();
-    for u in &mut log.motor_command {
+    for u in log.motor_command.rows_mut() {
         u.rotate_left(1);
     }
     let analysis = analyze(&log, &model(), "demo", &settings()).unwrap();
@@ -195,12 +195,12 @@ fn held_commands_set_the_timing_limit() {
     assert_eq!(content::measure(&log), None);
     let held: Vec<[f64; 4]> = (0..log.len())
         .map(|k| {
-            let mut u = log.motor_command[k - k % 5];
+            let mut u: [f64; 4] = log.motor_command.row(k - k % 5).try_into().unwrap();
             u[1] = 1500.0 + (k / 40) as f64;
             u
         })
         .collect();
-    log.motor_command = held;
+    log.motor_command = held.into_iter().collect();
     let measured = content::measure(&log).expect("held commands");
     let commands = measured
         .signals

@@ -38,7 +38,7 @@ fn rows_of(log: &data::FlightLog, rows: &[usize]) -> data::FlightLog {
         out.body_rate.extend(row.body_rate);
         out.thrust_setpoint.extend(row.thrust_setpoint);
         out.hover_throttle.extend(row.hover_throttle);
-        out.motor_command.extend(row.motor_command);
+        out.motor_command.extend(&row.motor_command);
     }
     out.position_desired = None;
     out.velocity_desired = None;

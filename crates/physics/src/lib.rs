@@ -1,4 +1,4 @@
-//! Quadrotor rigid-body physics for the sim-to-real mismatch tool.
+//! Multirotor rigid-body physics for the sim-to-real mismatch tool.
 //!
 //! What it is for: the nominal model read from JSON ([`NominalModel`]: mass, gravity, inertia, and
 //! how thrust and torques follow from a recorded command); the vocabulary of unmodelled effects
@@ -9,7 +9,9 @@
 //! only the nominal model, figure-8 and random-waypoint [`Trajectory`]s, measurement [`Noise`], rows
 //! jittered, dropped or missing over gaps as a real logger writes them ([`LogTiming`]); a
 //! [`Scenario`] is read from JSON or, for examples and tests, built by [`Scenario::figure_eight`])
-//! that writes Neural-Fly logs the data tools read back ([`write_readable`]); and the residual
+//! that writes Neural-Fly logs the data tools read back ([`write_readable`]), for 4 to 8 rotors
+//! through a [`Mixer`] (or a vehicle's command map) and with a [`Battery`] whose voltage a
+//! thrust map may read; and the residual
 //! force of a recorded flight ([`residual_force`], the `fa` column); descriptions of any multirotor
 //! ([`vehicle`]: rotors, command map, the allocation matrix, PX4's airframe parameters).
 //!
@@ -21,6 +23,7 @@
 // Index loops over 3- and 4-vectors read like the formulas they implement.
 #![allow(clippy::needless_range_loop)]
 
+mod battery;
 mod controller;
 mod effect_id;
 pub mod effects;
@@ -28,6 +31,7 @@ mod error;
 mod jitter;
 mod log_timing;
 mod logger;
+mod mixer;
 mod model;
 pub mod ranges;
 mod residual;
@@ -38,6 +42,7 @@ pub mod vector;
 pub mod vehicle;
 mod writer;
 
+pub use battery::{Battery, MAX_BATTERY_V};
 pub use controller::{ControlOutput, Gains, GeometricController, MeasuredState};
 pub use effect_id::UnknownEffectId;
 pub use effects::*;
@@ -47,8 +52,9 @@ pub use log_timing::{LogTiming, MAX_DROPPED_FRACTION};
 pub use logger::{
     CommandLogging, Logger, MAX_COMMAND_OFFSET_S, MAX_RATE_LOW_PASS_HZ, MIN_RATE_LOW_PASS_HZ,
 };
+pub use mixer::{Actuators, MAX_ACTUATORS, Mixer, actuators};
 pub use model::{
-    ComparedChannels, Mixer, NominalModel, ThrustSource, Wrench, angular_acceleration_with_inertia,
+    ComparedChannels, NominalModel, ThrustSource, Wrench, angular_acceleration_with_inertia,
 };
 pub use residual::{five_point_derivative, residual_force};
 pub use scenario::{

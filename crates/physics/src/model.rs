@@ -5,8 +5,8 @@
 //! `m v̇ = m [0, 0, −g] + R [0, 0, T]` and `J ω̇ = −ω × (J ω) + τ`.
 //! With `"thrust_source": "T_sp"`, `T = m g T_sp / hover_throttle` and the torques are unknown;
 //! with `"mixer"`, `[T, τx, τy, τz] = b0 · s²` where `s_i = (pwm_i − pwm_offset) / pwm_scale`.
-//! A `"vehicle"` description of four rotors (a file beside the model, or inline) gives the mixer
-//! instead: `s_i² = n_i` the rotor's thrust in units of its coefficient, from its logged command
+//! `b0` has a column per rotor (4 to [`crate::MAX_ACTUATORS`]). A `"vehicle"` description (a file
+//! beside the model, or inline) gives the mixer instead: `s_i² = n_i` the rotor's thrust in units of its coefficient, from its logged command
 //! (and the battery voltage) through the vehicle's command map.
 
 use std::path::{Path, PathBuf};
@@ -16,9 +16,10 @@ use serde_json::{Map, Value};
 
 use crate::error::{PhysicsError, Result};
 use crate::logger::Logger;
+use crate::mixer::{Actuators, Mixer};
 use crate::ranges::{self, PhysicalRange};
 use crate::vector::{E3, Vec3, add, cross, hadamard, mat_vec, scale};
-use crate::vehicle::{CommandMap, VehicleDescription};
+use crate::vehicle::VehicleDescription;
 
 /// Where the collective thrust comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -49,20 +50,6 @@ impl ComparedChannels {
     }
 }
 
-/// The map from motor commands to thrust and torques.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Mixer {
-    pub pwm_offset: f64,
-    pub pwm_scale: f64,
-    /// `[T, τx, τy, τz] = b0 · s²`.
-    pub b0: [[f64; 4]; 4],
-    #[serde(skip)]
-    inverse: [[f64; 4]; 4],
-    /// With a vehicle description: its command map, through which `s² = n(u, V)`.
-    #[serde(skip)]
-    command_map: Option<CommandMap>,
-}
-
 /// Thrust (N) and, when the model knows them, body torques (N·m).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Wrench {
@@ -91,88 +78,6 @@ pub struct NominalModel {
     /// The channels compared (optional field; default all).
     #[serde(skip_serializing_if = "ComparedChannels::is_all")]
     pub compared_channels: ComparedChannels,
-}
-
-impl Mixer {
-    /// Builds a mixer; fails (naming `field`) when `b0` is not invertible.
-    fn new(pwm_offset: f64, pwm_scale: f64, b0: [[f64; 4]; 4]) -> Option<Self> {
-        let inverse = invert4(&b0)?;
-        Some(Self {
-            pwm_offset,
-            pwm_scale,
-            b0,
-            inverse,
-            command_map: None,
-        })
-    }
-
-    /// The mixer of a vehicle of four rotors: `b0`'s columns are the allocation's times each
-    /// rotor's thrust coefficient, and `s_i² = n_i(u_i, V)`.
-    pub fn from_vehicle(vehicle: &VehicleDescription) -> Option<Self> {
-        if vehicle.rotors.len() != 4 {
-            return None;
-        }
-        let rows = vehicle.allocation().rows();
-        let b0 = std::array::from_fn(|r| {
-            std::array::from_fn(|i| rows[r][i] * vehicle.rotors[i].thrust_coefficient_n)
-        });
-        let mut mixer = Self::new(0.0, 1.0, b0)?;
-        mixer.command_map = Some(vehicle.command_map.clone());
-        Some(mixer)
-    }
-
-    /// Whether the speeds need the battery voltage.
-    pub fn needs_battery_voltage(&self) -> bool {
-        self.command_map
-            .as_ref()
-            .is_some_and(|map| map.thrust.needs_voltage())
-    }
-
-    /// Normalised motor speeds `s_i = (pwm_i − pwm_offset) / pwm_scale`, clipped at 0 (through the
-    /// command map with a vehicle: `s_i = √n_i(u_i, V)`, NaN without a voltage it needs).
-    pub fn speeds(&self, pwm: &[f64; 4], battery_v: Option<f64>) -> [f64; 4] {
-        match &self.command_map {
-            Some(map) => pwm.map(|command| {
-                let u = map.command.scaled(command);
-                map.thrust
-                    .relative_thrust(u, battery_v)
-                    .map_or(f64::NAN, f64::sqrt)
-            }),
-            None => pwm.map(|p| ((p - self.pwm_offset) / self.pwm_scale).max(0.0)),
-        }
-    }
-
-    /// Whether motor commands are written through `pwm_offset` and `pwm_scale` (not a vehicle's
-    /// command map, which the simulator cannot invert).
-    pub fn writes_pwm(&self) -> bool {
-        self.command_map.is_none()
-    }
-
-    /// The motor commands of normalised speeds.
-    pub fn pwm(&self, speeds: &[f64; 4]) -> [f64; 4] {
-        speeds.map(|s| self.pwm_offset + self.pwm_scale * s)
-    }
-
-    /// `[T, τx, τy, τz] = b0 · s²`.
-    pub fn wrench(&self, speeds: &[f64; 4]) -> [f64; 4] {
-        let squared = speeds.map(|s| s * s);
-        let mut out = [0.0; 4];
-        for (i, row) in self.b0.iter().enumerate() {
-            out[i] = (0..4).map(|j| row[j] * squared[j]).sum();
-        }
-        out
-    }
-
-    /// The speeds (clipped to [0, 1]) that produce a wrench `[T, τx, τy, τz]` as closely as the
-    /// limits allow.
-    pub fn speeds_for(&self, wrench: &[f64; 4]) -> [f64; 4] {
-        let mut out = [0.0; 4];
-        for (i, row) in self.inverse.iter().enumerate() {
-            let squared: f64 = (0..4).map(|j| row[j] * wrench[j]).sum();
-            out[i] = squared.max(0.0).sqrt().min(1.0);
-        }
-        out
-    }
 }
 
 impl NominalModel {
@@ -313,46 +218,54 @@ impl NominalModel {
         self.thrust_source == ThrustSource::Mixer && self.compared_channels == ComparedChannels::All
     }
 
-    /// The actuator states the recorded command asks for: the four normalised motor speeds with a
-    /// mixer, or `[T, 0, 0, 0]` (N) with `T_sp`. Delays and lags act on these.
+    /// The actuator states the recorded command asks for: the normalised motor speeds with a
+    /// mixer (`pwm` a command per rotor), or `[T, 0, …]` (N) with `T_sp`. Delays and lags act on
+    /// these.
     pub fn actuator_command(
         &self,
         thrust_setpoint: f64,
         hover_throttle: f64,
-        pwm: &[f64; 4],
+        pwm: &[f64],
         battery_v: Option<f64>,
-    ) -> [f64; 4] {
+    ) -> Actuators {
         match self.thrust_source {
             ThrustSource::Mixer => self
                 .mixer
                 .as_ref()
                 .expect("validated: a mixer model has a mixer")
                 .speeds(pwm, battery_v),
-            ThrustSource::ThrustSetpoint => [
-                self.mass_kg * self.gravity_m_s2 * thrust_setpoint / hover_throttle,
-                0.0,
-                0.0,
-                0.0,
-            ],
+            ThrustSource::ThrustSetpoint => {
+                let mut thrust = [0.0; crate::MAX_ACTUATORS];
+                thrust[0] = self.mass_kg * self.gravity_m_s2 * thrust_setpoint / hover_throttle;
+                thrust
+            }
         }
     }
 
-    /// How many entries of an actuator command are used (4 motors, or 1 thrust).
+    /// How many entries of an actuator command are used (a motor each, or 1 thrust).
     pub fn actuator_count(&self) -> usize {
-        match self.thrust_source {
-            ThrustSource::Mixer => 4,
-            ThrustSource::ThrustSetpoint => 1,
+        match (&self.mixer, self.thrust_source) {
+            (Some(mixer), ThrustSource::Mixer) => mixer.rotors(),
+            _ => 1,
+        }
+    }
+
+    /// How many motor commands a recording must have a row (none with `T_sp`).
+    pub fn motor_count(&self) -> Option<usize> {
+        match (&self.mixer, self.thrust_source) {
+            (Some(mixer), ThrustSource::Mixer) => Some(mixer.rotors()),
+            _ => None,
         }
     }
 
     /// Thrust and torques produced by actuator states whose values spread within the time they
     /// stand for with variances `spread` (a mixer's squares see the spread; `T_sp` is linear).
-    pub fn wrench_with_spread(&self, actuators: &[f64; 4], spread: &[f64; 4]) -> Wrench {
+    pub fn wrench_with_spread(&self, actuators: &Actuators, spread: &Actuators) -> Wrench {
         match (&self.mixer, self.thrust_source) {
             (Some(mixer), ThrustSource::Mixer) => {
                 let mut w = mixer.wrench(actuators);
-                for (i, row) in mixer.b0.iter().enumerate() {
-                    w[i] += (0..4).map(|j| row[j] * spread[j]).sum::<f64>();
+                for (total, extra) in w.iter_mut().zip(mixer.spread_wrench(spread)) {
+                    *total += extra;
                 }
                 Wrench {
                     thrust: w[0],
@@ -364,7 +277,7 @@ impl NominalModel {
     }
 
     /// Thrust and torques produced by actuator states.
-    pub fn wrench(&self, actuators: &[f64; 4]) -> Wrench {
+    pub fn wrench(&self, actuators: &Actuators) -> Wrench {
         match self.thrust_source {
             ThrustSource::Mixer => {
                 let w = self
@@ -485,7 +398,7 @@ impl FieldReader {
 
     /// The rotors at full speed must lift `weight_n` (and no vehicle lifts a hundred times it).
     fn check_lift(&self, mixer: &Mixer, weight_n: f64) -> Result<()> {
-        let full_thrust: f64 = mixer.b0[0].iter().sum();
+        let full_thrust: f64 = mixer.row(0).iter().sum();
         ranges::THRUST_TO_WEIGHT
             .check(full_thrust / weight_n)
             .map(drop)
@@ -573,14 +486,16 @@ impl FieldReader {
         }
     }
 
-    /// The mixer of a vehicle of four rotors.
+    /// The mixer of a vehicle of 4 to [`crate::MAX_ACTUATORS`] rotors.
     fn vehicle_mixer(&self, vehicle: &VehicleDescription) -> Result<Mixer> {
         Mixer::from_vehicle(vehicle).ok_or_else(|| {
             self.error(
                 "vehicle",
                 &format!(
-                    "the model takes a vehicle of 4 rotors whose allocation is invertible; this one has {} rotors",
-                    vehicle.rotors.len()
+                    "the model takes a vehicle of 4 to {} rotors that set thrust and the three torques independently (allocation rank 4); this one has {} rotors and rank {}",
+                    crate::MAX_ACTUATORS,
+                    vehicle.rotors.len(),
+                    vehicle.allocation().rank()
                 ),
             )
         })
@@ -598,15 +513,22 @@ impl FieldReader {
             ranges::PWM_SCALE.field,
             &ranges::PWM_SCALE,
         )?;
+        let shape = format!(
+            "expected 4 rows of 4 to {} numbers, one per rotor",
+            crate::MAX_ACTUATORS
+        );
         let rows = match mixer.get("b0") {
             None => return Err(self.error("mixer.b0", "missing")),
             Some(Value::Array(rows)) if rows.len() == 4 => rows,
-            Some(_) => return Err(self.error("mixer.b0", "expected 4 rows of 4 numbers")),
+            Some(_) => return Err(self.error("mixer.b0", &shape)),
         };
-        let mut b0 = [[0.0; 4]; 4];
+        let rotors = match &rows[0] {
+            Value::Array(first) if (4..=crate::MAX_ACTUATORS).contains(&first.len()) => first.len(),
+            _ => return Err(self.error("mixer.b0[0]", &shape)),
+        };
+        let mut b0: [Vec<f64>; 4] = Default::default();
         for (i, row) in rows.iter().enumerate() {
-            let values = self.numbers_of(Some(row), &format!("mixer.b0[{i}]"), 4)?;
-            b0[i].copy_from_slice(&values);
+            b0[i] = self.numbers_of(Some(row), &format!("mixer.b0[{i}]"), rotors)?;
         }
         // Row 0 maps the squared motor speeds to the collective thrust: every motor pushes up.
         if let Some(j) = b0[0].iter().position(|v| *v <= 0.0) {
@@ -630,42 +552,13 @@ impl FieldReader {
                     .map_err(|message| self.error(&format!("mixer.b0[{i}][{j}]"), &message))?;
             }
         }
-        Mixer::new(pwm_offset, pwm_scale, b0)
-            .ok_or_else(|| self.error("mixer.b0", "the matrix is singular (cannot be inverted)"))
+        Mixer::new(pwm_offset, pwm_scale, &b0).ok_or_else(|| {
+            self.error(
+                "mixer.b0",
+                "the matrix is singular (rank below 4: thrust and the three torques are not independent)",
+            )
+        })
     }
-}
-
-/// Inverse of a 4x4 matrix by Gauss–Jordan elimination with partial pivoting.
-fn invert4(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
-    let mut a = *m;
-    let mut inv = [[0.0; 4]; 4];
-    for (i, row) in inv.iter_mut().enumerate() {
-        row[i] = 1.0;
-    }
-    let magnitude = m.iter().flatten().fold(0.0f64, |acc, v| acc.max(v.abs()));
-    for col in 0..4 {
-        let pivot = (col..4).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if a[pivot][col].abs() <= 1e-12 * magnitude.max(f64::MIN_POSITIVE) {
-            return None;
-        }
-        a.swap(col, pivot);
-        inv.swap(col, pivot);
-        let p = a[col][col];
-        for j in 0..4 {
-            a[col][j] /= p;
-            inv[col][j] /= p;
-        }
-        for i in 0..4 {
-            if i != col {
-                let f = a[i][col];
-                for j in 0..4 {
-                    a[i][j] -= f * a[col][j];
-                    inv[i][j] -= f * inv[col][j];
-                }
-            }
-        }
-    }
-    Some(inv)
 }
 
 #[cfg(test)]
@@ -699,11 +592,46 @@ mod tests {
         let model = parse(MIXER_MODEL).unwrap();
         assert!(model.predicts_torque());
         let mixer = model.mixer.as_ref().unwrap();
-        let speeds = [0.6, 0.7, 0.65, 0.62];
+        let speeds = [0.6, 0.7, 0.65, 0.62, 0.0, 0.0, 0.0, 0.0];
         let back = mixer.speeds_for(&mixer.wrench(&speeds));
         for i in 0..4 {
             assert!((back[i] - speeds[i]).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn a_hexarotor_is_read_from_its_mixer_or_its_vehicle_and_nine_rotors_are_refused() {
+        let hexa = VehicleDescription::hexa_x(0.17, 6.0, 0.016).unwrap();
+        let by_vehicle = format!(
+            r#"{{"mass_kg": 1.8, "gravity_m_s2": 9.81, "inertia_kg_m2": [0.02, 0.02, 0.035],
+                "thrust_source": "mixer", "vehicle": {}}}"#,
+            hexa.to_json()
+        );
+        let model = parse(&by_vehicle).unwrap();
+        assert_eq!((model.actuator_count(), model.motor_count()), (6, Some(6)));
+        let mixer = model.mixer.as_ref().unwrap();
+        let rows: [Vec<f64>; 4] = std::array::from_fn(|i| mixer.row(i).to_vec());
+        let written = serde_json::json!({"pwm_offset": 1000.0, "pwm_scale": 1000.0, "b0": rows});
+        let by_mixer = MIXER_MODEL.replace(
+            &MIXER_MODEL[MIXER_MODEL.find("{\"pwm_offset").unwrap()..MIXER_MODEL.len() - 1],
+            &written.to_string(),
+        );
+        let read = parse(&by_mixer).unwrap();
+        assert_eq!(read.actuator_count(), 6);
+        // PX4's linear map: half command, half thrust; the mixer's: half speed, a quarter.
+        let half_command = model.actuator_command(0.0, 1.0, &[0.5; 6], None);
+        assert!((model.wrench(&half_command).thrust - 18.0).abs() < 1e-12);
+        let half_speed = read.actuator_command(0.0, 1.0, &[1500.0; 6], None);
+        assert!((read.wrench(&half_speed).thrust - 9.0).abs() < 1e-12);
+        let nine = by_mixer.replace(
+            "[6.0,6.0,6.0,6.0,6.0,6.0]",
+            "[6.0,6.0,6.0,6.0,6.0,6.0,6.0,6.0,6.0]",
+        );
+        let error = parse(&nine).unwrap_err().to_string();
+        assert!(
+            error.contains("mixer.b0[0]") && error.contains("4 to 8"),
+            "{error}"
+        );
     }
 
     #[test]
@@ -770,7 +698,7 @@ mod tests {
             r#"{"mass_kg": 2.644, "gravity_m_s2": 9.81, "inertia_kg_m2": [0.03, 0.03, 0.05], "thrust_source": "T_sp"}"#,
         )
         .unwrap();
-        let command = model.actuator_command(0.5, 0.5, &[0.0; 4], None);
+        let command = model.actuator_command(0.5, 0.5, &[], None);
         assert!((model.wrench(&command).thrust - 2.644 * 9.81).abs() < 1e-12);
         let level = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
         let a = model.translational_acceleration(&level, 2.644 * 9.81);

@@ -32,7 +32,7 @@ pub fn residual_force(model: &NominalModel, log: &FlightLog) -> Vec<Vec3> {
             let command = model.actuator_command(
                 log.thrust_setpoint[k],
                 log.hover_throttle[k],
-                &log.motor_command[k],
+                log.motor_command.row(k),
                 log.battery_voltage.as_ref().map(|v| v[k]),
             );
             let thrust = model.wrench(&command).thrust;

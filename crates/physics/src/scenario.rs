@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::battery::Battery;
 use crate::controller::Gains;
 use crate::effects::Effects;
 use crate::error::{PhysicsError, Result, readable};
@@ -65,6 +66,10 @@ pub struct Scenario {
     /// every row on time). Needs a `sample` logger of a controller faster than the log.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub log_timing: Option<LogTiming>,
+    /// The battery, whose voltage the log records and a voltage-dependent thrust map reads (none
+    /// by default; needed by such a map).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub battery: Option<Battery>,
 }
 
 fn default_physics_rate() -> f64 {
@@ -156,6 +161,7 @@ impl Scenario {
             logger: None,
             jitter: None,
             log_timing: None,
+            battery: None,
         }
     }
 
@@ -510,6 +516,20 @@ impl Scenario {
                     self.model.display()
                 ),
             ));
+        }
+        if let (Some(battery), Some(mixer)) = (&self.battery, &model.mixer) {
+            let max_thrust: f64 = mixer.row(0).iter().sum();
+            let span = (-self.warmup_s, self.duration_s);
+            battery
+                .check(span, max_thrust)
+                .map_err(|(name, message)| field(&name, message))?;
+        }
+        if let (Some(battery), Some(mixer)) = (&self.battery, &model.mixer) {
+            let max_thrust: f64 = mixer.row(0).iter().sum();
+            let span = (-self.warmup_s, self.duration_s);
+            battery
+                .check(span, max_thrust)
+                .map_err(|(name, message)| field(&name, message))?;
         }
         let generator = self.trajectory.generator();
         for t in self.control_times() {

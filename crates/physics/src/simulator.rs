@@ -14,25 +14,25 @@
 //! values, as on a real vehicle. An optional band-limited [`crate::Jitter`] is added to the
 //! commands (and logged with them).
 
-use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use data::FlightLog;
+use data::{FlightLog, MotorCommands};
 
 use crate::controller::{ControlOutput, GeometricController, MeasuredState};
 use crate::effects::Effects;
 use crate::error::{PhysicsError, Result};
 use crate::jitter::JitterSignal;
-use crate::logger::CommandLogging;
+use crate::mixer::{Actuators, MAX_ACTUATORS};
 use crate::model::NominalModel;
 use crate::scenario::{Noise, Scenario};
 use crate::vector::{
     Vec3, add, mat_mul, norm, quaternion_from_rotation, quaternion_multiply, quaternion_normalize,
     rotation_from_quaternion, rotation_from_rotation_vector, scale, sub,
 };
+use command_log::{CommandLog, CommandQueue};
 
 /// The true state of the plant.
 #[derive(Clone, Copy, Debug)]
@@ -43,7 +43,7 @@ struct PlantState {
     quaternion: [f64; 4],
     body_rate: Vec3,
     /// Normalised motor speeds (only integrated with a motor lag).
-    speeds: [f64; 4],
+    speeds: Actuators,
     /// The velocity the air terms see (only integrated with a drag lag).
     drag_velocity: Vec3,
 }
@@ -54,7 +54,7 @@ struct Derivative {
     acceleration: Vec3,
     quaternion: [f64; 4],
     angular_acceleration: Vec3,
-    speeds: [f64; 4],
+    speeds: Actuators,
     drag_velocity: Vec3,
 }
 
@@ -64,7 +64,7 @@ struct Plant<'a> {
 }
 
 impl Plant<'_> {
-    fn derivative(&self, state: &PlantState, commanded_speeds: [f64; 4]) -> Derivative {
+    fn derivative(&self, state: &PlantState, commanded_speeds: Actuators) -> Derivative {
         let lag = self.effects.lag_s();
         let speeds = if lag > 0.0 {
             state.speeds
@@ -99,13 +99,13 @@ impl Plant<'_> {
         let quaternion =
             quaternion_multiply(state.quaternion, [w[0], w[1], w[2], 0.0]).map(|v| 0.5 * v);
         let speeds_rate = if lag > 0.0 {
-            let mut out = [0.0; 4];
-            for i in 0..4 {
+            let mut out = [0.0; MAX_ACTUATORS];
+            for i in 0..MAX_ACTUATORS {
                 out[i] = (commanded_speeds[i] - state.speeds[i]) / lag;
             }
             out
         } else {
-            [0.0; 4]
+            [0.0; MAX_ACTUATORS]
         };
         Derivative {
             velocity: state.velocity,
@@ -123,6 +123,8 @@ fn advance(state: &PlantState, derivative: &Derivative, h: f64) -> PlantState {
     let mut speeds = state.speeds;
     for i in 0..4 {
         quaternion[i] += h * derivative.quaternion[i];
+    }
+    for i in 0..MAX_ACTUATORS {
         speeds[i] += h * derivative.speeds[i];
     }
     PlantState {
@@ -135,7 +137,7 @@ fn advance(state: &PlantState, derivative: &Derivative, h: f64) -> PlantState {
     }
 }
 
-fn rk4_step(plant: &Plant, state: &PlantState, command: [f64; 4], h: f64) -> PlantState {
+fn rk4_step(plant: &Plant, state: &PlantState, command: Actuators, h: f64) -> PlantState {
     let k1 = plant.derivative(state, command);
     let k2 = plant.derivative(&advance(state, &k1, h / 2.0), command);
     let k3 = plant.derivative(&advance(state, &k2, h / 2.0), command);
@@ -175,6 +177,8 @@ fn rk4_step(plant: &Plant, state: &PlantState, command: [f64; 4], h: f64) -> Pla
             k3.quaternion[i],
             k4.quaternion[i],
         );
+    }
+    for i in 0..MAX_ACTUATORS {
         combined.speeds[i] = combine(k1.speeds[i], k2.speeds[i], k3.speeds[i], k4.speeds[i]);
     }
     let mut next = advance(state, &combined, h);
@@ -213,9 +217,11 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
             "the simulator needs a model with a mixer (thrust_source \"mixer\")".into(),
         )
     })?;
-    if !mixer.writes_pwm() {
+    let battery = scenario.battery;
+    if model.needs_battery_voltage() && battery.is_none() {
         return Err(PhysicsError::Simulation(
-            "the simulator writes motor commands through a mixer's pwm_offset and pwm_scale; a model with a vehicle's command map is for analysing recordings".into(),
+            "the model's thrust map depends on the battery voltage: give the scenario a battery"
+                .into(),
         ));
     }
     let mut flight = Flight::new(model, mixer, scenario);
@@ -226,7 +232,9 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
     let last_row_step = warmup_steps + row_steps[rows - 1];
     // Run on after the last row until the commands a look-ahead logger records exist.
     let last_step = last_row_step + flight.look_ahead_steps();
-    let mut log = empty_log(name, rows);
+    let mut log = empty_log(name, rows, mixer.rotors(), battery.is_some());
+    // The load the battery sags under, from the last command (hover before the first).
+    let mut thrust = model.mass_kg * model.gravity_m_s2;
     let mut commands = CommandLog::new(scenario, rows);
     let mut next_row = row_steps.iter().map(|s| s + warmup_steps).peekable();
     for step in 0..=last_step {
@@ -236,8 +244,10 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
         let output = flight
             .controller
             .update(&measured, &reference, flight.control_dt);
-        let speeds = flight.speeds_for(&output, t);
-        commands.issue(step, speeds, mixer.wrench(&speeds)[0]);
+        let voltage = battery.map(|b| b.voltage(t, thrust));
+        let speeds = flight.speeds_for(&output, t, voltage);
+        thrust = mixer.wrench(&speeds)[0];
+        commands.issue(step, (speeds, thrust, voltage.unwrap_or(0.0)));
         if next_row.next_if_eq(&step).is_some() {
             record_row(&mut log, &measured, &reference, &output, t);
             commands.add_row(step - warmup_steps);
@@ -255,7 +265,7 @@ pub fn simulate(model: &NominalModel, scenario: &Scenario, name: &str) -> Result
 /// The plant, controller and sensors of one simulated flight.
 struct Flight<'a> {
     plant: Plant<'a>,
-    mixer: &'a crate::model::Mixer,
+    mixer: &'a crate::mixer::Mixer,
     state: PlantState,
     controller: GeometricController,
     generator: crate::trajectory::ReferenceGenerator,
@@ -273,7 +283,7 @@ struct Flight<'a> {
 }
 
 impl<'a> Flight<'a> {
-    fn new(model: &'a NominalModel, mixer: &'a crate::model::Mixer, scenario: &Scenario) -> Self {
+    fn new(model: &'a NominalModel, mixer: &'a crate::mixer::Mixer, scenario: &Scenario) -> Self {
         let control_dt = 1.0 / scenario.controller_rate();
         let substeps = (scenario.physics_rate_hz / scenario.controller_rate()).round() as usize;
         let h = control_dt / substeps as f64;
@@ -331,8 +341,9 @@ impl<'a> Flight<'a> {
         measure(&state, &self.noise_levels, &mut self.noise)
     }
 
-    /// The motor speeds the controller commands, jitter included.
-    fn speeds_for(&self, output: &ControlOutput, t: f64) -> [f64; 4] {
+    /// The motor speeds the controller commands, jitter included: with a vehicle's command map,
+    /// those of the commands it logs (at the battery's voltage).
+    fn speeds_for(&self, output: &ControlOutput, t: f64, battery_v: Option<f64>) -> Actuators {
         let mut wrench = [
             output.thrust,
             output.torque[0],
@@ -347,13 +358,19 @@ impl<'a> Flight<'a> {
                 wrench[i + 1] += model.inertia_kg_m2[i] * j[i + 1];
             }
         }
-        self.mixer.speeds_for(&wrench)
+        let speeds = self.mixer.speeds_for(&wrench);
+        if self.mixer.has_command_map() {
+            self.mixer
+                .speeds(&self.mixer.commands(&speeds, battery_v), battery_v)
+        } else {
+            speeds
+        }
     }
 
     /// Integrates one control period with the commanded speeds.
     fn advance(
         &mut self,
-        speeds: [f64; 4],
+        speeds: Actuators,
         t: f64,
         reference: &crate::trajectory::Reference,
     ) -> Result<()> {
@@ -373,7 +390,7 @@ impl<'a> Flight<'a> {
     }
 
     /// One integration step of length `h` with the actuators held at `command`.
-    fn integrate(&mut self, command: [f64; 4], h: f64) {
+    fn integrate(&mut self, command: Actuators, h: f64) {
         self.state = rk4_step(&self.plant, &self.state, command, h);
         let gain = if self.rate_time_constant > 0.0 {
             1.0 - (-h / self.rate_time_constant).exp()
@@ -405,164 +422,6 @@ fn record_row(
     push(&mut log.velocity_desired, reference.velocity);
     if let Some(setpoints) = log.attitude_setpoint.as_mut() {
         setpoints.push(quaternion_from_rotation(&output.desired_rotation));
-    }
-}
-
-/// Motor speeds and collective thrust (N) as logged.
-type LoggedCommand = ([f64; 4], f64);
-
-/// The commands the logger writes: for each row, the issued commands it reads (one, or the mean
-/// over a log period), found in a window of the most recent control steps.
-struct CommandLog {
-    logging: CommandLogging,
-    offset_steps: i64,
-    per_row: usize,
-    /// Recent control steps: (step, motor speeds, thrust).
-    recent: VecDeque<(usize, [f64; 4], f64)>,
-    /// Per row: its control step (from the first row) and, once known, its command.
-    rows: Vec<(usize, Option<LoggedCommand>)>,
-    warmup_steps: usize,
-    first: Option<LoggedCommand>,
-    /// Rows before this one are filled (rows are filled in order).
-    next: usize,
-}
-
-impl CommandLog {
-    fn new(scenario: &Scenario, rows: usize) -> Self {
-        let logger = scenario.logger();
-        let per_row = scenario.controller_steps_per_row();
-        Self {
-            logging: logger.command,
-            offset_steps: (logger.command_time_offset_s * scenario.controller_rate()).round()
-                as i64,
-            per_row,
-            recent: VecDeque::new(),
-            rows: Vec::with_capacity(rows),
-            warmup_steps: scenario.warmup_rows() * per_row,
-            first: None,
-            next: 0,
-        }
-    }
-
-    /// The control steps a row recorded at `step` reads: `[low, high]`.
-    fn span(&self, step: usize) -> (i64, i64) {
-        let at = step as i64 + self.offset_steps;
-        match self.logging {
-            CommandLogging::Sample | CommandLogging::Held => (at, at),
-            CommandLogging::PeriodMean => (at - self.per_row as i64, at - 1),
-        }
-    }
-
-    fn issue(&mut self, step: usize, speeds: [f64; 4], thrust: f64) {
-        self.first.get_or_insert((speeds, thrust));
-        self.recent.push_back((step, speeds, thrust));
-        let keep = self.per_row + self.offset_steps.unsigned_abs() as usize + 2;
-        while self.recent.len() > keep {
-            self.recent.pop_front();
-        }
-    }
-
-    fn add_row(&mut self, step_from_first_row: usize) {
-        self.rows.push((step_from_first_row, None));
-    }
-
-    /// Fills every pending row whose commands have all been issued by `step`.
-    fn fill_ready(&mut self, step: usize) {
-        while self.next < self.rows.len() {
-            let index = self.next;
-            let row_step = self.rows[index].0 + self.warmup_steps;
-            let (low, high) = self.span(row_step);
-            if high > step as i64 {
-                return;
-            }
-            self.next += 1;
-            let first = self.first.expect("a command was issued");
-            let mut sum = ([0.0; 4], 0.0);
-            for wanted in low..=high {
-                let (speeds, thrust) = self
-                    .recent
-                    .iter()
-                    .find(|(s, _, _)| *s as i64 == wanted)
-                    .map(|(_, speeds, thrust)| (*speeds, *thrust))
-                    .unwrap_or(first);
-                for i in 0..4 {
-                    sum.0[i] += speeds[i];
-                }
-                sum.1 += thrust;
-            }
-            let count = (high - low + 1) as f64;
-            self.rows[index].1 = Some((sum.0.map(|v| v / count), sum.1 / count));
-        }
-    }
-
-    fn write_into(
-        self,
-        log: &mut FlightLog,
-        model: &NominalModel,
-        mixer: &crate::model::Mixer,
-        hover_throttle: f64,
-    ) {
-        for (_, command) in self.rows {
-            let (speeds, thrust) = command.expect("every row's command is issued by the last step");
-            log.thrust_setpoint
-                .push(thrust / (model.mass_kg * model.gravity_m_s2) * hover_throttle);
-            log.hover_throttle.push(hover_throttle);
-            log.motor_command.push(mixer.pwm(&speeds));
-        }
-    }
-}
-
-/// The commands issued per physics step, of which only the last `delay_steps + 2` (and the very
-/// first) are kept. A delay of `delay_steps + fraction` steps is exact: over each step the
-/// actuators receive the command issued `delay_steps + 1` steps ago for its first `fraction`,
-/// and the one issued `delay_steps` ago for the rest.
-struct CommandQueue {
-    delay_steps: usize,
-    fraction: f64,
-    first: Option<[f64; 4]>,
-    recent: VecDeque<[f64; 4]>,
-}
-
-impl CommandQueue {
-    /// A queue for a delay of `steps` physics steps (any non-negative number).
-    fn new(steps: f64) -> Self {
-        // Within rounding of a whole number of steps, the delay is that number.
-        let nearest = steps.round();
-        let (whole, fraction) = if (steps - nearest).abs() < 1e-9 {
-            (nearest, 0.0)
-        } else {
-            (steps.floor(), steps - steps.floor())
-        };
-        let delay_steps = whole as usize;
-        Self {
-            delay_steps,
-            fraction,
-            first: None,
-            recent: VecDeque::with_capacity(delay_steps + 2),
-        }
-    }
-
-    /// Records a command and returns the two the actuators receive over this step: the one
-    /// issued `delay_steps + 1` physics steps ago (for the first `fraction` of it) and the one
-    /// issued `delay_steps` ago (the first command before those).
-    fn push(&mut self, command: [f64; 4]) -> ([f64; 4], [f64; 4]) {
-        let first = *self.first.get_or_insert(command);
-        self.recent.push_back(command);
-        if self.recent.len() > self.delay_steps + 2 {
-            self.recent.pop_front();
-        }
-        let issued_ago = |steps: usize| {
-            let len = self.recent.len();
-            if len > steps {
-                self.recent[len - 1 - steps]
-            } else {
-                first
-            }
-        };
-        (
-            issued_ago(self.delay_steps + 1),
-            issued_ago(self.delay_steps),
-        )
     }
 }
 
@@ -598,7 +457,7 @@ fn check_state(state: &PlantState, reference: &Vec3, t: f64) -> Result<()> {
     Ok(())
 }
 
-fn empty_log(name: &str, rows: usize) -> FlightLog {
+fn empty_log(name: &str, rows: usize, motors: usize, battery: bool) -> FlightLog {
     FlightLog {
         path: PathBuf::from(format!("{name}.csv")),
         meta: None,
@@ -610,8 +469,8 @@ fn empty_log(name: &str, rows: usize) -> FlightLog {
         body_rate: Vec::with_capacity(rows),
         thrust_setpoint: Vec::with_capacity(rows),
         hover_throttle: Vec::with_capacity(rows),
-        motor_command: Vec::with_capacity(rows),
-        battery_voltage: None,
+        motor_command: MotorCommands::with_capacity(motors, rows),
+        battery_voltage: battery.then(|| Vec::with_capacity(rows)),
         declared_rate_frame: None,
         position_desired: Some(Vec::with_capacity(rows)),
         velocity_desired: Some(Vec::with_capacity(rows)),
@@ -620,6 +479,7 @@ fn empty_log(name: &str, rows: usize) -> FlightLog {
     }
 }
 
+mod command_log;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

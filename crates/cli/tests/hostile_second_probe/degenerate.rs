@@ -124,7 +124,9 @@ fn constant_rows_and_zero_thrust_are_refused_naming_the_columns() {
             log.rotation[k] = first.rotation[0];
             log.body_rate[k] = first.body_rate[0];
             log.thrust_setpoint[k] = first.thrust_setpoint[0];
-            log.motor_command[k] = first.motor_command[0];
+            log.motor_command
+                .row_mut(k)
+                .copy_from_slice(first.motor_command.row(0));
         }
     });
     let neural_fly = workspace().join("experiments/mismatch/neural-fly.json");

@@ -11,12 +11,12 @@ use crate::flight_log::FlightLog;
 /// NED, `w` first), `vehicle_angular_velocity` (`xyz`, FRD), `actuator_outputs` (`output`, the
 /// four motor commands as logged), `vehicle_thrust_setpoint` (`xyz`, FRD: the thrust setpoint
 /// along −z) and `hover_thrust_estimate` (`hover_thrust`).
-fn topics() -> Vec<TopicFormat> {
+fn topics(motors: usize, battery: bool) -> Vec<TopicFormat> {
     let topic = |name: &str, fields: &[(&str, usize)]| TopicFormat {
         name: name.to_string(),
         fields: fields.iter().map(|(f, n)| (f.to_string(), *n)).collect(),
     };
-    vec![
+    let mut topics = vec![
         topic(
             "vehicle_local_position",
             &[
@@ -30,10 +30,14 @@ fn topics() -> Vec<TopicFormat> {
         ),
         topic("vehicle_attitude", &[("q", 4)]),
         topic("vehicle_angular_velocity", &[("xyz", 3)]),
-        topic("actuator_outputs", &[("output", 4)]),
+        topic("actuator_outputs", &[("output", motors)]),
         topic("vehicle_thrust_setpoint", &[("xyz", 3)]),
         topic("hover_thrust_estimate", &[("hover_thrust", 1)]),
-    ]
+    ];
+    if battery {
+        topics.push(topic("battery_status", &[("voltage_v", 1)]));
+    }
+    topics
 }
 
 /// When the written log's logging starts, µs (the rows' times count from it).
@@ -42,7 +46,7 @@ pub const START_TIME_US: u64 = 1_000_000;
 /// The bytes of `log` as a ULog (see [`topics`]); each row's time is `START_TIME_US` plus its
 /// time in whole microseconds. Fails on a time before zero or a message the format cannot hold.
 pub fn flight_log_as_ulog(log: &FlightLog) -> Result<Vec<u8>, String> {
-    let mut samples = Vec::with_capacity(6 * log.len());
+    let mut samples = Vec::with_capacity(7 * log.len());
     for k in 0..log.len() {
         let t = log.time[k];
         if !(t >= 0.0 && t.is_finite()) {
@@ -54,14 +58,17 @@ pub fn flight_log_as_ulog(log: &FlightLog) -> Result<Vec<u8>, String> {
         let [px, py, pz] = ned(log.position[k]);
         let [vx, vy, vz] = ned(log.velocity[k]);
         let [x, y, z, w] = log.quaternion[k];
-        let rows: [Vec<f64>; 6] = [
+        let mut rows: Vec<Vec<f64>> = vec![
             vec![px, py, pz, vx, vy, vz],
             vec![w, x, -y, -z],
             ned(log.body_rate[k]).to_vec(),
-            log.motor_command[k].to_vec(),
+            log.motor_command.row(k).to_vec(),
             vec![0.0, 0.0, -log.thrust_setpoint[k]],
             vec![log.hover_throttle[k]],
         ];
+        if let Some(volts) = &log.battery_voltage {
+            rows.push(vec![volts[k]]);
+        }
         for (topic, values) in rows.into_iter().enumerate() {
             samples.push(Sample {
                 topic,
@@ -70,5 +77,6 @@ pub fn flight_log_as_ulog(log: &FlightLog) -> Result<Vec<u8>, String> {
             });
         }
     }
-    write(START_TIME_US, &topics(), &samples)
+    let topics = topics(log.motor_command.count(), log.battery_voltage.is_some());
+    write(START_TIME_US, &topics, &samples)
 }

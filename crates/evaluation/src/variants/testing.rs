@@ -67,7 +67,7 @@ pub(super) fn cell(support: Segment, query: Segment) -> EvaluationCell {
         body_rate: Vec::new(),
         thrust_setpoint: Vec::new(),
         hover_throttle: Vec::new(),
-        motor_command: Vec::new(),
+        motor_command: Default::default(),
         battery_voltage: None,
         declared_rate_frame: None,
         position_desired: None,

@@ -126,7 +126,7 @@ pub struct Report {
     /// The limits the logged commands sat at, when any did (instantaneous samples are reconstructed
     /// through them: [`crate::recording::command_samples`]).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub command_limits: Option<[ActuatorLimits; 4]>,
+    pub command_limits: Option<Vec<ActuatorLimits>>,
     pub rate_frame: RateFrameReport,
     /// The time stamps, when they are not evenly spaced.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -264,8 +264,9 @@ pub(super) fn build_report(
         estimate_step_times: estimate.step_times.clone(),
         estimate_termination: estimate.termination,
         estimate_noise_bias: estimate.noise_bias.as_ref().map(|b| b.sources),
-        command_limits: (problem.recording.samples.rows_held() > 0)
-            .then_some(problem.recording.command_limits),
+        command_limits: (problem.recording.samples.rows_held() > 0).then(|| {
+            problem.recording.command_limits[..problem.model.actuator_count()].to_vec()
+        }),
         rate_frame: RateFrameReport {
             used: match problem.recording.rate_frame {
                 data::RateFrame::Body => RateFrame::Body,

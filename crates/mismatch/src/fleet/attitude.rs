@@ -145,7 +145,7 @@ fn mean_pwm_law(flights: &[FleetFlight]) -> (f64, f64, usize, f64) {
 
 /// The attitude check over the flights (calm ones identify, windy ones only check).
 pub fn check(flights: &[FleetFlight]) -> Option<AttitudeCheck> {
-    if flights.iter().all(|f| !f.calm) {
+    if flights.iter().all(|f| !f.calm) || flights.iter().any(|f| f.pwm.is_empty()) {
         return None;
     }
     let (lo, hi) = flights

@@ -139,7 +139,8 @@ pub struct FleetFlight {
     /// The position axes along which the flight spreads (standard deviation at least
     /// [`GRADIENT_SPREAD_M`]): those its air's gradient can be fitted along.
     pub axes: Vec<usize>,
-    /// The logged motor commands and thrust setpoint (for the attitude check).
+    /// The logged motor commands of a four-rotor log (empty otherwise) and the thrust setpoint
+    /// (for the attitude check, a map from four motor commands).
     pub pwm: Vec<[f64; 4]>,
     pub thrust_setpoint: Vec<f64>,
     /// The weak form of the log's own residual force over the mass (`fa / m`), when it has one.
@@ -243,7 +244,11 @@ impl FleetPlan {
                 });
                 let (reference_m, axes) = spread(&problem.recording.position);
                 Ok(FleetFlight {
-                    pwm: log.motor_command.clone(),
+                    pwm: log
+                        .motor_command
+                        .rows()
+                        .filter_map(|row| row.try_into().ok())
+                        .collect(),
                     thrust_setpoint: log.thrust_setpoint.clone(),
                     reference_m,
                     axes,

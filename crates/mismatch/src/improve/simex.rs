@@ -28,6 +28,7 @@
 //! noise variance).
 
 use physics::vector::Vec3;
+use physics::{Actuators, MAX_ACTUATORS};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -114,15 +115,20 @@ pub fn noise_bias(
         .map(|pair| {
             let mut rng = ChaCha8Rng::seed_from_u64(settings.seed.wrapping_add(pair as u64));
             let noise = reaction.map(|_| draw_rate(&mut rng));
-            let extra: Option<Vec<[f64; 4]>> = command_factor.map(|factor| {
+            let extra: Option<Vec<Actuators>> = command_factor.as_ref().map(|factor| {
+                let count = factor.len();
                 (0..length)
                     .map(|_| {
-                        let z: [f64; 4] = std::array::from_fn(|_| gaussian(&mut rng, 1.0));
-                        std::array::from_fn(|i| (0..4).map(|j| factor[i][j] * z[j]).sum())
+                        let z: Vec<f64> = (0..count).map(|_| gaussian(&mut rng, 1.0)).collect();
+                        let mut draw = [0.0; MAX_ACTUATORS];
+                        for (value, row) in draw.iter_mut().zip(factor) {
+                            *value = row.iter().zip(&z).map(|(f, z)| f * z).sum();
+                        }
+                        draw
                     })
                     .collect()
             });
-            let attitude: Option<Vec<[f64; 4]>> = reaction.map(|r| {
+            let attitude: Option<Vec<Actuators>> = reaction.map(|r| {
                 let mut normal = || gaussian(&mut rng, 1.0);
                 noise_reaction::attitude_estimate_error_response(&problem.recording, r, &mut normal)
             });
@@ -186,8 +192,8 @@ fn mean_and_standard_error(changes: &[Vec<f64>], parameters: usize) -> (Vec<f64>
 fn with_noise(
     problem: &Problem,
     rate: Option<(&noise_reaction::NoiseReaction, &[Vec3])>,
-    attitude: Option<&[[f64; 4]]>,
-    extra: Option<&[[f64; 4]]>,
+    attitude: Option<&[Actuators]>,
+    extra: Option<&[Actuators]>,
     sign: f64,
 ) -> Problem {
     let mut recording = problem.recording.clone();
@@ -234,7 +240,7 @@ fn with_noise(
 /// (`N` control steps per row); `None` otherwise. Where the reaction was removed, what remains of
 /// the samples' white noise is mostly the reaction to the row's other steps' noise, which the
 /// vehicle felt: not an error of the inputs.
-fn command_sample_noise(problem: &Problem) -> Option<[[f64; 4]; 4]> {
+fn command_sample_noise(problem: &Problem) -> Option<Vec<Vec<f64>>> {
     let logger = &problem.model.logger;
     let steps = logger.controller_rate_hz? * problem.recording.dt();
     let sampled = logger.command == physics::CommandLogging::Sample;
@@ -245,51 +251,56 @@ fn command_sample_noise(problem: &Problem) -> Option<[[f64; 4]; 4]> {
         return None;
     }
     let samples = &problem.recording.samples;
-    let in_domain: Vec<[f64; 4]> = problem
+    let in_domain: Vec<Actuators> = problem
         .recording
         .commands
         .iter()
         .map(|c| c.map(|v| samples.domain.to_domain(v)))
         .collect();
-    let covariance = white_covariance(&in_domain, &problem.recording.sampling);
+    let covariance = white_covariance(&in_domain, samples.count, &problem.recording.sampling);
     let unfelt = 1.0 - 1.0 / steps;
-    Some(std::array::from_fn(|i| {
-        std::array::from_fn(|j| {
-            if i < samples.count && j < samples.count {
-                unfelt * covariance[i][j]
-            } else {
-                0.0
-            }
-        })
-    }))
+    Some(
+        covariance
+            .into_iter()
+            .map(|row| row.into_iter().map(|c| unfelt * c).collect())
+            .collect(),
+    )
 }
 
-/// The covariance of the white noise on four smooth series sampled at `sampling`, by polarisation
-/// of [`Sampling::white_noise_sigma`]: `cov(a, b) = (σ(a + b)² − σ(a − b)²) / 4`.
-fn white_covariance(series: &[[f64; 4]], sampling: &Sampling) -> [[f64; 4]; 4] {
-    let sigma2 = |f: &dyn Fn(&[f64; 4]) -> f64| {
+/// The covariance of the white noise on the first `count` of smooth series sampled at
+/// `sampling`, by polarisation of [`Sampling::white_noise_sigma`]:
+/// `cov(a, b) = (σ(a + b)² − σ(a − b)²) / 4`.
+fn white_covariance(series: &[Actuators], count: usize, sampling: &Sampling) -> Vec<Vec<f64>> {
+    let sigma2 = |f: &dyn Fn(&Actuators) -> f64| {
         let values: Vec<f64> = series.iter().map(f).collect();
         sampling.white_noise_sigma(&values).powi(2)
     };
-    std::array::from_fn(|i| {
-        std::array::from_fn(|j| {
-            if i == j {
-                sigma2(&|x| x[i])
-            } else {
-                0.25 * (sigma2(&|x| x[i] + x[j]) - sigma2(&|x| x[i] - x[j]))
-            }
+    (0..count)
+        .map(|i| {
+            (0..count)
+                .map(|j| {
+                    if i == j {
+                        sigma2(&|x| x[i])
+                    } else {
+                        0.25 * (sigma2(&|x| x[i] + x[j]) - sigma2(&|x| x[i] - x[j]))
+                    }
+                })
+                .collect()
         })
-    })
+        .collect()
 }
 
 /// A square root `L` (`L Lᵀ = C`) of a symmetric matrix with its negative eigenvalues set to zero.
-fn square_root(matrix: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
-    let m = faer::Mat::from_fn(4, 4, |i, j| 0.5 * (matrix[i][j] + matrix[j][i]));
+fn square_root(matrix: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let n = matrix.len();
+    let m = faer::Mat::from_fn(n, n, |i, j| 0.5 * (matrix[i][j] + matrix[j][i]));
     let Ok(eigen) = m.self_adjoint_eigen(faer::Side::Lower) else {
-        return [[0.0; 4]; 4];
+        return vec![vec![0.0; n]; n];
     };
     let (u, s) = (eigen.U(), eigen.S());
-    std::array::from_fn(|i| std::array::from_fn(|j| u[(i, j)] * s[j].max(0.0).sqrt()))
+    (0..n)
+        .map(|i| (0..n).map(|j| u[(i, j)] * s[j].max(0.0).sqrt()).collect())
+        .collect()
 }
 
 /// A standard normal draw times `sigma`.

@@ -10,7 +10,7 @@
 //! angular acceleration goes through the same first-order filter, as the logged rate did.
 
 use physics::vector::{Mat3, Vec3};
-use physics::{CommandLogging, Effects, Logger, NominalModel};
+use physics::{Actuators, CommandLogging, Effects, Logger, MAX_ACTUATORS, NominalModel};
 
 use sindy::sampling::Sampling;
 
@@ -122,7 +122,7 @@ fn segment_starts_at(sampling: &Sampling, k: usize) -> bool {
 /// The within-row spread of the commands that reaches the actuators: a first-order lag of time
 /// constant `lag` passes `(1 − a) / (1 + a)` of white noise's variance at the command rate
 /// (`a = e^(−h/lag)`, `h` the command period).
-fn spread_after_lag(recording: &Recording, lag: f64) -> [f64; 4] {
+fn spread_after_lag(recording: &Recording, lag: f64) -> Actuators {
     match recording.command_rate_hz {
         Some(rate) if lag > 0.0 => {
             let a = (-1.0 / (rate * lag)).exp();
@@ -145,7 +145,7 @@ pub fn predict_at_rows(recording: &Recording, model: &NominalModel) -> RowPredic
 /// `commands` and the row's measured state.
 pub fn accelerations_at_rows(
     recording: &Recording,
-    commands: &[[f64; 4]],
+    commands: &[Actuators],
     model: &NominalModel,
     effects: &Effects,
 ) -> RowPrediction {
@@ -206,14 +206,14 @@ fn lerp_matrix(a: &Mat3, b: &Mat3, s: f64) -> Mat3 {
 
 /// The logged commands as a function of time (s from the first row), as the logger made them.
 struct Reconstruction<'a> {
-    commands: &'a [[f64; 4]],
+    commands: &'a [Actuators],
     sampling: &'a Sampling,
     count: usize,
     logging: CommandLogging,
 }
 
 impl Reconstruction<'_> {
-    fn at_index(&self, index: i64) -> [f64; 4] {
+    fn at_index(&self, index: i64) -> Actuators {
         self.commands[index.clamp(0, self.commands.len() as i64 - 1) as usize]
     }
 
@@ -229,7 +229,7 @@ impl Reconstruction<'_> {
     }
 
     /// The mean of the command over `[start, end]` (a sub-interval, shorter than a row interval).
-    fn mean(&self, start: f64, end: f64) -> [f64; 4] {
+    fn mean(&self, start: f64, end: f64) -> Actuators {
         match self.logging {
             CommandLogging::Sample => self.band_limited(0.5 * (start + end)),
             // Held over [t_j, t_{j+1}); the period mean is the same, one row earlier.
@@ -240,7 +240,7 @@ impl Reconstruction<'_> {
 
     /// A command constant over `[t_j, t_{j+1})`, the one of row `j + rows_later`, averaged over
     /// `[start, end]`.
-    fn steps(&self, start: f64, end: f64, rows_later: i64) -> [f64; 4] {
+    fn steps(&self, start: f64, end: f64, rows_later: i64) -> Actuators {
         let (first, crosses, weight_first) = match self.sampling {
             // One interval later, in seconds: the arithmetic of a fixed step.
             Sampling::Uniform { interval: dt, .. } => {
@@ -263,7 +263,7 @@ impl Reconstruction<'_> {
             return a;
         }
         let b = self.at_index(first + 1);
-        let mut mixed = [0.0; 4];
+        let mut mixed = [0.0; MAX_ACTUATORS];
         for i in 0..self.count {
             mixed[i] = weight_first * a[i] + (1.0 - weight_first) * b[i];
         }
@@ -275,13 +275,13 @@ impl Reconstruction<'_> {
     /// rate). On stamps the kernel runs in rows, time mapped to rows piecewise linearly, so that the
     /// curve passes through every sample at its time (a kernel on true time distances does not,
     /// and read as delays: docs/mismatch-history.md).
-    fn band_limited(&self, t: f64) -> [f64; 4] {
+    fn band_limited(&self, t: f64) -> Actuators {
         let position = self.sampling.position(t);
         let j = position.floor();
         let s = position - j;
         let j = j as i64;
         let a = LANCZOS_LOBES as i64;
-        let mut out = [0.0; 4];
+        let mut out = [0.0; MAX_ACTUATORS];
         let mut total = 0.0;
         for m in (1 - a)..=a {
             let x = s - m as f64;
@@ -343,7 +343,7 @@ pub fn actuator_trace(
     logger: &Logger,
     delay: f64,
     lag: f64,
-) -> Vec<[f64; 4]> {
+) -> Vec<Actuators> {
     let (commands, count) = (&samples.values[..], samples.count);
     let n = commands.len();
     let dt = sampling.interval();
@@ -391,7 +391,7 @@ pub fn actuator_trace(
             Some(phases) => {
                 let (base, weights) = &phases[j];
                 let first = k as i64 + base;
-                let mut value = [0.0; 4];
+                let mut value = [0.0; MAX_ACTUATORS];
                 for (m, w) in weights.iter().enumerate() {
                     let p = reconstruction.at_index(first + m as i64);
                     for i in 0..count {
@@ -409,7 +409,7 @@ pub fn actuator_trace(
             state = input;
         }
         if lag > 0.0 {
-            let mut midpoint = [0.0; 4];
+            let mut midpoint = [0.0; MAX_ACTUATORS];
             for i in 0..count {
                 midpoint[i] = input[i] + (state[i] - input[i]) * decay_half;
                 state[i] = input[i] + (state[i] - input[i]) * decay_full;
@@ -425,6 +425,7 @@ pub fn actuator_trace(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use physics::actuators;
 
     fn even(dt: f64, len: usize) -> Sampling {
         Sampling::Uniform {
@@ -443,7 +444,7 @@ mod tests {
 
     #[test]
     fn delay_shifts_the_held_commands_and_lag_approaches_them() {
-        let commands: Vec<[f64; 4]> = (0..6).map(|k| [k as f64, 0.0, 0.0, 0.0]).collect();
+        let commands: Vec<Actuators> = (0..6).map(|k| actuators(&[k as f64])).collect();
         let dt = 0.02;
         let plain = actuator_trace(
             &CommandSamples::plain(&commands, 1),
@@ -485,8 +486,8 @@ mod tests {
         );
         assert!((early[SUBSTEPS * 2 + 3][0] - 3.0).abs() < 1e-12);
         // A lag follows a step monotonically, without overshoot, and reaches 1 − e^(−t/τ).
-        let step: Vec<[f64; 4]> = (0..6)
-            .map(|k| [if k >= 2 { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0])
+        let step: Vec<Actuators> = (0..6)
+            .map(|k| actuators(&[if k >= 2 { 1.0 } else { 0.0 }]))
             .collect();
         let lagged = actuator_trace(
             &CommandSamples::plain(&step, 1),
@@ -508,9 +509,7 @@ mod tests {
     fn sampled_commands_are_interpolated_smoothly() {
         let dt = 0.02;
         let f = |t: f64| (2.0 * std::f64::consts::PI * 3.0 * t).sin();
-        let commands: Vec<[f64; 4]> = (0..100)
-            .map(|k| [f(k as f64 * dt), 0.0, 0.0, 0.0])
-            .collect();
+        let commands: Vec<Actuators> = (0..100).map(|k| actuators(&[f(k as f64 * dt)])).collect();
         let trace = actuator_trace(
             &CommandSamples::plain(&commands, 1),
             &even(dt, commands.len()),
@@ -546,7 +545,7 @@ mod tests {
         let time: Vec<f64> = (0..100)
             .map(|k| k as f64 * dt + 0.3 * dt * (k as f64 * 2.399).sin())
             .collect();
-        let commands: Vec<[f64; 4]> = time.iter().map(|&t| [f(t), 0.0, 0.0, 0.0]).collect();
+        let commands: Vec<Actuators> = time.iter().map(|&t| actuators(&[f(t)])).collect();
         let sampling = Sampling::new(&time);
         let reconstruction = Reconstruction {
             commands: &commands,
@@ -585,8 +584,8 @@ mod tests {
         use crate::recording::command_samples::{SampleDomain, detect_limits};
         let dt = 0.02;
         let demand = |t: f64| 0.3 + 0.5 * (2.0 * std::f64::consts::PI * 2.0 * t).sin();
-        let speeds: Vec<[f64; 4]> = (0..100)
-            .map(|k| [demand(k as f64 * dt).max(0.0).sqrt(), 0.0, 0.0, 0.0])
+        let speeds: Vec<Actuators> = (0..100)
+            .map(|k| actuators(&[demand(k as f64 * dt).max(0.0).sqrt()]))
             .collect();
         let limits = detect_limits(&speeds, 1);
         assert_eq!(limits[0].lower, Some(0.0));

@@ -12,7 +12,7 @@
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
-use physics::{NominalModel, ThrustSource};
+use physics::{Actuators, MAX_ACTUATORS, NominalModel, ThrustSource};
 use serde::Serialize;
 
 /// A value held on at least this many rows, at the extreme of its column, is an actuator limit
@@ -80,8 +80,8 @@ enum Held {
 
 /// The limits of the first `count` actuators: an extreme of a column held on at least
 /// [`MIN_ROWS_AT_LIMIT`] rows (none for a constant column).
-pub fn detect_limits(commands: &[[f64; 4]], count: usize) -> [ActuatorLimits; 4] {
-    let mut limits = [ActuatorLimits::default(); 4];
+pub fn detect_limits(commands: &[Actuators], count: usize) -> [ActuatorLimits; MAX_ACTUATORS] {
+    let mut limits = [ActuatorLimits::default(); MAX_ACTUATORS];
     for (i, limit) in limits.iter_mut().enumerate().take(count) {
         let column = || commands.iter().map(|c| c[i]);
         let low = column().fold(f64::INFINITY, f64::min);
@@ -111,38 +111,38 @@ pub const STEP_SIGMAS: f64 = 5.0;
 /// continued beyond it, and the limits in that domain.
 #[derive(Clone, Debug)]
 pub struct CommandSamples {
-    pub values: Vec<[f64; 4]>,
+    pub values: Vec<Actuators>,
     pub count: usize,
     pub domain: SampleDomain,
     /// Per actuator, the range the reconstruction is clipped to (in the domain).
-    pub range: [(f64, f64); 4],
+    pub range: [(f64, f64); MAX_ACTUATORS],
     /// Per row and actuator, whether the logged sample was held at a limit.
-    held: Vec<[Held; 4]>,
+    held: Vec<[Held; MAX_ACTUATORS]>,
     /// Whether the values are instantaneous samples (so a step between two says nothing of when).
     sampled: bool,
 }
 
 impl CommandSamples {
     /// The commands as they are, without limits (commands held or averaged over the log period).
-    pub fn plain(commands: &[[f64; 4]], count: usize) -> Self {
+    pub fn plain(commands: &[Actuators], count: usize) -> Self {
         Self {
             values: commands.to_vec(),
             count,
             domain: SampleDomain::Command,
-            range: [(f64::NEG_INFINITY, f64::INFINITY); 4],
-            held: vec![[Held::Inside; 4]; commands.len()],
+            range: [(f64::NEG_INFINITY, f64::INFINITY); MAX_ACTUATORS],
+            held: vec![[Held::Inside; MAX_ACTUATORS]; commands.len()],
             sampled: false,
         }
     }
 
     /// The samples of the logged commands in `domain`, those held at a limit continued beyond it.
     pub fn new(
-        logged: &[[f64; 4]],
+        logged: &[Actuators],
         count: usize,
         domain: SampleDomain,
-        limits: &[ActuatorLimits; 4],
+        limits: &[ActuatorLimits; MAX_ACTUATORS],
     ) -> Self {
-        let mut range = [(f64::NEG_INFINITY, f64::INFINITY); 4];
+        let mut range = [(f64::NEG_INFINITY, f64::INFINITY); MAX_ACTUATORS];
         for i in 0..count {
             let floor = if domain == SampleDomain::SquaredSpeed {
                 0.0
@@ -180,8 +180,8 @@ impl CommandSamples {
 
     /// The same limits and held samples with other values of the commands (corrected ones): the
     /// samples held at a limit are continued from the new values around them.
-    pub fn with_commands(&self, commands: &[[f64; 4]]) -> Self {
-        let mut values: Vec<[f64; 4]> = commands
+    pub fn with_commands(&self, commands: &[Actuators]) -> Self {
+        let mut values: Vec<Actuators> = commands
             .iter()
             .map(|c| c.map(|v| self.domain.to_domain(v)))
             .collect();
@@ -258,7 +258,7 @@ impl CommandSamples {
     }
 
     /// [`CommandSamples::command`] of every actuator of an interpolated value (the others kept).
-    pub fn commands(&self, mut values: [f64; 4]) -> [f64; 4] {
+    pub fn commands(&self, mut values: Actuators) -> Actuators {
         for (i, value) in values.iter_mut().enumerate().take(self.count) {
             *value = self.command(i, *value);
         }
@@ -348,18 +348,19 @@ fn continue_segment(column: &mut [f64], start: usize, end: usize, beyond: impl F
 #[cfg(test)]
 mod tests {
     use super::*;
+    use physics::actuators;
 
     #[test]
     fn a_repeated_extreme_is_a_limit_and_a_smooth_extreme_is_not() {
-        let smooth: Vec<[f64; 4]> = (0..200)
-            .map(|k| [(k as f64 * 0.1).sin(), 0.5, 0.0, 0.0])
+        let smooth: Vec<Actuators> = (0..200)
+            .map(|k| actuators(&[(k as f64 * 0.1).sin(), 0.5]))
             .collect();
         let limits = detect_limits(&smooth, 2);
         assert_eq!(limits[0], ActuatorLimits::default());
         assert_eq!(limits[1], ActuatorLimits::default(), "a constant column");
-        let clipped: Vec<[f64; 4]> = smooth
+        let clipped: Vec<Actuators> = smooth
             .iter()
-            .map(|c| [c[0].clamp(-0.8, 0.9), 0.0, 0.0, 0.0])
+            .map(|c| actuators(&[c[0].clamp(-0.8, 0.9)]))
             .collect();
         let limits = detect_limits(&clipped, 1);
         assert_eq!((limits[0].lower, limits[0].upper), (Some(-0.8), Some(0.9)));
@@ -372,8 +373,8 @@ mod tests {
     #[test]
     fn a_run_at_a_limit_is_continued_beyond_it() {
         let demand = |k: usize| 0.04 * (k as f64 - 20.0).powi(2) - 1.0;
-        let logged: Vec<[f64; 4]> = (0..40)
-            .map(|k| [demand(k).max(0.0).sqrt(), 0.0, 0.0, 0.0])
+        let logged: Vec<Actuators> = (0..40)
+            .map(|k| actuators(&[demand(k).max(0.0).sqrt()]))
             .collect();
         let limits = detect_limits(&logged, 1);
         assert_eq!(limits[0].lower, Some(0.0));
@@ -393,11 +394,11 @@ mod tests {
         use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         let mut noise = || crate::improve::simex::gaussian(&mut rng, 0.01);
-        let logged: Vec<[f64; 4]> = (0..300)
+        let logged: Vec<Actuators> = (0..300)
             .map(|k| {
                 let step = if k > 120 { 0.3 } else { 0.0 };
                 let smooth = 0.5 + 0.2 * (k as f64 * 0.05).sin();
-                [smooth + step + noise(), 0.5, 0.0, 0.0]
+                actuators(&[smooth + step + noise(), 0.5])
             })
             .collect();
         let limits = detect_limits(&logged, 2);

@@ -52,7 +52,9 @@ impl Signal {
             Self::Velocity => columns(&log.velocity),
             Self::Attitude => columns(&log.quaternion),
             Self::BodyRate => columns(&log.body_rate),
-            Self::MotorCommands => columns(&log.motor_command),
+            Self::MotorCommands => (0..log.motor_command.count())
+                .map(|i| log.motor_command.rows().map(|r| r[i]).collect())
+                .collect(),
         }
     }
 }

@@ -4,7 +4,7 @@
 //! units of the noise, which is then undefined); and the bound on the rows of one analysis.
 
 use data::FlightLog;
-use physics::{NominalModel, ThrustSource};
+use physics::{Actuators, NominalModel, ThrustSource};
 use sindy::median::median;
 
 use crate::locate::problem::{CHANNEL_NAMES, Problem};
@@ -105,7 +105,8 @@ pub fn check_excitation(log: &FlightLog, model: &NominalModel) -> Result<(), Deg
     let attitude = (0..4).all(|i| constant(log.quaternion.iter().map(|q| q[i])));
     let position = (0..3).all(|i| component(&log.position, i));
     let thrust = constant(log.thrust_setpoint.iter().copied());
-    let pwm = (0..4).all(|i| constant(log.motor_command.iter().map(|c| c[i])));
+    let motors = log.motor_command.count();
+    let pwm = (0..motors).all(|i| constant(log.motor_command.rows().map(|c| c[i])));
     for (is_constant, name) in [
         (position, "p"),
         (attitude, "q"),
@@ -127,7 +128,7 @@ fn constant(mut values: impl Iterator<Item = f64>) -> bool {
 
 /// Fails when the thrust the model reads from the commands (`commands`, the model's actuator
 /// states per row) stays below [`MIN_THRUST_TO_WEIGHT`] of the weight on every row.
-pub fn check_thrust(commands: &[[f64; 4]], model: &NominalModel) -> Result<(), Degeneracy> {
+pub fn check_thrust(commands: &[Actuators], model: &NominalModel) -> Result<(), Degeneracy> {
     let weight = model.mass_kg * model.gravity_m_s2;
     let largest = commands
         .iter()

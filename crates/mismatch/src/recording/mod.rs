@@ -14,7 +14,7 @@ use std::path::PathBuf;
 
 use data::{FlightLog, RateFrame};
 use physics::vector::{Mat3, Vec3, mat_t_vec};
-use physics::{CommandLogging, NominalModel};
+use physics::{Actuators, CommandLogging, MAX_ACTUATORS, NominalModel};
 use sindy::sampling::Sampling;
 
 use crate::error::{MismatchError, Result};
@@ -38,15 +38,15 @@ pub struct Recording {
     pub rate_frame: RateFrame,
     pub rate_frame_errors: (f64, f64),
     /// Actuator commands (four normalised motor speeds, or `[T, 0, 0, 0]` in N), as logged.
-    pub commands: Vec<[f64; 4]>,
+    pub commands: Vec<Actuators>,
     /// Variance of each actuator command within a row, when the rows hold means over the log
     /// period of a faster controller's commands (zero otherwise): `(m − 1)` times the variance of the
     /// logged means' sample-to-sample noise, `m` commands per row, for white command noise.
-    pub command_spread: [f64; 4],
+    pub command_spread: Actuators,
     /// The rate of the commands a row averages, Hz (when known).
     pub command_rate_hz: Option<f64>,
     /// The limits the logged commands sit at ([`crate::recording::command_samples`]).
-    pub command_limits: [ActuatorLimits; 4],
+    pub command_limits: [ActuatorLimits; MAX_ACTUATORS],
     /// What the model's command is reconstructed through: for instantaneous samples, per-rotor
     /// thrusts with the runs at a limit continued; otherwise the commands as they are. Kept in step
     /// with `commands` by [`Recording::set_commands`].
@@ -92,6 +92,14 @@ impl Recording {
                 ),
             });
         }
+        if let Some(rotors) = model.motor_count()
+            && log.motor_command.count() != rotors
+        {
+            return Err(bad(format!(
+                "{} motor commands a row, and the model's mixer has {rotors} rotors (the layout's motor_commands, or the pwm lists, give one command per rotor of the vehicle)",
+                log.motor_command.count()
+            )));
+        }
         let degenerate = |degeneracy| MismatchError::Degenerate {
             path: log.path.clone(),
             degeneracy,
@@ -113,12 +121,12 @@ impl Recording {
                 "the model's thrust map depends on the battery voltage, and the recording has none (map a battery_voltage column in its layout)".into(),
             ));
         }
-        let commands: Vec<[f64; 4]> = (0..log.len())
+        let commands: Vec<Actuators> = (0..log.len())
             .map(|k| {
                 model.actuator_command(
                     log.thrust_setpoint[k],
                     log.hover_throttle[k],
-                    &log.motor_command[k],
+                    log.motor_command.row(k),
                     log.battery_voltage.as_ref().map(|v| v[k]),
                 )
             })
@@ -130,7 +138,7 @@ impl Recording {
             CommandLogging::PeriodMean => model.logger.controller_rate_hz,
             _ => None,
         };
-        let mut command_spread = [0.0; 4];
+        let mut command_spread = [0.0; MAX_ACTUATORS];
         if let Some(rate) = command_rate_hz {
             let per_row = (rate * dt).max(1.0);
             for i in 0..model.actuator_count() {
@@ -168,7 +176,7 @@ impl Recording {
     }
 
     /// Replaces the commands (corrected ones) and the samples reconstructed through them.
-    pub fn set_commands(&mut self, commands: Vec<[f64; 4]>) {
+    pub fn set_commands(&mut self, commands: Vec<Actuators>) {
         self.samples = self.samples.with_commands(&commands);
         self.commands = commands;
     }

@@ -18,7 +18,7 @@
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use physics::vector::{Mat3, Vec3, mat_mul, transpose, vee};
-use physics::{CommandLogging, Logger};
+use physics::{Actuators, CommandLogging, Logger};
 use serde::Serialize;
 use sindy::median::robust_standard_deviation;
 use sindy::sampling::white_noise_sigma_of_fourth_differences;
@@ -51,10 +51,10 @@ pub struct NoiseReaction {
     pub velocity: bool,
     /// RMS of the removed part, per actuator command (in the commands' units; the parts come from
     /// independent noises and add in quadrature).
-    pub removed_rms: [f64; 4],
+    pub removed_rms: Vec<f64>,
     /// The commands as logged.
     #[serde(skip)]
-    pub logged_commands: Vec<[f64; 4]>,
+    pub logged_commands: Vec<Actuators>,
 }
 
 /// Control steps per row when the commands are samples of a faster controller taken with the
@@ -86,7 +86,7 @@ pub fn remove(recording: &mut Recording, logger: &Logger, actuators: usize) -> b
         unfelt_fraction: 1.0 - 1.0 / steps,
         gains,
         velocity: false,
-        removed_rms: [0.0; 4],
+        removed_rms: vec![0.0; actuators],
         logged_commands: recording.commands.clone(),
     };
     let attitude = attitude_noise(recording, &states);
@@ -136,7 +136,7 @@ pub fn rate_noise_response(
     recording: &Recording,
     reaction: &NoiseReaction,
     noise: &[Vec3],
-) -> Vec<[f64; 4]> {
+) -> Vec<Actuators> {
     let states = state_fourth_differences(recording);
     let before = attitude_noise(recording, &states);
     let mut perturbed = recording.clone();
@@ -157,7 +157,7 @@ fn unfelt_response(
     reaction: &NoiseReaction,
     rows: usize,
     change: impl Fn(usize, usize) -> (f64, f64),
-) -> Vec<[f64; 4]> {
+) -> Vec<Actuators> {
     (0..rows)
         .map(|k| {
             std::array::from_fn(|i| {
@@ -181,7 +181,7 @@ fn unfelt_response(
 fn subtract(recording: &mut Recording, reaction: &mut NoiseReaction, noises: &[(usize, &[Vec3])]) {
     let actuators = reaction.gains.len();
     let rows = recording.len() as f64;
-    let mut squares = reaction.removed_rms.map(|r| r * r * rows);
+    let mut squares: Vec<f64> = reaction.removed_rms.iter().map(|r| r * r * rows).collect();
     let mut commands = recording.commands.clone();
     for (k, command) in commands.iter_mut().enumerate() {
         for i in 0..actuators {
@@ -199,7 +199,7 @@ fn subtract(recording: &mut Recording, reaction: &mut NoiseReaction, noises: &[(
         }
     }
     recording.set_commands(commands);
-    reaction.removed_rms = squares.map(|s| (s / rows).sqrt());
+    reaction.removed_rms = squares.iter().map(|s| (s / rows).sqrt()).collect();
 }
 
 /// The rotation vector from the attitude of row `a` to that of row `b`, in the body frame of `a`
@@ -250,7 +250,7 @@ fn reaction_gains(
     states: &[[f64; STATES]],
     actuators: usize,
 ) -> Option<Vec<[f64; STATES]>> {
-    let commands: Vec<[f64; 4]> = (2..recording.len() - 2)
+    let commands: Vec<Actuators> = (2..recording.len() - 2)
         .map(|k| {
             let weights = fourth_difference(recording, k);
             std::array::from_fn(|i| {
@@ -289,7 +289,7 @@ fn reaction_gains(
 
 fn least_squares(
     states: &[[f64; STATES]],
-    commands: &[[f64; 4]],
+    commands: &[Actuators],
     keep: &[bool],
     actuators: usize,
 ) -> Option<Vec<[f64; STATES]>> {
@@ -370,7 +370,7 @@ pub fn attitude_estimate_error_response(
     recording: &Recording,
     reaction: &NoiseReaction,
     normal: &mut dyn FnMut() -> f64,
-) -> Vec<[f64; 4]> {
+) -> Vec<Actuators> {
     let states = state_fourth_differences(recording);
     let rows = recording.len();
     let error = per_axis(|a| {

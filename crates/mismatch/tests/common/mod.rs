@@ -65,5 +65,6 @@ pub fn scenario(effects: Effects, seed: u64) -> Scenario {
         logger: None,
         jitter: None,
         log_timing: None,
+        battery: None,
     }
 }

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::jitter::Jitter;
-use crate::logger::Logger;
+use crate::logger::{CommandLogging, Logger};
 use crate::scenario::*;
 use crate::trajectory::{MAX_POSITION_M, Trajectory};
 
@@ -288,7 +288,7 @@ fn the_command_log_reads_what_the_logger_describes() {
         let mut commands = CommandLog::new(&s, 3);
         let warmup_steps = s.warmup_rows() * 10;
         for step in 0..warmup_steps + 40 {
-            commands.issue(step, [step as f64; 4], 2.0 * step as f64);
+            commands.issue(step, ([step as f64; MAX_ACTUATORS], 2.0 * step as f64, 0.0));
             if step >= warmup_steps
                 && (step - warmup_steps).is_multiple_of(10)
                 && step < warmup_steps + 30
@@ -301,7 +301,7 @@ fn the_command_log_reads_what_the_logger_describes() {
             .rows
             .iter()
             .map(|(step, command)| {
-                let (speeds, thrust) = command.unwrap();
+                let (speeds, thrust, _) = command.unwrap();
                 assert_eq!(thrust, 2.0 * speeds[0]);
                 speeds[0] - (step + warmup_steps) as f64
             })
@@ -381,9 +381,18 @@ fn the_command_queue_delays_like_the_full_history() {
     for delay_steps in [0, 1, 3, 17] {
         let mut queue = CommandQueue::new(delay_steps as f64);
         assert_eq!(queue.fraction, 0.0);
-        let mut history: Vec<[f64; 4]> = Vec::new();
+        let mut history: Vec<Actuators> = Vec::new();
         for k in 0..60 {
-            let command = [k as f64, 0.5 * k as f64, 1.0, -(k as f64)];
+            let command = [
+                k as f64,
+                0.5 * k as f64,
+                1.0,
+                -(k as f64),
+                0.0,
+                0.0,
+                0.0,
+                2.0,
+            ];
             history.push(command);
             let index = history.len() - 1;
             let issued_ago = |steps: usize| history[index.saturating_sub(steps)];

@@ -6,7 +6,7 @@ use super::*;
 use crate::effects::Delay;
 use crate::jitter::Jitter;
 use crate::log_timing::LogTiming;
-use crate::logger::Logger;
+use crate::logger::{CommandLogging, Logger};
 
 /// The simulator as it was before the row steps were listed (commit 0c0ebf8): a row every
 /// `controller_steps_per_row()` control steps. The reference for "without a log timing nothing
@@ -19,7 +19,7 @@ fn simulate_evenly(model: &NominalModel, scenario: &Scenario, name: &str) -> Fli
     let rows = scenario.rows();
     let last_row_step = warmup_steps + (rows - 1) * per_row;
     let last_step = last_row_step + flight.look_ahead_steps();
-    let mut log = empty_log(name, rows);
+    let mut log = empty_log(name, rows, 4, false);
     let mut commands = CommandLog::new(scenario, rows);
     for step in 0..=last_step {
         let t = (step as f64 - warmup_steps as f64) * flight.control_dt;
@@ -28,8 +28,8 @@ fn simulate_evenly(model: &NominalModel, scenario: &Scenario, name: &str) -> Fli
         let output = flight
             .controller
             .update(&measured, &reference, flight.control_dt);
-        let speeds = flight.speeds_for(&output, t);
-        commands.issue(step, speeds, mixer.wrench(&speeds)[0]);
+        let speeds = flight.speeds_for(&output, t, None);
+        commands.issue(step, (speeds, mixer.wrench(&speeds)[0], 0.0));
         if step >= warmup_steps
             && (step - warmup_steps).is_multiple_of(per_row)
             && step <= last_row_step
@@ -138,7 +138,7 @@ fn jittered_rows_are_stamped_with_their_control_step() {
             on_time += 1;
             assert_eq!(log.position[k], even.position[j]);
             assert_eq!(log.body_rate[k], even.body_rate[j]);
-            assert_eq!(log.motor_command[k], even.motor_command[j]);
+            assert_eq!(log.motor_command.row(k), even.motor_command.row(j));
             assert_eq!(log.thrust_setpoint[k], even.thrust_setpoint[j]);
         }
     }

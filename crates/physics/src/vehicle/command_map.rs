@@ -53,6 +53,9 @@ pub enum ThrustCurve {
     Table { points: Vec<[f64; 2]> },
 }
 
+/// Bisection steps of [`ThrustCurve::command_for`]: the command to within 2⁻⁵² of its range.
+const COMMAND_BISECTIONS: usize = 52;
+
 /// The command → rotor thrust map shared by a vehicle's rotors.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -70,6 +73,15 @@ impl CommandScale {
             Self::Fraction65536 => command / FRACTION_FULL_SCALE,
         };
         u.clamp(0.0, 1.0)
+    }
+
+    /// The command of `u ∈ [0, 1]`: the inverse of [`CommandScale::scaled`] inside the range.
+    pub fn unscaled(&self, u: f64) -> f64 {
+        match *self {
+            Self::Normalised => u,
+            Self::PwmMicroseconds { min_us, max_us } => min_us + u * (max_us - min_us),
+            Self::Fraction65536 => u * FRACTION_FULL_SCALE,
+        }
     }
 
     fn check(&self) -> Result<()> {
@@ -127,6 +139,29 @@ impl ThrustCurve {
             }
             Self::Table { points } => Some(interpolate(points, u)),
         }
+    }
+
+    /// The smallest `u ∈ [0, 1]` whose thrust reaches `n` at `battery_v`, by bisection (a curve a
+    /// vehicle flies rises with its command): 0 when no thrust is asked, 1 when even the full
+    /// command falls short; `None` when the curve needs a voltage and none is given.
+    pub fn command_for(&self, n: f64, battery_v: Option<f64>) -> Option<f64> {
+        let thrust = |u: f64| self.relative_thrust(u, battery_v);
+        if thrust(1.0)? <= n {
+            return Some(1.0);
+        }
+        let (mut low, mut high) = (0.0, 1.0);
+        if thrust(low)? >= n {
+            return Some(low);
+        }
+        for _ in 0..COMMAND_BISECTIONS {
+            let middle = 0.5 * (low + high);
+            if thrust(middle)? < n {
+                low = middle;
+            } else {
+                high = middle;
+            }
+        }
+        Some(high)
     }
 
     fn check(&self) -> Result<()> {
@@ -192,6 +227,14 @@ impl CommandMap {
     pub fn check(&self) -> Result<()> {
         self.command.check()?;
         self.thrust.check()
+    }
+
+    /// The command whose relative thrust is `n` at `battery_v` ([`ThrustCurve::command_for`]).
+    pub fn command_for(&self, n: f64, battery_v: Option<f64>) -> Option<f64> {
+        Some(
+            self.command
+                .unscaled(self.thrust.command_for(n, battery_v)?),
+        )
     }
 
     /// The thrust of a rotor with coefficient `thrust_coefficient_n` at `command`, N; an error

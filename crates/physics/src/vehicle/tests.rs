@@ -396,3 +396,58 @@ fn commands_for_the_wrong_number_of_rotors_are_refused() {
         "{hover:?}"
     );
 }
+
+/// The simulator writes the command whose thrust a speed asks for: the inverse of each map within
+/// its range, the range's ends beyond it.
+#[test]
+fn a_command_map_is_inverted_within_its_range() {
+    let pwm = CommandMap {
+        command: CommandScale::PwmMicroseconds {
+            min_us: 1000.0,
+            max_us: 2000.0,
+        },
+        thrust: ThrustCurve::ThrustModel { factor: 0.6 },
+    };
+    let maps = [
+        (pwm, None),
+        (table(vec![[0.0, 0.0], [0.5, 0.2], [1.0, 1.0]]), None),
+        (
+            CommandMap {
+                command: CommandScale::Fraction65536,
+                thrust: ThrustCurve::VoltagePolynomial {
+                    reference_voltage_v: 16.0,
+                    terms: vec![
+                        PolynomialTerm {
+                            command_power: 1,
+                            voltage_power: 1,
+                            coefficient: 0.3,
+                        },
+                        PolynomialTerm {
+                            command_power: 2,
+                            voltage_power: 2,
+                            coefficient: 0.7,
+                        },
+                    ],
+                },
+            },
+            Some(15.2),
+        ),
+    ];
+    for (map, volts) in maps {
+        for n in [0.05, 0.3, 0.61] {
+            let command = map.command_for(n, volts).unwrap();
+            let back = map.rotor_thrust(1.0, command, volts).unwrap();
+            assert!(
+                (back - n).abs() < 1e-12,
+                "{map:?}: {n} -> {command} -> {back}"
+            );
+        }
+        let full = map.command_for(5.0, volts).unwrap();
+        assert_eq!(map.command.scaled(full), 1.0);
+        assert_eq!(
+            map.command.scaled(map.command_for(0.0, volts).unwrap()),
+            0.0
+        );
+    }
+    assert_eq!(polynomial().command_for(0.5, None), None);
+}

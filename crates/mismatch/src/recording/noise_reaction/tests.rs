@@ -1,6 +1,7 @@
 use std::path::PathBuf;
 
 use data::RateFrame;
+use physics::MAX_ACTUATORS;
 use physics::vector::{mat_mul, rotation_from_rotation_vector};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -11,7 +12,7 @@ use crate::recording::command_samples::CommandSamples;
 const DT: f64 = 0.02;
 const ROWS: usize = 2000;
 
-type Commands = Vec<[f64; 4]>;
+type Commands = Vec<Actuators>;
 
 use crate::improve::simex::gaussian;
 
@@ -51,7 +52,7 @@ fn flight(seed: u64) -> (Recording, Commands, Commands, Vec<Vec3>) {
         rate_frame: RateFrame::Body,
         rate_frame_errors: (0.0, 0.0),
         commands: Vec::new(),
-        command_spread: [0.0; 4],
+        command_spread: [0.0; MAX_ACTUATORS],
         command_rate_hz: None,
         command_limits: Default::default(),
         samples: CommandSamples::plain(&[], 4),
@@ -88,9 +89,9 @@ fn flight(seed: u64) -> (Recording, Commands, Commands, Vec<Vec3>) {
             .position
             .push(std::array::from_fn(|a| position[a] + position_noise[a]));
         true_velocity.push(velocity);
-        let mut command = [0.0; 4];
-        let mut reaction = [0.0; 4];
-        let mut to_velocity = [0.0; 4];
+        let mut command = [0.0; MAX_ACTUATORS];
+        let mut reaction = [0.0; MAX_ACTUATORS];
+        let mut to_velocity = [0.0; MAX_ACTUATORS];
         for i in 0..4 {
             let react = |gain: f64, n: Vec3| -> f64 {
                 (0..3).map(|a| 0.01 * mixing[i][a] * gain * n[a]).sum()
@@ -122,7 +123,7 @@ fn flight(seed: u64) -> (Recording, Commands, Commands, Vec<Vec3>) {
 
 /// The RMS of `corrected − (logged − 0.9 reaction)` over the RMS of `0.9 reaction`: 1 when nothing
 /// was removed, 0 when exactly the unfelt share was.
-fn removal_error(logged: &[[f64; 4]], corrected: &[[f64; 4]], reaction: &[[f64; 4]]) -> f64 {
+fn removal_error(logged: &[Actuators], corrected: &[Actuators], reaction: &[Actuators]) -> f64 {
     let (mut excess, mut error) = (0.0, 0.0);
     for k in 0..logged.len() {
         for i in 0..4 {

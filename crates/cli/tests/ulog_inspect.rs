@@ -161,3 +161,41 @@ fn sindy_fits_ulog_columns_on_one_clock() {
         "{log}: vehicle_angular_velocity.rate: topic vehicle_angular_velocity has no field 'rate'"
     )]);
 }
+
+/// `--vehicle-out` writes the description the airframe parameters give (the workspace's example
+/// of airframe 10017), never over an existing file without `--force`, and only for a ULog.
+#[test]
+fn the_airframe_parameters_are_written_as_a_vehicle_description() {
+    let Some(path) = log_file("sample_px4_events.ulg") else {
+        return;
+    };
+    let dir = scratch("ulog-vehicle-out");
+    let log = path.to_str().unwrap();
+    let run = learn_in(&dir, &["data", "inspect", log, "--vehicle-out", "v.json"]);
+    let text = run.success().to_string();
+    assert!(
+        text.contains("wrote v.json (4 rotors, quad X with unequal front and rear arms)"),
+        "{text}"
+    );
+    let written = physics::VehicleDescription::load(&dir.join("v.json")).unwrap();
+    let example = physics::VehicleDescription::load(
+        &workspace().join("experiments/vehicles/px4-airframe-10017.json"),
+    )
+    .unwrap();
+    assert_eq!(written.command_map, example.command_map);
+    for (a, b) in written.rotors.iter().zip(&example.rotors) {
+        assert_eq!(a.spin, b.spin);
+        for (x, y) in a.position_m.iter().zip(&b.position_m) {
+            assert!((x - y).abs() < 1e-6, "{a:?} against {b:?}");
+        }
+    }
+    let again = learn_in(&dir, &["data", "inspect", log, "--vehicle-out", "v.json"]);
+    again.one_line_error(&["v.json", "--force"]);
+    std::fs::write(dir.join("flight.csv"), "t\n0\n").unwrap();
+    let csv = learn_in(
+        &dir,
+        &["data", "inspect", "flight.csv", "--vehicle-out", "w.json"],
+    );
+    csv.one_line_error(&["flight.csv", "--vehicle-out", "not a .ulg"]);
+    assert!(!dir.join("w.json").exists());
+}

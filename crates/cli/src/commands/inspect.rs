@@ -1,8 +1,10 @@
-//! `learn data inspect FILE`: a Neural-Fly CSV flight log, or a PX4 ULog (`.ulg`).
+//! `learn data inspect FILE`: a Neural-Fly CSV flight log, or a PX4 ULog (`.ulg`), whose airframe
+//! parameters may be written as a vehicle description (`--vehicle-out`).
 
 use std::path::{Path, PathBuf};
 
 use data::FlightLog;
+use output_set::{Existing, FileId, OutputSet};
 
 use super::Global;
 
@@ -10,6 +12,13 @@ use super::Global;
 pub struct Args {
     /// A Neural-Fly CSV flight log, or a PX4 ULog file (`.ulg`).
     pub file: PathBuf,
+    /// For a ULog: also write the vehicle description its airframe parameters give (`CA_ROTOR*`,
+    /// `THR_MDL_FAC`) to this JSON file, for a nominal model's `vehicle`.
+    #[arg(long)]
+    pub vehicle_out: Option<PathBuf>,
+    /// Overwrite an existing --vehicle-out file.
+    #[arg(long)]
+    pub force: bool,
 }
 
 fn range3(name: &str, values: &[[f64; 3]]) -> String {
@@ -40,7 +49,7 @@ fn column_summary(columns: &[String]) -> String {
         "hover_throttle",
         "pwm",
     ];
-    const OPTIONAL: [&str; 4] = ["p_d", "v_d", "q_sp", "fa"];
+    const OPTIONAL: [&str; 5] = ["p_d", "v_d", "q_sp", "fa", "battery_voltage"];
     let used: Vec<String> = USED
         .iter()
         .map(|&name| match name {
@@ -68,7 +77,28 @@ fn column_summary(columns: &[String]) -> String {
 
 pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     if data::layout::is_ulog(&args.file) {
-        return inspect_ulog(&args.file);
+        // The output is proved writable before the log is read.
+        let output = match &args.vehicle_out {
+            Some(out) => {
+                let mut set = OutputSet::new("data inspect");
+                set.input("the inspected log", &args.file);
+                let file = set.file(out, "--vehicle-out", Existing::from_force(args.force));
+                set.check()?;
+                Some((set, file, out))
+            }
+            None => None,
+        };
+        inspect_ulog(&args.file)?;
+        return match output {
+            Some((set, file, out)) => write_vehicle(&args.file, set, file, out),
+            None => Ok(()),
+        };
+    }
+    if args.vehicle_out.is_some() {
+        anyhow::bail!(
+            "{}: --vehicle-out reads a PX4 ULog's airframe parameters; this is not a .ulg file",
+            args.file.display()
+        );
     }
     // Any spacing: a real logger's jitter, drops and gaps are reported, not refused.
     let (log, columns) = FlightLog::read_with_columns(&args.file, data::Spacing::Any)?;
@@ -110,7 +140,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     say!("  {:<16} [{lo:.4}, {hi:.4}]", "T_sp");
     let (lo, hi) = log
         .motor_command
-        .iter()
+        .rows()
         .flatten()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(*v), hi.max(*v))
@@ -125,7 +155,7 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     }
     if let Some(pwm) = log
         .motor_command
-        .iter()
+        .rows()
         .flatten()
         .find(|p| !(500.0..=2500.0).contains(*p))
     {
@@ -140,6 +170,26 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
             say!("  - {problem}");
         }
     }
+    Ok(())
+}
+
+/// Writes the vehicle description of `log`'s airframe parameters to `out`, the `set`'s `file`
+/// (atomically).
+fn write_vehicle(log: &Path, set: OutputSet, file: FileId, out: &Path) -> anyhow::Result<()> {
+    let parameters = data::ulog::parameter_table(&ulog::Log::read(log)?);
+    let vehicle = physics::VehicleDescription::from_px4_parameters(&parameters.values)
+        .map_err(|error| anyhow::anyhow!("{}: {error}", log.display()))?;
+    let staged = set.prepare()?;
+    super::staged_write(&staged, || {
+        std::fs::write(staged.path(file), vehicle.to_json() + "\n")
+    })?;
+    staged.commit()?;
+    say!(
+        "wrote {} ({} rotors, {})",
+        out.display(),
+        vehicle.rotors.len(),
+        vehicle.layout()
+    );
     Ok(())
 }
 

@@ -1,12 +1,14 @@
 //! The whole ULog path on a log of known physics: `learn simulate` writes a flight as PX4 logs it
 //! (NED/FRD topics in a `.ulg`), `learn mismatch` reads it back through a layout description and
-//! finds the concealed effect as it does from the same flight written as a Neural-Fly CSV.
+//! finds the concealed effect as it does from the same flight written as a Neural-Fly CSV; for a
+//! quadrotor, a hexarotor's six motor outputs and a vehicle whose thrust map reads the logged
+//! battery voltage.
 
 mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{learn_in, scratch};
+use common::{Scratch, learn_in, scratch};
 use serde_json::{Value, json};
 
 fn workspace() -> PathBuf {
@@ -23,45 +25,67 @@ fn thrust_scale(dir: &Path, name: &str) -> f64 {
     effects[0]["parameters"]["k"].as_f64().unwrap()
 }
 
-#[test]
-fn a_simulated_ulog_is_analysed_through_its_layout_as_its_csv_is() {
-    let dir = scratch("simulator-ulog");
+/// A scratch folder holding `model.json` (a model of `experiments/mismatch/vehicles/`) and the
+/// flight `flight.EXT` for each extension in `outputs`: 16 s of a configuration of
+/// `experiments/mismatch/configurations/` with a concealed thrust scale of 0.9.
+fn concealed_thrust_loss(
+    test: &str,
+    model: &str,
+    configuration: &str,
+    outputs: &[&str],
+) -> Scratch {
+    let dir = scratch(test);
+    let mismatch = workspace().join("experiments/mismatch");
     std::fs::copy(
-        workspace().join("experiments/mismatch/vehicles/quad-a.json"),
-        dir.join("quad.json"),
+        mismatch.join("vehicles").join(model),
+        dir.join("model.json"),
     )
     .unwrap();
     let text =
-        std::fs::read_to_string(workspace().join("experiments/mismatch/configurations/d.json"))
-            .unwrap();
+        std::fs::read_to_string(mismatch.join("configurations").join(configuration)).unwrap();
     let mut scenario: Value = serde_json::from_str(&text).unwrap();
-    scenario["model"] = json!("quad.json");
+    scenario["model"] = json!("model.json");
     scenario["duration_s"] = json!(16.0);
     scenario["effects"] = json!({"thrust_scale": {"k": 0.9}});
     std::fs::write(dir.join("s.json"), scenario.to_string()).unwrap();
-    for out in ["flight.ulg", "flight.csv"] {
-        let run = learn_in(&dir, &["simulate", "--scenario", "s.json", "--out", out]);
-        run.success();
+    for extension in outputs {
+        let out = format!("flight.{extension}");
+        learn_in(&dir, &["simulate", "--scenario", "s.json", "--out", &out]).success();
     }
-    let layout = workspace().join("experiments/layouts/simulator-ulog.json");
-    let layout = layout.display().to_string();
-    let runs: [&[&str]; 2] = [
-        &[
-            "--recording",
-            "flight.ulg",
-            "--layout",
-            &layout,
-            "--out",
-            "ulog",
-        ],
-        &["--recording", "flight.csv", "--out", "csv"],
+    dir
+}
+
+/// `learn mismatch` of `dir/flight.ulg` through the simulator's ULog layout, changed by `edit`,
+/// into `dir/ulog`; returns the thrust scale found.
+fn thrust_scale_through_layout(dir: &Path, edit: impl FnOnce(&mut Value)) -> f64 {
+    let path = workspace().join("experiments/layouts/simulator-ulog.json");
+    let mut layout: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    edit(&mut layout);
+    std::fs::write(dir.join("layout.json"), layout.to_string()).unwrap();
+    thrust_scale_of(dir, &["flight.ulg", "--layout", "layout.json"], "ulog")
+}
+
+/// `learn mismatch --recording RECORDING...` with `dir/model.json` into `dir/out`; returns the
+/// thrust scale found.
+fn thrust_scale_of(dir: &Path, recording: &[&str], out: &str) -> f64 {
+    let mut args = vec![
+        "mismatch",
+        "--model",
+        "model.json",
+        "--quiet",
+        "--recording",
     ];
-    for args in runs {
-        let mut all = vec!["mismatch", "--model", "quad.json", "--quiet"];
-        all.extend(args);
-        learn_in(&dir, &all).success();
-    }
-    let (from_ulog, from_csv) = (thrust_scale(&dir, "ulog"), thrust_scale(&dir, "csv"));
+    args.extend(recording);
+    args.extend(["--out", out]);
+    learn_in(dir, &args).success();
+    thrust_scale(dir, out)
+}
+
+#[test]
+fn a_simulated_ulog_is_analysed_through_its_layout_as_its_csv_is() {
+    let dir = concealed_thrust_loss("simulator-ulog", "quad-a.json", "d.json", &["ulg", "csv"]);
+    let from_ulog = thrust_scale_through_layout(&dir, |_| {});
+    let from_csv = thrust_scale_of(&dir, &["flight.csv"], "csv");
     assert!((from_ulog - 0.9).abs() < 0.01, "{from_ulog}");
     // The ULog holds single-precision values: the two reads agree to their rounding's effect.
     assert!(
@@ -74,49 +98,13 @@ fn a_simulated_ulog_is_analysed_through_its_layout_as_its_csv_is() {
 /// and the concealed thrust scale found from them.
 #[test]
 fn a_hexarotor_ulog_is_analysed_through_its_six_motor_outputs() {
-    let dir = scratch("simulator-ulog-hexa");
-    std::fs::copy(
-        workspace().join("experiments/mismatch/vehicles/hexa-x.json"),
-        dir.join("hexa.json"),
-    )
-    .unwrap();
-    let text =
-        std::fs::read_to_string(workspace().join("experiments/mismatch/configurations/g.json"))
-            .unwrap();
-    let mut scenario: Value = serde_json::from_str(&text).unwrap();
-    scenario["model"] = json!("hexa.json");
-    scenario["duration_s"] = json!(16.0);
-    scenario["effects"] = json!({"thrust_scale": {"k": 0.9}});
-    std::fs::write(dir.join("s.json"), scenario.to_string()).unwrap();
-    learn_in(
-        &dir,
-        &["simulate", "--scenario", "s.json", "--out", "hexa.ulg"],
-    )
-    .success();
-    let layout =
-        std::fs::read_to_string(workspace().join("experiments/layouts/simulator-ulog.json"))
-            .unwrap();
-    let mut layout: Value = serde_json::from_str(&layout).unwrap();
-    layout["motor_commands"] = json!(
-        (0..6)
+    let dir = concealed_thrust_loss("simulator-ulog-hexa", "hexa-x.json", "g.json", &["ulg"]);
+    let k = thrust_scale_through_layout(&dir, |layout| {
+        let outputs: Vec<String> = (0..6)
             .map(|i| format!("actuator_outputs.output[{i}]"))
-            .collect::<Vec<_>>()
-    );
-    std::fs::write(dir.join("hexa-layout.json"), layout.to_string()).unwrap();
-    let args = [
-        "mismatch",
-        "--model",
-        "hexa.json",
-        "--quiet",
-        "--recording",
-        "hexa.ulg",
-        "--layout",
-        "hexa-layout.json",
-        "--out",
-        "ulog",
-    ];
-    learn_in(&dir, &args).success();
-    let k = thrust_scale(&dir, "ulog");
+            .collect();
+        layout["motor_commands"] = json!(outputs);
+    });
     assert!((k - 0.9).abs() < 0.01, "{k}");
 }
 
@@ -125,44 +113,14 @@ fn a_hexarotor_ulog_is_analysed_through_its_six_motor_outputs() {
 /// is found through the vehicle's map at the logged voltage.
 #[test]
 fn a_voltage_map_vehicle_ulog_is_analysed_through_its_logged_battery() {
-    let dir = scratch("simulator-ulog-voltage");
-    std::fs::copy(
-        workspace().join("experiments/mismatch/vehicles/quad-voltage.json"),
-        dir.join("quad.json"),
-    )
-    .unwrap();
-    let text =
-        std::fs::read_to_string(workspace().join("experiments/mismatch/configurations/h.json"))
-            .unwrap();
-    let mut scenario: Value = serde_json::from_str(&text).unwrap();
-    scenario["model"] = json!("quad.json");
-    scenario["duration_s"] = json!(16.0);
-    scenario["effects"] = json!({"thrust_scale": {"k": 0.9}});
-    std::fs::write(dir.join("s.json"), scenario.to_string()).unwrap();
-    learn_in(
-        &dir,
-        &["simulate", "--scenario", "s.json", "--out", "v.ulg"],
-    )
-    .success();
-    let layout =
-        std::fs::read_to_string(workspace().join("experiments/layouts/simulator-ulog.json"))
-            .unwrap();
-    let mut layout: Value = serde_json::from_str(&layout).unwrap();
-    layout["battery_voltage"] = json!("battery_status.voltage_v");
-    std::fs::write(dir.join("v-layout.json"), layout.to_string()).unwrap();
-    let args = [
-        "mismatch",
-        "--model",
-        "quad.json",
-        "--quiet",
-        "--recording",
-        "v.ulg",
-        "--layout",
-        "v-layout.json",
-        "--out",
-        "ulog",
-    ];
-    learn_in(&dir, &args).success();
-    let k = thrust_scale(&dir, "ulog");
+    let dir = concealed_thrust_loss(
+        "simulator-ulog-voltage",
+        "quad-voltage.json",
+        "h.json",
+        &["ulg"],
+    );
+    let k = thrust_scale_through_layout(&dir, |layout| {
+        layout["battery_voltage"] = json!("battery_status.voltage_v");
+    });
     assert!((k - 0.9).abs() < 0.01, "{k}");
 }

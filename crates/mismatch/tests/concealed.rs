@@ -7,7 +7,7 @@ use physics::{EffectId, Effects, NominalModel, Scenario, ThrustScale, TorqueBias
 
 mod common;
 
-use common::{scenario, workspace};
+use common::{fast_settings, scenario, workspace};
 
 fn model() -> NominalModel {
     common::model_for_scenario()
@@ -17,13 +17,6 @@ fn flight(effects: Effects, seed: u64) -> data::FlightLog {
     simulate(&model(), &scenario(effects, seed), "test").unwrap()
 }
 
-fn settings() -> CheckedSettings {
-    let mut settings = Settings::default();
-    settings.analysis.block_s = 0.5;
-    settings.analysis.selection.resamples = 20;
-    settings.checked().unwrap()
-}
-
 #[test]
 fn finds_nothing_on_noise_alone() {
     for seed in [1, 2] {
@@ -31,7 +24,7 @@ fn finds_nothing_on_noise_alone() {
             &flight(Effects::default(), seed),
             &model(),
             "demo",
-            &settings(),
+            &fast_settings(),
         )
         .unwrap();
         assert!(
@@ -49,7 +42,7 @@ fn names_and_fits_a_concealed_thrust_loss() {
         thrust_scale: Some(ThrustScale { k: 0.9 }),
         ..Effects::default()
     };
-    let analysis = analyze(&flight(effects, 3), &model(), "demo", &settings()).unwrap();
+    let analysis = analyze(&flight(effects, 3), &model(), "demo", &fast_settings()).unwrap();
     assert_eq!(analysis.fitted.ids(), [EffectId::ThrustScale]);
     let k = analysis.fitted.thrust_scale.unwrap().k;
     assert!((k - 0.9).abs() < 0.01, "{k}");
@@ -70,7 +63,7 @@ fn names_a_torque_bias_and_renders_its_files() {
         }),
         ..Effects::default()
     };
-    let analysis = analyze(&flight(effects, 4), &model(), "demo", &settings()).unwrap();
+    let analysis = analyze(&flight(effects, 4), &model(), "demo", &fast_settings()).unwrap();
     assert_eq!(analysis.fitted.ids(), [EffectId::TorqueBias]);
     let b = analysis.fitted.torque_bias.unwrap().b;
     for (found, truth) in b.iter().zip([0.6, -0.4, 0.25]) {
@@ -107,7 +100,7 @@ fn a_too_short_recording_is_a_one_line_error() {
     log.thrust_setpoint.truncate(50);
     log.hover_throttle.truncate(50);
     log.motor_command = log.motor_command.range(0..50);
-    let error = analyze(&log, &model(), "demo", &settings())
+    let error = analyze(&log, &model(), "demo", &fast_settings())
         .unwrap_err()
         .to_string();
     assert!(error.contains("rows") && !error.contains('\n'), "{error}");
@@ -120,7 +113,7 @@ fn a_zero_hover_throttle_names_the_file_line_and_column() {
     let mut log = flight(Effects::default(), 6);
     log.path = "zero_hover.csv".into();
     log.hover_throttle[10] = 0.0;
-    let error = analyze(&log, &thrust_only, "nf", &settings())
+    let error = analyze(&log, &thrust_only, "nf", &fast_settings())
         .unwrap_err()
         .to_string();
     assert!(
@@ -168,7 +161,7 @@ fn sampled(effects: Effects, seed: u64) -> (data::FlightLog, NominalModel) {
 fn sampled_commands_of_a_fast_controller_leave_only_noise() {
     for seed in [11, 12] {
         let (log, model) = sampled(Effects::default(), seed);
-        let analysis = analyze(&log, &model, "sampled", &settings()).unwrap();
+        let analysis = analyze(&log, &model, "sampled", &fast_settings()).unwrap();
         assert!(
             analysis.report.effects.is_empty(),
             "seed {seed}: {:?}",
@@ -426,7 +419,7 @@ fn the_noise_of_sampled_commands_is_measured_and_explained() {
         },
         ..declared.clone()
     };
-    let raw = analyze(&log, &undeclared, "sampled", &settings()).unwrap();
+    let raw = analyze(&log, &undeclared, "sampled", &fast_settings()).unwrap();
     assert!(raw.report.noise_reaction.is_none());
     assert!(largest(&raw) >= 0.05, "{:?}", raw.report.channels);
     let markdown = raw.view().markdown();
@@ -439,7 +432,7 @@ fn the_noise_of_sampled_commands_is_measured_and_explained() {
         "{markdown}"
     );
 
-    let corrected = analyze(&log, &declared, "sampled", &settings()).unwrap();
+    let corrected = analyze(&log, &declared, "sampled", &fast_settings()).unwrap();
     let reaction = corrected.report.noise_reaction.as_ref().expect("removed");
     assert!(reaction.velocity && (reaction.steps_per_row - 10.0).abs() < 1e-9);
     assert!(
@@ -465,7 +458,7 @@ fn the_noise_of_sampled_commands_is_measured_and_explained() {
         ..common::model("vehicles/quad-a.json")
     };
     let log = simulate(&model, &scenario, "period-mean").unwrap();
-    let analysis = analyze(&log, &model, "period-mean", &settings()).unwrap();
+    let analysis = analyze(&log, &model, "period-mean", &fast_settings()).unwrap();
     for channel in &analysis.report.channels {
         assert!(channel.model_noise_share < 0.01, "{channel:?}");
     }

@@ -4,7 +4,7 @@
 //! samples, then every third row is kept, one row early or late at random, some dropped and 0.3 s
 //! cut out: what a 50 Hz logger with a jittering clock would have written.
 
-use mismatch::{CheckedSettings, Settings, analyze};
+use mismatch::analyze;
 use physics::{
     CommandLogging, Delay, EffectId, Effects, Logger, NominalModel, ThrustScale, simulate,
 };
@@ -12,6 +12,8 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 mod common;
+
+use common::fast_settings;
 
 fn model() -> NominalModel {
     NominalModel {
@@ -70,13 +72,6 @@ fn jittered_flight(effects: Effects, seed: u64) -> data::FlightLog {
     rows_of(&fast, &rows)
 }
 
-fn settings() -> CheckedSettings {
-    let mut settings = Settings::default();
-    settings.analysis.block_s = 0.5;
-    settings.analysis.selection.resamples = 20;
-    settings.checked().unwrap()
-}
-
 #[test]
 fn the_log_is_what_a_jittering_logger_writes() {
     let log = jittered_flight(Effects::default(), 1);
@@ -99,7 +94,7 @@ fn nothing_is_named_on_noise_alone() {
             &jittered_flight(Effects::default(), seed),
             &model(),
             "demo",
-            &settings(),
+            &fast_settings(),
         )
         .unwrap();
         assert!(
@@ -125,7 +120,13 @@ fn a_concealed_delay_is_timed_on_the_stamps() {
         delay: Some(Delay { delay_s: 0.03 }),
         ..Effects::default()
     };
-    let analysis = analyze(&jittered_flight(effects, 3), &model(), "demo", &settings()).unwrap();
+    let analysis = analyze(
+        &jittered_flight(effects, 3),
+        &model(),
+        "demo",
+        &fast_settings(),
+    )
+    .unwrap();
     assert_eq!(analysis.fitted.ids(), [EffectId::Delay]);
     let delay = analysis.fitted.delay_s();
     assert!((delay - 0.03).abs() < 0.003, "{delay}");
@@ -137,7 +138,13 @@ fn a_concealed_thrust_loss_is_fitted_across_the_gap() {
         thrust_scale: Some(ThrustScale { k: 0.9 }),
         ..Effects::default()
     };
-    let analysis = analyze(&jittered_flight(effects, 4), &model(), "demo", &settings()).unwrap();
+    let analysis = analyze(
+        &jittered_flight(effects, 4),
+        &model(),
+        "demo",
+        &fast_settings(),
+    )
+    .unwrap();
     assert_eq!(analysis.fitted.ids(), [EffectId::ThrustScale]);
     let k = analysis.fitted.thrust_scale.unwrap().k;
     assert!((k - 0.9).abs() < 0.01, "{k}");

@@ -2,14 +2,14 @@
 //! commands, a vehicle whose thrust map reads the logged battery voltage, and a recording whose
 //! motor count does not match the model refused with a one-line error.
 
-use mismatch::{CheckedSettings, Settings, analyze};
+use mismatch::analyze;
 use physics::{
     Battery, EffectId, Effects, MotorLag, NominalModel, Scenario, ThrustScale, simulate,
 };
 
 mod common;
 
-use common::scenario;
+use common::{fast_settings, scenario};
 
 /// The hexarotor of the vehicles matrix (six rotors on a 0.17 m ring), with the test scenario's
 /// logger.
@@ -18,13 +18,6 @@ fn hexarotor() -> NominalModel {
         logger: scenario(Effects::default(), 0).logger(),
         ..common::model("vehicles/hexa-x.json")
     }
-}
-
-fn settings() -> CheckedSettings {
-    let mut settings = Settings::default();
-    settings.analysis.block_s = 0.5;
-    settings.analysis.selection.resamples = 20;
-    settings.checked().unwrap()
 }
 
 #[test]
@@ -37,7 +30,7 @@ fn a_hexarotor_thrust_loss_and_motor_lag_are_found_through_its_six_rotors() {
     };
     let log = simulate(&model, &scenario(effects, 21), "hexa").unwrap();
     assert_eq!(log.motor_command.count(), 6);
-    let analysis = analyze(&log, &model, "demo", &settings()).unwrap();
+    let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
     assert_eq!(
         analysis.fitted.ids(),
         [EffectId::ThrustScale, EffectId::MotorLag]
@@ -52,7 +45,7 @@ fn a_hexarotor_thrust_loss_and_motor_lag_are_found_through_its_six_rotors() {
 fn a_recording_with_another_motor_count_is_refused_naming_both() {
     let quad = common::model_for_scenario();
     let log = simulate(&quad, &scenario(Effects::default(), 22), "quad").unwrap();
-    let message = analyze(&log, &hexarotor(), "demo", &settings())
+    let message = analyze(&log, &hexarotor(), "demo", &fast_settings())
         .unwrap_err()
         .to_string();
     assert!(
@@ -82,7 +75,13 @@ fn a_voltage_dependent_thrust_map_reads_the_logged_voltage() {
         };
         simulate(&model, &scenario, "voltage").unwrap()
     };
-    let control = analyze(&flight(Effects::default(), 23), &model, "demo", &settings()).unwrap();
+    let control = analyze(
+        &flight(Effects::default(), 23),
+        &model,
+        "demo",
+        &fast_settings(),
+    )
+    .unwrap();
     assert!(
         control.report.effects.is_empty(),
         "{:?}",
@@ -92,7 +91,7 @@ fn a_voltage_dependent_thrust_map_reads_the_logged_voltage() {
         thrust_scale: Some(ThrustScale { k: 0.93 }),
         ..Effects::default()
     };
-    let analysis = analyze(&flight(effects, 24), &model, "demo", &settings()).unwrap();
+    let analysis = analyze(&flight(effects, 24), &model, "demo", &fast_settings()).unwrap();
     assert_eq!(analysis.fitted.ids(), [EffectId::ThrustScale]);
     let k = analysis.fitted.thrust_scale.unwrap().k;
     assert!((k - 0.93).abs() < 0.01, "{k}");

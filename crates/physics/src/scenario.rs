@@ -524,13 +524,6 @@ impl Scenario {
                 .check(span, max_thrust)
                 .map_err(|(name, message)| field(&name, message))?;
         }
-        if let (Some(battery), Some(mixer)) = (&self.battery, &model.mixer) {
-            let max_thrust: f64 = mixer.row(0).iter().sum();
-            let span = (-self.warmup_s, self.duration_s);
-            battery
-                .check(span, max_thrust)
-                .map_err(|(name, message)| field(&name, message))?;
-        }
         let generator = self.trajectory.generator();
         for t in self.control_times() {
             let z = generator.at(t).position[2];

@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
+use mismatch::{CheckedSettings, Settings};
 use physics::{Effects, Noise, NominalModel, Scenario, Trajectory};
 
 pub fn workspace() -> PathBuf {
@@ -17,6 +18,14 @@ pub fn temp_dir(name: &str) -> tempfile::TempDir {
         .prefix(&format!("mismatch-{name}-"))
         .tempdir()
         .unwrap()
+}
+
+/// The analysis settings of the short test flights: half-second blocks, 20 resamples.
+pub fn fast_settings() -> CheckedSettings {
+    let mut settings = Settings::default();
+    settings.analysis.block_s = 0.5;
+    settings.analysis.selection.resamples = 20;
+    settings.checked().unwrap()
 }
 
 /// A nominal model of `experiments/mismatch/`, e.g. `vehicles/quad-a.json`.

@@ -50,8 +50,9 @@ impl Serialize for Mixer {
 }
 
 impl Mixer {
-    /// Builds a mixer of `rows` (4 rows of N columns, 1 ≤ N ≤ [`MAX_ACTUATORS`]); `None` when
-    /// the rotors cannot set thrust and the three torques independently (rank below 4).
+    /// Builds a mixer of `rows` (4 rows of N columns, 4 ≤ N ≤ [`MAX_ACTUATORS`]); `None` for
+    /// another N or when the rotors cannot set thrust and the three torques independently (rank
+    /// below 4).
     pub fn new(pwm_offset: f64, pwm_scale: f64, rows: &[Vec<f64>; 4]) -> Option<Self> {
         let rotors = rows[0].len();
         if !(4..=MAX_ACTUATORS).contains(&rotors) || rows.iter().any(|r| r.len() != rotors) {
@@ -108,10 +109,10 @@ impl Mixer {
 
     /// Normalised motor speeds `s_i = (pwm_i − pwm_offset) / pwm_scale`, clipped at 0 (through the
     /// command map with a vehicle: `s_i = √n_i(u_i, V)`, NaN without a voltage it needs), for the
-    /// rotors' commands `pwm` (one per rotor).
+    /// rotors' commands `pwm` (one per rotor; a rotor without one gets speed 0).
     pub fn speeds(&self, pwm: &[f64], battery_v: Option<f64>) -> Actuators {
         let mut out = [0.0; MAX_ACTUATORS];
-        for (speed, &command) in out.iter_mut().zip(&pwm[..self.rotors]) {
+        for (speed, &command) in out.iter_mut().zip(pwm.iter().take(self.rotors)) {
             *speed = match &self.command_map {
                 Some(map) => map
                     .thrust
@@ -239,6 +240,15 @@ mod tests {
             "{equal:?}"
         );
         assert!(equal[6..].iter().all(|s| *s == 0.0));
+    }
+
+    #[test]
+    fn rotors_without_a_command_spin_at_zero() {
+        let hexa = VehicleDescription::hexa_x(0.17, 6.0, 0.016).unwrap();
+        let from_vehicle = Mixer::from_vehicle(&hexa).unwrap();
+        let rows: [Vec<f64>; 4] = std::array::from_fn(|i| from_vehicle.row(i).to_vec());
+        let mixer = Mixer::new(1000.0, 1000.0, &rows).unwrap();
+        assert_eq!(mixer.speeds(&[1500.0; 4], None), actuators(&[0.5; 4]));
     }
 
     #[test]

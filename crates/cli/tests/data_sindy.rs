@@ -202,6 +202,24 @@ fn inspect_lists_the_columns_the_file_has() {
         "{line}"
     );
     assert!(line.contains("not used: battery"), "{line}");
+    assert!(
+        q_only.stdout.contains("[1300.0, 1300.0] (4 motors)"),
+        "{}",
+        q_only.stdout
+    );
+    // Named `battery_voltage`, the column is the optional battery voltage, read and ranged.
+    std::fs::write(
+        dir.join("volts.csv"),
+        flight(true, false).replacen("battery", "battery_voltage", 1),
+    )
+    .unwrap();
+    let volts = learn_in(&dir, &["data", "inspect", "volts.csv"]);
+    let text = volts.success();
+    assert!(text.contains("fa (absent), battery_voltage\n"), "{text}");
+    assert!(
+        text.contains("battery_voltage [V] [16.000, 16.000]"),
+        "{text}"
+    );
     let r_only = learn_in(&dir, &["data", "inspect", "r_only.csv"]);
     assert!(
         r_only.success().contains("q (absent, derived from R), R,"),

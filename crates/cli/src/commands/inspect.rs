@@ -145,7 +145,19 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(*v), hi.max(*v))
         });
-    say!("  {:<16} [{lo:.1}, {hi:.1}]", "pwm");
+    say!(
+        "  {:<16} [{lo:.1}, {hi:.1}] ({} motors)",
+        "pwm",
+        log.motor_command.count()
+    );
+    if let Some(volts) = &log.battery_voltage {
+        let (lo, hi) = volts
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(*v), hi.max(*v))
+            });
+        say!("  {:<16} [{lo:.3}, {hi:.3}]", "battery_voltage [V]");
+    }
     let (frame, body, world) = log.rate_frame();
     let mut problems = Vec::new();
     if frame == data::RateFrame::World {

@@ -87,14 +87,13 @@ pub(crate) fn in_flight(
 /// The crate's result type.
 pub type Result<T> = std::result::Result<T, EvaluationError>;
 
-/// Writes `text` to `path`, creating the parent directory.
+/// Writes `text` to `path`, creating the parent folders (never a staging folder an interrupt
+/// removed: [`output_set::create_parent_folders`]).
 pub(crate) fn write_text(path: &std::path::Path, text: &str) -> Result<()> {
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).map_err(|source| EvaluationError::Io {
-            path: parent.to_path_buf(),
-            source,
-        })?;
-    }
+    output_set::create_parent_folders(path).map_err(|source| EvaluationError::Io {
+        path: path.parent().unwrap_or(path).to_path_buf(),
+        source,
+    })?;
     std::fs::write(path, text).map_err(|source| EvaluationError::Io {
         path: path.to_path_buf(),
         source,

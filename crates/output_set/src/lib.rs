@@ -40,7 +40,7 @@ use std::path::{Path, PathBuf};
 pub use error::{OutputError, Result};
 pub use manifest::{MANIFEST, Manifest};
 pub use signals::wait_if_interrupted;
-pub use stage::{Staged, in_final_terms};
+pub use stage::{Staged, create_parent_folders, in_final_terms};
 
 use paths::FileKind;
 

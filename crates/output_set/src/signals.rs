@@ -92,18 +92,32 @@ fn install() {
 }
 
 /// Removes every path, and again while a thread still at work (a writer making its file's folder)
-/// brings one back, until none has come back 2 ms later (at most about 50 ms).
+/// brings one back, until none has come back over [`QUIET_CHECKS`] checks 2 ms apart (at most
+/// about 200 ms). A writer descheduled past the last check can still bring one back before the
+/// process ends (a busy machine showed it with one quiet check); the next run into the folder
+/// removes it, as it removes what SIGKILL leaves.
 fn remove_until_gone(paths: &[PathBuf]) {
-    for _ in 0..25 {
-        for path in paths {
-            remove(path);
+    let mut quiet = 0;
+    for _ in 0..100 {
+        if quiet == 0 {
+            for path in paths {
+                remove(path);
+            }
         }
         std::thread::sleep(std::time::Duration::from_millis(2));
         if paths.iter().all(|path| !path.exists()) {
-            return;
+            quiet += 1;
+            if quiet == QUIET_CHECKS {
+                return;
+            }
+        } else {
+            quiet = 0;
         }
     }
 }
+
+/// How many checks in a row must find every staging path gone before the process ends.
+const QUIET_CHECKS: usize = 5;
 
 /// Removes a staging file or folder, whichever it is; errors are ignored (nothing more can be
 /// done on the way out).

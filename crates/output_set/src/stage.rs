@@ -217,6 +217,40 @@ pub(crate) fn refuse_foreign_folder(dir: &Path, relative: &Path, option: &str) -
     }
 }
 
+/// Creates the missing folders above `path`, as `create_dir_all` would, except a staging folder
+/// (`.learn-staging-*`, made by this crate only): one that an interrupt removed stays removed
+/// (made again by a writer still at work, it would outlive the process) and the write fails
+/// instead, which the caller reports only after [`crate::wait_if_interrupted`].
+pub fn create_parent_folders(path: &Path) -> std::io::Result<()> {
+    let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) else {
+        return Ok(());
+    };
+    let mut missing = Vec::new();
+    let mut folder = parent;
+    while !folder.is_dir() {
+        missing.push(folder);
+        match folder.parent().filter(|p| !p.as_os_str().is_empty()) {
+            Some(above) => folder = above,
+            None => break,
+        }
+    }
+    for folder in missing.into_iter().rev() {
+        let name = folder.file_name().map(|n| n.to_string_lossy());
+        if name.is_some_and(|n| n.starts_with(STAGING)) {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!("{}: the staging folder is gone", folder.display()),
+            ));
+        }
+        match std::fs::create_dir(folder) {
+            Ok(()) => {}
+            Err(error) if error.kind() == std::io::ErrorKind::AlreadyExists && folder.is_dir() => {}
+            Err(error) => return Err(error),
+        }
+    }
+    Ok(())
+}
+
 /// Creates the folders of `relative` inside `root`, never `root` itself: once an interrupt has
 /// removed a staging folder, making its subfolders fails instead of bringing it back (which
 /// `create_dir_all` would, leaving it behind when the process exits).
@@ -517,6 +551,24 @@ mod tests {
     /// Staging subfolders are made inside an existing staging folder only: when an interrupt has
     /// just removed it, making them fails and nothing comes back (with `create_dir_all` the
     /// staging folder reappeared and outlived the process).
+    /// A writer's parent folders are made as `create_dir_all` makes them, except a staging folder:
+    /// after an interrupt removed it, writing into it fails and it stays removed.
+    #[test]
+    fn a_writers_folders_never_bring_back_a_removed_staging() {
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("a/b/c.md");
+        create_parent_folders(&plain).unwrap();
+        assert!(dir.path().join("a/b").is_dir());
+        let staging = dir.path().join(".learn-staging-1-x");
+        std::fs::create_dir(&staging).unwrap();
+        create_parent_folders(&staging.join("tables/t.md")).unwrap();
+        assert!(staging.join("tables").is_dir());
+        signals::remove(&staging);
+        let error = create_parent_folders(&staging.join("tables/t.md")).unwrap_err();
+        assert_eq!(error.kind(), std::io::ErrorKind::NotFound);
+        assert!(!staging.exists(), "the removed staging stays removed");
+    }
+
     #[test]
     fn subfolders_do_not_bring_back_a_removed_staging() {
         let dir = tempfile::tempdir().unwrap();

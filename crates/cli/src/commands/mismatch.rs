@@ -100,15 +100,14 @@ fn load_model(path: &Path) -> anyhow::Result<physics::NominalModel> {
     Ok(physics::NominalModel::from_json(&text, path)?)
 }
 
-/// Writes `contents` to `path`, creating its folder; the error names the file.
+/// Writes `contents` to `path`, creating its folders (never a staging folder an interrupt removed);
+/// the error names the file.
 fn write_file(path: &Path, contents: &str) -> mismatch::Result<()> {
     let io = |source| mismatch::MismatchError::Io {
         path: path.to_path_buf(),
         source,
     };
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).map_err(io)?;
-    }
+    output_set::create_parent_folders(path).map_err(io)?;
     std::fs::write(path, contents).map_err(io)
 }
 

@@ -37,9 +37,19 @@ type Condition = (&'static str, Option<[f64; 3]>, f64);
 /// Simulates one flight per condition with the vehicle's effects (air forces lagging by
 /// `lag_s`), runs the joint analysis on them and returns its report.
 fn analyse(name: &str, conditions: &[Condition], lag_s: Option<f64>) -> FleetReport {
+    analyse_vehicle(name, conditions, lag_s, "vehicles/quad-a.json")
+}
+
+/// [`analyse`] of flights of the simulated `vehicle` (a model of `experiments/mismatch/`).
+fn analyse_vehicle(
+    name: &str,
+    conditions: &[Condition],
+    lag_s: Option<f64>,
+    vehicle: &str,
+) -> FleetReport {
     let tmp = scratch(name);
     let dir = tmp.path();
-    let vehicle = common::model("vehicles/quad-a.json");
+    let vehicle = common::model(vehicle);
     for (k, (name, wind, _)) in conditions.iter().enumerate() {
         let scenario = Scenario {
             duration_s: 24.0,
@@ -154,4 +164,21 @@ fn a_lag_of_the_air_forces_is_found_in_still_air_and_bounds_the_winds_scale() {
         assert!(low - 0.2 <= known && known <= high + 0.2, "{f:?}");
     }
     assert_winds(&report, &conditions, 0.6);
+}
+
+/// A hexarotor's flights: the attitude check maps its six motor commands to the body's angular
+/// acceleration (it was a map from four, and skipped for other motor counts).
+#[test]
+fn a_hexarotors_attitude_check_reads_its_six_motors() {
+    let conditions: [Condition; 2] = [
+        ("still", None, 0.0),
+        ("breeze", Some([-3.0, 0.5, 0.0]), 3.0),
+    ];
+    let report = analyse_vehicle("hexa", &conditions, None, "vehicles/hexa-x.json");
+    let attitude = report.attitude.expect("an attitude check");
+    assert!(attitude.pwm_range[0] >= 1000.0 && attitude.pwm_range[1] <= 2000.0);
+    assert!(
+        attitude.explained_calm_heldout.iter().all(|e| *e > 0.5),
+        "{attitude:?}"
+    );
 }

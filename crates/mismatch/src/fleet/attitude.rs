@@ -1,6 +1,6 @@
 //! What the logs allow on the angular channels when the nominal model has no torques (its thrust
 //! comes from `T_sp`): how the motor commands relate to the thrust setpoint, and how much of the
-//! body's angular acceleration a torque map from the four motor commands explains, identified on
+//! body's angular acceleration a torque map from the motor commands explains, identified on
 //! the calm flights and checked where it was not fitted. Nothing is named in the angular channels
 //! unless such a map explains most of them.
 
@@ -14,8 +14,8 @@ use super::FleetFlight;
 const MAX_LAG_ROWS: usize = 6;
 
 /// Per flight and row: the weak-form target of the body rate, and the weak form of the lagged
-/// motor commands.
-fn regressors(flight: &FleetFlight, lag: usize) -> (Vec<[f64; 3]>, Vec<[f64; 4]>) {
+/// motor commands (one per motor).
+fn regressors(flight: &FleetFlight, lag: usize) -> (Vec<[f64; 3]>, Vec<Vec<f64>>) {
     let problem = &flight.problem;
     let form = &problem.weak_form;
     let rate = &problem.recording.body_rate;
@@ -27,14 +27,25 @@ fn regressors(flight: &FleetFlight, lag: usize) -> (Vec<[f64; 3]>, Vec<[f64; 4]>
         }
     }
     let pwm = &flight.pwm;
-    let lagged: Vec<[f64; 4]> = (0..pwm.len())
-        .map(|k| pwm[k.saturating_sub(lag)].map(|v| v / 100.0))
+    let motors = pwm.count();
+    let lagged: Vec<Vec<f64>> = (0..pwm.len())
+        .map(|k| {
+            pwm.row(k.saturating_sub(lag))
+                .iter()
+                .map(|v| v / 100.0)
+                .collect()
+        })
         .collect();
-    let mut commands = vec![[0.0; 4]; problem.rows()];
-    for pair in [[0, 1, 2], [1, 2, 3]] {
-        let three: Vec<[f64; 3]> = lagged.iter().map(|p| pair.map(|i| p[i])).collect();
+    let mut commands = vec![vec![0.0; motors]; problem.rows()];
+    // Three motors at a time (the weak form integrates triples), the last triple ending at the
+    // last motor: for four, motors 0–2 and 1–3.
+    for start in (0..motors).step_by(3) {
+        let triple = std::array::from_fn::<usize, 3, _>(|k| {
+            (start.min(motors.saturating_sub(3)) + k).min(motors - 1)
+        });
+        let three: Vec<[f64; 3]> = lagged.iter().map(|p| triple.map(|i| p[i])).collect();
         for (row, value) in commands.iter_mut().zip(form.integrate_rows(&three)) {
-            for (k, &i) in pair.iter().enumerate() {
+            for (k, &i) in triple.iter().enumerate() {
                 row[i] = value[k];
             }
         }
@@ -43,24 +54,20 @@ fn regressors(flight: &FleetFlight, lag: usize) -> (Vec<[f64; 3]>, Vec<[f64; 4]>
 }
 
 /// One flight's weak-form angular acceleration and motor commands, with the rows to use.
-type Sample = (Vec<[f64; 3]>, Vec<[f64; 4]>, std::ops::Range<usize>);
+type Sample = (Vec<[f64; 3]>, Vec<Vec<f64>>, std::ops::Range<usize>);
 
-/// Least squares of `y = c + B u` per axis on the given rows; returns the coefficients per axis
-/// (constant first).
-fn fit_map(samples: &[Sample]) -> [[f64; 5]; 3] {
-    let mut gram = Mat::<f64>::zeros(5, 5);
-    let mut cross = Mat::<f64>::zeros(5, 3);
+/// Least squares of `y = c + B u` per axis on the given rows, `u` the `motors` commands; returns
+/// the coefficients per axis (constant first).
+fn fit_map(samples: &[Sample], motors: usize) -> [Vec<f64>; 3] {
+    let size = motors + 1;
+    let mut gram = Mat::<f64>::zeros(size, size);
+    let mut cross = Mat::<f64>::zeros(size, 3);
+    let mut x = vec![1.0; size];
     for (target, commands, rows) in samples {
         for r in rows.clone() {
-            let x = [
-                1.0,
-                commands[r][0],
-                commands[r][1],
-                commands[r][2],
-                commands[r][3],
-            ];
-            for i in 0..5 {
-                for j in 0..5 {
+            x[1..].copy_from_slice(&commands[r]);
+            for i in 0..size {
+                for j in 0..size {
                     gram[(i, j)] += x[i] * x[j];
                 }
                 for c in 0..3 {
@@ -69,29 +76,24 @@ fn fit_map(samples: &[Sample]) -> [[f64; 5]; 3] {
             }
         }
     }
-    for i in 0..5 {
+    for i in 0..size {
         gram[(i, i)] += 1e-9 * (1.0 + gram[(i, i)]);
     }
     let solution = gram.full_piv_lu().solve(&cross);
-    let mut out = [[0.0; 5]; 3];
-    for c in 0..3 {
-        for i in 0..5 {
-            out[c][i] = solution[(i, c)];
-        }
-    }
-    out
+    std::array::from_fn(|c| (0..size).map(|i| solution[(i, c)]).collect())
 }
 
 /// `1 − SSE / SST` per axis (SST about the mean) of the map on the given rows.
-fn explained(samples: &[Sample], map: &[[f64; 5]; 3]) -> [f64; 3] {
+fn explained(samples: &[Sample], map: &[Vec<f64>; 3]) -> [f64; 3] {
     let mut out = [0.0; 3];
     for c in 0..3 {
         let values: Vec<(f64, f64)> = samples
             .iter()
             .flat_map(|(target, commands, rows)| {
                 rows.clone().map(move |r| {
-                    let u = commands[r];
-                    let predicted = map[c][0] + (0..4).map(|i| map[c][i + 1] * u[i]).sum::<f64>();
+                    let u = &commands[r];
+                    let predicted =
+                        map[c][0] + (0..u.len()).map(|i| map[c][i + 1] * u[i]).sum::<f64>();
                     (target[r][c], predicted)
                 })
             })
@@ -113,11 +115,11 @@ fn mean_pwm_law(flights: &[FleetFlight]) -> (f64, f64, usize, f64) {
         let pairs: Vec<(f64, f64)> = flights
             .iter()
             .flat_map(|f| {
-                let n = f.pwm.len();
+                let (n, motors) = (f.pwm.len(), f.pwm.count() as f64);
                 (lag..n).map(move |k| {
                     (
                         f.thrust_setpoint[k - lag],
-                        f.pwm[k].iter().sum::<f64>() / 4.0,
+                        f.pwm.row(k).iter().sum::<f64>() / motors,
                     )
                 })
             })
@@ -145,12 +147,13 @@ fn mean_pwm_law(flights: &[FleetFlight]) -> (f64, f64, usize, f64) {
 
 /// The attitude check over the flights (calm ones identify, windy ones only check).
 pub fn check(flights: &[FleetFlight]) -> Option<AttitudeCheck> {
-    if flights.iter().all(|f| !f.calm) || flights.iter().any(|f| f.pwm.is_empty()) {
+    let motors = flights.first()?.pwm.count();
+    if flights.iter().all(|f| !f.calm) || flights.iter().any(|f| f.pwm.count() != motors) {
         return None;
     }
     let (lo, hi) = flights
         .iter()
-        .flat_map(|f| f.pwm.iter().flatten())
+        .flat_map(|f| f.pwm.rows().flatten())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
             (a.min(*v), b.max(*v))
         });
@@ -170,7 +173,7 @@ pub fn check(flights: &[FleetFlight]) -> Option<AttitudeCheck> {
     let all_rows = |f: &FleetFlight| 0..f.problem.rows();
     let (lag, map, calm_heldout) = (0..=MAX_LAG_ROWS)
         .map(|lag| {
-            let map = fit_map(&samples_at(lag, true, fit_part));
+            let map = fit_map(&samples_at(lag, true, fit_part), motors);
             let score = explained(&samples_at(lag, true, heldout_part), &map);
             (lag, map, score)
         })

@@ -139,9 +139,8 @@ pub struct FleetFlight {
     /// The position axes along which the flight spreads (standard deviation at least
     /// [`GRADIENT_SPREAD_M`]): those its air's gradient can be fitted along.
     pub axes: Vec<usize>,
-    /// The logged motor commands of a four-rotor log (empty otherwise) and the thrust setpoint
-    /// (for the attitude check, a map from four motor commands).
-    pub pwm: Vec<[f64; 4]>,
+    /// The logged motor commands and thrust setpoint (for the attitude check).
+    pub pwm: data::MotorCommands,
     pub thrust_setpoint: Vec<f64>,
     /// The weak form of the log's own residual force over the mass (`fa / m`), when it has one.
     pub residual_force: Option<Vec<[f64; 3]>>,
@@ -244,11 +243,7 @@ impl FleetPlan {
                 });
                 let (reference_m, axes) = spread(&problem.recording.position);
                 Ok(FleetFlight {
-                    pwm: log
-                        .motor_command
-                        .rows()
-                        .filter_map(|row| row.try_into().ok())
-                        .collect(),
+                    pwm: log.motor_command.clone(),
                     thrust_setpoint: log.thrust_setpoint.clone(),
                     reference_m,
                     axes,

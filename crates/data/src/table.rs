@@ -169,60 +169,74 @@ impl TextTable {
     /// Parses a column whose cells hold exactly `N` numbers, written `[a, b, ...]` (nested brackets,
     /// as in a 3x3 matrix, are flattened row by row).
     pub fn arrays<const N: usize>(&self, name: &str) -> Result<Vec<[f64; N]>> {
-        let column = self.text_column(name)?;
-        let mut out = Vec::with_capacity(column.ends.len());
-        let mut buffer = Vec::with_capacity(N);
-        for (index, cell) in column.cells().enumerate() {
-            let row = self.line(index);
-            cell_numbers(&self.path, row, name, cell, &mut buffer)?;
-            if buffer.len() != N {
-                return Err(DataError::WrongLength {
-                    path: self.path.clone(),
-                    row,
-                    column: name.to_string(),
-                    expected: N,
-                    found: buffer.len(),
-                });
-            }
-            check_finite(&self.path, row, name, &buffer)?;
-            let mut array = [0.0; N];
-            array.copy_from_slice(&buffer);
-            out.push(array);
-        }
+        let mut out = Vec::new();
+        self.lists(
+            name,
+            |_| Ok(N),
+            |values, rows| {
+                if out.is_empty() {
+                    out.reserve_exact(rows);
+                }
+                let mut array = [0.0; N];
+                array.copy_from_slice(values);
+                out.push(array);
+            },
+        )?;
         Ok(out)
     }
+
     /// Parses a column of motor commands, `[a, b, ...]`: as many values on every row as on the
     /// first, 1 to [`MAX_MOTORS`].
     pub fn motor_commands(&self, name: &str) -> Result<MotorCommands> {
-        let column = self.text_column(name)?;
-        let mut buffer = Vec::with_capacity(MAX_MOTORS);
+        let first = |length: usize| {
+            if (1..=MAX_MOTORS).contains(&length) {
+                Ok(length)
+            } else {
+                Err(format!("{length} motors; expected 1 to {MAX_MOTORS}"))
+            }
+        };
         let mut out: Option<MotorCommands> = None;
+        self.lists(name, first, |values, rows| {
+            out.get_or_insert_with(|| MotorCommands::with_capacity(values.len(), rows))
+                .push(values)
+        })?;
+        Ok(out.unwrap_or_default())
+    }
+
+    /// Reads every cell of column `name` as a list of finite numbers, each as long as `length`
+    /// says from the first list's length (its error refuses the first cell), and gives each list
+    /// with the column's row count to `take`, in order. Errors name the file, line and column.
+    fn lists(
+        &self,
+        name: &str,
+        length: impl FnOnce(usize) -> std::result::Result<usize, String>,
+        mut take: impl FnMut(&[f64], usize),
+    ) -> Result<()> {
+        let column = self.text_column(name)?;
+        let rows = column.ends.len();
+        let mut buffer = Vec::new();
+        let mut length = Some(length);
+        let mut expected = 0;
         for (index, cell) in column.cells().enumerate() {
             let row = self.line(index);
             cell_numbers(&self.path, row, name, cell, &mut buffer)?;
-            let commands = match &mut out {
-                Some(commands) => commands,
-                None if (1..=MAX_MOTORS).contains(&buffer.len()) => out.insert(
-                    MotorCommands::with_capacity(buffer.len(), column.ends.len()),
-                ),
-                None => {
-                    let reason = format!("{} motors; expected 1 to {MAX_MOTORS}", buffer.len());
-                    return Err(bad_cell(&self.path, row, name, cell, reason));
-                }
-            };
-            if buffer.len() != commands.count() {
+            if let Some(length) = length.take() {
+                expected = length(buffer.len())
+                    .map_err(|reason| bad_cell(&self.path, row, name, cell, reason))?;
+            }
+            if buffer.len() != expected {
                 return Err(DataError::WrongLength {
                     path: self.path.clone(),
                     row,
                     column: name.to_string(),
-                    expected: commands.count(),
+                    expected,
                     found: buffer.len(),
                 });
             }
             check_finite(&self.path, row, name, &buffer)?;
-            commands.push(&buffer);
+            take(&buffer, rows);
         }
-        Ok(out.unwrap_or_default())
+        Ok(())
     }
 }
 

@@ -21,14 +21,19 @@ pub struct Args {
     pub force: bool,
 }
 
+/// The smallest and the largest of `values` (infinities reversed when there are none).
+fn extremes<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64) {
+    values
+        .into_iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        })
+}
+
 fn range3(name: &str, values: &[[f64; 3]]) -> String {
     let mut parts = Vec::new();
     for (axis, label) in ["x", "y", "z"].iter().enumerate() {
-        let (lo, hi) = values
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(v[axis]), hi.max(v[axis]))
-            });
+        let (lo, hi) = extremes(values.iter().map(|v| &v[axis]));
         parts.push(format!("{label} [{lo:.3}, {hi:.3}]"));
     }
     format!("  {name:<16} {}", parts.join("  "))
@@ -131,31 +136,16 @@ pub fn run(_global: &Global, args: Args) -> anyhow::Result<()> {
     say!("{}", range3("p [m]", &log.position));
     say!("{}", range3("v [m/s]", &log.velocity));
     say!("{}", range3("w [rad/s]", &log.body_rate));
-    let (lo, hi) = log
-        .thrust_setpoint
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(*v), hi.max(*v))
-        });
+    let (lo, hi) = extremes(&log.thrust_setpoint);
     say!("  {:<16} [{lo:.4}, {hi:.4}]", "T_sp");
-    let (lo, hi) = log
-        .motor_command
-        .rows()
-        .flatten()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(*v), hi.max(*v))
-        });
+    let (lo, hi) = extremes(log.motor_command.rows().flatten());
     say!(
         "  {:<16} [{lo:.1}, {hi:.1}] ({} motors)",
         "pwm",
         log.motor_command.count()
     );
     if let Some(volts) = &log.battery_voltage {
-        let (lo, hi) = volts
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(*v), hi.max(*v))
-            });
+        let (lo, hi) = extremes(volts);
         say!("  {:<16} [{lo:.3}, {hi:.3}]", "battery_voltage [V]");
     }
     let (frame, body, world) = log.rate_frame();

@@ -92,9 +92,12 @@ impl Plant<'_> {
             [0.0; 3]
         };
         let torque = wrench.torque.unwrap_or([0.0; 3]);
+        let air_body = self
+            .effects
+            .body_airspeed(&rotation, air_velocity, state.position);
         let angular_acceleration =
             self.effects
-                .angular_acceleration(self.model, state.body_rate, torque);
+                .angular_acceleration(self.model, state.body_rate, torque, air_body);
         let w = state.body_rate;
         let quaternion =
             quaternion_multiply(state.quaternion, [w[0], w[1], w[2], 0.0]).map(|v| 0.5 * v);

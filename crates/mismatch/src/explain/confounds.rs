@@ -3,8 +3,8 @@
 //! the commands); a wind through a drag, a thrust scale and a drag along the body axes (each can
 //! be a steady force along the thrust); a wind and a tilted thrust axis (a steady sideways force,
 //! as an uncalibrated attitude gives); a thrust scale and a ground effect at a nearly constant
-//! height; a drag along the body axes and a rotor drag proportional to the thrust (one force near
-//! hover). The evidence rule tests each named effect against nothing; here each named effect that
+//! height; a drag along the body axes and a rotor drag proportional to the thrust or to the rotor
+//! speed (one force near hover), and those two rotor drags. The evidence rule tests each named effect against nothing; here each named effect that
 //! has such stand-ins is tested against each of them:
 //!
 //! the effect is replaced by the stand-in, every other parameter refitted, and the stand-in
@@ -31,7 +31,7 @@ use crate::model::refine::effects_from;
 
 /// The stand-ins of an effect, in the order they are tried (each needs no other effect to act
 /// through). Declared with the rule, before any evaluation data was seen, except the wind's thrust
-/// tilt and the linear drag's rotor drag (docs/mismatch.md).
+/// tilt and the linear drag's rotor drags (docs/mismatch.md).
 pub fn stand_ins(id: EffectId) -> &'static [EffectId] {
     use EffectId::*;
     match id {
@@ -39,7 +39,9 @@ pub fn stand_ins(id: EffectId) -> &'static [EffectId] {
         MotorLag => &[Delay],
         Wind => &[ThrustScale, LinearDrag, ThrustTilt],
         ThrustScale => &[LinearDrag, GroundEffect],
-        LinearDrag => &[ThrustScale, RotorDrag],
+        LinearDrag => &[ThrustScale, RotorDrag, RotorSpeedDrag],
+        RotorDrag => &[RotorSpeedDrag],
+        RotorSpeedDrag => &[RotorDrag],
         GroundEffect => &[ThrustScale],
         _ => &[],
     }

@@ -198,9 +198,10 @@ fn screen_estimates(
                 let radius = profiled_ground_radius(problem, columns, &others, block_rows);
                 push(GROUND_RADIUS, radius);
             }
-            CandidateId::TorqueBias => {
+            CandidateId::TorqueBias | CandidateId::AerodynamicTorque => {
+                let id = candidate.id.screened_effect();
                 for (i, &c) in cols.iter().enumerate() {
-                    push(EffectNumber::new(EffectId::TorqueBias, i), coefficient(c));
+                    push(EffectNumber::new(id, i), coefficient(c));
                 }
             }
             CandidateId::InertiaScale => {

@@ -23,11 +23,12 @@ pub enum CandidateId {
     DelayOrMotorLag,
     TorqueBias,
     InertiaScale,
+    AerodynamicTorque,
 }
 
 impl CandidateId {
     /// Every candidate, in the library's order (its columns' order).
-    pub const ALL: [CandidateId; 7] = [
+    pub const ALL: [CandidateId; 8] = [
         Self::ThrustScale,
         Self::LinearDrag,
         Self::QuadraticDrag,
@@ -35,6 +36,7 @@ impl CandidateId {
         Self::DelayOrMotorLag,
         Self::TorqueBias,
         Self::InertiaScale,
+        Self::AerodynamicTorque,
     ];
 
     /// The effect whose screening terms the candidate's are (the timing term's are the delay's).
@@ -55,6 +57,7 @@ impl CandidateId {
             Self::DelayOrMotorLag => None,
             Self::TorqueBias => Some(EffectId::TorqueBias),
             Self::InertiaScale => Some(EffectId::InertiaScale),
+            Self::AerodynamicTorque => Some(EffectId::AerodynamicTorque),
         }
     }
 

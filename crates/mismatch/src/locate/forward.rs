@@ -68,7 +68,8 @@ pub fn predict_substeps(
             if angular_wanted {
                 let rate = lerp(recording.body_rate[k], recording.body_rate[k + 1], s);
                 let torque = wrench.torque.unwrap_or([0.0; 3]);
-                angular.push(effects.angular_acceleration(model, rate, torque));
+                let air_body = effects.body_airspeed(&rotation, velocity, position);
+                angular.push(effects.angular_acceleration(model, rate, torque, air_body));
             }
         }
     }
@@ -161,7 +162,17 @@ pub fn accelerations_at_rows(
             wrench.thrust,
         ));
         if let Some(torque) = wrench.torque {
-            angular.push(effects.angular_acceleration(model, recording.body_rate[k], torque));
+            let air_body = effects.body_airspeed(
+                &recording.rotation[k],
+                recording.velocity[k],
+                recording.position[k],
+            );
+            angular.push(effects.angular_acceleration(
+                model,
+                recording.body_rate[k],
+                torque,
+                air_body,
+            ));
         }
     }
     let angular = model.predicts_torque().then_some(angular);

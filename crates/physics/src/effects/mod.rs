@@ -28,11 +28,13 @@
 //! | `drag_lag` | `tau_s` | the velocity the air terms (drags, lift) see lags `v` by a first-order lag |
 //! | `wind_gradient` | `per_m: 3 × 3`, `reference_m` | the air velocity varies in space: `w_air + G (p − p_ref)` |
 //! | `axial_thrust_loss` | `c` | `T_real ×= max(0, 1 − c v_bz)`: less thrust climbing through the air (s/m) |
+//! | `rotor_speed_drag` | `d: [horizontal, vertical]` | `a = −√f R diag(dh, dh, dv) Rᵀ (v − w_air)` (1/s): drag proportional to the rotor speed |
+//! | `aerodynamic_torque` | `k: [x, y]` | `ω̇ += [kx v_by, −ky v_bx, 0]` (rad/s² per m/s): a drag acting above or below the centre of mass |
 //!
 //! How the hooks compose (the order of each sum and product is the registry's):
-//! `a = [0, 0, −g] + g f R a_T − f Σ thrust drags + Σ air drags` with
+//! `a = [0, 0, −g] + g f R a_T − f Σ thrust drags − √f Σ speed drags + Σ air drags` with
 //! `f = curve(T / m g) · Π gains` the real thrust over `m g` and `a_T` the thrust axis;
-//! `ω̇ = J_real⁻¹ (τ − ω × J_real ω) + Σ biases`.
+//! `ω̇ = J_real⁻¹ (τ − ω × J_real ω) + Σ biases + Σ air torques`.
 
 mod registry;
 #[cfg(test)]
@@ -62,6 +64,8 @@ registry::vocabulary! {
     DragLag drag_lag;
     WindGradient wind_gradient;
     AxialThrustLoss axial_thrust_loss;
+    RotorSpeedDrag rotor_speed_drag;
+    AerodynamicTorque aerodynamic_torque;
 }
 
 use crate::model::{NominalModel, angular_acceleration_with_inertia};
@@ -113,6 +117,11 @@ pub trait Effect: Send + Sync {
         let _ = (rotation, air_body);
         None
     }
+    /// A deceleration per unit rotor speed, `√f` (world frame), at body-frame airspeed `air_body`.
+    fn speed_drag(&self, rotation: &Mat3, air_body: Vec3) -> Option<Vec3> {
+        let _ = (rotation, air_body);
+        None
+    }
     /// A deceleration (world frame) from the velocity `relative` to the air.
     fn air_drag(&self, rotation: &Mat3, relative: Vec3) -> Option<Vec3> {
         let _ = (rotation, relative);
@@ -124,6 +133,11 @@ pub trait Effect: Send + Sync {
     }
     /// An angular acceleration added to the rigid body's (rad/s²).
     fn angular_bias(&self) -> Option<Vec3> {
+        None
+    }
+    /// An angular acceleration (rad/s²) from the body-frame airspeed `air_body`.
+    fn air_torque(&self, air_body: Vec3) -> Option<Vec3> {
+        let _ = air_body;
         None
     }
     /// The signal that is late or lags, and by how much (s).
@@ -454,13 +468,19 @@ impl Effects {
     ) -> Vec3 {
         let g = model.gravity_m_s2;
         let height_above_ground = position[2] - model.ground_height_m;
-        let air_body = mat_t_vec(rotation, sub(velocity, self.air_velocity_at(position)));
+        let air_body = self.body_airspeed(rotation, velocity, position);
         let ratio = self.thrust_ratio(thrust / (model.mass_kg * g), height_above_ground, air_body);
         let axis = mat_vec(rotation, self.thrust_axis());
         let thrust_part = add([0.0, 0.0, -g], scale(axis, g * ratio));
         let thrust_part = self.fold(thrust_part, |a, e| {
             match e.thrust_drag(rotation, air_body) {
                 Some(drag) => sub(a, scale(drag, ratio)),
+                None => a,
+            }
+        });
+        let thrust_part = self.fold(thrust_part, |a, e| {
+            match e.speed_drag(rotation, air_body) {
+                Some(drag) => sub(a, scale(drag, ratio.max(0.0).sqrt())),
                 None => a,
             }
         });
@@ -493,14 +513,33 @@ impl Effects {
         self.fold(model.inertia_kg_m2, |inertia, e| e.inertia(inertia))
     }
 
-    /// The real angular acceleration `J_real⁻¹ (τ − ω × J_real ω) + Σ biases`.
-    pub fn angular_acceleration(&self, model: &NominalModel, rate: Vec3, torque: Vec3) -> Vec3 {
+    /// The real angular acceleration `J_real⁻¹ (τ − ω × J_real ω) + Σ biases + Σ air torques`,
+    /// with `air_body` the body-frame airspeed ([`Self::body_airspeed`]).
+    pub fn angular_acceleration(
+        &self,
+        model: &NominalModel,
+        rate: Vec3,
+        torque: Vec3,
+        air_body: Vec3,
+    ) -> Vec3 {
         let base = angular_acceleration_with_inertia(self.inertia(model), rate, torque);
-        let bias = self.fold([0.0; 3], |b, e| match e.angular_bias() {
-            Some(extra) => add(b, extra),
-            None => b,
+        let bias = self.fold([0.0; 3], |b, e| {
+            let b = match e.angular_bias() {
+                Some(extra) => add(b, extra),
+                None => b,
+            };
+            match e.air_torque(air_body) {
+                Some(extra) => add(b, extra),
+                None => b,
+            }
         });
         add(base, bias)
+    }
+
+    /// The body-frame airspeed `Rᵀ (v − w_air(p))` at attitude `rotation`, velocity `velocity` and
+    /// position `position`.
+    pub fn body_airspeed(&self, rotation: &Mat3, velocity: Vec3, position: Vec3) -> Vec3 {
+        mat_t_vec(rotation, sub(velocity, self.air_velocity_at(position)))
     }
 
     /// The total of the effects' `timing` of this kind, s (0 without one).

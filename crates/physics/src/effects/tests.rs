@@ -273,8 +273,8 @@ fn every_registered_effect_keeps_the_registry_contract() {
             "{id}"
         );
         assert_eq!(
-            neutral.angular_acceleration(&m, rate, torque),
-            nominal.angular_acceleration(&m, rate, torque),
+            neutral.angular_acceleration(&m, rate, torque, velocity),
+            nominal.angular_acceleration(&m, rate, torque, velocity),
             "{id}"
         );
         for number in EffectNumber::all_of(id) {
@@ -309,6 +309,8 @@ fn numbers_are_set_and_dependants_removed_through_the_registry() {
         .without(EffectId::QuadraticDrag);
     assert!(drags_gone.contains(EffectId::Wind));
     drags_gone = drags_gone.without(EffectId::RotorDrag);
+    assert!(drags_gone.contains(EffectId::Wind));
+    drags_gone = drags_gone.without(EffectId::RotorSpeedDrag);
     assert!(!drags_gone.contains(EffectId::Wind) && !drags_gone.contains(EffectId::WindGradient));
     assert!(drags_gone.validate().is_ok());
 }
@@ -340,6 +342,61 @@ fn axial_thrust_loss_acts_as_documented() {
         ..Effects::default()
     };
     assert_eq!(negative.validate().unwrap_err().0, "axial_thrust_loss.c");
+}
+
+/// Rotor drag proportional to the rotor speed: at four times the hover thrust it doubles (the
+/// speeds double), against the airspeed; a negative coefficient is refused.
+#[test]
+fn rotor_speed_drag_grows_with_the_square_root_of_the_thrust() {
+    let m = model();
+    let hover = 20.0;
+    let drag = Effects {
+        rotor_speed_drag: Some(RotorSpeedDrag { d: [0.3, 0.6] }),
+        wind: Some(Wind {
+            w_air: [1.0, 0.0, 0.0],
+        }),
+        ..Effects::default()
+    };
+    // −2 · 0.3 · (3 − 1) edgewise, −2 · 0.6 · 1 axial, on a thrust of 4 m g.
+    let a =
+        drag.translational_acceleration(&m, &LEVEL, [3.0, 0.0, 1.0], [0.0, 0.0, 5.0], 4.0 * hover);
+    assert!(
+        (a[0] + 1.2).abs() < 1e-12 && (a[2] - (40.0 - 10.0 - 1.2)).abs() < 1e-12,
+        "{a:?}"
+    );
+    let at_hover = drag.translational_acceleration(&m, &LEVEL, [3.0, 0.0, 1.0], [0.0; 3], hover);
+    assert!((at_hover[0] + 0.6).abs() < 1e-12, "{at_hover:?}");
+    let negative = Effects {
+        rotor_speed_drag: Some(RotorSpeedDrag { d: [-0.1, 0.0] }),
+        ..Effects::default()
+    };
+    assert_eq!(negative.validate().unwrap_err().0, "rotor_speed_drag.d");
+}
+
+/// A drag acting above the centre of mass pitches the nose up in forward flight and rolls away
+/// from a sideways airspeed; the torque follows the air, not the ground speed.
+#[test]
+fn aerodynamic_torque_follows_the_body_airspeed() {
+    let m = model();
+    let effects = Effects {
+        aerodynamic_torque: Some(AerodynamicTorque { k: [0.5, 0.25] }),
+        linear_drag: Some(LinearDrag { d: [0.1; 3] }),
+        wind: Some(Wind {
+            w_air: [1.0, 0.0, 0.0],
+        }),
+        ..Effects::default()
+    };
+    let air_body = effects.body_airspeed(&LEVEL, [3.0, 2.0, 0.0], [0.0; 3]);
+    assert_eq!(air_body, [2.0, 2.0, 0.0]);
+    let nominal = Effects::default().angular_acceleration(&m, [0.0; 3], [0.0; 3], air_body);
+    let a = effects.angular_acceleration(&m, [0.0; 3], [0.0; 3], air_body);
+    assert_eq!(nominal, [0.0; 3]);
+    assert!((a[0] - 1.0).abs() < 1e-12 && (a[1] + 0.5).abs() < 1e-12 && a[2] == 0.0, "{a:?}");
+    let nan = Effects {
+        aerodynamic_torque: Some(AerodynamicTorque { k: [f64::NAN, 0.0] }),
+        ..Effects::default()
+    };
+    assert_eq!(nan.validate().unwrap_err().0, "aerodynamic_torque.k");
 }
 
 /// A profile search tries only values a fit may keep: every grid point inside the number's fit

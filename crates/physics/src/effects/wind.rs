@@ -58,8 +58,9 @@ impl EffectKind for Wind {
             EffectId::LinearDrag,
             EffectId::QuadraticDrag,
             EffectId::RotorDrag,
+            EffectId::RotorSpeedDrag,
         ],
-        message: "needs a drag effect (linear_drag, quadratic_drag or rotor_drag) to act through",
+        message: "needs a drag effect (linear_drag, quadratic_drag, rotor_drag or rotor_speed_drag) to act through",
     });
 
     fn from_numbers(numbers: &[f64]) -> Self {

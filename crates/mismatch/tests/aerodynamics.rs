@@ -1,0 +1,39 @@
+//! The aerodynamics of real rotors that the single-recording analysis names: a rotor drag
+//! proportional to the rotor speed (Gazebo's and PX4 SITL's form), screened as a drag along the
+//! body axes and named in its place, and a torque from a drag acting above the centre of mass,
+//! found on the angular channels instead of being absorbed as a wrong inertia.
+
+use mismatch::analyze;
+use physics::{AerodynamicTorque, EffectId, Effects, RotorSpeedDrag, simulate};
+
+mod common;
+
+use common::{fast_settings, scenario};
+
+#[test]
+fn a_rotor_drag_proportional_to_the_rotor_speed_is_named_in_place_of_a_body_axis_drag() {
+    let model = common::model_for_scenario();
+    let effects = Effects {
+        rotor_speed_drag: Some(RotorSpeedDrag { d: [0.35, 0.1] }),
+        ..Effects::default()
+    };
+    let log = simulate(&model, &scenario(effects, 41), "rotor-speed").unwrap();
+    let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
+    assert_eq!(analysis.fitted.ids(), [EffectId::RotorSpeedDrag]);
+    let d = analysis.fitted.rotor_speed_drag.unwrap().d;
+    assert!((d[0] - 0.35).abs() < 0.02 && (d[1] - 0.1).abs() < 0.02, "{d:?}");
+}
+
+#[test]
+fn a_torque_from_drag_above_the_centre_of_mass_is_named_not_an_inertia() {
+    let model = common::model_for_scenario();
+    let effects = Effects {
+        aerodynamic_torque: Some(AerodynamicTorque { k: [0.4, 0.3] }),
+        ..Effects::default()
+    };
+    let log = simulate(&model, &scenario(effects, 42), "air-torque").unwrap();
+    let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
+    assert_eq!(analysis.fitted.ids(), [EffectId::AerodynamicTorque]);
+    let k = analysis.fitted.aerodynamic_torque.unwrap().k;
+    assert!((k[0] - 0.4).abs() < 0.03 && (k[1] - 0.3).abs() < 0.03, "{k:?}");
+}

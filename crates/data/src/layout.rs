@@ -212,7 +212,8 @@ impl RecordingLayout {
     }
 }
 
-/// Reads `path` (a CSV file, or a PX4 ULog when its extension is `.ulg`) as `layout` says. The
+/// Reads `path` (a CSV file, a PX4 ULog when its extension is `.ulg`, or a folder holding a PX4 log
+/// exported to CSV, one file per topic) as `layout` says. The
 /// time stamps are kept as logged (strictly increasing, every interval within
 /// [`SAMPLE_INTERVAL_RANGE_S`]); errors name the file, line and column.
 pub fn read_with_layout(path: &Path, layout: &RecordingLayout) -> Result<FlightLog> {
@@ -238,6 +239,11 @@ pub fn read_rows_with_layout(
         let aligned = crate::ulog::aligned_table(&log, path, Some(&layout.time.column), &columns)?;
         // Seconds since the log started, as the ULog inspection counts them.
         let start = log.start_time_us as f64 * 1e-6;
+        let time: Vec<f64> = aligned.time.iter().map(|t| t - start).collect();
+        (time, aligned.table)
+    } else if path.is_dir() {
+        let (aligned, start) =
+            crate::ulog::aligned_export_table(path, Some(&layout.time.column), &columns)?;
         let time: Vec<f64> = aligned.time.iter().map(|t| t - start).collect();
         (time, aligned.table)
     } else {

@@ -21,7 +21,10 @@ fn a_rotor_drag_proportional_to_the_rotor_speed_is_named_in_place_of_a_body_axis
     let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
     assert_eq!(analysis.fitted.ids(), [EffectId::RotorSpeedDrag]);
     let d = analysis.fitted.rotor_speed_drag.unwrap().d;
-    assert!((d[0] - 0.35).abs() < 0.02 && (d[1] - 0.1).abs() < 0.02, "{d:?}");
+    assert!(
+        (d[0] - 0.35).abs() < 0.02 && (d[1] - 0.1).abs() < 0.02,
+        "{d:?}"
+    );
 }
 
 #[test]
@@ -35,5 +38,8 @@ fn a_torque_from_drag_above_the_centre_of_mass_is_named_not_an_inertia() {
     let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
     assert_eq!(analysis.fitted.ids(), [EffectId::AerodynamicTorque]);
     let k = analysis.fitted.aerodynamic_torque.unwrap().k;
-    assert!((k[0] - 0.4).abs() < 0.03 && (k[1] - 0.3).abs() < 0.03, "{k:?}");
+    assert!(
+        (k[0] - 0.4).abs() < 0.03 && (k[1] - 0.3).abs() < 0.03,
+        "{k:?}"
+    );
 }

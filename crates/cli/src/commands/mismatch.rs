@@ -29,7 +29,8 @@ use super::Global;
         .args(["recording", "demo", "flights"])
 ))]
 pub struct Args {
-    /// A recording: in the Neural-Fly CSV layout, or a CSV file or PX4 ULog that --layout describes.
+    /// A recording: in the Neural-Fly CSV layout, or a CSV file, PX4 ULog or folder of a PX4 CSV
+    /// export that --layout describes.
     #[arg(long, conflicts_with_all = ["demo", "flights"])]
     pub recording: Option<PathBuf>,
     /// With --recording: a layout description (JSON) saying which columns or ULog topics hold the

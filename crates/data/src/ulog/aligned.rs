@@ -39,14 +39,14 @@ pub struct HeldColumn {
 }
 
 /// A column's topic (name and instance) and field.
-struct ColumnName<'a> {
-    topic: &'a str,
-    instance: u8,
-    field: &'a str,
+pub(super) struct ColumnName<'a> {
+    pub topic: &'a str,
+    pub instance: u8,
+    pub field: &'a str,
 }
 
 /// Splits `topic.field` or `topic[k].field`.
-fn column_name(column: &str) -> Option<ColumnName<'_>> {
+pub(super) fn column_name(column: &str) -> Option<ColumnName<'_>> {
     let (topic, field) = column.split_once('.')?;
     let (topic, instance) = topic_name(topic)?;
     (!field.is_empty()).then_some(ColumnName {
@@ -57,7 +57,7 @@ fn column_name(column: &str) -> Option<ColumnName<'_>> {
 }
 
 /// Splits `topic` or `topic[k]`.
-fn topic_name(text: &str) -> Option<(&str, u8)> {
+pub(super) fn topic_name(text: &str) -> Option<(&str, u8)> {
     match text.strip_suffix(']').and_then(|t| t.split_once('[')) {
         Some((topic, instance)) => Some((topic, instance.parse().ok()?)),
         None => Some((text, 0)),
@@ -116,26 +116,54 @@ pub fn aligned_table(
             .map(|(topic, _)| *topic)
             .ok_or_else(|| bad("columns", "no column named".into()))?,
     };
-    let clock = base_topic.timestamps();
+    let sources: Vec<(TopicClock, Vec<f64>)> = sources
+        .into_iter()
+        .map(|(topic, values)| (clock_of(topic), values))
+        .collect();
+    join(path, &clock_of(base_topic), columns, sources)
+}
+
+fn clock_of(topic: &Topic) -> TopicClock<'_> {
+    TopicClock {
+        label: format!("{}[{}]", topic.name, topic.multi_id),
+        timestamps: topic.timestamps(),
+    }
+}
+
+/// One topic's clock: its label (`name[k]`) and its samples' time stamps, µs.
+pub(super) struct TopicClock<'a> {
+    pub label: String,
+    pub timestamps: &'a [u64],
+}
+
+/// The columns `columns`, each given by its topic's clock and values in `sources`, as of each
+/// sample of `base` (a topic's label names it; the base's own columns are not held).
+pub(super) fn join(
+    path: &Path,
+    base: &TopicClock,
+    columns: &[&str],
+    sources: Vec<(TopicClock, Vec<f64>)>,
+) -> Result<AlignedTable> {
+    let clock = base.timestamps;
     // Rows before every column's topic has a sample have nothing to hold.
     let start = sources
         .iter()
-        .map(|(topic, _)| clock.partition_point(|&t| t < topic.timestamps()[0]))
+        .map(|(topic, _)| clock.partition_point(|&t| t < topic.timestamps[0]))
         .max()
         .unwrap_or(0);
     let rows = start..clock.len();
     let mut held = Vec::new();
     let mut values = Vec::with_capacity(columns.len());
     for (&column, (topic, column_values)) in columns.iter().zip(&sources) {
-        let picked = as_of(topic.timestamps(), &clock[rows.clone()]);
-        if !std::ptr::eq(*topic, base_topic) {
+        let picked = as_of(topic.timestamps, &clock[rows.clone()]);
+        if topic.label != base.label {
             held.push(HeldColumn {
                 column: column.to_string(),
-                median_rate_hz: median_rate_hz(topic),
+                median_rate_hz: median_rate_hz(topic.timestamps),
                 longest_hold_s: picked
                     .iter()
                     .zip(&clock[rows.clone()])
-                    .map(|(&sample, &t)| (t - topic.timestamps()[sample]) as f64 * 1e-6)
+                    .map(|(&sample, &t)| (t - topic.timestamps[sample]) as f64 * 1e-6)
                     .fold(0.0, f64::max),
             });
         }
@@ -146,14 +174,13 @@ pub fn aligned_table(
         .iter()
         .map(|&t| t as f64 * 1e-6)
         .collect();
-    let base = format!("{}[{}]", base_topic.name, base_topic.multi_id);
     // A clock that stands still or runs back has no derivative: its sample is named.
-    check_time_axis_at(path, &base, &time, f64::INFINITY, &|k| start + k + 1)?;
+    check_time_axis_at(path, &base.label, &time, f64::INFINITY, &|k| start + k + 1)?;
     let lines = rows.map(|row| row + 1).collect();
     Ok(AlignedTable {
         time,
         table: NumericTable::from_columns(path, names, values, lines),
-        base,
+        base: base.label.clone(),
         held,
     })
 }
@@ -174,12 +201,8 @@ fn as_of(samples: &[u64], clock: &[u64]) -> Vec<usize> {
 }
 
 /// One over the median step of a topic's time stamps (0 for fewer than two samples).
-fn median_rate_hz(topic: &Topic) -> f64 {
-    let seconds: Vec<f64> = topic
-        .timestamps()
-        .iter()
-        .map(|&t| t as f64 * 1e-6)
-        .collect();
+fn median_rate_hz(timestamps: &[u64]) -> f64 {
+    let seconds: Vec<f64> = timestamps.iter().map(|&t| t as f64 * 1e-6).collect();
     let median = median_interval(&seconds);
     if median > 0.0 { 1.0 / median } else { 0.0 }
 }

@@ -478,11 +478,9 @@ impl Effects {
                 None => a,
             }
         });
-        let thrust_part = self.fold(thrust_part, |a, e| {
-            match e.speed_drag(rotation, air_body) {
-                Some(drag) => sub(a, scale(drag, ratio.max(0.0).sqrt())),
-                None => a,
-            }
+        let thrust_part = self.fold(thrust_part, |a, e| match e.speed_drag(rotation, air_body) {
+            Some(drag) => sub(a, scale(drag, ratio.max(0.0).sqrt())),
+            None => a,
         });
         add(
             thrust_part,

@@ -391,7 +391,10 @@ fn aerodynamic_torque_follows_the_body_airspeed() {
     let nominal = Effects::default().angular_acceleration(&m, [0.0; 3], [0.0; 3], air_body);
     let a = effects.angular_acceleration(&m, [0.0; 3], [0.0; 3], air_body);
     assert_eq!(nominal, [0.0; 3]);
-    assert!((a[0] - 1.0).abs() < 1e-12 && (a[1] + 0.5).abs() < 1e-12 && a[2] == 0.0, "{a:?}");
+    assert!(
+        (a[0] - 1.0).abs() < 1e-12 && (a[1] + 0.5).abs() < 1e-12 && a[2] == 0.0,
+        "{a:?}"
+    );
     let nan = Effects {
         aerodynamic_torque: Some(AerodynamicTorque { k: [f64::NAN, 0.0] }),
         ..Effects::default()

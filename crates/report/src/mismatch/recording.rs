@@ -203,11 +203,7 @@ impl StandInLine<'_> {
             self.likelihood_ratio,
             self.likelihood_ratio_threshold,
             100.0 * change.abs(),
-            if change >= 0.0 {
-                "higher"
-            } else {
-                "lower"
-            }
+            if change >= 0.0 { "higher" } else { "lower" }
         )
     }
 }

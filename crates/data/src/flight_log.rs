@@ -61,6 +61,7 @@ pub struct FlightLog {
     pub meta: Option<FlightMeta>,
     /// Time in seconds, strictly increasing (at a uniform rate when read with [`Spacing::Uniform`]).
     pub time: Vec<f64>,
+    /// World position, m; NaN on every row when the log has none ([`FlightLog::position_logged`]).
     pub position: Vec<[f64; 3]>,
     pub velocity: Vec<[f64; 3]>,
     pub quaternion: Vec<[f64; 4]>,
@@ -339,6 +340,13 @@ impl FlightLog {
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.time.len()
+    }
+
+    /// Whether the log holds the position (a layout may map none: its positions are then NaN).
+    pub fn position_logged(&self) -> bool {
+        self.position
+            .first()
+            .is_some_and(|p| p.iter().all(|x| x.is_finite()))
     }
 
     /// Whether the log has no samples (never true for a log that was read successfully).

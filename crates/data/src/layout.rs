@@ -89,8 +89,9 @@ pub struct RecordingLayout {
     /// (`column` a topic name, the unit ignored).
     pub time: TimeColumn,
     pub frames: Frames,
-    /// World position, m.
-    pub position: [String; 3],
+    /// World position, m (optional: without it the ground effect is not looked for).
+    #[serde(default)]
+    pub position: Option<[String; 3]>,
     /// World velocity, m/s.
     pub velocity: [String; 3],
     pub quaternion: QuaternionColumns,
@@ -121,9 +122,12 @@ pub struct RecordingLayout {
     pub header_prefix: Option<String>,
 }
 
-/// Where the motor commands begin among the layout's columns (after position, velocity,
-/// quaternion and body rate).
-const FIRST_MOTOR_COLUMN: usize = 13;
+/// Where the velocity, the quaternion (w, x, y, z), the body rate and the motor commands begin
+/// among the layout's columns.
+const VELOCITY_COLUMN: usize = 0;
+const QUATERNION_COLUMN: usize = 3;
+const BODY_RATE_COLUMN: usize = 7;
+const FIRST_MOTOR_COLUMN: usize = 10;
 
 fn unit_scale() -> f64 {
     1.0
@@ -157,14 +161,13 @@ impl RecordingLayout {
         Ok(layout)
     }
 
-    /// The data columns in reading order: position, velocity, quaternion (w, x, y, z), body rate,
-    /// motor commands, then the optional ones present ([`Self::optional_columns`]).
+    /// The data columns in reading order: velocity, quaternion (w, x, y, z), body rate, motor
+    /// commands, then the optional ones present ([`Self::optional_columns`]).
     fn columns(&self) -> Vec<&str> {
         let q = &self.quaternion;
         let mut columns: Vec<&str> = self
-            .position
+            .velocity
             .iter()
-            .chain(&self.velocity)
             .chain([&q.w, &q.x, &q.y, &q.z])
             .chain(&self.body_rate)
             .chain(&self.motor_commands)
@@ -173,6 +176,7 @@ impl RecordingLayout {
         columns.extend(self.battery_voltage.as_deref());
         columns.extend(self.thrust_setpoint.as_ref().map(|c| c.column.as_str()));
         columns.extend(self.hover_throttle.as_deref());
+        columns.extend(self.position.iter().flatten().map(String::as_str));
         columns
     }
 
@@ -189,14 +193,14 @@ impl RecordingLayout {
         })
     }
 
-    /// Position, velocity, quaternion, body rate and motor commands: 3 + 3 + 4 + 3 + N columns.
+    /// Velocity, quaternion, body rate and motor commands: 3 + 4 + 3 + N columns.
     fn required_columns(&self) -> usize {
         FIRST_MOTOR_COLUMN + self.motor_commands.len()
     }
 
     /// Where the optional columns are among [`Self::columns`]: battery voltage, thrust setpoint,
-    /// hover throttle.
-    fn optional_columns(&self) -> [Option<usize>; 3] {
+    /// hover throttle, position (its first of three).
+    fn optional_columns(&self) -> [Option<usize>; 4] {
         let mut next = self.required_columns();
         let mut place = |present: bool| {
             present.then(|| {
@@ -208,6 +212,7 @@ impl RecordingLayout {
             place(self.battery_voltage.is_some()),
             place(self.thrust_setpoint.is_some()),
             place(self.hover_throttle.is_some()),
+            place(self.position.is_some()),
         ]
     }
 }
@@ -293,11 +298,15 @@ pub fn read_rows_with_layout(
             })
             .collect()
     };
+    let [battery, thrust_setpoint, hover_throttle, position] = layout.optional_columns();
+    let position_columns = position.zip(layout.position.as_ref());
     for (first, range, names) in [
-        (0, "p", &layout.position),
-        (3, "v", &layout.velocity),
-        (10, "w", &layout.body_rate),
-    ] {
+        (VELOCITY_COLUMN, "v", &layout.velocity),
+        (BODY_RATE_COLUMN, "w", &layout.body_rate),
+    ]
+    .into_iter()
+    .chain(position_columns.map(|(first, names)| (first, "p", names)))
+    {
         check_plausible(&table, first, range, names)?;
     }
     let quaternion = quaternions(&table, layout)?;
@@ -311,7 +320,6 @@ pub fn read_rows_with_layout(
         }
         motor_command.push(&row);
     }
-    let [battery, thrust_setpoint, hover_throttle] = layout.optional_columns();
     let scale = layout.thrust_setpoint.as_ref().map_or(1.0, |c| c.scale);
     let scaled = |index: Option<usize>, factor: f64, range: &str, name: Option<&String>| {
         let Some(i) = index else {
@@ -336,9 +344,13 @@ pub fn read_rows_with_layout(
     Ok(FlightLog {
         path: path.to_path_buf(),
         meta: FlightMeta::from_file_name(path),
-        position: vector(0),
-        velocity: vector(3),
-        body_rate: vector(10),
+        // Not logged: NaN, which `FlightLog::position_logged` reports.
+        position: match position {
+            Some(first) => vector(first),
+            None => vec![[f64::NAN; 3]; time.len()],
+        },
+        velocity: vector(VELOCITY_COLUMN),
+        body_rate: vector(BODY_RATE_COLUMN),
         thrust_setpoint,
         hover_throttle,
         motor_command,
@@ -400,7 +412,7 @@ fn quaternions(table: &NumericTable, layout: &RecordingLayout) -> Result<Vec<[f6
     let column = |i: usize| &table.columns[i];
     (0..table.rows())
         .map(|k| {
-            let (w, x, y, z) = (column(6)[k], column(7)[k], column(8)[k], column(9)[k]);
+            let [w, x, y, z] = std::array::from_fn(|i| column(QUATERNION_COLUMN + i)[k]);
             let norm = (w * w + x * x + y * y + z * z).sqrt();
             if (norm - 1.0).abs() > 1e-3 {
                 return Err(DataError::BadCell {

@@ -62,6 +62,27 @@ fn a_ned_frd_log_reads_z_up_in_seconds_on_its_own_stamps() {
     assert_eq!(layout(PX4_LIKE).frames, Frames::NedFrd);
 }
 
+/// A layout without position reads the rest; the log says it holds no position.
+#[test]
+fn a_layout_without_position_reads_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("timestamp,x,y,z,vx,vy,vz,q0,q1,q2,q3,p,q,r,m1,m2,m3,m4,volts\n");
+    for k in 0..6 {
+        text.push_str(&ned_row(k, 0.4, 2.0));
+    }
+    let path = write(dir.path(), "px4.csv", &text);
+    let without = PX4_LIKE.replace(r#""position": ["x", "y", "z"],"#, "");
+    let log = read_with_layout(&path, &layout(&without)).unwrap();
+    assert!(!log.position_logged());
+    assert_eq!(log.velocity[0], [0.5, 0.25, 1.0]);
+    assert_eq!(log.body_rate[0], [0.1, -0.2, -0.3]);
+    assert_eq!(log.motor_command.row(0), [1500.0, 1510.0, 1490.0, 1505.0]);
+    let with = read_with_layout(&path, &layout(PX4_LIKE)).unwrap();
+    assert!(with.position_logged());
+    assert_eq!(with.velocity, log.velocity);
+    assert_eq!(with.quaternion, log.quaternion);
+}
+
 #[test]
 fn a_header_written_as_a_comment_needs_its_prefix_declared() {
     let dir = tempfile::tempdir().unwrap();

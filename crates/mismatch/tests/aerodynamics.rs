@@ -43,3 +43,33 @@ fn a_torque_from_drag_above_the_centre_of_mass_is_named_not_an_inertia() {
         "{k:?}"
     );
 }
+
+/// A log without position (a layout may leave it out): the ground effect is not looked for, the
+/// rest is analysed as with it, and the report says what is missing.
+#[test]
+fn a_log_without_position_is_analysed_without_the_ground_effect() {
+    let model = common::model_for_scenario();
+    let effects = Effects {
+        rotor_speed_drag: Some(RotorSpeedDrag { d: [0.35, 0.1] }),
+        ..Effects::default()
+    };
+    let mut log = simulate(&model, &scenario(effects, 41), "no-position").unwrap();
+    log.position = vec![[f64::NAN; 3]; log.len()];
+    let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
+    assert_eq!(analysis.fitted.ids(), [EffectId::RotorSpeedDrag]);
+    let d = analysis.fitted.rotor_speed_drag.unwrap().d;
+    assert!(
+        (d[0] - 0.35).abs() < 0.02 && (d[1] - 0.1).abs() < 0.02,
+        "{d:?}"
+    );
+    let json = serde_json::to_value(&analysis.report).unwrap();
+    assert_eq!(json["not_logged"], serde_json::json!(["position"]));
+    let screened: Vec<&str> = json["selection"]["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["id"].as_str().unwrap())
+        .collect();
+    assert!(!screened.contains(&"ground_effect"), "{screened:?}");
+    assert!(screened.contains(&"linear_drag"), "{screened:?}");
+}

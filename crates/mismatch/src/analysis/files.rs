@@ -18,7 +18,7 @@ use crate::error::Result;
 use crate::explain::confounds::StandIn;
 use crate::explain::evidence::Evidence;
 use crate::locate::problem::CHANNEL_NAMES;
-use crate::recording::content::LogContent;
+use crate::recording::content::{LogContent, Signal};
 use crate::recording::noise_reaction;
 
 /// The names of an analysis's files in its folder, in the order of [`Analysis::render`].
@@ -116,6 +116,7 @@ impl Analysis {
             rate_frame: &report.rate_frame,
             time_stamps: report.time_stamps.as_ref(),
             log_content: report.log_content.as_ref().map(log_content_view),
+            position_logged: !report.not_logged.contains(&Signal::Position),
             below_resolution: report
                 .selection
                 .below_resolution

@@ -23,7 +23,7 @@ use crate::locate::windows::{Residuals, channel_reports, locate_windows, without
 use crate::model::least_squares::Termination;
 use crate::model::refine::effects_from;
 use crate::recording::command_samples::ActuatorLimits;
-use crate::recording::content::LogContent;
+use crate::recording::content::{LogContent, Signal};
 use crate::recording::noise_reaction::NoiseReaction;
 use crate::settings::{AnalysisRecord, CheckedSettings};
 
@@ -140,6 +140,9 @@ pub struct Report {
     /// between slower updates ([`crate::recording::content`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub log_content: Option<LogContent>,
+    /// Signals the log does not hold (the position, which a layout may leave out).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub not_logged: Vec<Signal>,
     /// How the recording's commands and rates were logged (from the model file).
     pub logger: Logger,
     /// What was taken out of sampled commands of a faster controller: their unfelt reaction to the
@@ -277,6 +280,11 @@ pub(super) fn build_report(
         },
         time_stamps: stamped_timing(problem),
         log_content: screen.log_content,
+        not_logged: if problem.recording.position_logged {
+            Vec::new()
+        } else {
+            vec![Signal::Position]
+        },
         uninformative_torques: screen.uninformative_torques,
         logger: problem.model.logger,
         noise_reaction: problem.recording.noise_reaction.clone(),

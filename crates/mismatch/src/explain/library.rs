@@ -104,6 +104,10 @@ pub fn build_library(problem: &Problem) -> (Vec<Candidate>, Vec<Vec<Channels>>) 
         if effect.acts_on() == ChannelGroup::Angular && problem.channels != 6 {
             continue;
         }
+        // The height above the ground comes from the logged position.
+        if id == CandidateId::GroundEffect && !problem.recording.position_logged {
+            continue;
+        }
         let Some((terms, perturbed)) = effect.screening(problem.recording.dt()) else {
             continue;
         };

@@ -92,6 +92,7 @@ pub fn measure(log: &FlightLog) -> Option<LogContent> {
     }
     let signals: Vec<SignalContent> = Signal::ALL
         .into_iter()
+        .filter(|signal| *signal != Signal::Position || log.position_logged())
         .filter_map(|signal| content_of(signal, log, duration))
         .collect();
     if signals.iter().all(|s| s.pattern == ColumnPattern::Fresh) {

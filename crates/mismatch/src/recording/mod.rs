@@ -31,7 +31,11 @@ pub struct Recording {
     pub rotation: Vec<Mat3>,
     pub velocity: Vec<Vec3>,
     /// Position, m (world frame).
+    /// World position (NaN when the log has none: [`Recording::position_logged`]).
     pub position: Vec<Vec3>,
+    /// Whether the log holds the position (without it the ground effect is not looked for and
+    /// the commands' reaction to position noise is not removed).
+    pub position_logged: bool,
     /// Body rate, rad/s (converted from the world frame when the `w` column is in the world frame).
     pub body_rate: Vec<Vec3>,
     /// The frame the `w` column was found to be in, with the RMS errors (body, world) of the check.
@@ -161,6 +165,7 @@ impl Recording {
             rotation: log.rotation.clone(),
             velocity: log.velocity.clone(),
             position: log.position.clone(),
+            position_logged: log.position_logged(),
             body_rate,
             rate_frame: frame,
             rate_frame_errors: (body_rms, world_rms),

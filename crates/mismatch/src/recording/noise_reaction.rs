@@ -90,8 +90,12 @@ pub fn remove(recording: &mut Recording, logger: &Logger, actuators: usize) -> b
         logged_commands: recording.commands.clone(),
     };
     let attitude = attitude_noise(recording, &states);
-    let position = position_noise(recording);
-    subtract(recording, &mut reaction, &[(3, &attitude), (9, &position)]);
+    if recording.position_logged {
+        let position = position_noise(recording);
+        subtract(recording, &mut reaction, &[(3, &attitude), (9, &position)]);
+    } else {
+        subtract(recording, &mut reaction, &[(3, &attitude)]);
+    }
     recording.noise_reaction = Some(reaction);
     true
 }
@@ -236,7 +240,9 @@ fn state_fourth_differences(recording: &Recording) -> Vec<[f64; STATES]> {
             for a in 0..3 {
                 row[a] = fourth(&recording.body_rate, a);
                 row[6 + a] = fourth(&recording.velocity, a);
-                row[9 + a] = fourth(&recording.position, a);
+                if recording.position_logged {
+                    row[9 + a] = fourth(&recording.position, a);
+                }
             }
             row
         })

@@ -260,6 +260,8 @@ pub struct RecordingView<'a> {
     pub time_stamps: Option<&'a StampedTiming>,
     /// What the log holds, when some signal is slower than the rows.
     pub log_content: Option<LogContentView<'a>>,
+    /// Whether the log holds the position (without it the ground effect is not looked for).
+    pub position_logged: bool,
     /// Delays and motor lags fitted shorter than the log resolves (left out).
     pub below_resolution: Vec<BelowResolutionLine<'a>>,
     pub channels: &'a [ChannelReport],
@@ -412,6 +414,12 @@ impl RecordingView<'_> {
                 );
             }
             let _ = writeln!(md, "\n");
+        }
+        if !self.position_logged {
+            let _ = writeln!(
+                md,
+                "**No position in the log.** The ground effect, which needs the height, is not looked for, and the commands' reaction to position noise is not removed.\n"
+            );
         }
     }
 
@@ -841,6 +849,7 @@ mod tests {
             model: "model.json",
             rate_frame: &rate_frame,
             time_stamps: None,
+            position_logged: false,
             log_content: Some(LogContentView {
                 row_rate_hz: 50.0,
                 signals: vec![
@@ -942,6 +951,7 @@ mod tests {
             "| fit | 0.50000 | 0.12500 | 75.0% |\n| held out | 0.40000 | 0.20000 | 50.0% |\n",
             "\n**Noise on the model's side.** The commands and attitude the model reads are noisy too: relative to the variance of the model's value, their noise's variance is 12% on vdot_y.",
             "samples of a controller 10 times faster than the log",
+            "**No position in the log.** The ground effect, which needs the height, is not looked for",
         ] {
             assert!(md.contains(line), "missing {line:?} in\n{md}");
         }
@@ -981,6 +991,7 @@ mod tests {
             rate_frame: &rate_frame,
             time_stamps: None,
             log_content: None,
+            position_logged: true,
             below_resolution: Vec::new(),
             channels: &channels,
             translational_only: false,

@@ -48,6 +48,7 @@ fn flight(seed: u64) -> (Recording, Commands, Commands, Vec<Vec3>) {
         rotation: Vec::new(),
         velocity: Vec::new(),
         position: Vec::new(),
+        position_logged: true,
         body_rate: Vec::new(),
         rate_frame: RateFrame::Body,
         rate_frame_errors: (0.0, 0.0),

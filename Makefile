@@ -80,5 +80,5 @@ mismatch-demo: data build
 	$(LEARN) mismatch --demo experiments/mismatch/demo-vehicles.json --work target/mismatch-demo-vehicles --out results/mismatch/vehicles --force
 	$(LEARN) mismatch --flights experiments/conditions.json --model experiments/mismatch/neural-fly.json --out results/mismatch --force
 	$(LEARN) mismatch --recording data/crazyflie/randomwalk_l_cf102_01.csv --layout experiments/layouts/crazyflie-neural-swarm.json --model experiments/mismatch/vehicles/crazyflie-parrot.json --out results/mismatch/shared/crazyflie --force
-	$(LEARN) mismatch --recording data/ulog/sample_px4_events.ulg --layout experiments/layouts/px4-ulog.json --model experiments/mismatch/vehicles/jmavsim-iris.json --half-width 0.4 --rows 160:280 --out results/mismatch/shared/jmavsim --force
+	$(LEARN) mismatch --recording data/ulog/sample_px4_events.ulg --layout experiments/layouts/px4-ulog.json --model experiments/mismatch/vehicles/jmavsim-iris.json --half-width 0.4 --rows 186:262 --out results/mismatch/shared/jmavsim --force
 	$(LEARN) mismatch --recording data/ulog/quadrotor_local.ulg --layout experiments/layouts/px4-ulog-thrust-setpoint.json --model experiments/mismatch/vehicles/px4-thrust-setpoint.json --half-width 0.4 --rows 0:720 --out results/mismatch/shared/quadrotor-local --force

@@ -1,25 +1,36 @@
 //! The aerodynamics of real rotors that the single-recording analysis names: a rotor drag
 //! proportional to the rotor speed (Gazebo's and PX4 SITL's form), screened as a drag along the
 //! body axes and named in its place, and a torque from a drag acting above the centre of mass,
-//! found on the angular channels instead of being absorbed as a wrong inertia.
+//! found on the angular channels instead of being absorbed as a wrong inertia. A log without
+//! position is analysed without the ground effect.
 
-use mismatch::analyze;
-use physics::{AerodynamicTorque, EffectId, Effects, RotorSpeedDrag, simulate};
+use data::FlightLog;
+use mismatch::{Analysis, analyze};
+use physics::{AerodynamicTorque, Effects, RotorSpeedDrag, simulate};
 
 mod common;
 
 use common::{fast_settings, scenario};
 
-#[test]
-fn a_rotor_drag_proportional_to_the_rotor_speed_is_named_in_place_of_a_body_axis_drag() {
+/// The test scenario flown with `effects`, its log changed by `edit`, analysed; the analysis
+/// must name `effects` alone.
+fn named_alone(effects: Effects, seed: u64, edit: impl FnOnce(&mut FlightLog)) -> Analysis {
     let model = common::model_for_scenario();
-    let effects = Effects {
+    let mut log = simulate(&model, &scenario(effects, seed), "aerodynamics").unwrap();
+    edit(&mut log);
+    let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
+    assert_eq!(analysis.fitted.ids(), effects.ids());
+    analysis
+}
+
+fn rotor_speed_drag() -> Effects {
+    Effects {
         rotor_speed_drag: Some(RotorSpeedDrag { d: [0.35, 0.1] }),
         ..Effects::default()
-    };
-    let log = simulate(&model, &scenario(effects, 41), "rotor-speed").unwrap();
-    let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
-    assert_eq!(analysis.fitted.ids(), [EffectId::RotorSpeedDrag]);
+    }
+}
+
+fn assert_rotor_speed_drag(analysis: &Analysis) {
     let d = analysis.fitted.rotor_speed_drag.unwrap().d;
     assert!(
         (d[0] - 0.35).abs() < 0.02 && (d[1] - 0.1).abs() < 0.02,
@@ -28,15 +39,18 @@ fn a_rotor_drag_proportional_to_the_rotor_speed_is_named_in_place_of_a_body_axis
 }
 
 #[test]
+fn a_rotor_drag_proportional_to_the_rotor_speed_is_named_in_place_of_a_body_axis_drag() {
+    let analysis = named_alone(rotor_speed_drag(), 41, |_| {});
+    assert_rotor_speed_drag(&analysis);
+}
+
+#[test]
 fn a_torque_from_drag_above_the_centre_of_mass_is_named_not_an_inertia() {
-    let model = common::model_for_scenario();
     let effects = Effects {
         aerodynamic_torque: Some(AerodynamicTorque { k: [0.4, 0.3] }),
         ..Effects::default()
     };
-    let log = simulate(&model, &scenario(effects, 42), "air-torque").unwrap();
-    let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
-    assert_eq!(analysis.fitted.ids(), [EffectId::AerodynamicTorque]);
+    let analysis = named_alone(effects, 42, |_| {});
     let k = analysis.fitted.aerodynamic_torque.unwrap().k;
     assert!(
         (k[0] - 0.4).abs() < 0.03 && (k[1] - 0.3).abs() < 0.03,
@@ -48,20 +62,10 @@ fn a_torque_from_drag_above_the_centre_of_mass_is_named_not_an_inertia() {
 /// rest is analysed as with it, and the report says what is missing.
 #[test]
 fn a_log_without_position_is_analysed_without_the_ground_effect() {
-    let model = common::model_for_scenario();
-    let effects = Effects {
-        rotor_speed_drag: Some(RotorSpeedDrag { d: [0.35, 0.1] }),
-        ..Effects::default()
-    };
-    let mut log = simulate(&model, &scenario(effects, 41), "no-position").unwrap();
-    log.position = vec![[f64::NAN; 3]; log.len()];
-    let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
-    assert_eq!(analysis.fitted.ids(), [EffectId::RotorSpeedDrag]);
-    let d = analysis.fitted.rotor_speed_drag.unwrap().d;
-    assert!(
-        (d[0] - 0.35).abs() < 0.02 && (d[1] - 0.1).abs() < 0.02,
-        "{d:?}"
-    );
+    let analysis = named_alone(rotor_speed_drag(), 41, |log| {
+        log.position = vec![[f64::NAN; 3]; log.len()];
+    });
+    assert_rotor_speed_drag(&analysis);
     let json = serde_json::to_value(&analysis.report).unwrap();
     assert_eq!(json["not_logged"], serde_json::json!(["position"]));
     let screened: Vec<&str> = json["selection"]["candidates"]

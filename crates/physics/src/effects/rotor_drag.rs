@@ -24,11 +24,7 @@ impl Effect for RotorDrag {
     }
 
     fn check(&self) -> Result<(), InvalidParameter> {
-        require(
-            self.d.iter().all(|v| v.is_finite() && *v >= 0.0),
-            "rotor_drag.d",
-            "must be two finite non-negative numbers",
-        )
+        check_coefficients(self.d, "rotor_drag.d")
     }
 
     fn describe(&self, _gravity_m_s2: f64) -> String {
@@ -42,9 +38,22 @@ impl Effect for RotorDrag {
     }
 
     fn thrust_drag(&self, rotation: &Mat3, air_body: Vec3) -> Option<Vec3> {
-        let d = [self.d[0], self.d[0], self.d[1]];
-        Some(mat_vec(rotation, hadamard(d, air_body)))
+        Some(edgewise_and_axial(self.d, rotation, air_body))
     }
+}
+
+/// `R diag(dh, dh, dv) v_b`: a rotor drag's deceleration per unit of what scales it (world frame).
+pub(super) fn edgewise_and_axial(d: [f64; 2], rotation: &Mat3, air_body: Vec3) -> Vec3 {
+    mat_vec(rotation, hadamard([d[0], d[0], d[1]], air_body))
+}
+
+/// A rotor drag's two coefficients are finite and non-negative; the error names `field`.
+pub(super) fn check_coefficients(d: [f64; 2], field: &str) -> Result<(), InvalidParameter> {
+    require(
+        d.iter().all(|v| v.is_finite() && *v >= 0.0),
+        field,
+        "must be two finite non-negative numbers",
+    )
 }
 
 impl EffectKind for RotorDrag {

@@ -6,10 +6,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{
-    ChannelGroup, Effect, EffectId, EffectKind, InvalidParameter, ParameterValue, require,
-};
-use crate::vector::{Mat3, Vec3, hadamard, mat_vec};
+use super::rotor_drag::{check_coefficients, edgewise_and_axial};
+use super::{ChannelGroup, Effect, EffectId, EffectKind, InvalidParameter, ParameterValue};
+use crate::vector::{Mat3, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -27,11 +26,7 @@ impl Effect for RotorSpeedDrag {
     }
 
     fn check(&self) -> Result<(), InvalidParameter> {
-        require(
-            self.d.iter().all(|v| v.is_finite() && *v >= 0.0),
-            "rotor_speed_drag.d",
-            "must be two finite non-negative numbers",
-        )
+        check_coefficients(self.d, "rotor_speed_drag.d")
     }
 
     fn describe(&self, _gravity_m_s2: f64) -> String {
@@ -45,8 +40,7 @@ impl Effect for RotorSpeedDrag {
     }
 
     fn speed_drag(&self, rotation: &Mat3, air_body: Vec3) -> Option<Vec3> {
-        let d = [self.d[0], self.d[0], self.d[1]];
-        Some(mat_vec(rotation, hadamard(d, air_body)))
+        Some(edgewise_and_axial(self.d, rotation, air_body))
     }
 }
 

@@ -105,10 +105,42 @@ fn a_slow_ulog_needs_a_wider_window() {
         .map(|e| e["id"].as_str().unwrap())
         .collect();
     assert!(!named.contains(&"wind"), "{named:?}");
+    assert_every_kept_candidate_is_accounted_for(&report);
     // In the air the nominal thrust (jMAVSim's 4 N per unit command) holds: the vertical residual
     // is a few noise floors (2.3 m/s² RMS with the rows on the ground, which holds the vehicle).
     let vertical = report["channels"][2]["residual_rms"].as_f64().unwrap();
     assert!(vertical < 0.2, "{vertical}");
+}
+
+/// Every candidate the screen kept is in the report's account of it: named, not separable,
+/// replaced by a stand-in, dropped by the evidence rule or shorter than the log resolves (the
+/// timing term may also resolve to no timing at all).
+fn assert_every_kept_candidate_is_accounted_for(report: &serde_json::Value) {
+    let ids = |list: &serde_json::Value| -> Vec<String> {
+        list.as_array()
+            .map(|items| {
+                items
+                    .iter()
+                    .map(|e| e["id"].as_str().unwrap().to_string())
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let selection = &report["selection"];
+    let mut accounted = ids(&report["effects"]);
+    accounted.extend(ids(&report["not_separable"]));
+    accounted.extend(ids(&selection["replaced"]));
+    accounted.extend(ids(&selection["dropped"]));
+    accounted.extend(ids(&selection["below_resolution"]));
+    for candidate in selection["candidates"].as_array().unwrap() {
+        let id = candidate["id"].as_str().unwrap();
+        if candidate["kept"].as_bool().unwrap() && id != "delay_or_motor_lag" {
+            assert!(
+                accounted.iter().any(|a| a == id),
+                "{id} kept but not reported: {accounted:?}"
+            );
+        }
+    }
 }
 
 /// A real flight of a vehicle whose rotors and mass are not known, compared through its thrust

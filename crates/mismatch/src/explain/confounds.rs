@@ -122,6 +122,8 @@ pub fn separate(problem: &Problem, judgement: Judgement, how: &Separate) -> Sepa
             .filter(|(s, _)| wins(s))
             .min_by(|a, b| a.0.likelihood_ratio.total_cmp(&b.0.likelihood_ratio));
         if let Some((_, swapped)) = best {
+            // What the rule dropped before the replacement stays reported, first.
+            let mut dropped = std::mem::take(&mut judgement.dropped);
             judgement = evidence::apply(
                 problem,
                 swapped,
@@ -129,6 +131,8 @@ pub fn separate(problem: &Problem, judgement: Judgement, how: &Separate) -> Sepa
                 how.iterations,
                 how.block_rows,
             );
+            dropped.append(&mut judgement.dropped);
+            judgement.dropped = dropped;
             replaced.push(confound.clone());
         }
         if !confound.stand_ins.is_empty() {

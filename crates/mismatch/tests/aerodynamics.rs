@@ -6,7 +6,7 @@
 
 use data::FlightLog;
 use mismatch::{Analysis, analyze};
-use physics::{AerodynamicTorque, Effects, RotorSpeedDrag, simulate};
+use physics::{AerodynamicTorque, AxialThrustLoss, Effects, RotorSpeedDrag, simulate};
 
 mod common;
 
@@ -76,4 +76,20 @@ fn a_log_without_position_is_analysed_without_the_ground_effect() {
         .collect();
     assert!(!screened.contains(&"ground_effect"), "{screened:?}");
     assert!(screened.contains(&"linear_drag"), "{screened:?}");
+}
+
+/// A thrust loss with axial airspeed (`T ×= 1 − c v_bz`) is the axial part of a rotor drag
+/// proportional to the thrust, `dv = g c`: it is named so, in place of the body-axis drag.
+#[test]
+fn a_thrust_loss_with_axial_airspeed_is_named_as_the_rotor_drags_axial_part() {
+    let effects = Effects {
+        axial_thrust_loss: Some(AxialThrustLoss { c: 0.03 }),
+        ..Effects::default()
+    };
+    let model = common::model_for_scenario();
+    let log = simulate(&model, &scenario(effects, 43), "axial").unwrap();
+    let analysis = analyze(&log, &model, "demo", &fast_settings()).unwrap();
+    let d = analysis.fitted.rotor_drag.expect("a rotor drag").d;
+    let axial = model.gravity_m_s2 * 0.03;
+    assert!(d[0] < 0.02 && (d[1] - axial).abs() < 0.1 * axial, "{d:?}");
 }

@@ -118,7 +118,9 @@ fn csv_layout_faults_name_the_file_and_line() {
 fn a_directory_or_a_binary_file_is_named_as_such() {
     let dir = scratch("sindy-not-csv");
     std::fs::create_dir_all(dir.join("folder")).unwrap();
-    sindy(&dir, "folder", "poly:1", &[]).one_line_error(&["folder: is a directory"]);
+    // A folder is read as a PX4 log exported to CSV, whose columns are `topic.field`.
+    sindy(&dir, "folder", "poly:1", &[])
+        .one_line_error(&["folder: x: is a directory, read as a PX4 CSV export"]);
     std::fs::write(dir.join("blob.csv"), b"\x00\x01\x02binary\xc3\xbf\n").unwrap();
     sindy(&dir, "blob.csv", "poly:1", &[]).one_line_error(&["blob.csv:1: not a CSV text file"]);
 }

@@ -199,3 +199,58 @@ fn the_airframe_parameters_are_written_as_a_vehicle_description() {
     csv.one_line_error(&["flight.csv", "--vehicle-out", "not a .ulg"]);
     assert!(!dir.join("w.json").exists());
 }
+
+/// `learn sindy` reads a PX4 log exported to CSV (a folder of `<log>_<topic>_<k>.csv` files, each
+/// with its own µs `timestamp`) as it reads the `.ulg`: a 100 Hz state decaying as `e^(−t)` and a
+/// 20 Hz control held as of each of its rows.
+#[test]
+fn sindy_fits_the_columns_of_a_csv_export_on_one_clock() {
+    let dir = scratch("ulog-csv-export");
+    let export = dir.join("export");
+    std::fs::create_dir(&export).unwrap();
+    let mut rate = String::from("timestamp,x\n");
+    let mut command = String::from("timestamp,u\n");
+    for k in 0..400 {
+        let t_us = 1_000_000 + 10_000 * k;
+        rate.push_str(&format!("{t_us},{:?}\n", (-(k as f64) * 0.01).exp()));
+        if k % 5 == 0 {
+            command.push_str(&format!("{t_us},{:?}\n", 0.5 + 0.1 * ((k / 5) % 2) as f64));
+        }
+    }
+    std::fs::write(export.join("flight_rate_0.csv"), rate).unwrap();
+    std::fs::write(export.join("flight_command_0.csv"), command).unwrap();
+    let run = learn_in(
+        &dir,
+        &[
+            "sindy",
+            "--csv",
+            "export",
+            "--state",
+            "rate.x",
+            "--control",
+            "command.u",
+        ],
+    );
+    let text = run.success();
+    assert_lines(
+        text,
+        &[
+            "export: 400 rows on the clock of rate[0]",
+            "  command.u held from its 20.0 Hz samples (at most 0.040 s)",
+        ],
+    );
+    assert!(text.contains("rate.x' = -1.000 rate.x"), "{text}");
+    learn_in(
+        &dir,
+        &[
+            "sindy",
+            "--csv",
+            "export",
+            "--state",
+            "rate.x",
+            "--control",
+            "motor.u",
+        ],
+    )
+    .one_line_error(&["export: motor[0]: no file named <log>_motor_0.csv"]);
+}

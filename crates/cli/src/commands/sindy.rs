@@ -31,10 +31,10 @@ pub enum OptimizerKind {
 pub struct Args {
     #[command(subcommand)]
     pub command: Option<ApplyCommand>,
-    /// A numeric CSV file with a header row, or a PX4 ULog (`.ulg`: columns `topic.field` on the
-    /// clock of the first column's topic, or of the topic --time names; other topics' values held
-    /// as of it); give --csv once per recording to fit several trajectories together (derivatives
-    /// are estimated within each).
+    /// A numeric CSV file with a header row, or a PX4 ULog (`.ulg`, or a folder of its CSV export:
+    /// columns `topic.field` on the clock of the first column's topic, or of the topic --time
+    /// names; other topics' values held as of it); give --csv once per recording to fit several
+    /// trajectories together (derivatives are estimated within each).
     #[arg(long, required = true)]
     pub csv: Vec<PathBuf>,
     /// The time column (strictly increasing; forward and central differences use the true time
@@ -183,7 +183,7 @@ pub(super) fn read_recording(
     columns: &[&str],
     derivative: Derivative,
 ) -> anyhow::Result<Recording> {
-    let (time, table) = if data::layout::is_ulog(path) {
+    let (time, table) = if data::layout::is_ulog(path) || path.is_dir() {
         read_ulog_columns(path, time_column, columns)?
     } else {
         NumericTable::read_with_increasing_time(path, time_column, columns)?
@@ -202,16 +202,21 @@ pub(super) fn read_recording(
     })
 }
 
-/// The columns (`topic.field`) of a ULog on the clock of `--time` when it names a topic (of the
-/// first column's topic while it is the default `t`); says which columns were held, and how long.
+/// The columns (`topic.field`) of a ULog, or of a folder holding its CSV export (one file per
+/// topic), on the clock of `--time` when it names a topic (of the first column's topic while it
+/// is the default `t`); says which columns were held, and how long.
 fn read_ulog_columns(
     path: &Path,
     time_column: &str,
     columns: &[&str],
 ) -> anyhow::Result<(Vec<f64>, NumericTable)> {
-    let log = ulog::Log::read(path)?;
     let base = (time_column != "t").then_some(time_column);
-    let aligned = data::ulog::aligned_table(&log, path, base, columns)?;
+    let aligned = if path.is_dir() {
+        data::ulog::aligned_export_table(path, base, columns)?.0
+    } else {
+        let log = ulog::Log::read(path)?;
+        data::ulog::aligned_table(&log, path, base, columns)?
+    };
     say!(
         "{}: {} rows on the clock of {}",
         path.display(),
@@ -541,8 +546,13 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         .library(library)
         .optimizer(optimizer)
         .derivative(derivative);
-    if args.stream && args.csv.iter().any(|path| data::layout::is_ulog(path)) {
-        bail!("--stream reads a CSV; a ULog is read whole");
+    if args.stream
+        && args
+            .csv
+            .iter()
+            .any(|path| data::layout::is_ulog(path) || path.is_dir())
+    {
+        bail!("--stream reads a CSV; a ULog or a folder of its CSV export is read whole");
     }
     let streamed = args.stream
         || (args.csv.len() == 1

@@ -40,7 +40,7 @@ pub fn aligned_export_table(
         let name = column_name(column).ok_or_else(|| {
             bad(
                 column,
-                "a column of a PX4 CSV export is named topic.field or topic[k].field".into(),
+                "is a directory, read as a PX4 CSV export, whose columns are named topic.field or topic[k].field".into(),
             )
         })?;
         let key = (name.topic.to_string(), name.instance);

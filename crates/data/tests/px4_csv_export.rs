@@ -79,8 +79,9 @@ fn an_export_reads_as_its_ulog() {
     assert_eq!(from_csv.battery_voltage, from_ulog.battery_voltage);
 }
 
-/// A topic without its file, two logs in one folder and a time stamp that is not a whole number
-/// of microseconds are refused in one line naming the folder or file, topic and line.
+/// A topic without its file, two logs in one folder, rows out of time order and a time stamp that
+/// is not a whole number of microseconds are refused in one line naming the folder or file, topic
+/// and line.
 #[test]
 fn a_bad_export_is_refused_naming_what_is_wrong() {
     let Some(path) = data::ulog_file_for_tests(&workspace(), "sample_px4_events.ulg") else {
@@ -110,6 +111,20 @@ fn a_bad_export_is_refused_naming_what_is_wrong() {
         "{twice}"
     );
     std::fs::remove_file(&second).unwrap();
+
+    let battery = dir.join("flight_battery_status_0.csv");
+    let text = std::fs::read_to_string(&battery).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    lines.swap(5, 6);
+    std::fs::write(&battery, lines.join("\n") + "\n").unwrap();
+    let unordered = message(&dir);
+    assert!(
+        unordered.contains("flight_battery_status_0.csv")
+            && unordered.contains("7")
+            && unordered.contains("in time order"),
+        "{unordered}"
+    );
+    std::fs::write(&battery, text).unwrap();
 
     let attitude = dir.join("flight_vehicle_attitude_0.csv");
     let text = std::fs::read_to_string(&attitude).unwrap();

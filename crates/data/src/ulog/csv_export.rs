@@ -145,7 +145,18 @@ fn read_topic(path: &Path, fields: &[String]) -> Result<TopicFile> {
                 "a time stamp is a whole number of microseconds".into(),
             ));
         }
-        timestamps.push(stamp as u64);
+        let stamp = stamp as u64;
+        // The as-of join reads each topic in time order.
+        if timestamps.last().is_some_and(|&last| stamp < last) {
+            return Err(bad_cell(
+                path,
+                table.line(row),
+                "timestamp",
+                &stamp.to_string(),
+                "earlier than the row before: a topic's rows must be in time order".into(),
+            ));
+        }
+        timestamps.push(stamp);
     }
     if timestamps.is_empty() {
         return Err(DataError::Config {

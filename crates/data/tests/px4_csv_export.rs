@@ -47,6 +47,15 @@ fn export(log: &ulog::Log, topics: &[&str], dir: &Path) {
     }
 }
 
+/// Rewrites the file at `path` with its lines changed by `edit`; returns its text before.
+fn edit_lines(path: &Path, edit: impl FnOnce(&mut Vec<String>)) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    edit(&mut lines);
+    std::fs::write(path, lines.join("\n") + "\n").unwrap();
+    text
+}
+
 const TOPICS: [&str; 5] = [
     "vehicle_local_position",
     "vehicle_attitude",
@@ -113,10 +122,7 @@ fn a_bad_export_is_refused_naming_what_is_wrong() {
     std::fs::remove_file(&second).unwrap();
 
     let battery = dir.join("flight_battery_status_0.csv");
-    let text = std::fs::read_to_string(&battery).unwrap();
-    let mut lines: Vec<String> = text.lines().map(String::from).collect();
-    lines.swap(5, 6);
-    std::fs::write(&battery, lines.join("\n") + "\n").unwrap();
+    let text = edit_lines(&battery, |lines| lines.swap(5, 6));
     let unordered = message(&dir);
     assert!(
         unordered.contains("flight_battery_status_0.csv")
@@ -127,10 +133,9 @@ fn a_bad_export_is_refused_naming_what_is_wrong() {
     std::fs::write(&battery, text).unwrap();
 
     let attitude = dir.join("flight_vehicle_attitude_0.csv");
-    let text = std::fs::read_to_string(&attitude).unwrap();
-    let mut lines: Vec<String> = text.lines().map(String::from).collect();
-    lines[3] = lines[3].replacen(',', ".5,", 1);
-    std::fs::write(&attitude, lines.join("\n") + "\n").unwrap();
+    edit_lines(&attitude, |lines| {
+        lines[3] = lines[3].replacen(',', ".5,", 1)
+    });
     let fraction = message(&dir);
     assert!(
         fraction.contains("flight_vehicle_attitude_0.csv")

@@ -702,10 +702,26 @@ impl RecordingView<'_> {
         if let Some(timing) = self.timing {
             let _ = writeln!(
                 md,
-                "\nThe command-rate term was resolved by fitting a pure delay, a first-order motor lag and both exactly; noise-normalised fit errors: {}. The smallest was kept, then judged by the evidence rule.",
-                serde_json::to_string(timing).expect("numbers serialise")
+                "\nThe command-rate term was resolved by fitting a pure delay, a first-order motor lag and both exactly; noise-normalised fit errors: {}. The smallest was kept, then judged by the evidence rule.{}",
+                serde_json::to_string(timing).expect("numbers serialise"),
+                if self.reports_a_timing() {
+                    ""
+                } else {
+                    " It was fitted at zero (no lateness) and left out."
+                }
             );
         }
+    }
+
+    /// Whether a delay or a motor lag is among the effects the report names, cannot separate,
+    /// replaced, dropped or found below the log's resolution.
+    fn reports_a_timing(&self) -> bool {
+        let timing = |id: &str| id == "delay" || id == "motor_lag";
+        self.effects.iter().any(|e| timing(e.evidence.id))
+            || self.not_separable.iter().any(|e| timing(e.id))
+            || self.replaced.iter().any(|e| timing(e.id))
+            || self.dropped.iter().any(|e| timing(e.id))
+            || self.below_resolution.iter().any(|e| timing(e.id))
     }
 
     /// The fit and held-out errors before and after.
@@ -943,7 +959,7 @@ mod tests {
             "- not named: wind (likelihood ratio 3.2 against 16.3, gain 0.750, 0.500 without its two largest blocks, held-out reduction 33.3%): below the evidence rule.\n",
             "- unexplained residual on vdot_x, 2.0–2.8 s\n",
             "- linear_drag (`drag_x` = −v_x [m/s]): 88%, kept\n",
-            "noise-normalised fit errors: {\"both\":1.25,\"delay\":1.5,\"motor_lag\":2.0}. The smallest",
+            "noise-normalised fit errors: {\"both\":1.25,\"delay\":1.5,\"motor_lag\":2.0}. The smallest was kept, then judged by the evidence rule.\n",
             "The effects were chosen with parameters fitted on 0.2–14.0 s and checked on the held-out 14.0–20.0 s (the table). The parameters reported above were then estimated on the whole recording, residuals beyond 2.5 robust standard deviations counting linearly (Huber's loss; 6.2% of the residuals were downweighted).\n",
             "The command samples carry the controller's reaction to the gyro noise, which the vehicle felt for one control step in a row. Such noise biases the parameters: adding it once more (4 pairs of draws, seed 7) measured the bias",
             "The commands step between two samples 3 time(s)",
@@ -956,6 +972,17 @@ mod tests {
             assert!(md.contains(line), "missing {line:?} in\n{md}");
         }
         assert!(md.ends_with("\nFigure: `mismatch.svg`.\n"));
+        // A timing term that no list accounts for was fitted at zero, and the report says so.
+        let untimed = RecordingView {
+            not_separable: Vec::new(),
+            below_resolution: Vec::new(),
+            ..view
+        };
+        let md = untimed.markdown();
+        assert!(
+            md.contains("The smallest was kept, then judged by the evidence rule. It was fitted at zero (no lateness) and left out.\n"),
+            "{md}"
+        );
     }
 
     /// A stand-in's held-out residual is said against the named set's: a stand-in that leaves

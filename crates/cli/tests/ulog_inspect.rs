@@ -219,18 +219,21 @@ fn sindy_fits_the_columns_of_a_csv_export_on_one_clock() {
     }
     std::fs::write(export.join("flight_rate_0.csv"), rate).unwrap();
     std::fs::write(export.join("flight_command_0.csv"), command).unwrap();
-    let run = learn_in(
-        &dir,
-        &[
-            "sindy",
-            "--csv",
-            "export",
-            "--state",
-            "rate.x",
-            "--control",
-            "command.u",
-        ],
-    );
+    let sindy = |control: &str| {
+        learn_in(
+            &dir,
+            &[
+                "sindy",
+                "--csv",
+                "export",
+                "--state",
+                "rate.x",
+                "--control",
+                control,
+            ],
+        )
+    };
+    let run = sindy("command.u");
     let text = run.success();
     assert_lines(
         text,
@@ -240,17 +243,5 @@ fn sindy_fits_the_columns_of_a_csv_export_on_one_clock() {
         ],
     );
     assert!(text.contains("rate.x' = -1.000 rate.x"), "{text}");
-    learn_in(
-        &dir,
-        &[
-            "sindy",
-            "--csv",
-            "export",
-            "--state",
-            "rate.x",
-            "--control",
-            "motor.u",
-        ],
-    )
-    .one_line_error(&["export: motor[0]: no file named <log>_motor_0.csv"]);
+    sindy("motor.u").one_line_error(&["export: motor[0]: no file named <log>_motor_0.csv"]);
 }

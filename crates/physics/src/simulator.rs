@@ -79,11 +79,15 @@ impl Plant<'_> {
         } else {
             state.velocity
         };
-        let acceleration = self.effects.translational_acceleration(
+        let air_body = self
+            .effects
+            .body_airspeed(&rotation, air_velocity, state.position);
+        let acceleration = self.effects.translational_acceleration_in_air(
             self.model,
             &rotation,
             air_velocity,
             state.position,
+            air_body,
             wrench.thrust,
         );
         let drag_velocity = if drag_lag > 0.0 {
@@ -92,9 +96,6 @@ impl Plant<'_> {
             [0.0; 3]
         };
         let torque = wrench.torque.unwrap_or([0.0; 3]);
-        let air_body = self
-            .effects
-            .body_airspeed(&rotation, air_velocity, state.position);
         let angular_acceleration =
             self.effects
                 .angular_acceleration(self.model, state.body_rate, torque, air_body);

@@ -62,9 +62,14 @@ pub fn aligned_export_table(
             .ok_or_else(|| bad("columns", "no column named".into()))?,
     };
     wanted.entry(base_key.clone()).or_default();
+    let entries = std::fs::read_dir(dir).map_err(|source| DataError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let listed: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
     let mut files = BTreeMap::new();
     for ((topic, instance), fields) in &wanted {
-        let path = topic_file(dir, topic, *instance)?;
+        let path = topic_file(dir, &listed, topic, *instance)?;
         files.insert((topic.clone(), *instance), read_topic(&path, fields)?);
     }
     let clock = |key: &(String, u8)| TopicClock {
@@ -83,21 +88,18 @@ pub fn aligned_export_table(
     ))
 }
 
-/// The file of topic `topic`, instance `instance`: the one file of `dir` named
-/// `<log>_<topic>_<instance>.csv`.
-fn topic_file(dir: &Path, topic: &str, instance: u8) -> Result<PathBuf> {
+/// The file of topic `topic`, instance `instance`: the one file of `dir` (whose files are
+/// `listed`) named `<log>_<topic>_<instance>.csv`.
+fn topic_file(dir: &Path, listed: &[PathBuf], topic: &str, instance: u8) -> Result<PathBuf> {
     let suffix = format!("_{topic}_{instance}.csv");
-    let entries = std::fs::read_dir(dir).map_err(|source| DataError::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    let mut found: Vec<PathBuf> = entries
-        .filter_map(|entry| entry.ok().map(|e| e.path()))
+    let mut found: Vec<PathBuf> = listed
+        .iter()
         .filter(|path| {
             path.file_name()
                 .and_then(|n| n.to_str())
                 .is_some_and(|n| n.ends_with(&suffix) && n.len() > suffix.len())
         })
+        .cloned()
         .collect();
     found.sort();
     let config = |message: String| DataError::Config {

@@ -58,17 +58,18 @@ pub fn predict_substeps(
             };
             let position = lerp(recording.position[k], recording.position[k + 1], s);
             let wrench = model.wrench_with_spread(&actuators[k * SUBSTEPS + j], &spread);
-            translational.push(effects.translational_acceleration(
+            let air_body = effects.body_airspeed(&rotation, velocity, position);
+            translational.push(effects.translational_acceleration_in_air(
                 model,
                 &rotation,
                 velocity,
                 position,
+                air_body,
                 wrench.thrust,
             ));
             if angular_wanted {
                 let rate = lerp(recording.body_rate[k], recording.body_rate[k + 1], s);
                 let torque = wrench.torque.unwrap_or([0.0; 3]);
-                let air_body = effects.body_airspeed(&rotation, velocity, position);
                 angular.push(effects.angular_acceleration(model, rate, torque, air_body));
             }
         }
@@ -154,19 +155,21 @@ pub fn accelerations_at_rows(
     let mut angular = Vec::with_capacity(recording.len());
     for k in 0..recording.len() {
         let wrench = model.wrench(&commands[k]);
-        translational.push(effects.translational_acceleration(
-            model,
+        let (rotation, velocity, position) = (
             &recording.rotation[k],
             recording.velocity[k],
             recording.position[k],
+        );
+        let air_body = effects.body_airspeed(rotation, velocity, position);
+        translational.push(effects.translational_acceleration_in_air(
+            model,
+            rotation,
+            velocity,
+            position,
+            air_body,
             wrench.thrust,
         ));
         if let Some(torque) = wrench.torque {
-            let air_body = effects.body_airspeed(
-                &recording.rotation[k],
-                recording.velocity[k],
-                recording.position[k],
-            );
             angular.push(effects.angular_acceleration(
                 model,
                 recording.body_rate[k],

@@ -466,9 +466,26 @@ impl Effects {
         position: Vec3,
         thrust: f64,
     ) -> Vec3 {
+        let air_body = self.body_airspeed(rotation, velocity, position);
+        self.translational_acceleration_in_air(
+            model, rotation, velocity, position, air_body, thrust,
+        )
+    }
+
+    /// [`Self::translational_acceleration`] with the body airspeed `air_body` already computed
+    /// ([`Self::body_airspeed`] of the same attitude, velocity and position), for a caller that
+    /// needs it for the angular acceleration too.
+    pub fn translational_acceleration_in_air(
+        &self,
+        model: &NominalModel,
+        rotation: &Mat3,
+        velocity: Vec3,
+        position: Vec3,
+        air_body: Vec3,
+        thrust: f64,
+    ) -> Vec3 {
         let g = model.gravity_m_s2;
         let height_above_ground = position[2] - model.ground_height_m;
-        let air_body = self.body_airspeed(rotation, velocity, position);
         let ratio = self.thrust_ratio(thrust / (model.mass_kg * g), height_above_ground, air_body);
         let axis = mat_vec(rotation, self.thrust_axis());
         let thrust_part = add([0.0, 0.0, -g], scale(axis, g * ratio));

@@ -45,7 +45,7 @@ pub use source::{
     real_data_dir_for_tests, resolve_data_dir, shared_file_for_tests, ulog_file_for_tests,
 };
 pub use split::{Split, SplitSpec};
-pub use stream::{NumericBlock, NumericStream};
+pub use stream::{NumericBlock, NumericStream, ReadAhead};
 pub use table::ColumnRef;
 pub use tasks::{MAX_TASKS, TaskTable, interval_text, read_column_tasks, read_file_tasks};
 pub use time::{

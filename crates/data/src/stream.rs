@@ -3,11 +3,14 @@
 //! [`NumericTable`](crate::NumericTable) for files that fit). The rows come from the same splitter
 //! and layout checks as the whole-file reader's ([`CsvRecords`]) and the cells are read by the same
 //! code ([`NumericColumn`]): a file is read by both or by neither, to the same values, and a fault
-//! is named by the same `file:line:column` message.
+//! is named by the same `file:line:column` message. [`NumericStream::read_ahead`] reads the same
+//! blocks on a thread of its own, so that parsing overlaps the work done on the blocks before.
 
 use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::thread::JoinHandle;
 
 use crate::cells::NumericColumn;
 use crate::error::{DataError, Result};
@@ -61,6 +64,29 @@ impl NumericStream {
         self.rows.next_block(max_rows)
     }
 
+    /// The same blocks of at most `max_rows` rows, read on a thread of its own while the caller
+    /// works: at most `blocks` of them wait to be taken (memory is bounded by those), and the
+    /// first error ends the stream after the blocks before it, as [`Self::next_block`] does.
+    pub fn read_ahead(mut self, max_rows: usize, blocks: usize) -> ReadAhead {
+        let (sender, receiver) = sync_channel(blocks.max(1));
+        let reader = std::thread::spawn(move || {
+            let send = |sender: &SyncSender<_>, item| sender.send(item).is_ok();
+            loop {
+                let item = self.next_block(max_rows);
+                let last = !matches!(item, Ok(Some(_)));
+                // A receiver gone (the caller stopped early) ends the reading too.
+                if !send(&sender, item) || last {
+                    return;
+                }
+            }
+        });
+        ReadAhead {
+            receiver: Some(receiver),
+            reader: Some(reader),
+            ended: false,
+        }
+    }
+
     /// The line of the file on which data row `row` (0-based) starts, found by reading the file
     /// again to that row (for an error about a row found after its block was dropped); `None` if
     /// the file no longer has that row.
@@ -74,6 +100,48 @@ impl NumericStream {
             }
         }
         Some(record.line)
+    }
+}
+
+/// The blocks of a [`NumericStream`] read ahead ([`NumericStream::read_ahead`]).
+pub struct ReadAhead {
+    receiver: Option<Receiver<Result<Option<NumericBlock>>>>,
+    reader: Option<JoinHandle<()>>,
+    ended: bool,
+}
+
+impl ReadAhead {
+    /// The next block, in file order; `None` at the end of the file, and after an error.
+    pub fn next_block(&mut self) -> Result<Option<NumericBlock>> {
+        if self.ended {
+            return Ok(None);
+        }
+        let received = self
+            .receiver
+            .as_ref()
+            .and_then(|receiver| receiver.recv().ok());
+        let item = match received {
+            Some(item) => item,
+            // The reader ended without its last item: it panicked, and so does the caller.
+            None => {
+                if let Some(Err(panic)) = self.reader.take().map(JoinHandle::join) {
+                    std::panic::resume_unwind(panic);
+                }
+                Ok(None)
+            }
+        };
+        self.ended = !matches!(item, Ok(Some(_)));
+        item
+    }
+}
+
+impl Drop for ReadAhead {
+    /// Stops the reader (its next send fails) and waits for it.
+    fn drop(&mut self) {
+        drop(self.receiver.take());
+        if let Some(reader) = self.reader.take() {
+            let _ = reader.join();
+        }
     }
 }
 

@@ -1,5 +1,5 @@
 //! The whole-file reader ([`NumericTable`]) and the block reader ([`NumericStream`], used by
-//! `learn sindy --stream` and for every CSV over 8 MiB) agree (issue 31, class 9): on generated
+//! `learn sindy --stream` and for every CSV over 8 MiB, directly or read ahead) agree (issue 31, class 9): on generated
 //! files with blank and comment lines, quoted cells (multi-line, escaped quotes), LF, CRLF and
 //! CR-only line endings, repeated header names, ragged rows, a byte-order mark and cells that are
 //! not numbers, both read the same values on the same lines, or both fail with the same message.
@@ -322,6 +322,21 @@ fn read_streamed(path: &Path, columns: &[&str], block_rows: usize) -> Reading {
     Ok(rows)
 }
 
+/// The same blocks read ahead on a thread of their own ([`NumericStream::read_ahead`]).
+fn read_ahead(path: &Path, columns: &[&str], block_rows: usize) -> Reading {
+    let stream = NumericStream::open(path, columns).map_err(|e| e.to_string())?;
+    let mut stream = stream.read_ahead(block_rows, 2);
+    let mut rows = Vec::new();
+    while let Some(block) = stream.next_block().map_err(|e| e.to_string())? {
+        for (k, &line) in block.lines.iter().enumerate() {
+            rows.push((line, block.columns.iter().map(|c| c[k].to_bits()).collect()));
+        }
+    }
+    // After the end (or an error), the stream stays ended.
+    assert!(matches!(stream.next_block(), Ok(None)));
+    Ok(rows)
+}
+
 fn runner(seed: u8) -> TestRunner {
     let config = Config {
         cases: CASES,
@@ -349,6 +364,8 @@ fn the_whole_file_and_block_readers_agree_on_generated_files() {
                 let whole = read_whole(&path, columns);
                 let streamed = read_streamed(&path, columns, block_rows);
                 prop_assert_eq!(&whole, &streamed, "{:?} {:?}", columns, file);
+                let ahead = read_ahead(&path, columns, block_rows);
+                prop_assert_eq!(&whole, &ahead, "read ahead: {:?} {:?}", columns, file);
                 if let Err(message) = &whole {
                     prop_assert!(!message.contains('\n'), "one line: {}", message);
                     prop_assert!(message.starts_with(&path.display().to_string()));
@@ -393,4 +410,23 @@ fn generated_files_without_a_fault_read_to_the_values_written() {
             Ok(())
         })
         .unwrap();
+}
+
+#[test]
+fn a_stream_read_ahead_and_left_early_stops_its_reader() {
+    let dir = common::temp_dir("read-ahead-left");
+    let path = dir.join("long.csv");
+    let mut text = String::from("t,x\n");
+    for k in 0..20_000 {
+        text.push_str(&format!("{k},{}\n", k * 2));
+    }
+    std::fs::write(&path, text).unwrap();
+    let mut stream = NumericStream::open(&path, &["x"])
+        .unwrap()
+        .read_ahead(100, 1);
+    let first = stream.next_block().unwrap().unwrap();
+    assert_eq!(first.columns[0][..3], [0.0, 2.0, 4.0]);
+    assert_eq!(first.lines[..2], [2, 3]);
+    // Dropped with 199 blocks unread: the reader, blocked on a full queue, ends and is joined.
+    drop(stream);
 }

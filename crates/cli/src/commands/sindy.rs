@@ -167,6 +167,11 @@ pub const STREAM_ABOVE_BYTES: u64 = 8 << 20;
 /// Rows per block read from a streamed CSV.
 const STREAM_BLOCK_ROWS: usize = 1 << 14;
 
+/// Blocks a streamed CSV is read ahead of the fit, per fitting thread: about one batch of the
+/// segments the fit reduces at once (two blocks per thread), parsed while the batch before it is
+/// reduced (a few MiB per thread).
+const STREAM_BLOCKS_AHEAD_PER_THREAD: usize = 2;
+
 /// One recording read whole: its trajectory and the line of the file each row starts on.
 pub(super) struct Recording {
     pub(super) path: PathBuf,
@@ -354,9 +359,11 @@ fn fit_streamed(
         Derivative::SavitzkyGolay { .. } => (DEFAULT_UNIFORM_TOLERANCE, false),
         Derivative::Forward | Derivative::Central => (f64::INFINITY, true),
     };
-    let mut stream = NumericStream::open(csv, &[args.time.as_str()])?;
+    let ahead = STREAM_BLOCKS_AHEAD_PER_THREAD * evaluation::worker_threads();
+    let mut stream =
+        NumericStream::open(csv, &[args.time.as_str()])?.read_ahead(STREAM_BLOCK_ROWS, ahead);
     let mut axis = StreamedTimeAxis::new(csv, &args.time, tolerance);
-    while let Some(block) = stream.next_block(STREAM_BLOCK_ROWS)? {
+    while let Some(block) = stream.next_block()? {
         axis.push(&block.columns[0], &block.lines)
             .map_err(|error| streamed_time_error(args.derivative, error))?;
     }
@@ -374,11 +381,11 @@ fn fit_streamed(
         names.push(args.time.as_str());
     }
     names.extend_from_slice(columns);
-    let mut stream = NumericStream::open(csv, &names)?;
+    let mut stream = NumericStream::open(csv, &names)?.read_ahead(STREAM_BLOCK_ROWS, ahead);
     let fit = params
         .fit_streamed(n, dt, || {
             let block = stream
-                .next_block(STREAM_BLOCK_ROWS)
+                .next_block()
                 .map_err(|error| SindyError::Source(Box::new(error)))?;
             Ok(block.map(|mut block| {
                 let time = stamped.then(|| block.columns.remove(0));

@@ -18,12 +18,14 @@
 //! the row (line number in the file, header = line 1) and column: `file:row:column: message`.
 
 mod cells;
+mod chunked;
 mod conditions;
 mod error;
 mod flight_log;
 pub mod layout;
 mod motors;
 mod numeric;
+mod pieces;
 mod records;
 mod source;
 mod split;

@@ -197,6 +197,23 @@ impl<R: BufRead> CsvRecords<R> {
         }
     }
 
+    /// A splitter of the data rows of a file whose header (of `width` fields) was read elsewhere:
+    /// `input` begins at a record start on line `line`, after the header and any byte-order mark
+    /// ([`crate::pieces`]).
+    pub(crate) fn continuing(path: &Path, input: R, line: usize, width: usize) -> Self {
+        let mut records = Self::new(path, input);
+        records.splitter.line = line;
+        records.splitter.field_line = line;
+        records.splitter.byte_order_mark = None;
+        records.splitter.width = Some(width);
+        records
+    }
+
+    /// The input not read yet, and the line it begins on.
+    pub(crate) fn into_rest(self) -> (R, usize) {
+        (self.input, self.splitter.line)
+    }
+
     /// The header's names: at most [`MAX_CSV_COLUMNS`], each once. Must be read first.
     pub fn header(&mut self) -> Result<Vec<String>> {
         let mut record = Record::default();

@@ -1,6 +1,7 @@
 //! Named numeric columns of a CSV file read a block of rows at a time, in memory bounded by the
-//! block (and the longest row), for recordings too long to hold whole (see
-//! [`NumericTable`](crate::NumericTable) for files that fit). The rows come from the same splitter
+//! block and a chunk of the file per thread (and the longest row), for recordings too long to hold
+//! whole (see [`NumericTable`](crate::NumericTable) for files that fit). Each chunk is cut into
+//! pieces parsed in parallel ([`crate::chunked`]). The rows come from the same splitter
 //! and layout checks as the whole-file reader's ([`CsvRecords`]) and the cells are read by the same
 //! code ([`NumericColumn`]): a file is read by both or by neither, to the same values, and a fault
 //! is named by the same `file:line:column` message. [`NumericStream::read_ahead`] reads the same
@@ -13,12 +14,19 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
 use crate::cells::NumericColumn;
+use crate::chunked::{CHUNK_BYTES_PER_THREAD, ChunkedRows, ParsedRows, row_numbers};
 use crate::error::{DataError, Result};
 use crate::records::{CsvRecords, Record};
 
-/// A reader of named numeric columns of a regular file, row blocks in file order.
+/// A reader of named numeric columns of a regular file, row blocks in file order (each chunk of
+/// the file parsed in parallel pieces: [`crate::chunked`]).
 pub struct NumericStream {
-    rows: NumericRows<BufReader<File>>,
+    rows: ChunkedRows,
+    parsed: ParsedRows,
+    /// Rows of `parsed` handed out already.
+    taken: usize,
+    /// Rows returned so far.
+    returned: usize,
 }
 
 /// Named numeric columns read from any text source, row by row: the code of both readers.
@@ -53,15 +61,70 @@ impl NumericBlock {
 impl NumericStream {
     /// Opens `path` (a regular file) and finds `columns` in its header.
     pub fn open(path: &Path, columns: &[&str]) -> Result<Self> {
+        let chunk_bytes = CHUNK_BYTES_PER_THREAD * rayon::current_num_threads().max(1);
+        Self::open_in_chunks(path, columns, chunk_bytes)
+    }
+
+    /// [`Self::open`], reading `chunk_bytes` of the file at a time (cut into pieces parsed in
+    /// parallel): the rows and errors are the same whatever the size.
+    pub fn open_in_chunks(path: &Path, columns: &[&str], chunk_bytes: usize) -> Result<Self> {
+        check_regular_file(path)?;
+        let rows = ChunkedRows::open(path, columns, chunk_bytes)?;
+        let parsed = ParsedRows {
+            columns: vec![Vec::new(); rows.width()],
+            ..ParsedRows::default()
+        };
         Ok(Self {
-            rows: NumericRows::new(path, open_records(path)?, columns)?,
+            rows,
+            parsed,
+            taken: 0,
+            returned: 0,
         })
     }
 
     /// The next block of at most `max_rows` rows; `None` at the end of the file. A file without
-    /// data rows is an error, as for the whole-file reader.
+    /// data rows is an error, as for the whole-file reader; the rows before a fault are returned
+    /// before it.
     pub fn next_block(&mut self, max_rows: usize) -> Result<Option<NumericBlock>> {
-        self.rows.next_block(max_rows)
+        while self.parsed.lines.len() - self.taken < max_rows
+            && self.parsed.error.is_none()
+            && !self.rows.finished()
+        {
+            self.compact();
+            self.rows.parse_more(&mut self.parsed)?;
+        }
+        let count = (self.parsed.lines.len() - self.taken).min(max_rows);
+        if count == 0 {
+            if let Some(error) = self.parsed.error.take() {
+                return Err(error);
+            }
+            if self.returned == 0 {
+                return Err(DataError::Empty {
+                    path: self.rows.path().to_path_buf(),
+                });
+            }
+            return Ok(None);
+        }
+        let rows = self.taken..self.taken + count;
+        let block = NumericBlock {
+            columns: (self.parsed.columns.iter())
+                .map(|column| column[rows.clone()].to_vec())
+                .collect(),
+            lines: self.parsed.lines[rows].to_vec(),
+            first_row: self.returned,
+        };
+        self.taken += count;
+        self.returned += count;
+        Ok(Some(block))
+    }
+
+    /// Drops the rows handed out from the parsed ones.
+    fn compact(&mut self) {
+        for column in &mut self.parsed.columns {
+            column.drain(..self.taken);
+        }
+        self.parsed.lines.drain(..self.taken);
+        self.taken = 0;
     }
 
     /// The same blocks of at most `max_rows` rows, read on a thread of its own while the caller
@@ -168,13 +231,19 @@ impl<R: BufRead> NumericRows<R> {
             first_row: self.rows,
         };
         let mut buffer = Vec::with_capacity(1);
+        let mut row = Vec::with_capacity(self.columns.len());
         while block.rows() < max_rows && self.records.next_row(&mut self.record, &self.header)? {
-            let line = self.record.line;
-            for (column, values) in self.columns.iter().zip(&mut block.columns) {
-                let cell = &self.record.fields[column.field];
-                values.push(column.number(&self.path, line, cell, &mut buffer)?);
+            row_numbers(
+                &self.path,
+                &self.columns,
+                &self.record,
+                &mut buffer,
+                &mut row,
+            )?;
+            for (values, &value) in block.columns.iter_mut().zip(&row) {
+                values.push(value);
             }
-            block.lines.push(line);
+            block.lines.push(self.record.line);
             self.rows += 1;
         }
         if self.rows == 0 {
@@ -188,6 +257,19 @@ impl<R: BufRead> NumericRows<R> {
 
 /// The rows of `path`, a regular file (it is read twice: a pipe cannot be).
 fn open_records(path: &Path) -> Result<CsvRecords<BufReader<File>>> {
+    check_regular_file(path)?;
+    let file = File::open(path).map_err(|source| DataError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    Ok(CsvRecords::new(
+        path,
+        BufReader::with_capacity(1 << 20, file),
+    ))
+}
+
+/// Refuses a directory, and anything but a regular file (a stream is read twice).
+fn check_regular_file(path: &Path) -> Result<()> {
     let io = |source| DataError::Io {
         path: path.to_path_buf(),
         source,
@@ -204,9 +286,5 @@ fn open_records(path: &Path) -> Result<CsvRecords<BufReader<File>>> {
             "not a regular file: a recording read in blocks must be a file",
         )));
     }
-    let file = File::open(path).map_err(io)?;
-    Ok(CsvRecords::new(
-        path,
-        BufReader::with_capacity(1 << 20, file),
-    ))
+    Ok(())
 }

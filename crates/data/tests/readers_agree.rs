@@ -312,7 +312,18 @@ fn read_whole(path: &Path, columns: &[&str]) -> Reading {
 }
 
 fn read_streamed(path: &Path, columns: &[&str], block_rows: usize) -> Reading {
-    let mut stream = NumericStream::open(path, columns).map_err(|e| e.to_string())?;
+    let stream = NumericStream::open(path, columns).map_err(|e| e.to_string())?;
+    read_blocks(stream, block_rows)
+}
+
+/// The block reader parsing `chunk_bytes` of the file at a time, each chunk cut into pieces.
+fn read_in_chunks(path: &Path, columns: &[&str], block_rows: usize, chunk_bytes: usize) -> Reading {
+    let stream =
+        NumericStream::open_in_chunks(path, columns, chunk_bytes).map_err(|e| e.to_string())?;
+    read_blocks(stream, block_rows)
+}
+
+fn read_blocks(mut stream: NumericStream, block_rows: usize) -> Reading {
     let mut rows = Vec::new();
     while let Some(block) = stream.next_block(block_rows).map_err(|e| e.to_string())? {
         for (k, &line) in block.lines.iter().enumerate() {
@@ -358,24 +369,36 @@ fn the_whole_file_and_block_readers_agree_on_generated_files() {
     let path = dir.join("generated.csv");
     let outcomes = std::cell::Cell::new([0usize; 2]);
     runner(31)
-        .run(&(generated_file(), 1usize..4), |(file, block_rows)| {
-            std::fs::write(&path, file.bytes()).unwrap();
-            for columns in SELECTIONS {
-                let whole = read_whole(&path, columns);
-                let streamed = read_streamed(&path, columns, block_rows);
-                prop_assert_eq!(&whole, &streamed, "{:?} {:?}", columns, file);
-                let ahead = read_ahead(&path, columns, block_rows);
-                prop_assert_eq!(&whole, &ahead, "read ahead: {:?} {:?}", columns, file);
-                if let Err(message) = &whole {
-                    prop_assert!(!message.contains('\n'), "one line: {}", message);
-                    prop_assert!(message.starts_with(&path.display().to_string()));
+        .run(
+            &(generated_file(), 1usize..4, 1usize..96),
+            |(file, block_rows, chunk)| {
+                std::fs::write(&path, file.bytes()).unwrap();
+                for columns in SELECTIONS {
+                    let whole = read_whole(&path, columns);
+                    let streamed = read_streamed(&path, columns, block_rows);
+                    prop_assert_eq!(&whole, &streamed, "{:?} {:?}", columns, file);
+                    let chunked = read_in_chunks(&path, columns, block_rows, chunk);
+                    prop_assert_eq!(
+                        &whole,
+                        &chunked,
+                        "chunks of {}: {:?} {:?}",
+                        chunk,
+                        columns,
+                        file
+                    );
+                    let ahead = read_ahead(&path, columns, block_rows);
+                    prop_assert_eq!(&whole, &ahead, "read ahead: {:?} {:?}", columns, file);
+                    if let Err(message) = &whole {
+                        prop_assert!(!message.contains('\n'), "one line: {}", message);
+                        prop_assert!(message.starts_with(&path.display().to_string()));
+                    }
+                    let mut counts = outcomes.get();
+                    counts[usize::from(whole.is_ok())] += 1;
+                    outcomes.set(counts);
                 }
-                let mut counts = outcomes.get();
-                counts[usize::from(whole.is_ok())] += 1;
-                outcomes.set(counts);
-            }
-            Ok(())
-        })
+                Ok(())
+            },
+        )
         .unwrap();
     // Both outcomes are exercised, not only refusals.
     let [refused, read] = outcomes.get();
@@ -391,24 +414,29 @@ fn generated_files_without_a_fault_read_to_the_values_written() {
     let dir = common::temp_dir("readers-clean");
     let path = dir.join("clean.csv");
     runner(32)
-        .run(&(clean_file(), 1usize..4), |(file, block_rows)| {
-            std::fs::write(&path, file.bytes()).unwrap();
-            let columns = ["t", "x", "v[1]"];
-            let whole = read_whole(&path, &columns);
-            prop_assert_eq!(&whole, &read_streamed(&path, &columns, block_rows));
-            let rows = whole.map_err(TestCaseError::fail)?;
-            let written = file.written();
-            prop_assert_eq!(rows.len(), written.len());
-            // Each row after the first starts two lines after the one before: the note of every
-            // row spans two lines.
-            let header_line = 1 + file.leading_blank_lines;
-            for (k, ((line, values), expected)) in rows.iter().zip(&written).enumerate() {
-                prop_assert_eq!(*line, header_line + 1 + 2 * k);
-                let expected: Vec<u64> = expected.iter().map(|v| v.to_bits()).collect();
-                prop_assert_eq!(values, &expected);
-            }
-            Ok(())
-        })
+        .run(
+            &(clean_file(), 1usize..4, 1usize..96),
+            |(file, block_rows, chunk)| {
+                std::fs::write(&path, file.bytes()).unwrap();
+                let columns = ["t", "x", "v[1]"];
+                let whole = read_whole(&path, &columns);
+                prop_assert_eq!(&whole, &read_streamed(&path, &columns, block_rows));
+                let chunked = read_in_chunks(&path, &columns, block_rows, chunk);
+                prop_assert_eq!(&whole, &chunked, "chunks of {}", chunk);
+                let rows = whole.map_err(TestCaseError::fail)?;
+                let written = file.written();
+                prop_assert_eq!(rows.len(), written.len());
+                // Each row after the first starts two lines after the one before: the note of every
+                // row spans two lines.
+                let header_line = 1 + file.leading_blank_lines;
+                for (k, ((line, values), expected)) in rows.iter().zip(&written).enumerate() {
+                    prop_assert_eq!(*line, header_line + 1 + 2 * k);
+                    let expected: Vec<u64> = expected.iter().map(|v| v.to_bits()).collect();
+                    prop_assert_eq!(values, &expected);
+                }
+                Ok(())
+            },
+        )
         .unwrap();
 }
 
@@ -429,4 +457,62 @@ fn a_stream_read_ahead_and_left_early_stops_its_reader() {
     assert_eq!(first.lines[..2], [2, 3]);
     // Dropped with 199 blocks unread: the reader, blocked on a full queue, ends and is joined.
     drop(stream);
+}
+
+/// A line of a generated file without quotes.
+#[derive(Clone, Copy, Debug)]
+enum PlainLine {
+    Row(u16),
+    Blank,
+    Comment,
+    ExtraCell,
+    NotANumber,
+}
+
+/// Files without a quote, whose pieces are cut without looking at every byte: plain rows with
+/// blank lines (between rows, an error; at the end, allowed), comments and bad rows among them.
+fn plain_file() -> impl Strategy<Value = (Vec<PlainLine>, bool)> {
+    let line = prop_oneof![
+        40 => any::<u16>().prop_map(PlainLine::Row),
+        3 => Just(PlainLine::Blank),
+        1 => Just(PlainLine::Comment),
+        1 => Just(PlainLine::ExtraCell),
+        1 => Just(PlainLine::NotANumber),
+    ];
+    (proptest::collection::vec(line, 0..40), any::<bool>())
+}
+
+fn plain_text(lines: &[PlainLine], crlf: bool) -> Vec<u8> {
+    let end = if crlf { "\r\n" } else { "\n" };
+    let mut text = format!("t,x{end}");
+    for line in lines {
+        let body = match line {
+            PlainLine::Row(v) => format!("{v},{}", f64::from(*v) / 8.0),
+            PlainLine::Blank => String::new(),
+            PlainLine::Comment => "# note".to_string(),
+            PlainLine::ExtraCell => "1,2,3".to_string(),
+            PlainLine::NotANumber => "1,x".to_string(),
+        };
+        text.push_str(&body);
+        text.push_str(end);
+    }
+    text.into_bytes()
+}
+
+#[test]
+fn files_without_quotes_read_the_same_in_pieces() {
+    let dir = common::temp_dir("readers-plain");
+    let path = dir.join("plain.csv");
+    runner(33)
+        .run(
+            &(plain_file(), 1usize..4, 1usize..64),
+            |((lines, crlf), block_rows, chunk)| {
+                std::fs::write(&path, plain_text(&lines, crlf)).unwrap();
+                let whole = read_whole(&path, &["x", "t"]);
+                let chunked = read_in_chunks(&path, &["x", "t"], block_rows, chunk);
+                prop_assert_eq!(&whole, &chunked, "chunks of {}: {:?}", chunk, lines);
+                Ok(())
+            },
+        )
+        .unwrap();
 }

@@ -3,10 +3,15 @@
 //! reduced segment by segment (as [`crate::Problem::reduced`]). Memory is a few segments whatever the
 //! length; the coefficients are those of [`SindyParams::fit_matrices`] on the whole recording (the
 //! same segments, merged in the same order), and the score follows from the reduced problem.
+//! Segments are reduced by one worker thread per rayon thread as their rows arrive, and merged in
+//! row order whichever finishes first.
+
+use std::sync::Mutex;
+use std::sync::mpsc::{Receiver, Sender, channel, sync_channel};
+
+use faer::Mat;
 
 use crate::differentiation::Derivative;
-use faer::Mat;
-use rayon::prelude::*;
 
 use crate::error::{Result, SindyError, shape};
 use crate::model::{CONSTANT_RELATIVE_SPREAD, FeatureSizes, Score, SindyModel, SindyParams};
@@ -93,6 +98,134 @@ enum Sampling<'a> {
 /// What a reduced segment hands to the merge: its triangle, target moments, feature sizes.
 type Reduced = (Mat<f64>, Vec<Moments>, Vec<f64>, usize);
 
+/// The segments merged so far: their triangle, target moments and feature sizes.
+struct Merged {
+    reduction: Reduction,
+    moments: Vec<Moments>,
+    sizes: Vec<f64>,
+}
+
+impl Merged {
+    fn add(&mut self, (triangle, moments, sizes, count): Reduced) {
+        self.reduction.merge(&triangle, count);
+        for (total, part) in self.moments.iter_mut().zip(moments) {
+            *total = total.merge(part);
+        }
+        for (total, part) in self.sizes.iter_mut().zip(sizes) {
+            *total = total.max(part);
+        }
+    }
+}
+
+/// Reduced segments that came back before the ones ahead of them, held until those are merged.
+#[derive(Default)]
+struct InOrder {
+    waiting: std::collections::BTreeMap<usize, Result<Reduced>>,
+    sent: usize,
+    merged: usize,
+}
+
+impl InOrder {
+    /// Takes segment `index`'s result and merges every result now in order; the first error in
+    /// row order stops the fit.
+    fn merge(
+        &mut self,
+        (index, result): (usize, Result<Reduced>),
+        into: &mut Merged,
+    ) -> Result<()> {
+        self.waiting.insert(index, result);
+        while let Some(result) = self.waiting.remove(&self.merged) {
+            into.add(result?);
+            self.merged += 1;
+        }
+        Ok(())
+    }
+}
+
+/// The rows read and not yet dropped: every column, and the time stamps when the blocks carry them.
+struct RowBuffer {
+    columns: Vec<Vec<f64>>,
+    times: Option<Vec<f64>>,
+    /// The global row of the first buffered row.
+    start: usize,
+    /// Rows read so far.
+    read: usize,
+}
+
+impl RowBuffer {
+    fn new(width: usize) -> Self {
+        Self {
+            columns: vec![Vec::new(); width],
+            times: None,
+            start: 0,
+            read: 0,
+        }
+    }
+
+    /// Reads blocks from `next` until `needed` rows of the recording's `rows` are read.
+    fn fill(
+        &mut self,
+        needed: usize,
+        rows: usize,
+        next: &mut impl FnMut() -> Result<Option<RowBlock>>,
+    ) -> Result<()> {
+        while self.read < needed {
+            let block = next()?.ok_or_else(|| {
+                let read = self.read;
+                shape(
+                    "recording",
+                    format!("ended after {read} rows, {rows} were counted"),
+                )
+            })?;
+            let mixed = self.read > 0 && block.time.is_some() != self.times.is_some();
+            check_block(&block, self.columns.len(), mixed)?;
+            self.read += block.columns[0].len();
+            if let Some(time) = block.time {
+                self.times.get_or_insert_with(Vec::new).extend(time);
+            }
+            for (column, values) in self.columns.iter_mut().zip(block.columns) {
+                column.extend(values);
+            }
+        }
+        Ok(())
+    }
+
+    /// The times of the buffered rows.
+    fn sampling(&self, dt: f64) -> Sampling<'_> {
+        match &self.times {
+            Some(times) => Sampling::Stamped(times),
+            None => Sampling::Every(dt),
+        }
+    }
+
+    /// Drops the rows before global row `row` (none before the buffer's first).
+    fn keep_from(&mut self, row: usize) {
+        let row = row.max(self.start);
+        for column in self.columns.iter_mut().chain(self.times.as_mut()) {
+            column.drain(..row - self.start);
+        }
+        self.start = row;
+    }
+}
+
+/// Refuses a block with the wrong number of columns, or with time stamps where the blocks before
+/// had none (or the reverse: `mixed`).
+fn check_block(block: &RowBlock, width: usize, mixed: bool) -> Result<()> {
+    if block.columns.len() != width {
+        return Err(shape(
+            "recording",
+            format!(
+                "a block of {} columns, {width} expected",
+                block.columns.len()
+            ),
+        ));
+    }
+    if mixed {
+        return Err(shape("recording", "time stamps in some blocks only"));
+    }
+    Ok(())
+}
+
 impl SindyParams {
     /// Fits on a recording of `rows` rows sampled every `dt` seconds whose blocks `next` yields in
     /// order (any block sizes; `None` at the end). Its derivatives are those of
@@ -118,73 +251,61 @@ impl SindyParams {
         }
         let (left, right) = context(derivative);
         let optimizer = self.checked_optimizer()?;
-        let mut buffer: Vec<Vec<f64>> = vec![Vec::new(); width];
-        let mut times: Option<Vec<f64>> = None;
-        let mut buffer_start = 0;
-        let mut read = 0;
-        let mut reduction = Reduction::new(features, dim_x);
-        let mut moments = vec![Moments::default(); dim_x];
-        let mut sizes = vec![0.0f64; features];
-        let batch = rayon::current_num_threads().max(1);
-        let mut pending: Vec<Segment> = Vec::new();
-        for start in (0..rows).step_by(SEGMENT_ROWS) {
-            let end = (start + SEGMENT_ROWS).min(rows);
-            let needed = (end + right).min(rows);
-            while read < needed {
-                let block = next()?.ok_or_else(|| {
-                    shape(
-                        "recording",
-                        format!("ended after {read} rows, {rows} were counted"),
-                    )
-                })?;
-                if block.columns.len() != width {
-                    return Err(shape(
-                        "recording",
-                        format!(
-                            "a block of {} columns, {width} expected",
-                            block.columns.len()
-                        ),
-                    ));
+        let mut merged = Merged {
+            reduction: Reduction::new(features, dim_x),
+            moments: vec![Moments::default(); dim_x],
+            sizes: vec![0.0f64; features],
+        };
+        // Segments go to the workers as their rows arrive, at most `workers` waiting, and come
+        // back in any order: they are merged in row order, so the result does not depend on the
+        // thread count or the timing.
+        let workers = rayon::current_num_threads().max(1);
+        let (jobs, queue) = sync_channel::<(usize, Segment)>(workers);
+        let queue = Mutex::new(queue);
+        let (done, finished) = channel::<(usize, Result<Reduced>)>();
+        std::thread::scope(|scope| -> Result<()> {
+            let jobs = jobs;
+            for _ in 0..workers {
+                let (queue, done) = (&queue, done.clone());
+                scope.spawn(move || self.reduce_segments(queue, done, features));
+            }
+            drop(done);
+            let mut order = InOrder::default();
+            let mut buffer = RowBuffer::new(width);
+            for (index, start) in (0..rows).step_by(SEGMENT_ROWS).enumerate() {
+                let end = (start + SEGMENT_ROWS).min(rows);
+                let needed = (end + right).min(rows);
+                buffer.fill(needed, rows, &mut next)?;
+                let segment = self.segment(
+                    &buffer.columns,
+                    buffer.sampling(dt),
+                    buffer.start,
+                    start..end,
+                    needed,
+                )?;
+                if jobs.send((index, segment)).is_err() {
+                    break;
                 }
-                if read > 0 && block.time.is_some() != times.is_some() {
-                    return Err(shape("recording", "time stamps in some blocks only"));
-                }
-                read += block.columns[0].len();
-                if let Some(time) = block.time {
-                    times.get_or_insert_with(Vec::new).extend(time);
-                }
-                for (column, values) in buffer.iter_mut().zip(block.columns) {
-                    column.extend(values);
+                order.sent += 1;
+                // Keep the rows the next segment's left context needs.
+                buffer.keep_from(end.saturating_sub(left));
+                while let Ok(result) = finished.try_recv() {
+                    order.merge(result, &mut merged)?;
                 }
             }
-            let sampling = match &times {
-                Some(times) => Sampling::Stamped(times),
-                None => Sampling::Every(dt),
-            };
-            pending.push(self.segment(&buffer, sampling, buffer_start, start..end, needed)?);
-            // Keep the rows the next segment's left context needs.
-            let keep_from = end.saturating_sub(left).max(buffer_start);
-            for column in buffer.iter_mut().chain(times.as_mut()) {
-                column.drain(..keep_from - buffer_start);
+            drop(jobs);
+            while order.merged < order.sent {
+                let result = (finished.recv())
+                    .map_err(|_| shape("recording", "a segment's reduction ended early"))?;
+                order.merge(result, &mut merged)?;
             }
-            buffer_start = keep_from;
-            if pending.len() == batch || end == rows {
-                let reduced = pending
-                    .par_iter()
-                    .map(|segment| self.reduce_segment(segment, features))
-                    .collect::<Result<Vec<Reduced>>>()?;
-                for (triangle, segment_moments, segment_sizes, count) in reduced {
-                    reduction.merge(&triangle, count);
-                    for (total, part) in moments.iter_mut().zip(segment_moments) {
-                        *total = total.merge(part);
-                    }
-                    for (total, part) in sizes.iter_mut().zip(segment_sizes) {
-                        *total = total.max(part);
-                    }
-                }
-                pending.clear();
-            }
-        }
+            Ok(())
+        })?;
+        let Merged {
+            reduction,
+            moments,
+            sizes,
+        } = merged;
         let names = self.feature_names_for_inputs();
         crate::model::check_scale(&sizes, &names)?;
         let reduced = reduction.finish().with_target_names(self.state_names());
@@ -196,6 +317,29 @@ impl SindyParams {
             score: score(&residuals, &moments, rows),
             rows,
         })
+    }
+
+    /// A worker: reduces the segments it takes from `queue` until it is closed, and sends each
+    /// result with its index.
+    fn reduce_segments(
+        &self,
+        queue: &Mutex<Receiver<(usize, Segment)>>,
+        done: Sender<(usize, Result<Reduced>)>,
+        features: usize,
+    ) {
+        loop {
+            let job = match queue.lock() {
+                Ok(queue) => queue.recv(),
+                Err(_) => return,
+            };
+            let Ok((index, segment)) = job else {
+                return;
+            };
+            let reduced = self.reduce_segment(&segment, features);
+            if done.send((index, reduced)).is_err() {
+                return;
+            }
+        }
     }
 
     /// Inputs and targets of the rows `range`, from the buffer (global rows from `buffer_start`)

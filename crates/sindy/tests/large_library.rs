@@ -184,3 +184,64 @@ fn a_streamed_recording_fits_as_the_whole_one() {
         assert_eq!(a.constant_states, b.constant_states);
     }
 }
+
+/// `fit_streamed` of `inputs` (3 states, 4 controls) in blocks of 7,777 rows, within a pool of
+/// `threads` threads.
+fn streamed_in_pool(
+    params: &SindyParams,
+    inputs: &Mat<f64>,
+    threads: usize,
+) -> sindy::Result<sindy::StreamedFit> {
+    let rows = inputs.nrows();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let mut next_row = 0;
+        params.fit_streamed(rows, 1e-3, || {
+            if next_row == rows {
+                return Ok(None);
+            }
+            let end = (next_row + 7_777).min(rows);
+            let columns = (0..7)
+                .map(|j| (next_row..end).map(|i| inputs[(i, j)]).collect())
+                .collect();
+            next_row = end;
+            Ok(Some(sindy::RowBlock {
+                columns,
+                time: None,
+            }))
+        })
+    })
+}
+
+/// Segments reduced by any number of workers, finishing in any order, are merged in row order:
+/// the same coefficients, bit for bit, and the first fault in row order is the one named.
+#[test]
+fn a_streamed_fit_is_the_same_on_any_number_of_threads() {
+    let rows = 4 * 32_768 + 1_001;
+    let (mut inputs, _) = data(rows);
+    let params = SindyParams::new(&["a", "b", "c"], &["p", "q", "r", "s"])
+        .library(FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap())
+        .optimizer(OptimizerSpec::stlsq(0.05));
+    let one = streamed_in_pool(&params, &inputs, 1).unwrap();
+    for threads in [2, 5] {
+        let many = streamed_in_pool(&params, &inputs, threads).unwrap();
+        assert_eq!(
+            many.model.coefficients().to_owned(),
+            one.model.coefficients().to_owned(),
+            "{threads} threads"
+        );
+        assert_eq!(many.score.mse.to_bits(), one.score.mse.to_bits());
+    }
+    // Faults in the fourth segment and in the second: the second's row is named.
+    inputs[(3 * 32_768 + 5, 4)] = 1e200;
+    inputs[(32_768 + 17, 5)] = 1e200;
+    for threads in [1, 2, 5] {
+        match streamed_in_pool(&params, &inputs, threads).unwrap_err() {
+            SindyError::NonFinite { row, .. } => assert_eq!(row, 32_768 + 17, "{threads}"),
+            other => panic!("{other}"),
+        }
+    }
+}

@@ -192,23 +192,17 @@ impl Problem {
     pub fn predict(&self, effects: &Effects) -> Vec<Channels> {
         let substeps = predict_substeps(&self.recording, &self.model, effects);
         let mut out = vec![[0.0; 6]; self.rows()];
-        for c in 0..self.channels {
-            let series: Vec<f64> = if c < 3 {
-                substeps.translational.iter().map(|a| a[c]).collect()
-            } else {
-                substeps
-                    .angular
-                    .as_ref()
-                    .expect("angular channels")
-                    .iter()
-                    .map(|a| a[c - 3])
-                    .collect()
-            };
-            for (row, value) in out
-                .iter_mut()
-                .zip(self.weak_form.integrate(&series, SUBSTEPS))
-            {
-                row[c] = value;
+        let translational = self
+            .weak_form
+            .integrate_channels(&substeps.translational, SUBSTEPS);
+        for (row, value) in out.iter_mut().zip(translational) {
+            row[..3].copy_from_slice(&value);
+        }
+        if self.channels == 6 {
+            let angular = substeps.angular.as_ref().expect("angular channels");
+            let angular = self.weak_form.integrate_channels(angular, SUBSTEPS);
+            for (row, value) in out.iter_mut().zip(angular) {
+                row[3..].copy_from_slice(&value);
             }
         }
         out

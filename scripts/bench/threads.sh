@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `make bench`, SINDy on all cores: the 1,000,000-row × 455-feature fit (`learn sindy --library
 # poly:3 --threshold 0.1 --derivative central` on 10 states and 2 controls, a 190 MB CSV read in
-# blocks) with 1 and 2 threads, in one run on this machine: seconds, the serial fraction from
-# Amdahl's law, whether the saved models are byte-identical, and the ratio to the seconds OpenBLAS
+# blocks) with 1 and 2 threads, in one run on this machine: seconds, peak RSS, the serial fraction
+# from Amdahl's law, whether the saved models are byte-identical, and the ratio to the seconds OpenBLAS
 # (NumPy) takes for the Gram matrix of the same 455 columns (scripts/bench/gram_floor.py), the
 # arithmetic floor of the fit. A reading-dominated fit of the same file (poly:1, 13 features) gives
 # the rows parsed per second.
@@ -22,22 +22,22 @@ states=$(seq -s, -f 'x%g' 0 9)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# Seconds of one fit with $1 threads and library $2, its model saved to $3.
+# Seconds and peak RSS (KiB) of one fit with $1 threads and library $2, its model saved to $3.
 fit() {
-    { RAYON_NUM_THREADS=$1 /usr/bin/time -f '%e' "$learn" sindy --quiet --csv "$csv" --state "$states" \
+    { RAYON_NUM_THREADS=$1 /usr/bin/time -f '%e %M' "$learn" sindy --quiet --csv "$csv" --state "$states" \
         --control u0,u1 --library "$2" --threshold 0.1 --derivative central --out "$3" >/dev/null; } \
         2>&1 | tail -1
 }
 
-one=$(fit 1 poly:3 "$work/one.json")
-two=$(fit 2 poly:3 "$work/two.json")
-read_one=$(fit 1 poly:1 "$work/read-one.json")
-read_two=$(fit 2 poly:1 "$work/read-two.json")
+read -r one one_kib <<<"$(fit 1 poly:3 "$work/one.json")"
+read -r two two_kib <<<"$(fit 2 poly:3 "$work/two.json")"
+read -r read_one _ <<<"$(fit 1 poly:1 "$work/read-one.json")"
+read -r read_two _ <<<"$(fit 2 poly:1 "$work/read-two.json")"
 same=no
 cmp -s "$work/one.json" "$work/two.json" && same=yes
 gram=$(env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE .venv/bin/python scripts/bench/gram_floor.py "$csv" 10 2)
 
-ROWS=$rows ONE=$one TWO=$two READ_ONE=$read_one READ_TWO=$read_two SAME=$same GRAM="$gram" python3 - <<'PY'
+ROWS=$rows ONE=$one TWO=$two ONE_KIB=$one_kib TWO_KIB=$two_kib READ_ONE=$read_one READ_TWO=$read_two SAME=$same GRAM="$gram" python3 - <<'PY'
 import json, os
 rows = int(os.environ["ROWS"])
 one, two = float(os.environ["ONE"]), float(os.environ["TWO"])
@@ -46,8 +46,10 @@ gram = json.loads(os.environ["GRAM"])["seconds"]
 # Amdahl: t2 = t1 (s + (1 - s) / 2), so s = 2 t2 / t1 - 1.
 serial = 2 * two / one - 1
 print(f"{rows} rows x 455 features, learn sindy (whole command, CSV read in blocks)")
-print(f"{'1 thread':<34}{one:>8.2f} s")
-print(f"{'2 threads':<34}{two:>8.2f} s   speed-up {one / two:.2f}x, serial fraction {100 * serial:.0f}%")
+one_mb, two_mb = int(os.environ["ONE_KIB"]) // 1024, int(os.environ["TWO_KIB"]) // 1024
+print(f"{'1 thread':<34}{one:>8.2f} s   peak RSS {one_mb} MB")
+print(f"{'2 threads':<34}{two:>8.2f} s   peak RSS {two_mb} MB; speed-up {one / two:.2f}x,"
+      f" serial fraction {100 * serial:.0f}%")
 print(f"{'models identical across threads':<34}{os.environ['SAME']:>8}")
 print(f"{'NumPy Gram matrix, 2 threads':<34}{gram:>8.2f} s   learn sindy / Gram {two / gram:.1f}x")
 print(f"{'poly:1 (reading-dominated), 1 / 2':<34}{read_one:>8.2f} s {read_two:>6.2f} s"

@@ -26,6 +26,16 @@ pub(crate) struct ParsedRows {
     pub error: Option<DataError>,
 }
 
+impl ParsedRows {
+    /// No rows yet, of `width` columns.
+    pub(crate) fn new(width: usize) -> Self {
+        Self {
+            columns: vec![Vec::new(); width],
+            ..Self::default()
+        }
+    }
+}
+
 /// The file after its header, read in chunks and parsed into [`ParsedRows`].
 pub(crate) struct ChunkedRows {
     path: PathBuf,
@@ -156,37 +166,27 @@ impl ChunkedRows {
 
     /// The rows of one piece that begins at a record start on line `line`, up to its first error.
     fn parse_piece(&self, text: &[u8], line: usize) -> ParsedRows {
+        let mut piece = ParsedRows::new(self.columns.len());
+        if let Err(error) = self.read_piece(text, line, &mut piece) {
+            piece.error = Some(error);
+        }
+        piece
+    }
+
+    /// Appends the rows of a piece to `piece` until its end or its first error.
+    fn read_piece(&self, text: &[u8], line: usize, piece: &mut ParsedRows) -> Result<()> {
         let mut records = CsvRecords::continuing(&self.path, text, line, self.header.len());
-        let mut piece = ParsedRows {
-            columns: vec![Vec::new(); self.columns.len()],
-            ..ParsedRows::default()
-        };
         let mut record = Record::default();
         let mut buffer = Vec::with_capacity(1);
         let mut row = Vec::with_capacity(self.columns.len());
-        loop {
-            let read = records
-                .next_row(&mut record, &self.header)
-                .and_then(|more| {
-                    if more {
-                        row_numbers(&self.path, &self.columns, &record, &mut buffer, &mut row)?;
-                    }
-                    Ok(more)
-                });
-            match read {
-                Ok(true) => {
-                    for (values, &value) in piece.columns.iter_mut().zip(&row) {
-                        values.push(value);
-                    }
-                    piece.lines.push(record.line);
-                }
-                Ok(false) => return piece,
-                Err(error) => {
-                    piece.error = Some(error);
-                    return piece;
-                }
+        while records.next_row(&mut record, &self.header)? {
+            row_numbers(&self.path, &self.columns, &record, &mut buffer, &mut row)?;
+            for (values, &value) in piece.columns.iter_mut().zip(&row) {
+                values.push(value);
             }
+            piece.lines.push(record.line);
         }
+        Ok(())
     }
 
     /// The file read.

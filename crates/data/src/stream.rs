@@ -10,7 +10,7 @@
 use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::sync::mpsc::{Receiver, sync_channel};
 use std::thread::JoinHandle;
 
 use crate::cells::NumericColumn;
@@ -70,13 +70,9 @@ impl NumericStream {
     pub fn open_in_chunks(path: &Path, columns: &[&str], chunk_bytes: usize) -> Result<Self> {
         check_regular_file(path)?;
         let rows = ChunkedRows::open(path, columns, chunk_bytes)?;
-        let parsed = ParsedRows {
-            columns: vec![Vec::new(); rows.width()],
-            ..ParsedRows::default()
-        };
         Ok(Self {
+            parsed: ParsedRows::new(rows.width()),
             rows,
-            parsed,
             taken: 0,
             returned: 0,
         })
@@ -133,12 +129,11 @@ impl NumericStream {
     pub fn read_ahead(mut self, max_rows: usize, blocks: usize) -> ReadAhead {
         let (sender, receiver) = sync_channel(blocks.max(1));
         let reader = std::thread::spawn(move || {
-            let send = |sender: &SyncSender<_>, item| sender.send(item).is_ok();
             loop {
                 let item = self.next_block(max_rows);
                 let last = !matches!(item, Ok(Some(_)));
                 // A receiver gone (the caller stopped early) ends the reading too.
-                if !send(&sender, item) || last {
+                if sender.send(item).is_err() || last {
                     return;
                 }
             }

@@ -188,7 +188,7 @@ pub(super) fn read_recording(
     columns: &[&str],
     derivative: Derivative,
 ) -> anyhow::Result<Recording> {
-    let (time, table) = if data::layout::is_ulog(path) || path.is_dir() {
+    let (time, table) = if is_px4_log(path) {
         read_ulog_columns(path, time_column, columns)?
     } else {
         NumericTable::read_with_increasing_time(path, time_column, columns)?
@@ -205,6 +205,11 @@ pub(super) fn read_recording(
         trajectory,
         table,
     })
+}
+
+/// Whether `path` is read as a PX4 log: a `.ulg`, or a folder holding its CSV export.
+fn is_px4_log(path: &Path) -> bool {
+    data::layout::is_ulog(path) || path.is_dir()
 }
 
 /// The columns (`topic.field`) of a ULog, or of a folder holding its CSV export (one file per
@@ -553,12 +558,7 @@ pub fn run(global: &Global, args: Args) -> anyhow::Result<()> {
         .library(library)
         .optimizer(optimizer)
         .derivative(derivative);
-    if args.stream
-        && args
-            .csv
-            .iter()
-            .any(|path| data::layout::is_ulog(path) || path.is_dir())
-    {
+    if args.stream && args.csv.iter().any(|path| is_px4_log(path)) {
         bail!("--stream reads a CSV; a ULog or a folder of its CSV export is read whole");
     }
     let streamed = args.stream

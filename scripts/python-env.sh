@@ -30,6 +30,8 @@ else
         scipy==1.17.1
         numpy==2.4.6
         pandas==3.1.1
+        # data: Parquet files for the ingestion bench and tests' fixtures (scripts/bench/parquet*)
+        pyarrow==26.0.1
         # learn: JAX reference of the LeARN meta-iteration (scripts/bench/learn*)
         jax[cpu]==0.10.2
     )

@@ -53,9 +53,11 @@
 //!
 //! # Large libraries and long recordings
 //! A library of more than [`LARGE_LIBRARY_ENTRIES`] entries is evaluated by row blocks and
-//! reduced as it is built to the triangle of a QR factorisation (see [`Problem::reduced`]);
-//! [`SindyParams::fit_streamed`] fits a recording whose rows arrive in blocks, in memory that
-//! does not grow with its length. The coefficients are those of the whole matrix up to rounding.
+//! reduced as it is built to the triangle of a QR factorisation (see [`Problem::reduced`]): from
+//! its Gram matrix where that is as accurate ([`GRAM_CONDITION_LIMIT`], [`GRAM_RESIDUAL_SHARE`]),
+//! by Householder QR otherwise ([`RowReduction`]); [`SindyParams::fit_streamed`] fits a recording
+//! whose rows arrive in blocks, in memory that does not grow with its length. The coefficients
+//! are those of the whole matrix up to rounding.
 //!
 //! # STLSQ semantics
 //! See [`Stlsq`]: ridge `‖Θξ − y‖² + α‖ξ‖²` (no column normalisation), threshold `|ξ| ≥ t`,
@@ -96,8 +98,8 @@ pub use model::{
     LARGE_LIBRARY_ENTRIES, Score, SindyModel, SindyParams, Trajectory, mean_squared_error,
 };
 pub use optimizers::{
-    DEFAULT_ALPHA, DEFAULT_MAX_ITER, Lasso, Optimizer, OptimizerSpec, Problem, Ridge, Stlsq,
-    StlsqFit, kkt_violation,
+    DEFAULT_ALPHA, DEFAULT_MAX_ITER, GRAM_CONDITION_LIMIT, GRAM_RESIDUAL_SHARE, Lasso, Optimizer,
+    OptimizerSpec, Problem, Reduction, Ridge, RowReduction, Stlsq, StlsqFit, kkt_violation,
 };
 pub use regression::{
     Bagging, BlockedFolds, EnsemblePrediction, LinearFit, MAX_BAGGING_BLOCK, MAX_BAGGING_MEMBERS,

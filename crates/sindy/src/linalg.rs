@@ -14,11 +14,12 @@
 //! prediction, the row-block reduction — can forget it. `tests/vector_state.rs` checks it on every
 //! public entry point.
 
+use faer::linalg::matmul::triangular::{BlockStructure, matmul};
 use faer::linalg::solvers::{Qr, Solve, SolveLstsq};
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
-use faer::{Mat, MatRef, Par, Side};
+use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 
 /// Runs `work`, which calls faer, and leaves the vector registers' upper halves clear (see the
 /// module documentation): every faer call of the crate runs inside it.
@@ -93,6 +94,56 @@ pub(crate) fn solve_upper(r: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> 
     kernels(|| {
         let mut solution = rhs.to_owned();
         solve_upper_triangular_in_place(r, solution.as_mut(), Par::Seq);
+        solution
+    })
+}
+
+/// Adds the lower triangle of `[a b]ᵀ[a b]` to `sums` (p + m square, for `a` of p columns and `b`
+/// of m): `aᵀa` and `bᵀb` as lower triangles, `bᵀa` whole below them. Each product is summed in
+/// one fixed order, whatever the thread count.
+pub(crate) fn add_gram(sums: MatMut<'_, f64>, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
+    let p = a.ncols();
+    let (top, bottom) = sums.split_at_row_mut(p);
+    let (library, _) = top.split_at_col_mut(p);
+    let (cross, targets) = bottom.split_at_col_mut(p);
+    kernels(|| {
+        let lower = |dst: MatMut<'_, f64>, left: MatRef<'_, f64>| {
+            let rect = BlockStructure::Rectangular;
+            let structure = BlockStructure::TriangularLower;
+            matmul(
+                dst,
+                structure,
+                Accum::Add,
+                left.transpose(),
+                rect,
+                left,
+                rect,
+                1.0,
+                Par::Seq,
+            );
+        };
+        lower(library, a);
+        lower(targets, b);
+        faer::linalg::matmul::matmul(cross, Accum::Add, b.transpose(), a, 1.0, Par::Seq);
+    })
+}
+
+/// The upper triangular R with RᵀR = `gram` (its lower triangle read), if it is numerically
+/// positive definite.
+pub(crate) fn cholesky_upper(gram: MatRef<'_, f64>) -> Option<Mat<f64>> {
+    kernels(|| upper_cholesky(gram))
+}
+
+/// The inverse of an upper triangular `r`.
+pub(crate) fn invert_upper(r: MatRef<'_, f64>) -> Mat<f64> {
+    kernels(|| upper_triangular_inverse(r))
+}
+
+/// `r⁻ᵀ·rhs` for an upper triangular `r`.
+pub(crate) fn solve_upper_transposed(r: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
+    kernels(|| {
+        let mut solution = rhs.to_owned();
+        solve_lower_triangular_in_place(r.transpose(), solution.as_mut(), Par::Seq);
         solution
     })
 }

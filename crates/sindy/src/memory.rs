@@ -23,7 +23,7 @@
 //! 3,321 (row blocks) 840 MB, rank-deficient 636 MB, against 1.3 GB.
 
 use crate::optimizers::OptimizerSpec;
-use crate::optimizers::tsqr::{BLOCK_ROWS, SEGMENT_ROWS};
+use crate::optimizers::row_blocks::{BLOCK_ROWS, SEGMENT_ROWS};
 
 /// Bytes of one matrix entry.
 const ENTRY_BYTES: f64 = 8.0;

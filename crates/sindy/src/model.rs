@@ -6,7 +6,8 @@ use faer::{Mat, MatRef};
 use crate::error::{Result, SindyError, invalid, shape};
 use crate::library::{FeatureLibrary, LibrarySpec};
 use crate::linalg::product;
-use crate::optimizers::tsqr::{BLOCK_ROWS, reduce_row_blocks};
+use crate::optimizers::RowReduction;
+use crate::optimizers::row_blocks::{BLOCK_ROWS, reduce_row_blocks};
 use crate::optimizers::{Optimizer, OptimizerSpec, Problem};
 
 /// One recorded trajectory: states x(t), optional controls u(t), optional derivatives ẋ(t).
@@ -139,6 +140,7 @@ pub struct SindyParams {
     library_spec: Option<LibrarySpec>,
     optimizer: OptimizerSpec,
     derivative: Derivative,
+    pub(crate) reduction: RowReduction,
 }
 
 impl SindyParams {
@@ -156,6 +158,7 @@ impl SindyParams {
             library_spec: Some(spec),
             optimizer: OptimizerSpec::stlsq(0.1),
             derivative: Derivative::Central,
+            reduction: RowReduction::default(),
         }
     }
 
@@ -175,6 +178,13 @@ impl SindyParams {
     /// Estimates missing derivatives with `derivative`.
     pub fn derivative(mut self, derivative: Derivative) -> Self {
         self.derivative = derivative;
+        self
+    }
+
+    /// Reduces the rows of fits too long to hold whole by `reduction` (the guarded Gram matrix by
+    /// default).
+    pub fn reduction(mut self, reduction: RowReduction) -> Self {
+        self.reduction = reduction;
         self
     }
 
@@ -237,7 +247,8 @@ impl SindyParams {
         let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
         let feature_names = self.library.feature_names(&input_names);
         let sizes = FeatureSizes::new(features);
-        let reduced = reduce_row_blocks(inputs.nrows(), features, targets.ncols(), |rows| {
+        let (rows, width) = (inputs.nrows(), targets.ncols());
+        let (reduced, _) = reduce_row_blocks(self.reduction, rows, features, width, |rows| {
             let inputs = inputs.subrows(rows.start, rows.len());
             let theta = self.library_block(inputs, rows.start, &feature_names, &sizes)?;
             Ok::<_, SindyError>((theta, targets.subrows(rows.start, rows.len()).to_owned()))

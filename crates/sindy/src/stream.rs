@@ -15,7 +15,8 @@ use crate::differentiation::Derivative;
 
 use crate::error::{Result, SindyError, shape};
 use crate::model::{CONSTANT_RELATIVE_SPREAD, FeatureSizes, Score, SindyModel, SindyParams};
-use crate::optimizers::tsqr::{Reduction, SEGMENT_ROWS, segment_triangle};
+use crate::optimizers::row_blocks::{RowMerge, SEGMENT_ROWS, reduce_by, segment_part};
+use crate::optimizers::{Reduction, RowReduction};
 
 /// Consecutive rows of a recording: one vector per state, then one per control; and their time
 /// stamps when the steps are uneven (`None`: every step is the `dt` of the fit).
@@ -25,12 +26,14 @@ pub struct RowBlock {
     pub time: Option<Vec<f64>>,
 }
 
-/// A model fitted on a streamed recording, with its score on all rows.
+/// A model fitted on a streamed recording, with its score on all rows and how its rows were
+/// reduced.
 #[derive(Clone, Debug)]
 pub struct StreamedFit {
     pub model: SindyModel,
     pub score: Score,
     pub rows: usize,
+    pub reduction: Reduction,
 }
 
 /// Rows before and after a sample that its derivative estimate may read (edge formulas included).
@@ -95,19 +98,20 @@ enum Sampling<'a> {
     Stamped(&'a [f64]),
 }
 
-/// What a reduced segment hands to the merge: its triangle, target moments, feature sizes.
+/// What a reduced segment hands to the merge: its part (Gram matrix or triangle), target moments,
+/// feature sizes and rows.
 type Reduced = (Mat<f64>, Vec<Moments>, Vec<f64>, usize);
 
-/// The segments merged so far: their triangle, target moments and feature sizes.
+/// The segments merged so far: their reduction, target moments and feature sizes.
 struct Merged {
-    reduction: Reduction,
+    merge: RowMerge,
     moments: Vec<Moments>,
     sizes: Vec<f64>,
 }
 
 impl Merged {
-    fn add(&mut self, (triangle, moments, sizes, count): Reduced) {
-        self.reduction.merge(&triangle, count);
+    fn add(&mut self, (part, moments, sizes, count): Reduced) {
+        self.merge.add(&part, count);
         for (total, part) in self.moments.iter_mut().zip(moments) {
             *total = total.merge(part);
         }
@@ -227,20 +231,21 @@ fn check_block(block: &RowBlock, width: usize, mixed: bool) -> Result<()> {
 }
 
 impl SindyParams {
-    /// Fits on a recording of `rows` rows sampled every `dt` seconds whose blocks `next` yields in
-    /// order (any block sizes; `None` at the end). Its derivatives are those of
-    /// [`crate::Trajectory`] with the same `dt`; blocks that carry their time stamps (every block
-    /// or none) have them estimated on those stamps ([`Derivative::apply_at_times`]). Errors name
-    /// rows 0-based from the first.
-    pub fn fit_streamed(
+    /// Fits on a recording of `rows` rows sampled every `dt` seconds, read from its first row by
+    /// the blocks each call of `open` yields in order (any block sizes; `None` at the end): once,
+    /// or twice when the Gram matrix of the first reading is refused ([`RowReduction`]). Its
+    /// derivatives are those of [`crate::Trajectory`] with the same `dt`; blocks that carry their
+    /// time stamps (every block or none) have them estimated on those stamps
+    /// ([`Derivative::apply_at_times`]). Errors name rows 0-based from the first.
+    pub fn fit_streamed<Blocks>(
         &self,
         rows: usize,
         dt: f64,
-        mut next: impl FnMut() -> Result<Option<RowBlock>>,
-    ) -> Result<StreamedFit> {
-        let (dim_x, dim_u) = (self.state_names().len(), self.control_names().len());
-        let width = dim_x + dim_u;
-        let features = self.library_feature_count(width);
+        mut open: impl FnMut() -> Result<Blocks>,
+    ) -> Result<StreamedFit>
+    where
+        Blocks: FnMut() -> Result<Option<RowBlock>>,
+    {
         let derivative = self.derivative_estimator();
         derivative.validate()?;
         if rows < derivative.min_samples().max(2) {
@@ -249,10 +254,40 @@ impl SindyParams {
                 format!("{rows} rows, too few for the {derivative} derivative"),
             ));
         }
-        let (left, right) = context(derivative);
         let optimizer = self.checked_optimizer()?;
+        let (problem, (moments, sizes), reduction) = reduce_by(self.reduction, |method| {
+            let merged = self.reduce_stream(method, rows, dt, open()?)?;
+            Ok::<_, SindyError>((merged.merge, (merged.moments, merged.sizes)))
+        })?;
+        let names = self.feature_names_for_inputs();
+        crate::model::check_scale(&sizes, &names)?;
+        let reduced = problem.with_target_names(self.state_names());
+        let coefficients = optimizer.solve(&reduced)?;
+        let residuals = reduced.residual_sum_of_squares(coefficients.as_ref());
+        let model = self.model(names, coefficients);
+        Ok(StreamedFit {
+            model,
+            score: score(&residuals, &moments, rows),
+            rows,
+            reduction,
+        })
+    }
+
+    /// One reading of the recording: every segment reduced by `method` as its rows arrive from
+    /// `next`, and merged in row order.
+    fn reduce_stream(
+        &self,
+        method: RowReduction,
+        rows: usize,
+        dt: f64,
+        mut next: impl FnMut() -> Result<Option<RowBlock>>,
+    ) -> Result<Merged> {
+        let (dim_x, dim_u) = (self.state_names().len(), self.control_names().len());
+        let width = dim_x + dim_u;
+        let features = self.library_feature_count(width);
+        let (left, right) = context(self.derivative_estimator());
         let mut merged = Merged {
-            reduction: Reduction::new(features, dim_x),
+            merge: RowMerge::new(method, features, dim_x),
             moments: vec![Moments::default(); dim_x],
             sizes: vec![0.0f64; features],
         };
@@ -267,7 +302,7 @@ impl SindyParams {
             let jobs = jobs;
             for _ in 0..workers {
                 let (queue, done) = (&queue, done.clone());
-                scope.spawn(move || self.reduce_segments(queue, done, features));
+                scope.spawn(move || self.reduce_segments(method, queue, done, features));
             }
             drop(done);
             let mut order = InOrder::default();
@@ -301,28 +336,14 @@ impl SindyParams {
             }
             Ok(())
         })?;
-        let Merged {
-            reduction,
-            moments,
-            sizes,
-        } = merged;
-        let names = self.feature_names_for_inputs();
-        crate::model::check_scale(&sizes, &names)?;
-        let reduced = reduction.finish().with_target_names(self.state_names());
-        let coefficients = optimizer.solve(&reduced)?;
-        let residuals = reduced.residual_sum_of_squares(coefficients.as_ref());
-        let model = self.model(names, coefficients);
-        Ok(StreamedFit {
-            model,
-            score: score(&residuals, &moments, rows),
-            rows,
-        })
+        Ok(merged)
     }
 
     /// A worker: reduces the segments it takes from `queue` until it is closed, and sends each
     /// result with its index.
     fn reduce_segments(
         &self,
+        method: RowReduction,
         queue: &Mutex<Receiver<(usize, Segment)>>,
         done: Sender<(usize, Result<Reduced>)>,
         features: usize,
@@ -335,7 +356,7 @@ impl SindyParams {
             let Ok((index, segment)) = job else {
                 return;
             };
-            let reduced = self.reduce_segment(&segment, features);
+            let reduced = self.reduce_segment(method, &segment, features);
             if done.send((index, reduced)).is_err() {
                 return;
             }
@@ -379,15 +400,21 @@ impl SindyParams {
         })
     }
 
-    /// One segment's triangle, target moments and feature sizes; non-finite values are errors
-    /// naming their global row.
-    fn reduce_segment(&self, segment: &Segment, features: usize) -> Result<Reduced> {
+    /// One segment's part (by `method`), target moments and feature sizes; non-finite values are
+    /// errors naming their global row.
+    fn reduce_segment(
+        &self,
+        method: RowReduction,
+        segment: &Segment,
+        features: usize,
+    ) -> Result<Reduced> {
         self.check_values(segment.inputs.as_ref(), segment.targets.as_ref())
             .map_err(|error| error.offset_row(segment.start))?;
         let names = self.feature_names_for_inputs();
         let sizes = FeatureSizes::new(features);
         let rows = segment.inputs.nrows();
-        let triangle = segment_triangle(rows, features + segment.targets.ncols(), |block| {
+        let width = features + segment.targets.ncols();
+        let part = segment_part(method, rows, width, |block| {
             let inputs = segment.inputs.subrows(block.start, block.len());
             let theta = self.library_block(inputs, segment.start + block.start, &names, &sizes)?;
             Ok::<_, SindyError>((
@@ -398,7 +425,7 @@ impl SindyParams {
         let moments = (0..segment.targets.ncols())
             .map(|j| Moments::of(&segment.targets.col(j).iter().copied().collect::<Vec<_>>()))
             .collect();
-        Ok((triangle, moments, sizes.into_vec(), rows))
+        Ok((part, moments, sizes.into_vec(), rows))
     }
 }
 

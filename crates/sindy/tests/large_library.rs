@@ -3,8 +3,8 @@
 //! for STLSQ and LASSO, and a non-finite feature is reported on its row.
 
 use sindy::{
-    FeatureLibrary, LARGE_LIBRARY_ENTRIES, LibrarySpec, Mat, OptimizerSpec, SindyError,
-    SindyParams, Stlsq,
+    FeatureLibrary, LARGE_LIBRARY_ENTRIES, LibrarySpec, Mat, OptimizerSpec, RowReduction,
+    SindyError, SindyParams, Stlsq,
 };
 
 /// Smooth, well-conditioned inputs (7 columns: an offset and four sinusoids of distinct
@@ -123,25 +123,28 @@ fn a_streamed_recording_fits_as_the_whole_one() {
         let whole = params.fit(std::slice::from_ref(&trajectory)).unwrap();
         let whole_score = whole.score(&trajectory).unwrap();
         let step = (time[rows - 1] - time[0]) / (rows - 1) as f64;
-        let mut next_row = 0;
         let streamed = params
             .fit_streamed(rows, step, || {
-                if next_row == rows {
-                    return Ok(None);
-                }
-                let end = (next_row + 7_777).min(rows);
-                let mut columns = Vec::new();
-                for j in 0..3 {
-                    columns.push((next_row..end).map(|i| states[(i, j)]).collect());
-                }
-                for j in 0..4 {
-                    columns.push((next_row..end).map(|i| controls[(i, j)]).collect());
-                }
-                next_row = end;
-                Ok(Some(RowBlock {
-                    columns,
-                    time: None,
-                }))
+                let (states, controls) = (&states, &controls);
+                let mut next_row = 0;
+                Ok(move || {
+                    if next_row == rows {
+                        return Ok(None);
+                    }
+                    let end = (next_row + 7_777).min(rows);
+                    let mut columns = Vec::new();
+                    for j in 0..3 {
+                        columns.push((next_row..end).map(|i| states[(i, j)]).collect());
+                    }
+                    for j in 0..4 {
+                        columns.push((next_row..end).map(|i| controls[(i, j)]).collect());
+                    }
+                    next_row = end;
+                    Ok(Some(RowBlock {
+                        columns,
+                        time: None,
+                    }))
+                })
             })
             .unwrap();
         assert_eq!(streamed.rows, rows);
@@ -198,20 +201,22 @@ fn streamed_in_pool(
         .build()
         .unwrap();
     pool.install(|| {
-        let mut next_row = 0;
         params.fit_streamed(rows, 1e-3, || {
-            if next_row == rows {
-                return Ok(None);
-            }
-            let end = (next_row + 7_777).min(rows);
-            let columns = (0..7)
-                .map(|j| (next_row..end).map(|i| inputs[(i, j)]).collect())
-                .collect();
-            next_row = end;
-            Ok(Some(sindy::RowBlock {
-                columns,
-                time: None,
-            }))
+            let mut next_row = 0;
+            Ok(move || {
+                if next_row == rows {
+                    return Ok(None);
+                }
+                let end = (next_row + 7_777).min(rows);
+                let columns = (0..7)
+                    .map(|j| (next_row..end).map(|i| inputs[(i, j)]).collect())
+                    .collect();
+                next_row = end;
+                Ok(Some(sindy::RowBlock {
+                    columns,
+                    time: None,
+                }))
+            })
         })
     })
 }
@@ -221,27 +226,105 @@ fn streamed_in_pool(
 #[test]
 fn a_streamed_fit_is_the_same_on_any_number_of_threads() {
     let rows = 4 * 32_768 + 1_001;
-    let (mut inputs, _) = data(rows);
-    let params = SindyParams::new(&["a", "b", "c"], &["p", "q", "r", "s"])
-        .library(FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap())
-        .optimizer(OptimizerSpec::stlsq(0.05));
-    let one = streamed_in_pool(&params, &inputs, 1).unwrap();
-    for threads in [2, 5] {
-        let many = streamed_in_pool(&params, &inputs, threads).unwrap();
-        assert_eq!(
-            many.model.coefficients().to_owned(),
-            one.model.coefficients().to_owned(),
-            "{threads} threads"
-        );
-        assert_eq!(many.score.mse.to_bits(), one.score.mse.to_bits());
+    let mut inputs = full_rank_inputs(rows);
+    for reduction in [RowReduction::Gram, RowReduction::Householder] {
+        let params = SindyParams::new(&["a", "b", "c"], &["p", "q", "r", "s"])
+            .library(FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap())
+            .optimizer(OptimizerSpec::stlsq(0.05))
+            .reduction(reduction);
+        let one = streamed_in_pool(&params, &inputs, 1).unwrap();
+        assert_eq!(one.reduction.method, reduction);
+        for threads in [2, 5] {
+            let many = streamed_in_pool(&params, &inputs, threads).unwrap();
+            assert_eq!(
+                many.model.coefficients().to_owned(),
+                one.model.coefficients().to_owned(),
+                "{threads} threads, {reduction:?}"
+            );
+            assert_eq!(many.score.mse.to_bits(), one.score.mse.to_bits());
+        }
     }
     // Faults in the fourth segment and in the second: the second's row is named.
     inputs[(3 * 32_768 + 5, 4)] = 1e200;
     inputs[(32_768 + 17, 5)] = 1e200;
+    let params = SindyParams::new(&["a", "b", "c"], &["p", "q", "r", "s"])
+        .library(FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap());
     for threads in [1, 2, 5] {
         match streamed_in_pool(&params, &inputs, threads).unwrap_err() {
             SindyError::NonFinite { row, .. } => assert_eq!(row, 32_768 + 17, "{threads}"),
             other => panic!("{other}"),
         }
     }
+}
+
+/// The inputs of [`data`] plus a pseudo-random part (a multiplicative hash of the position):
+/// sinusoids of shared frequencies alone make the quadratic library rank-deficient.
+fn full_rank_inputs(rows: usize) -> Mat<f64> {
+    let (inputs, _) = data(rows);
+    Mat::from_fn(rows, 7, |i, j| {
+        let hash = ((i * 7 + j) as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        inputs[(i, j)] + 0.05 * (hash as f64 / 2f64.powi(64) - 0.5)
+    })
+}
+
+/// `fit_streamed` of `inputs` in blocks of 7,777 rows, and how many times it opened them.
+fn streamed_counting_opens(params: &SindyParams, inputs: &Mat<f64>) -> (sindy::StreamedFit, usize) {
+    let rows = inputs.nrows();
+    let mut opens = 0;
+    let fit = params
+        .fit_streamed(rows, 1e-3, || {
+            opens += 1;
+            let mut next_row = 0;
+            Ok(move || {
+                let end = (next_row + 7_777).min(rows);
+                let columns = (0..7)
+                    .map(|j| (next_row..end).map(|i| inputs[(i, j)]).collect())
+                    .collect();
+                let block = (next_row < end).then_some(sindy::RowBlock {
+                    columns,
+                    time: None,
+                });
+                next_row = end;
+                Ok(block)
+            })
+        })
+        .unwrap();
+    (fit, opens)
+}
+
+/// The rows are read once when their Gram matrix is kept, and again (by Householder QR, to the
+/// same coefficients as a fit that uses it from the start) when it is refused.
+#[test]
+fn a_streamed_fit_reads_its_rows_again_only_when_the_gram_matrix_is_refused() {
+    let rows = 2 * 32_768 + 99;
+    let mut inputs = full_rank_inputs(rows);
+    let params = SindyParams::new(&["a", "b", "c"], &["p", "q", "r", "s"])
+        .library(FeatureLibrary::from_spec(&LibrarySpec::parse("poly:2").unwrap()).unwrap())
+        .optimizer(OptimizerSpec::stlsq(0.05));
+    let (fit, opens) = streamed_counting_opens(&params, &inputs);
+    assert_eq!((opens, fit.reduction.method), (1, RowReduction::Gram));
+    let condition = fit.reduction.gram_condition.unwrap();
+    assert!(condition <= sindy::GRAM_CONDITION_LIMIT, "{condition}");
+    let householder = params.clone().reduction(RowReduction::Householder);
+    let (reference, opens) = streamed_counting_opens(&householder, &inputs);
+    assert_eq!((opens, reference.reduction.gram_condition), (1, None));
+    let difference = (fit.model.coefficients() - reference.model.coefficients()).norm_max();
+    assert!(difference < 1e-9, "{difference}");
+
+    // The last control nearly equal to the one before: the scaled condition number explodes.
+    for i in 0..rows {
+        inputs[(i, 6)] = inputs[(i, 5)] * (1.0 + 1e-5 * (i as f64 * 0.01).sin());
+    }
+    let (fit, opens) = streamed_counting_opens(&params, &inputs);
+    assert_eq!(
+        (opens, fit.reduction.method),
+        (2, RowReduction::Householder)
+    );
+    assert!(fit.reduction.gram_condition.unwrap() > sindy::GRAM_CONDITION_LIMIT);
+    let (reference, _) = streamed_counting_opens(&householder, &inputs);
+    assert_eq!(
+        fit.model.coefficients().to_owned(),
+        reference.model.coefficients().to_owned()
+    );
+    assert_eq!(fit.score.mse.to_bits(), reference.score.mse.to_bits());
 }

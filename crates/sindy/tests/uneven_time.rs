@@ -127,33 +127,36 @@ fn a_streamed_fit_on_stamped_blocks_is_the_fit_of_the_whole_trajectory() {
     let whole = params.fit(std::slice::from_ref(&trajectory)).unwrap();
     let rows = trajectory.time.len();
     let mean = (trajectory.time[rows - 1] - trajectory.time[0]) / (rows - 1) as f64;
-    let mut start = 0;
     let streamed = params
         .fit_streamed(rows, mean, || {
-            let end = (start + 777).min(rows);
-            let block = (start < end).then(|| sindy::RowBlock {
-                columns: vec![
-                    trajectory
-                        .states
-                        .col(0)
-                        .iter()
-                        .skip(start)
-                        .take(end - start)
-                        .copied()
-                        .collect(),
-                    trajectory
-                        .controls
-                        .col(0)
-                        .iter()
-                        .skip(start)
-                        .take(end - start)
-                        .copied()
-                        .collect(),
-                ],
-                time: Some(trajectory.time[start..end].to_vec()),
-            });
-            start = end;
-            Ok(block)
+            let trajectory = &trajectory;
+            let mut start = 0;
+            Ok(move || {
+                let end = (start + 777).min(rows);
+                let block = (start < end).then(|| sindy::RowBlock {
+                    columns: vec![
+                        trajectory
+                            .states
+                            .col(0)
+                            .iter()
+                            .skip(start)
+                            .take(end - start)
+                            .copied()
+                            .collect(),
+                        trajectory
+                            .controls
+                            .col(0)
+                            .iter()
+                            .skip(start)
+                            .take(end - start)
+                            .copied()
+                            .collect(),
+                    ],
+                    time: Some(trajectory.time[start..end].to_vec()),
+                });
+                start = end;
+                Ok(block)
+            })
         })
         .unwrap();
     for (a, b) in whole

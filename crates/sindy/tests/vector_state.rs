@@ -155,22 +155,25 @@ fn trajectories(failures: &mut Vec<String>, small_inputs: &Mat<f64>) {
     .apply(&column, 1e-3)
     .unwrap();
     check(failures, "a Savitzky–Golay derivative");
-    let mut next = 0;
     params
         .fit_streamed(rows, 1e-3, || {
-            if next == rows {
-                return Ok(None);
-            }
-            let end = (next + 1_000).min(rows);
-            let mut columns: Vec<Vec<f64>> = (0..3)
-                .map(|j| (next..end).map(|i| states[(i, j)]).collect())
-                .collect();
-            columns.extend((0..4).map(|j| (next..end).map(|i| controls[(i, j)]).collect()));
-            next = end;
-            Ok(Some(RowBlock {
-                columns,
-                time: None,
-            }))
+            let (states, controls) = (&states, &controls);
+            let mut next = 0;
+            Ok(move || {
+                if next == rows {
+                    return Ok(None);
+                }
+                let end = (next + 1_000).min(rows);
+                let mut columns: Vec<Vec<f64>> = (0..3)
+                    .map(|j| (next..end).map(|i| states[(i, j)]).collect())
+                    .collect();
+                columns.extend((0..4).map(|j| (next..end).map(|i| controls[(i, j)]).collect()));
+                next = end;
+                Ok(Some(RowBlock {
+                    columns,
+                    time: None,
+                }))
+            })
         })
         .unwrap();
     check(failures, "fit_streamed");

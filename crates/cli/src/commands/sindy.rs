@@ -386,19 +386,23 @@ fn fit_streamed(
         names.push(args.time.as_str());
     }
     names.extend_from_slice(columns);
-    let mut stream = NumericStream::open(csv, &names)?.read_ahead(STREAM_BLOCK_ROWS, ahead);
     let fit = params
         .fit_streamed(n, dt, || {
-            let block = stream
-                .next_block()
-                .map_err(|error| SindyError::Source(Box::new(error)))?;
-            Ok(block.map(|mut block| {
-                let time = stamped.then(|| block.columns.remove(0));
-                RowBlock {
-                    columns: block.columns,
-                    time,
-                }
-            }))
+            let mut stream = NumericStream::open(csv, &names)
+                .map_err(|error| SindyError::Source(Box::new(error)))?
+                .read_ahead(STREAM_BLOCK_ROWS, ahead);
+            Ok(move || {
+                let block = stream
+                    .next_block()
+                    .map_err(|error| SindyError::Source(Box::new(error)))?;
+                Ok(block.map(|mut block| {
+                    let time = stamped.then(|| block.columns.remove(0));
+                    RowBlock {
+                        columns: block.columns,
+                        time,
+                    }
+                }))
+            })
         })
         .map_err(|error| {
             fit_error(args, csv, error, |row| {

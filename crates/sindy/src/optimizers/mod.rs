@@ -11,20 +11,23 @@
 //! from there through [`crate::linalg`], which owns the faer calls and the vector-state clearing
 //! after them: an optimizer written against this trait cannot skip it.
 
+mod gram;
 mod lasso;
 mod problem;
 mod ridge;
+pub(crate) mod row_blocks;
 mod stlsq;
-pub(crate) mod tsqr;
 
 use faer::Mat;
 use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
 
+pub use gram::{GRAM_CONDITION_LIMIT, GRAM_RESIDUAL_SHARE};
 pub use lasso::{Lasso, kkt_violation};
 pub use problem::Problem;
 pub use ridge::Ridge;
+pub use row_blocks::{Reduction, RowReduction};
 pub use stlsq::{Stlsq, StlsqFit};
 
 /// PySINDy's default ridge strength of STLSQ.

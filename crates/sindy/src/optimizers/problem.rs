@@ -12,7 +12,7 @@
 //! matrix, or by Householder when Θ is too ill-conditioned for it, made when a least-squares step
 //! first asks; Θ itself when it is wide or rank-deficient), or reduced by blocks of rows as they
 //! are evaluated ([`Problem::reduced`], and the large-library and streaming fits through
-//! [`super::tsqr`]), where R, Z and the residual outside Θ's range are all that is kept. Either
+//! [`super::row_blocks`]), where R, Z and the residual outside Θ's range are all that is kept. Either
 //! way the optimizers see the same interface, and every dense computation runs in
 //! [`crate::linalg`].
 
@@ -234,10 +234,11 @@ impl<'a> Problem<'a> {
 
 impl Problem<'static> {
     /// Θ (n × p) and Y reduced by rows to the QR triangle, as a large library is reduced block by
-    /// block (see [`crate::LARGE_LIBRARY_ENTRIES`]): the optimizers give the same coefficients up
-    /// to rounding, and [`Problem::residual_sum_of_squares`] needs no row of Θ.
+    /// block (see [`crate::LARGE_LIBRARY_ENTRIES`] and [`crate::RowReduction`]): the optimizers
+    /// give the same coefficients up to rounding, and [`Problem::residual_sum_of_squares`] needs
+    /// no row of Θ.
     pub fn reduced(theta: MatRef<'_, f64>, targets: MatRef<'_, f64>) -> Self {
-        super::tsqr::reduce(theta, targets)
+        super::row_blocks::reduce(theta, targets)
     }
 
     /// The problem of R (p × p, upper triangular), Z = QᵀY and `‖s_j‖²` from the reduction of

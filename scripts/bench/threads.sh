@@ -5,7 +5,9 @@
 # from Amdahl's law, whether the saved models are byte-identical, and the ratio to the seconds OpenBLAS
 # (NumPy) takes for the Gram matrix of the same 455 columns (scripts/bench/gram_floor.py), the
 # arithmetic floor of the fit. A reading-dominated fit of the same file (poly:1, 13 features) gives
-# the rows parsed per second.
+# the rows parsed per second. The same columns as Parquet (written by pyarrow: one row group,
+# snappy) are fitted with 2 threads, their model compared with the CSV's, and read by pyarrow as
+# the Python reference of ingestion (scripts/bench/ingest_reference.py).
 #
 # THREADS_ROWS=1000000 scripts/bench/threads.sh
 set -euo pipefail
@@ -18,25 +20,39 @@ mkdir -p "$data_dir"
 learn=target/debug/learn
 csv="$data_dir/scaling-$rows-10-2.csv"
 [ -f "$csv" ] || .venv/bin/python scripts/bench/scaling_data.py "$rows" "$csv" 10 2
+parquet="$data_dir/scaling-$rows-10-2.parquet"
+[ -f "$parquet" ] || .venv/bin/python -c "import pyarrow.csv as c, pyarrow.parquet as p, sys
+p.write_table(c.read_csv(sys.argv[1]), sys.argv[2])" "$csv" "$parquet"
 states=$(seq -s, -f 'x%g' 0 9)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# Seconds and peak RSS (KiB) of one fit with $1 threads and library $2, its model saved to $3.
+# Seconds and peak RSS (KiB) of one fit of file $4 (the CSV by default) with $1 threads and
+# library $2, its model saved to $3.
 fit() {
-    { RAYON_NUM_THREADS=$1 /usr/bin/time -f '%e %M' "$learn" sindy --quiet --csv "$csv" --state "$states" \
-        --control u0,u1 --library "$2" --threshold 0.1 --derivative central --out "$3" >/dev/null; } \
-        2>&1 | tail -1
+    { RAYON_NUM_THREADS=$1 /usr/bin/time -f '%e %M' "$learn" sindy --quiet --csv "${4:-$csv}" \
+        --state "$states" --control u0,u1 --library "$2" --threshold 0.1 --derivative central \
+        --out "$3" >/dev/null; } 2>&1 | tail -1
 }
 
 read -r one one_kib <<<"$(fit 1 poly:3 "$work/one.json")"
 read -r two two_kib <<<"$(fit 2 poly:3 "$work/two.json")"
 read -r read_one _ <<<"$(fit 1 poly:1 "$work/read-one.json")"
 read -r read_two _ <<<"$(fit 2 poly:1 "$work/read-two.json")"
+read -r pq_one pq_one_kib <<<"$(fit 1 poly:3 "$work/pq-one.json" "$parquet")"
+read -r pq_two pq_two_kib <<<"$(fit 2 poly:3 "$work/pq-two.json" "$parquet")"
+read -r pq_read_one _ <<<"$(fit 1 poly:1 "$work/pq-read-one.json" "$parquet")"
+read -r pq_read_two _ <<<"$(fit 2 poly:1 "$work/pq-read-two.json" "$parquet")"
 same=no
 cmp -s "$work/one.json" "$work/two.json" && same=yes
+same_parquet=no
+cmp -s "$work/two.json" "$work/pq-two.json" && cmp -s "$work/pq-one.json" "$work/pq-two.json" \
+    && same_parquet=yes
 gram=$(env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE .venv/bin/python scripts/bench/gram_floor.py "$csv" 10 2)
+ingest=$(.venv/bin/python scripts/bench/ingest_reference.py "$csv" "$parquet" 10 2)
 
+export PQ_ONE=$pq_one PQ_TWO=$pq_two PQ_ONE_KIB=$pq_one_kib PQ_TWO_KIB=$pq_two_kib
+export PQ_READ_ONE=$pq_read_one PQ_READ_TWO=$pq_read_two SAME_PARQUET=$same_parquet INGEST="$ingest"
 ROWS=$rows ONE=$one TWO=$two ONE_KIB=$one_kib TWO_KIB=$two_kib READ_ONE=$read_one READ_TWO=$read_two SAME=$same GRAM="$gram" python3 - <<'PY'
 import json, os
 rows = int(os.environ["ROWS"])
@@ -54,4 +70,20 @@ print(f"{'models identical across threads':<34}{os.environ['SAME']:>8}")
 print(f"{'NumPy Gram matrix, 2 threads':<34}{gram:>8.2f} s   learn sindy / Gram {two / gram:.1f}x")
 print(f"{'poly:1 (reading-dominated), 1 / 2':<34}{read_one:>8.2f} s {read_two:>6.2f} s"
       f"   {rows / read_one / 1e3:.0f}k / {rows / read_two / 1e3:.0f}k rows/s")
+env = os.environ
+pq_one, pq_two = float(env["PQ_ONE"]), float(env["PQ_TWO"])
+pq_read_one, pq_read_two = float(env["PQ_READ_ONE"]), float(env["PQ_READ_TWO"])
+pq_serial = 2 * pq_two / pq_one - 1
+print("the same columns as Parquet (pyarrow: one row group, snappy)")
+print(f"{'1 thread':<34}{pq_one:>8.2f} s   peak RSS {int(env['PQ_ONE_KIB']) // 1024} MB")
+print(f"{'2 threads':<34}{pq_two:>8.2f} s   peak RSS {int(env['PQ_TWO_KIB']) // 1024} MB;"
+      f" speed-up {pq_one / pq_two:.2f}x, serial fraction {100 * pq_serial:.0f}%")
+print(f"{'models identical to the CSV fit':<34}{env['SAME_PARQUET']:>8}")
+print(f"{'NumPy Gram matrix, 2 threads':<34}{gram:>8.2f} s   learn sindy / Gram {pq_two / gram:.1f}x")
+print(f"{'poly:1 (reading-dominated), 1 / 2':<34}{pq_read_one:>8.2f} s {pq_read_two:>6.2f} s"
+      f"   {rows / pq_read_one / 1e3:.0f}k / {rows / pq_read_two / 1e3:.0f}k rows/s")
+ingest = json.loads(env["INGEST"])
+print("Python reference, pyarrow reading the same 13 columns (2 threads, fastest of 3)")
+for kind, seconds in (("CSV", ingest["csv_seconds"]), ("Parquet", ingest["parquet_seconds"])):
+    print(f"{'pyarrow ' + kind:<34}{seconds:>8.2f} s   {rows / seconds / 2e3:.0f}k rows/s per core")
 PY

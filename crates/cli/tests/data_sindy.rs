@@ -598,3 +598,29 @@ fn a_streamed_file_fits_as_the_whole_file_and_names_bad_lines() {
     sindy(&dir, "short-row.csv", "poly:2", &["--stream"])
         .one_line_error(&["short-row.csv:1500", "too few fields: 3 of the header's 4"]);
 }
+
+/// A Parquet file (known by its content, whatever its name) fits as the CSV of its values does,
+/// read whole or in blocks; a null is named by its row, counted from 1.
+#[test]
+fn a_parquet_recording_fits_as_its_csv() {
+    let dir = scratch("sindy-parquet");
+    std::fs::write(dir.join("s.csv"), signal(3000)).unwrap();
+    let names = ["t", "x", "y", "u"];
+    let table = data::NumericTable::read(&dir.join("s.csv"), &names).unwrap();
+    data::write_numeric_parquet(&dir.join("s.parquet"), &table.names, &table.columns).unwrap();
+    std::fs::copy(dir.join("s.parquet"), dir.join("s.bin")).unwrap();
+    let extra = ["--precision", "9"];
+    let csv = sindy(&dir, "s.csv", "poly:2", &extra);
+    for file in ["s.parquet", "s.bin"] {
+        assert_eq!(sindy(&dir, file, "poly:2", &extra).success(), csv.success());
+        let streamed = sindy(&dir, file, "poly:2", &["--precision", "9", "--stream"]);
+        assert_eq!(streamed.success(), csv.success(), "{file}");
+    }
+    let mut columns = table.columns.clone();
+    columns[2][1234] = f64::NAN;
+    data::write_numeric_parquet(&dir.join("nan.parquet"), &table.names, &columns).unwrap();
+    for extra in [&[][..], &["--stream"]] {
+        sindy(&dir, "nan.parquet", "poly:2", extra)
+            .one_line_error(&["nan.parquet:1235:y", "not finite (NaN)"]);
+    }
+}

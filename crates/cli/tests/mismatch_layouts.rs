@@ -246,3 +246,50 @@ fn a_bad_layout_or_vehicle_model_is_named() {
     );
     run.one_line_error(&["randomwalk_l_cf102_01.csv", "T_sp", "no thrust setpoint"]);
 }
+
+/// The Crazyflie flight saved as Parquet (its columns as doubles) is analysed as its CSV is,
+/// through the same layout without the CSV's header prefix.
+#[test]
+fn a_parquet_recording_is_analysed_as_its_csv() {
+    let Some(flight) =
+        data::shared_file_for_tests(&workspace(), "crazyflie", "randomwalk_l_cf102_01.csv")
+    else {
+        return;
+    };
+    let dir = scratch("crazyflie-parquet");
+    let text = std::fs::read_to_string(&flight).unwrap();
+    let header = text.lines().next().unwrap().trim_start_matches("# ");
+    let names: Vec<&str> = header.split(',').collect();
+    let table = data::NumericTable::read_after_header_prefix(&flight, "# ", &names).unwrap();
+    let parquet = dir.join("flight.parquet");
+    data::write_numeric_parquet(&parquet, &table.names, &table.columns).unwrap();
+    let layout = "experiments/layouts/crazyflie-neural-swarm.json";
+    let mut fields: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root(layout)).unwrap()).unwrap();
+    fields.as_object_mut().unwrap().remove("header_prefix");
+    std::fs::write(dir.join("layout.json"), fields.to_string()).unwrap();
+    let model = "experiments/mismatch/vehicles/crazyflie-parrot.json";
+    let rows = ["--rows", "0:700"];
+    learn_through_layout(&flight, (layout, model), &dir, &rows).success();
+    let from_csv = report_in(&dir);
+    let mut args: Vec<String> = ["mismatch", "--recording", "flight.parquet", "--layout"]
+        .map(String::from)
+        .to_vec();
+    args.push("layout.json".into());
+    args.extend([
+        "--model".into(),
+        root(model),
+        "--out".into(),
+        "parquet-out".into(),
+    ]);
+    args.extend(["--quiet", "--rows", "0:700"].map(String::from));
+    learn_in(&dir, &args.iter().map(String::as_str).collect::<Vec<_>>()).success();
+    let text = std::fs::read_to_string(dir.join("parquet-out/mismatch.json")).unwrap();
+    let from_parquet: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for field in ["time_stamps", "channels", "effects", "fit"] {
+        assert_eq!(from_parquet[field], from_csv[field], "{field}");
+    }
+    // The CSV layout's header prefix is refused for a Parquet file, by name.
+    let refused = learn_through_layout(&parquet, (layout, model), &dir, &["--force"]);
+    refused.one_line_error(&["flight.parquet", "header_prefix", "no header line"]);
+}

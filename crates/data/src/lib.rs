@@ -3,7 +3,8 @@
 //! What it is for: reading Neural-Fly flight logs into a typed, validated [`FlightLog`] (uniformly
 //! sampled, or with [`Spacing::Any`] as a real logger spaces them: jitter, dropped rows, gaps;
 //! [`SampleTiming`] says which); reading plain
-//! numeric CSVs by column name ([`NumericTable`], [`ColumnRef`] for `v[k]`); several CSV
+//! numeric CSV and Parquet files by column name ([`NumericTable`], [`NumericStream`];
+//! [`ColumnRef`] for `v[k]` of a CSV's list cells); several CSV
 //! recordings of one system as the tasks of meta-learning ([`read_file_tasks`],
 //! [`read_column_tasks`]); support/query splits ([`SplitSpec`]); the experiment's wind conditions
 //! ([`ExperimentConditions`]); file hashes ([`file_sha256`]); finding the data directory
@@ -15,10 +16,12 @@
 //! meta-training flights are the `evaluation` crate's.
 //!
 //! Every error is a [`DataError`] whose message is one line naming the file, and where it applies
-//! the row (line number in the file, header = line 1) and column: `file:row:column: message`.
+//! the row (line number in the file, header = line 1; in a Parquet file the row counted from 1)
+//! and column: `file:row:column: message`.
 
 mod cells;
 mod chunked;
+mod columnar;
 mod conditions;
 mod error;
 mod flight_log;
@@ -36,6 +39,7 @@ mod time;
 pub mod ulog;
 mod write;
 
+pub use columnar::{is_parquet, write_numeric_parquet};
 pub use conditions::{Condition, ExperimentConditions, FlightFile, PaperTraining, Role};
 pub use error::{DataError, Result};
 pub use flight_log::{FlightLog, FlightMeta, REQUIRED_COLUMNS, RateFrame, SAMPLE_INTERVAL_RANGE_S};

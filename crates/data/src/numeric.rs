@@ -26,8 +26,28 @@ impl NumericTable {
     /// The rows are read as [`crate::NumericStream`] reads them, by the same code from a source
     /// read once (a file or a pipe, at most [`bounded_read::MAX_CSV_BYTES`]): the same values, or the
     /// same first error in file order.
+    ///
+    /// A Parquet file ([`crate::is_parquet`]) is read by [`crate::NumericStream`]'s Parquet
+    /// reader; its rows are numbered from 1 in place of lines.
     pub fn read(path: &Path, columns: &[&str]) -> Result<Self> {
+        if crate::columnar::is_parquet(path) {
+            return Self::from_parquet(path, columns);
+        }
         Self::from_records(path, CsvRecords::open(path)?, columns)
+    }
+
+    /// Every row of the named columns of a Parquet file.
+    fn from_parquet(path: &Path, columns: &[&str]) -> Result<Self> {
+        let mut stream = crate::NumericStream::open(path, columns)?;
+        let block = stream
+            .next_block(usize::MAX)?
+            .expect("a file without rows is an error");
+        Ok(Self::from_columns(
+            path,
+            columns.iter().map(|s| s.to_string()).collect(),
+            block.columns,
+            block.lines,
+        ))
     }
 
     /// The named columns of every row `records` (of `path`) holds.
@@ -53,6 +73,13 @@ impl NumericTable {
     /// writes it); the error names the file when its first line does not begin so.
     pub fn read_after_header_prefix(path: &Path, prefix: &str, columns: &[&str]) -> Result<Self> {
         use std::io::BufRead;
+        if crate::columnar::is_parquet(path) {
+            return Err(DataError::Config {
+                path: path.to_path_buf(),
+                field: "header_prefix".into(),
+                message: "a Parquet file has no header line (remove header_prefix)".into(),
+            });
+        }
         let io = |source| DataError::Io {
             path: path.to_path_buf(),
             source,

@@ -15,12 +15,25 @@ use std::thread::JoinHandle;
 
 use crate::cells::NumericColumn;
 use crate::chunked::{CHUNK_BYTES_PER_THREAD, ChunkedRows, ParsedRows, row_numbers};
+use crate::columnar::ParquetRows;
 use crate::error::{DataError, Result};
 use crate::records::{CsvRecords, Record};
 
-/// A reader of named numeric columns of a regular file, row blocks in file order (each chunk of
-/// the file parsed in parallel pieces: [`crate::chunked`]).
+/// A reader of named numeric columns of a regular file, row blocks in file order: a CSV (each
+/// chunk of the file parsed in parallel pieces: [`crate::chunked`]) or a Parquet file (its column
+/// chunks decoded in parallel: [`crate::columnar`]).
 pub struct NumericStream {
+    source: StreamSource,
+}
+
+/// What a [`NumericStream`] reads.
+enum StreamSource {
+    Csv(Box<CsvBlocks>),
+    Parquet(Box<ParquetRows>),
+}
+
+/// The rows of a CSV, parsed a chunk at a time.
+struct CsvBlocks {
     rows: ChunkedRows,
     parsed: ParsedRows,
     /// Rows of `parsed` handed out already.
@@ -59,7 +72,8 @@ impl NumericBlock {
 }
 
 impl NumericStream {
-    /// Opens `path` (a regular file) and finds `columns` in its header.
+    /// Opens `path` (a regular file: a CSV, or a Parquet file whatever its name,
+    /// [`crate::is_parquet`]) and finds `columns` in its header or schema.
     pub fn open(path: &Path, columns: &[&str]) -> Result<Self> {
         let chunk_bytes = CHUNK_BYTES_PER_THREAD * rayon::current_num_threads().max(1);
         Self::open_in_chunks(path, columns, chunk_bytes)
@@ -69,19 +83,77 @@ impl NumericStream {
     /// parallel): the rows and errors are the same whatever the size.
     pub fn open_in_chunks(path: &Path, columns: &[&str], chunk_bytes: usize) -> Result<Self> {
         check_regular_file(path)?;
+        if crate::columnar::is_parquet(path) {
+            let rows = ParquetRows::open(path, columns)?;
+            return Ok(Self {
+                source: StreamSource::Parquet(Box::new(rows)),
+            });
+        }
         let rows = ChunkedRows::open(path, columns, chunk_bytes)?;
         Ok(Self {
-            parsed: ParsedRows::new(rows.width()),
-            rows,
-            taken: 0,
-            returned: 0,
+            source: StreamSource::Csv(Box::new(CsvBlocks {
+                parsed: ParsedRows::new(rows.width()),
+                rows,
+                taken: 0,
+                returned: 0,
+            })),
         })
     }
 
     /// The next block of at most `max_rows` rows; `None` at the end of the file. A file without
     /// data rows is an error, as for the whole-file reader; the rows before a fault are returned
-    /// before it.
+    /// before it. A Parquet file's "lines" are its rows counted from 1.
     pub fn next_block(&mut self, max_rows: usize) -> Result<Option<NumericBlock>> {
+        match &mut self.source {
+            StreamSource::Csv(csv) => csv.next_block(max_rows),
+            StreamSource::Parquet(parquet) => parquet.next_block(max_rows),
+        }
+    }
+
+    /// The same blocks of at most `max_rows` rows, read on a thread of its own while the caller
+    /// works: at most `blocks` of them wait to be taken (memory is bounded by those), and the
+    /// first error ends the stream after the blocks before it, as [`Self::next_block`] does.
+    pub fn read_ahead(mut self, max_rows: usize, blocks: usize) -> ReadAhead {
+        let (sender, receiver) = sync_channel(blocks.max(1));
+        let reader = std::thread::spawn(move || {
+            loop {
+                let item = self.next_block(max_rows);
+                let last = !matches!(item, Ok(Some(_)));
+                // A receiver gone (the caller stopped early) ends the reading too.
+                if sender.send(item).is_err() || last {
+                    return;
+                }
+            }
+        });
+        ReadAhead {
+            receiver: Some(receiver),
+            reader: Some(reader),
+            ended: false,
+        }
+    }
+
+    /// The line of the file on which data row `row` (0-based) starts, found by reading the file
+    /// again to that row (for an error about a row found after its block was dropped); `None` if
+    /// the file no longer has that row.
+    pub fn line_of_row(path: &Path, row: usize) -> Option<usize> {
+        if crate::columnar::is_parquet(path) {
+            return Some(row + 1);
+        }
+        let mut records = open_records(path).ok()?;
+        let header = records.header().ok()?;
+        let mut record = Record::default();
+        for _ in 0..=row {
+            if !records.next_row(&mut record, &header).ok()? {
+                return None;
+            }
+        }
+        Some(record.line)
+    }
+}
+
+impl CsvBlocks {
+    /// [`NumericStream::next_block`] of a CSV.
+    fn next_block(&mut self, max_rows: usize) -> Result<Option<NumericBlock>> {
         while self.parsed.lines.len() - self.taken < max_rows
             && self.parsed.error.is_none()
             && !self.rows.finished()
@@ -121,43 +193,6 @@ impl NumericStream {
         }
         self.parsed.lines.drain(..self.taken);
         self.taken = 0;
-    }
-
-    /// The same blocks of at most `max_rows` rows, read on a thread of its own while the caller
-    /// works: at most `blocks` of them wait to be taken (memory is bounded by those), and the
-    /// first error ends the stream after the blocks before it, as [`Self::next_block`] does.
-    pub fn read_ahead(mut self, max_rows: usize, blocks: usize) -> ReadAhead {
-        let (sender, receiver) = sync_channel(blocks.max(1));
-        let reader = std::thread::spawn(move || {
-            loop {
-                let item = self.next_block(max_rows);
-                let last = !matches!(item, Ok(Some(_)));
-                // A receiver gone (the caller stopped early) ends the reading too.
-                if sender.send(item).is_err() || last {
-                    return;
-                }
-            }
-        });
-        ReadAhead {
-            receiver: Some(receiver),
-            reader: Some(reader),
-            ended: false,
-        }
-    }
-
-    /// The line of the file on which data row `row` (0-based) starts, found by reading the file
-    /// again to that row (for an error about a row found after its block was dropped); `None` if
-    /// the file no longer has that row.
-    pub fn line_of_row(path: &Path, row: usize) -> Option<usize> {
-        let mut records = open_records(path).ok()?;
-        let header = records.header().ok()?;
-        let mut record = Record::default();
-        for _ in 0..=row {
-            if !records.next_row(&mut record, &header).ok()? {
-                return None;
-            }
-        }
-        Some(record.line)
     }
 }
 

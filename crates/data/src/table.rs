@@ -61,6 +61,16 @@ impl TextTable {
     /// Reads `path` (a file, or a pipe: the bytes are read, whatever the length reported) and checks
     /// its layout ([`CsvRecords`]). Errors name the file and the line.
     pub fn read(path: &Path) -> Result<Self> {
+        if crate::columnar::is_parquet(path) {
+            return Err(DataError::Config {
+                path: path.to_path_buf(),
+                field: "(Parquet)".into(),
+                message: "a Parquet recording is read through a layout (--layout: \
+                          docs/layouts.md) or by column name; the Neural-Fly layout's list \
+                          cells are CSV text"
+                    .into(),
+            });
+        }
         let mut records = CsvRecords::open(path)?;
         let names = records.header()?;
         let mut columns = vec![TextColumn::default(); names.len()];

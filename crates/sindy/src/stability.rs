@@ -74,27 +74,32 @@ impl BlockDesign {
             parameters: p,
         };
         let mut x = vec![0.0; p];
+        // The lower triangle, row by row: each entry summed over the samples in order.
+        let mut lower = vec![0.0; p * (p + 1) / 2];
         let mut start = 0;
         while start < samples {
             let end = (start + block_samples.max(1)).min(samples);
-            let mut gram = Mat::<f64>::zeros(p, p);
+            lower.fill(0.0);
             let mut cross = vec![0.0; p];
             let mut squares = 0.0;
             for k in start..end {
                 let y = sample(k, &mut x);
-                for i in 0..p {
-                    cross[i] += x[i] * y;
-                    for j in 0..=i {
-                        gram[(i, j)] += x[i] * x[j];
+                let mut row_start = 0;
+                for (i, &xi) in x.iter().enumerate() {
+                    cross[i] += xi * y;
+                    let row = &mut lower[row_start..row_start + i + 1];
+                    for (entry, &xj) in row.iter_mut().zip(&x) {
+                        *entry += xi * xj;
                     }
+                    row_start += i + 1;
                 }
                 squares += y * y;
             }
-            for i in 0..p {
-                for j in 0..i {
-                    gram[(j, i)] = gram[(i, j)];
-                }
-            }
+            let entry = |i: usize, j: usize| {
+                let (row, column) = if j <= i { (i, j) } else { (j, i) };
+                lower[row * (row + 1) / 2 + column]
+            };
+            let gram = Mat::<f64>::from_fn(p, p, entry);
             design.grams.push(gram);
             design.cross.push(cross);
             design.target_squares.push(squares);

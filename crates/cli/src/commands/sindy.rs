@@ -31,7 +31,8 @@ pub enum OptimizerKind {
 pub struct Args {
     #[command(subcommand)]
     pub command: Option<ApplyCommand>,
-    /// A numeric CSV file with a header row, or a PX4 ULog (`.ulg`, or a folder of its CSV export:
+    /// A numeric CSV file with a header row, a Parquet file (columns of numbers, known by its
+    /// first bytes), or a PX4 ULog (`.ulg`, or a folder of its CSV export:
     /// columns `topic.field` on the clock of the first column's topic, or of the topic --time
     /// names; other topics' values held as of it); give --csv once per recording to fit several
     /// trajectories together (derivatives are estimated within each).

@@ -339,14 +339,15 @@ impl Splitter {
     /// Ends the current field: checks its text and keeps it as field `record.count` when fewer
     /// than `keep` are kept.
     fn end_field(&mut self, keep: usize, record: &mut Record) -> Result<()> {
-        self.check_utf8()?;
         let index = record.count;
-        record.count += 1;
         if index >= keep {
+            self.check_utf8()?;
+            record.count += 1;
             self.field.clear();
             return Ok(());
         }
-        // The field's bytes become the cell without a copy; the cell's old buffer is reused.
+        // The field's bytes become the cell without a copy (checked as UTF-8 once, there); the
+        // cell's old buffer is reused.
         let mut bytes = record
             .fields
             .get_mut(index)
@@ -354,7 +355,15 @@ impl Splitter {
             .unwrap_or_default();
         bytes.clear();
         std::mem::swap(&mut bytes, &mut self.field);
-        let cell = String::from_utf8(bytes).expect("checked as UTF-8 above");
+        let cell = match String::from_utf8(bytes) {
+            Ok(cell) => cell,
+            Err(error) => {
+                let at = error.utf8_error().valid_up_to();
+                self.field = error.into_bytes();
+                return Err(self.utf8_fault(at));
+            }
+        };
+        record.count += 1;
         match record.fields.get_mut(index) {
             Some(slot) => *slot = cell,
             None => record.fields.push(cell),
@@ -373,12 +382,14 @@ impl Splitter {
     fn check_utf8(&self) -> Result<()> {
         match std::str::from_utf8(&self.field) {
             Ok(_) => Ok(()),
-            Err(error) => {
-                let at = error.valid_up_to();
-                let line = self.field_line + lines_in(&self.field[..at]);
-                Err(self.not_utf8(line, self.field[at]))
-            }
+            Err(error) => Err(self.utf8_fault(error.valid_up_to())),
         }
+    }
+
+    /// The current field's first byte that is not UTF-8, at `at`, named by its line.
+    fn utf8_fault(&self, at: usize) -> DataError {
+        let line = self.field_line + lines_in(&self.field[..at]);
+        self.not_utf8(line, self.field[at])
     }
 
     fn not_utf8(&self, line: usize, byte: u8) -> DataError {
@@ -418,15 +429,15 @@ impl Splitter {
         record: &mut Record,
     ) -> Result<(usize, Option<State>)> {
         // Runs of plain cell text are copied at once.
-        let special: Option<fn(u8) -> bool> = match state {
-            State::Unquoted => Some(|b| (b < 0x20 && b != b'\t') || b == b',' || b == b'"'),
-            State::Quoted => Some(|b| (b < 0x20 && b != b'\t') || b == b'"'),
+        let special = match state {
+            State::Unquoted => Some(&UNQUOTED_SPECIAL),
+            State::Quoted => Some(&QUOTED_SPECIAL),
             _ => None,
         };
         if let Some(special) = special {
             let run = chunk
                 .iter()
-                .position(|&b| special(b))
+                .position(|&b| special[usize::from(b)])
                 .unwrap_or(chunk.len());
             if run > 0 {
                 self.field.extend_from_slice(&chunk[..run]);
@@ -564,6 +575,24 @@ impl Splitter {
         };
         Ok((1, Some(next)))
     }
+}
+
+/// The bytes that end a run of plain text outside quotes: control bytes but the tab, the
+/// separator and the quote.
+const UNQUOTED_SPECIAL: [bool; 256] = special_bytes(true);
+/// Inside quotes: control bytes but the tab, and the quote.
+const QUOTED_SPECIAL: [bool; 256] = special_bytes(false);
+
+const fn special_bytes(separator: bool) -> [bool; 256] {
+    let mut table = [false; 256];
+    let mut byte = 0;
+    while byte < 0x20 {
+        table[byte] = byte != b'\t' as usize;
+        byte += 1;
+    }
+    table[b'"' as usize] = true;
+    table[b',' as usize] = separator;
+    table
 }
 
 fn lines_in(bytes: &[u8]) -> usize {

@@ -292,4 +292,14 @@ fn a_parquet_recording_is_analysed_as_its_csv() {
     // The CSV layout's header prefix is refused for a Parquet file, by name.
     let refused = learn_through_layout(&parquet, (layout, model), &dir, &["--force"]);
     refused.one_line_error(&["flight.parquet", "header_prefix", "no header line"]);
+    // Without a layout, the Neural-Fly layout's CSV text is expected: the error says what to do.
+    let args = [
+        "mismatch",
+        "--recording",
+        "flight.parquet",
+        "--model",
+        &root(model),
+    ];
+    let bare = learn_in(&dir, &[&args[..], &["--out", "bare", "--quiet"]].concat());
+    bare.one_line_error(&["flight.parquet", "read by column name", "--layout"]);
 }

@@ -65,9 +65,10 @@ impl TextTable {
             return Err(DataError::Config {
                 path: path.to_path_buf(),
                 field: "(Parquet)".into(),
-                message: "a Parquet recording is read through a layout (--layout: \
-                          docs/layouts.md) or by column name; the Neural-Fly layout's list \
-                          cells are CSV text"
+                message: "read here as CSV text (a Neural-Fly log's list cells, a column of \
+                          labels); a Parquet file is read by column name (learn sindy --csv, \
+                          learn meta-train --tasks) or through a layout (--layout: \
+                          docs/layouts.md)"
                     .into(),
             });
         }

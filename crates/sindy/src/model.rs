@@ -247,15 +247,19 @@ impl SindyParams {
         let input_names: Vec<&str> = names.iter().map(String::as_str).collect();
         let feature_names = self.library.feature_names(&input_names);
         let sizes = FeatureSizes::new(features);
-        let (rows, width) = (inputs.nrows(), targets.ncols());
-        let (reduced, _) = reduce_row_blocks(self.reduction, rows, features, width, |rows| {
+        let shape = (inputs.nrows(), features, targets.ncols());
+        let block = |rows: std::ops::Range<usize>| {
             let inputs = inputs.subrows(rows.start, rows.len());
             let theta = self.library_block(inputs, rows.start, &feature_names, &sizes)?;
             Ok::<_, SindyError>((theta, targets.subrows(rows.start, rows.len()).to_owned()))
-        })?;
-        let sizes = sizes.into_vec();
-        check_scale(&sizes, &feature_names)?;
-        let coefficients = optimizer.solve(&reduced.with_target_names(&self.state_names))?;
+        };
+        let solve = |reduced: Problem<'static>| {
+            check_scale(&sizes.to_vec(), &feature_names)?;
+            let reduced = reduced.with_target_names(&self.state_names);
+            let coefficients = optimizer.solve(&reduced)?;
+            Ok((reduced, coefficients))
+        };
+        let ((_, coefficients), _) = reduce_row_blocks(self.reduction, shape, block, solve)?;
         Ok(self.model(feature_names, coefficients))
     }
 
@@ -863,6 +867,14 @@ impl FeatureSizes {
         self.0
             .into_inner()
             .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// The sizes recorded so far.
+    pub(crate) fn to_vec(&self) -> Vec<f64> {
+        self.0
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+            .clone()
     }
 }
 

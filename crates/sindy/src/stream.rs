@@ -255,14 +255,19 @@ impl SindyParams {
             ));
         }
         let optimizer = self.checked_optimizer()?;
-        let (problem, (moments, sizes), reduction) = reduce_by(self.reduction, |method| {
-            let merged = self.reduce_stream(method, rows, dt, open()?)?;
-            Ok::<_, SindyError>((merged.merge, (merged.moments, merged.sizes)))
-        })?;
         let names = self.feature_names_for_inputs();
-        crate::model::check_scale(&sizes, &names)?;
-        let reduced = problem.with_target_names(self.state_names());
-        let coefficients = optimizer.solve(&reduced)?;
+        let attempt = |method| {
+            let merged = self.reduce_stream(method, rows, dt, open()?)?;
+            crate::model::check_scale(&merged.sizes, &names)?;
+            Ok::<_, SindyError>((merged.merge, merged.moments))
+        };
+        let solve = |problem: crate::Problem<'static>| {
+            let reduced = problem.with_target_names(self.state_names());
+            let coefficients = optimizer.solve(&reduced)?;
+            Ok((reduced, coefficients))
+        };
+        let ((reduced, coefficients), moments, reduction) =
+            reduce_by(self.reduction, attempt, solve)?;
         let residuals = reduced.residual_sum_of_squares(coefficients.as_ref());
         let model = self.model(names, coefficients);
         Ok(StreamedFit {

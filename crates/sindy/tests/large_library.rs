@@ -328,3 +328,53 @@ fn a_streamed_fit_reads_its_rows_again_only_when_the_gram_matrix_is_refused() {
     );
     assert_eq!(fit.score.mse.to_bits(), reference.score.mse.to_bits());
 }
+
+/// A noise-free recording of ẋ = −0.1 x + y, ẏ = −x − 0.1 y: a threshold that drops the −0.1
+/// terms leaves a model whose residual the Gram matrix resolves (read once); one that keeps them
+/// fits to the rounding of the derivatives, which the Gram matrix cannot resolve (read again).
+#[test]
+fn the_gram_matrix_is_judged_by_the_residual_of_the_chosen_model() {
+    let rows = 40_000;
+    let signal = Mat::from_fn(rows, 3, |i, j| {
+        let t = i as f64 * 1e-3;
+        let decay = (-0.1 * t).exp();
+        [decay * t.cos(), -decay * t.sin(), (0.5 * t).sin()][j]
+    });
+    let fit = |threshold: f64| {
+        let params =
+            SindyParams::new(&["x", "y"], &["u"]).optimizer(OptimizerSpec::stlsq(threshold));
+        let mut opens = 0;
+        let fit = params
+            .fit_streamed(rows, 1e-3, || {
+                opens += 1;
+                let mut next_row = 0;
+                let signal = &signal;
+                Ok(move || {
+                    let end = (next_row + 5_000).min(rows);
+                    let columns = (0..3)
+                        .map(|j| (next_row..end).map(|i| signal[(i, j)]).collect())
+                        .collect();
+                    let block = (next_row < end).then_some(sindy::RowBlock {
+                        columns,
+                        time: None,
+                    });
+                    next_row = end;
+                    Ok(block)
+                })
+            })
+            .unwrap();
+        (fit, opens)
+    };
+    let (sparse, opens) = fit(0.2);
+    assert_eq!((opens, sparse.reduction.method), (1, RowReduction::Gram));
+    assert_eq!(
+        sparse.model.equations(2),
+        vec!["x' = 1.01 y", "y' = -0.99 x"]
+    );
+    let (exact, opens) = fit(0.05);
+    assert_eq!(
+        (opens, exact.reduction.method),
+        (2, RowReduction::Householder)
+    );
+    assert!(exact.reduction.gram_condition.unwrap() <= sindy::GRAM_CONDITION_LIMIT);
+}

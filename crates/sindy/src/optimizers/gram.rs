@@ -12,8 +12,9 @@
 //! - with D the columns' norms, `κ_F(R·D⁻¹) = ‖R·D⁻¹‖_F·‖D·R⁻¹‖_F ≤` [`GRAM_CONDITION_LIMIT`]: the
 //!   scaled condition number (the one Cholesky's accuracy depends on, van der Sluis), bounded from
 //!   above, so that `κ₂² ε ≤ 2·10⁻⁸`;
-//! - every target keeps at least [`GRAM_RESIDUAL_SHARE`] of its sum of squares as residual, so that
-//!   `‖y_j‖² − ‖z_j‖²` does not lose more than six of its digits to cancellation.
+//! - the model chosen on it leaves every target at least [`GRAM_RESIDUAL_SHARE`] of its sum of
+//!   squares as residual, so that the score's `‖y_j‖² − ‖z_j‖²` part does not lose more than six
+//!   of its digits to cancellation (checked by [`super::row_blocks`] once the model is solved).
 //!
 //! Otherwise the caller reduces the rows again by Householder QR ([`super::row_blocks`]).
 
@@ -26,7 +27,7 @@ use crate::linalg::{cholesky_upper, invert_upper, solve_upper_transposed};
 /// Largest scaled condition number `κ_F(R·D⁻¹)` at which the Gram reduction is kept.
 pub const GRAM_CONDITION_LIMIT: f64 = 1e4;
 
-/// Smallest share of a target's sum of squares left as the least-squares residual at which the
+/// Smallest share of a target's sum of squares left as the chosen model's residual at which the
 /// Gram reduction is kept.
 pub const GRAM_RESIDUAL_SHARE: f64 = 1e-6;
 
@@ -45,17 +46,15 @@ pub(crate) fn reduced_from_sums(sums: MatRef<'_, f64>, features: usize, rows: us
     let targets = sums.ncols() - features;
     let cross = sums.submatrix(features, 0, targets, features).transpose();
     let projected = solve_upper_transposed(triangular.as_ref(), cross);
-    let residual_squares = (0..targets)
-        .map(|j| {
-            let total = sums[(features + j, features + j)];
+    let target_squares: Vec<f64> = (0..targets)
+        .map(|j| sums[(features + j, features + j)])
+        .collect();
+    let residual_squares = (target_squares.iter().enumerate())
+        .map(|(j, total)| {
             let explained: f64 = projected.col(j).iter().map(|z| z * z).sum();
-            let residual = (total - explained).max(0.0);
-            (residual >= GRAM_RESIDUAL_SHARE * total).then_some(residual)
+            (total - explained).max(0.0)
         })
-        .collect::<Option<Vec<f64>>>();
-    let Some(residual_squares) = residual_squares else {
-        return Finished::refused(condition);
-    };
+        .collect();
     Finished {
         problem: Some(Problem::from_triangle(
             triangular,
@@ -64,7 +63,20 @@ pub(crate) fn reduced_from_sums(sums: MatRef<'_, f64>, features: usize, rows: us
             rows,
         )),
         gram_condition: condition,
+        target_squares: Some(target_squares),
     }
+}
+
+/// Whether the model `coefficients` (one row per target) chosen on a Gram reduction leaves every
+/// target at least [`GRAM_RESIDUAL_SHARE`] of its sum of squares `target_squares` as residual.
+pub(crate) fn residual_resolved(
+    problem: &Problem<'_>,
+    coefficients: MatRef<'_, f64>,
+    target_squares: &[f64],
+) -> bool {
+    let residuals = problem.residual_sum_of_squares(coefficients);
+    (residuals.iter().zip(target_squares))
+        .all(|(residual, total)| *residual >= GRAM_RESIDUAL_SHARE * total)
 }
 
 /// `‖R·D⁻¹‖_F·‖D·R⁻¹‖_F`, with D the square roots of the Gram matrix's diagonal; `None` for a

@@ -26,7 +26,7 @@ use faer::{Mat, MatRef};
 use rayon::prelude::*;
 
 use super::Problem;
-use super::gram::reduced_from_sums;
+use super::gram::{reduced_from_sums, residual_resolved};
 use crate::linalg::{add_gram, qr_triangle};
 
 /// Rows of one block of the library (the memory of the reduction is about this many rows of Θ
@@ -58,19 +58,19 @@ pub struct Reduction {
     pub gram_condition: Option<f64>,
 }
 
-/// Reduces the rows `0..rows` by `method` (Householder as well, if the Gram matrix is refused);
+/// Reduces the rows `0..rows` by `method` (Householder as well, if the Gram matrix is refused)
+/// and solves the problem with `solve` (which returns it, and ξ with one row per target);
 /// `block(range)` returns Θ and Y on those rows (p and m columns), or an error that stops it.
 pub(crate) fn reduce_row_blocks<E: Send>(
     method: RowReduction,
-    rows: usize,
-    features: usize,
-    targets: usize,
+    (rows, features, targets): (usize, usize, usize),
     block: impl Fn(Range<usize>) -> std::result::Result<(Mat<f64>, Mat<f64>), E> + Sync,
-) -> std::result::Result<(Problem<'static>, Reduction), E> {
+    solve: impl FnMut(Problem<'static>) -> std::result::Result<Solved, E>,
+) -> std::result::Result<(Solved, Reduction), E> {
     let segments: Vec<Range<usize>> = (0..rows.div_ceil(SEGMENT_ROWS))
         .map(|s| s * SEGMENT_ROWS..((s + 1) * SEGMENT_ROWS).min(rows))
         .collect();
-    let (problem, (), reduction) = reduce_by(method, |method| {
+    let attempt = |method| {
         let parts = segments
             .par_iter()
             .map(|segment| {
@@ -84,28 +84,42 @@ pub(crate) fn reduce_row_blocks<E: Send>(
             merge.add(part, segment.len());
         }
         Ok((merge, ()))
-    })?;
-    Ok((problem, reduction))
+    };
+    let (solved, (), reduction) = reduce_by(method, attempt, solve)?;
+    Ok((solved, reduction))
 }
 
-/// The problem of the first of `method`'s reductions kept: `attempt` reduces every row by the
-/// method it is given (with something of its own, `T`), Householder after a refused Gram matrix.
+/// A reduced problem and the coefficients solved on it (one row per target).
+pub(crate) type Solved = (Problem<'static>, Mat<f64>);
+
+/// The problem of the first of `method`'s reductions kept, solved: `attempt` reduces every row by
+/// the method it is given (with something of its own, `T`) and `solve` solves it; Householder
+/// follows a Gram matrix refused before the solve (its conditioning) or after (the chosen
+/// model's residual, [`residual_resolved`]).
 pub(crate) fn reduce_by<T, E>(
     method: RowReduction,
     mut attempt: impl FnMut(RowReduction) -> std::result::Result<(RowMerge, T), E>,
-) -> std::result::Result<(Problem<'static>, T, Reduction), E> {
+    mut solve: impl FnMut(Problem<'static>) -> std::result::Result<Solved, E>,
+) -> std::result::Result<(Solved, T, Reduction), E> {
     let mut gram_condition = None;
     for &method in methods_from(method) {
         let (merge, own) = attempt(method)?;
         let finished = merge.finish();
         gram_condition = gram_condition.or(finished.gram_condition);
-        if let Some(problem) = finished.problem {
-            let reduction = Reduction {
-                method,
-                gram_condition,
-            };
-            return Ok((problem, own, reduction));
+        let Some(problem) = finished.problem else {
+            continue;
+        };
+        let (problem, coefficients) = solve(problem)?;
+        if let Some(squares) = &finished.target_squares
+            && !residual_resolved(&problem, coefficients.as_ref(), squares)
+        {
+            continue;
         }
+        let reduction = Reduction {
+            method,
+            gram_condition,
+        };
+        return Ok(((problem, coefficients), own, reduction));
     }
     unreachable!("the Householder reduction always gives a problem")
 }
@@ -118,22 +132,23 @@ fn methods_from(method: RowReduction) -> &'static [RowReduction] {
     }
 }
 
-/// Reduces Θ and Y given whole.
+/// Reduces Θ and Y given whole (the Gram matrix judged by the least-squares solution's residual).
 pub(crate) fn reduce(theta: MatRef<'_, f64>, targets: MatRef<'_, f64>) -> Problem<'static> {
-    let reduced: std::result::Result<_, std::convert::Infallible> = reduce_row_blocks(
-        RowReduction::default(),
-        theta.nrows(),
-        theta.ncols(),
-        targets.ncols(),
-        |range| {
-            Ok((
-                theta.subrows(range.start, range.len()).to_owned(),
-                targets.subrows(range.start, range.len()).to_owned(),
-            ))
-        },
-    );
+    let shape = (theta.nrows(), theta.ncols(), targets.ncols());
+    let block = |range: Range<usize>| {
+        Ok((
+            theta.subrows(range.start, range.len()).to_owned(),
+            targets.subrows(range.start, range.len()).to_owned(),
+        ))
+    };
+    let solve = |problem: Problem<'static>| {
+        let coefficients = problem.least_squares_solution().transpose().to_owned();
+        Ok((problem, coefficients))
+    };
+    let reduced: std::result::Result<_, std::convert::Infallible> =
+        reduce_row_blocks(RowReduction::default(), shape, block, solve);
     match reduced {
-        Ok((reduced, _)) => reduced,
+        Ok(((reduced, _), _)) => reduced,
     }
 }
 
@@ -169,11 +184,13 @@ pub(crate) struct RowMerge {
     rows: usize,
 }
 
-/// A finished merge: its problem (`None` when the Gram matrix was refused) and the Gram matrix's
-/// scaled condition number.
+/// A finished merge: its problem (`None` when the Gram matrix was refused), the Gram matrix's
+/// scaled condition number, and each target's sum of squares (from a Gram matrix: what its
+/// chosen model's residual is compared with).
 pub(crate) struct Finished {
     pub(crate) problem: Option<Problem<'static>>,
     pub(crate) gram_condition: Option<f64>,
+    pub(crate) target_squares: Option<Vec<f64>>,
 }
 
 impl Finished {
@@ -182,6 +199,7 @@ impl Finished {
         Self {
             problem: None,
             gram_condition,
+            target_squares: None,
         }
     }
 }
@@ -242,6 +260,7 @@ impl RowMerge {
                 self.rows,
             )),
             gram_condition: None,
+            target_squares: None,
         }
     }
 }
@@ -296,15 +315,21 @@ mod tests {
         theta: &Mat<f64>,
         y: &Mat<f64>,
     ) -> (Problem<'static>, Reduction) {
+        let shape = (theta.nrows(), theta.ncols(), y.ncols());
+        let block = |range: Range<usize>| {
+            Ok((
+                theta.subrows(range.start, range.len()).to_owned(),
+                y.subrows(range.start, range.len()).to_owned(),
+            ))
+        };
+        let solve = |problem: Problem<'static>| {
+            let coefficients = problem.least_squares_solution().transpose().to_owned();
+            Ok((problem, coefficients))
+        };
         let reduced: std::result::Result<_, std::convert::Infallible> =
-            reduce_row_blocks(method, theta.nrows(), theta.ncols(), y.ncols(), |range| {
-                Ok((
-                    theta.subrows(range.start, range.len()).to_owned(),
-                    y.subrows(range.start, range.len()).to_owned(),
-                ))
-            });
+            reduce_row_blocks(method, shape, block, solve);
         match reduced {
-            Ok(reduced) => reduced,
+            Ok(((problem, _), reduction)) => (problem, reduction),
         }
     }
 

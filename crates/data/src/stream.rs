@@ -101,8 +101,9 @@ impl NumericStream {
     }
 
     /// The next block of at most `max_rows` rows; `None` at the end of the file. A file without
-    /// data rows is an error, as for the whole-file reader; the rows before a fault are returned
-    /// before it. A Parquet file's "lines" are its rows counted from 1.
+    /// data rows is an error, as for the whole-file reader; in a CSV, the rows before a fault are
+    /// returned before it (in a Parquet file, the block holding a fault is the error). A Parquet
+    /// file's "lines" are its rows counted from 1.
     pub fn next_block(&mut self, max_rows: usize) -> Result<Option<NumericBlock>> {
         match &mut self.source {
             StreamSource::Csv(csv) => csv.next_block(max_rows),

@@ -267,25 +267,16 @@ fn a_parquet_recording_is_analysed_as_its_csv() {
     let mut fields: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(root(layout)).unwrap()).unwrap();
     fields.as_object_mut().unwrap().remove("header_prefix");
-    std::fs::write(dir.join("layout.json"), fields.to_string()).unwrap();
+    let parquet_layout = dir.join("layout.json");
+    std::fs::write(&parquet_layout, fields.to_string()).unwrap();
     let model = "experiments/mismatch/vehicles/crazyflie-parrot.json";
     let rows = ["--rows", "0:700"];
     learn_through_layout(&flight, (layout, model), &dir, &rows).success();
     let from_csv = report_in(&dir);
-    let mut args: Vec<String> = ["mismatch", "--recording", "flight.parquet", "--layout"]
-        .map(String::from)
-        .to_vec();
-    args.push("layout.json".into());
-    args.extend([
-        "--model".into(),
-        root(model),
-        "--out".into(),
-        "parquet-out".into(),
-    ]);
-    args.extend(["--quiet", "--rows", "0:700"].map(String::from));
-    learn_in(&dir, &args.iter().map(String::as_str).collect::<Vec<_>>()).success();
-    let text = std::fs::read_to_string(dir.join("parquet-out/mismatch.json")).unwrap();
-    let from_parquet: serde_json::Value = serde_json::from_str(&text).unwrap();
+    // An absolute layout path is kept as it is by `root`.
+    let files = (parquet_layout.to_str().unwrap(), model);
+    learn_through_layout(&parquet, files, &dir, &["--rows", "0:700", "--force"]).success();
+    let from_parquet = report_in(&dir);
     for field in ["time_stamps", "channels", "effects", "fit"] {
         assert_eq!(from_parquet[field], from_csv[field], "{field}");
     }

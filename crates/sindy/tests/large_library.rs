@@ -188,6 +188,23 @@ fn a_streamed_recording_fits_as_the_whole_one() {
     }
 }
 
+/// The rows of `inputs` (every column: states, then controls) in blocks of 7,777, from the first.
+fn blocks_of(inputs: &Mat<f64>) -> impl FnMut() -> sindy::Result<Option<sindy::RowBlock>> + '_ {
+    let mut next_row = 0;
+    move || {
+        let end = (next_row + 7_777).min(inputs.nrows());
+        let columns = (0..inputs.ncols())
+            .map(|j| (next_row..end).map(|i| inputs[(i, j)]).collect())
+            .collect();
+        let block = (next_row < end).then_some(sindy::RowBlock {
+            columns,
+            time: None,
+        });
+        next_row = end;
+        Ok(block)
+    }
+}
+
 /// `fit_streamed` of `inputs` (3 states, 4 controls) in blocks of 7,777 rows, within a pool of
 /// `threads` threads.
 fn streamed_in_pool(
@@ -195,30 +212,11 @@ fn streamed_in_pool(
     inputs: &Mat<f64>,
     threads: usize,
 ) -> sindy::Result<sindy::StreamedFit> {
-    let rows = inputs.nrows();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap();
-    pool.install(|| {
-        params.fit_streamed(rows, 1e-3, || {
-            let mut next_row = 0;
-            Ok(move || {
-                if next_row == rows {
-                    return Ok(None);
-                }
-                let end = (next_row + 7_777).min(rows);
-                let columns = (0..7)
-                    .map(|j| (next_row..end).map(|i| inputs[(i, j)]).collect())
-                    .collect();
-                next_row = end;
-                Ok(Some(sindy::RowBlock {
-                    columns,
-                    time: None,
-                }))
-            })
-        })
-    })
+    pool.install(|| params.fit_streamed(inputs.nrows(), 1e-3, || Ok(blocks_of(inputs))))
 }
 
 /// Segments reduced by any number of workers, finishing in any order, are merged in row order:
@@ -269,24 +267,11 @@ fn full_rank_inputs(rows: usize) -> Mat<f64> {
 
 /// `fit_streamed` of `inputs` in blocks of 7,777 rows, and how many times it opened them.
 fn streamed_counting_opens(params: &SindyParams, inputs: &Mat<f64>) -> (sindy::StreamedFit, usize) {
-    let rows = inputs.nrows();
     let mut opens = 0;
     let fit = params
-        .fit_streamed(rows, 1e-3, || {
+        .fit_streamed(inputs.nrows(), 1e-3, || {
             opens += 1;
-            let mut next_row = 0;
-            Ok(move || {
-                let end = (next_row + 7_777).min(rows);
-                let columns = (0..7)
-                    .map(|j| (next_row..end).map(|i| inputs[(i, j)]).collect())
-                    .collect();
-                let block = (next_row < end).then_some(sindy::RowBlock {
-                    columns,
-                    time: None,
-                });
-                next_row = end;
-                Ok(block)
-            })
+            Ok(blocks_of(inputs))
         })
         .unwrap();
     (fit, opens)
@@ -343,27 +328,7 @@ fn the_gram_matrix_is_judged_by_the_residual_of_the_chosen_model() {
     let fit = |threshold: f64| {
         let params =
             SindyParams::new(&["x", "y"], &["u"]).optimizer(OptimizerSpec::stlsq(threshold));
-        let mut opens = 0;
-        let fit = params
-            .fit_streamed(rows, 1e-3, || {
-                opens += 1;
-                let mut next_row = 0;
-                let signal = &signal;
-                Ok(move || {
-                    let end = (next_row + 5_000).min(rows);
-                    let columns = (0..3)
-                        .map(|j| (next_row..end).map(|i| signal[(i, j)]).collect())
-                        .collect();
-                    let block = (next_row < end).then_some(sindy::RowBlock {
-                        columns,
-                        time: None,
-                    });
-                    next_row = end;
-                    Ok(block)
-                })
-            })
-            .unwrap();
-        (fit, opens)
+        streamed_counting_opens(&params, &signal)
     };
     let (sparse, opens) = fit(0.2);
     assert_eq!((opens, sparse.reduction.method), (1, RowReduction::Gram));

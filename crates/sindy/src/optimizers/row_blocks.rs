@@ -134,6 +134,15 @@ fn methods_from(method: RowReduction) -> &'static [RowReduction] {
 
 /// Reduces Θ and Y given whole (the Gram matrix judged by the least-squares solution's residual).
 pub(crate) fn reduce(theta: MatRef<'_, f64>, targets: MatRef<'_, f64>) -> Problem<'static> {
+    reduce_whole(RowReduction::default(), theta, targets).0
+}
+
+/// [`reduce`] by `method`, with how the rows were reduced.
+fn reduce_whole(
+    method: RowReduction,
+    theta: MatRef<'_, f64>,
+    targets: MatRef<'_, f64>,
+) -> (Problem<'static>, Reduction) {
     let shape = (theta.nrows(), theta.ncols(), targets.ncols());
     let block = |range: Range<usize>| {
         Ok((
@@ -146,9 +155,9 @@ pub(crate) fn reduce(theta: MatRef<'_, f64>, targets: MatRef<'_, f64>) -> Proble
         Ok((problem, coefficients))
     };
     let reduced: std::result::Result<_, std::convert::Infallible> =
-        reduce_row_blocks(RowReduction::default(), shape, block, solve);
+        reduce_row_blocks(method, shape, block, solve);
     match reduced {
-        Ok(((reduced, _), _)) => reduced,
+        Ok(((problem, _), reduction)) => (problem, reduction),
     }
 }
 
@@ -315,22 +324,7 @@ mod tests {
         theta: &Mat<f64>,
         y: &Mat<f64>,
     ) -> (Problem<'static>, Reduction) {
-        let shape = (theta.nrows(), theta.ncols(), y.ncols());
-        let block = |range: Range<usize>| {
-            Ok((
-                theta.subrows(range.start, range.len()).to_owned(),
-                y.subrows(range.start, range.len()).to_owned(),
-            ))
-        };
-        let solve = |problem: Problem<'static>| {
-            let coefficients = problem.least_squares_solution().transpose().to_owned();
-            Ok((problem, coefficients))
-        };
-        let reduced: std::result::Result<_, std::convert::Infallible> =
-            reduce_row_blocks(method, shape, block, solve);
-        match reduced {
-            Ok(((problem, _), reduction)) => (problem, reduction),
-        }
+        reduce_whole(method, theta.as_ref(), y.as_ref())
     }
 
     /// A noisy least-squares problem: Θ well conditioned, Y a tenth noise.

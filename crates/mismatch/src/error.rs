@@ -18,7 +18,7 @@ pub enum MismatchError {
     Recording { path: PathBuf, message: String },
     /// More rows than one analysis accepts ([`crate::recording::degenerate::MAX_ANALYSED_ROWS`]).
     #[error(
-        "{}: {rows} rows, more than the {} one analysis accepts: its time grows faster than the rows ({}); analyse a part (learn mismatch --recording takes --rows A:B)",
+        "{}: {rows} rows, more than the {} one analysis accepts ({}); analyse it in parts (mismatch::analyze_in_parts, as learn mismatch --recording does)",
         path.display(),
         crate::recording::degenerate::MAX_ANALYSED_ROWS,
         crate::recording::degenerate::COST_MEASURED

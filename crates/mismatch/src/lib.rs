@@ -52,6 +52,9 @@ pub mod recording;
 mod settings;
 
 pub use analysis::files::ANALYSIS_FILES;
+pub use analysis::parts::{
+    MIN_PART_ROWS, Part, PartedAnalysis, analyze_in_parts, check_part_rows, part_ranges,
+};
 pub use analysis::{
     Analysis, ChannelReport, EffectReport, Fit, RateFrame, Report, Stage, Window, analyze,
     analyze_observed,

@@ -194,8 +194,8 @@ fn a_recording_over_the_cost_bound_is_refused_before_the_work() {
         message.starts_with(&format!(
             "generated/flight.csv: {} rows, more than the {MAX_ANALYSED_ROWS}",
             MAX_ANALYSED_ROWS + 1
-        )) && message.contains("n^1.75")
-            && message.contains("--rows A:B"),
+        )) && message.contains("8 KB per row")
+            && message.contains("analyze_in_parts"),
         "{message}"
     );
 }

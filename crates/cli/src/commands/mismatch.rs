@@ -1,7 +1,9 @@
 //! `learn mismatch`: locate, name and fit the physics a nominal model leaves out.
 //!
-//! - `--recording REAL.csv --model NOMINAL.json --out DIR [--rows A:B]`: one recording (or its data
-//!   rows A:B) → DIR/mismatch.{json,svg,md}; the analysis's stages shown on a terminal.
+//! - `--recording REAL.csv --model NOMINAL.json --out DIR [--rows A:B] [--part-rows N]`: one
+//!   recording (or its data rows A:B) → DIR/mismatch.{json,svg,md}; one longer than N rows (40,000
+//!   by default, the most one analysis takes) is analysed in consecutive parts and those files
+//!   summarise them; the analysis's stages shown on a terminal.
 //! - `--demo MANIFEST --out DIR [--work WORK]`: simulate every case of the manifest with a concealed
 //!   effect (`WORK/<case>/recording.csv`), run the analysis blind on each (`WORK/<case>/mismatch.*`),
 //!   and write DIR/summary.{md,json}.
@@ -61,6 +63,11 @@ pub struct Args {
     /// recording longer than one analysis accepts.
     #[arg(long, value_parser = super::evaluate::parse_rows, requires = "recording")]
     pub rows: Option<std::ops::Range<usize>>,
+    /// With --recording: the most rows one analysis takes (1,250 to 40,000, the default); a longer
+    /// recording is analysed in consecutive equal parts of at most this many rows, and its effects
+    /// are those more than half of the parts name, their parameters pooled.
+    #[arg(long, requires = "recording")]
+    pub part_rows: Option<usize>,
     /// With --recording: half the support of the comparison's test function, s (default 0.2); it
     /// must span at least three sample intervals, so a log sampled slower than 15 Hz needs more.
     #[arg(long, requires = "recording")]
@@ -246,6 +253,10 @@ fn run_recording(
     args: &Args,
     settings: &mismatch::CheckedSettings,
 ) -> anyhow::Result<()> {
+    let part_rows = args
+        .part_rows
+        .unwrap_or(mismatch::recording::degenerate::MAX_ANALYSED_ROWS);
+    mismatch::check_part_rows(part_rows)?;
     let mut set = OutputSet::new("mismatch --recording");
     set.input("the --model file", model_path);
     set.input("the --recording", recording);
@@ -260,6 +271,16 @@ fn run_recording(
     let model = load_model(model_path)?;
     let staged = set.prepare()?;
     let log = read_recording(recording, args.layout.as_deref(), args.rows.as_ref())?;
+    if log.len() > part_rows {
+        let analysis = analyze_in_parts(global, &log, part_rows, (&model, model_path), settings)?;
+        super::staged_write(&staged, || {
+            let dir = staged.dir(out);
+            write_files(dir, ANALYSIS_FILES.into_iter().zip(analysis.render(dir)?))
+        })?;
+        staged.commit()?;
+        say_parts(&analysis, &args.out);
+        return Ok(());
+    }
     let spinner = super::progress::spinner(global.show_progress(), "preparing the recording");
     let analysis = mismatch::analyze_observed(
         &log,
@@ -294,4 +315,57 @@ fn run_recording(
         args.out.display()
     );
     Ok(())
+}
+
+/// A recording longer than `part_rows` rows, analysed in parts, each part's stage shown.
+fn analyze_in_parts(
+    global: &Global,
+    log: &data::FlightLog,
+    part_rows: usize,
+    (model, model_path): (&physics::NominalModel, &Path),
+    settings: &mismatch::CheckedSettings,
+) -> anyhow::Result<mismatch::PartedAnalysis> {
+    let parts = mismatch::part_ranges(log.len(), part_rows).len();
+    let spinner = super::progress::spinner(
+        global.show_progress(),
+        &format!("{} rows in {parts} parts", log.len()),
+    );
+    let analysis = mismatch::analyze_in_parts(
+        log,
+        part_rows,
+        model,
+        &model_path.display().to_string(),
+        settings,
+        &|part, pass, stage| {
+            spinner.set_message(format!(
+                "part {} of {parts}, pass {pass}: {}",
+                part + 1,
+                stage.describe()
+            ))
+        },
+    );
+    spinner.finish_and_clear();
+    Ok(analysis?)
+}
+
+/// The one line a long recording's analysis ends with.
+fn say_parts(analysis: &mismatch::PartedAnalysis, out: &Path) {
+    let parts = analysis.parts.len();
+    let named: Vec<String> = analysis
+        .effects
+        .iter()
+        .filter(|e| e.named)
+        .map(|e| format!("{} ({} of {parts} parts)", e.id, e.named_in))
+        .collect();
+    let [before, after] = analysis.heldout;
+    say!(
+        "{} rows in {parts} parts; effects: {}; held-out MSE {before:.5} -> {after:.5} (mean over the parts); wrote {}",
+        analysis.rows,
+        if named.is_empty() {
+            "none".to_string()
+        } else {
+            named.join(", ")
+        },
+        out.display()
+    );
 }

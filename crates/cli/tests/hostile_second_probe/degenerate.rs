@@ -246,32 +246,71 @@ fn absurd_model_numbers_are_refused_naming_the_field() {
     }
 }
 
-/// The cost is checked before the work: a recording over the bound is refused at once with the
-/// bound, the reason and the way on (`--rows A:B`), which analyses a part.
+/// A recording longer than one analysis is analysed in consecutive parts (here parts of 1,500 rows
+/// through `--part-rows`, so that the test stays short), each part listed and the effects pooled;
+/// a part length out of its range is refused before any work.
 #[test]
-fn a_recording_over_the_cost_bound_is_refused_and_a_part_is_analysed() {
-    let bound = mismatch_bound();
+fn a_recording_longer_than_a_part_is_analysed_in_parts() {
     let dir = setup("degenerate-long", demo_noise());
     let mut scenario: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("flight.json")).unwrap()).unwrap();
-    scenario["duration_s"] = json!(bound as f64 / 50.0);
+    scenario["duration_s"] = json!(60.0);
+    scenario["effects"] = json!({"linear_drag": {"d": [0.35, 0.35, 0.1]}});
     std::fs::write(dir.join("flight.json"), scenario.to_string()).unwrap();
     simulate(&dir);
-    let start = std::time::Instant::now();
-    mismatch(&dir, "flight.csv", "held.json", &[]).one_line_error(&[
-        &format!("flight.csv: {} rows, more than the {bound}", bound + 1),
-        "n^1.75",
-        "--rows A:B",
-    ]);
-    assert!(start.elapsed().as_secs_f64() < 30.0, "refused before work");
-    mismatch(&dir, "flight.csv", "held.json", &["--rows", "0:1500"]).success();
+    for bad in ["100", &(mismatch_bound() + 1).to_string()] {
+        let start = std::time::Instant::now();
+        mismatch(&dir, "flight.csv", "held.json", &["--part-rows", bad]).one_line_error(&[
+            &format!("setting 'part_rows': {bad} rows per part; it must be from 1250"),
+            &mismatch_bound().to_string(),
+        ]);
+        assert!(start.elapsed().as_secs_f64() < 30.0, "refused before work");
+        assert!(!dir.join("out").exists());
+    }
+    let run = mismatch(
+        &dir,
+        "flight.csv",
+        "held.json",
+        &["--rows", "0:3000", "--part-rows", "1500"],
+    );
+    run.success();
+    assert!(
+        run.stdout
+            .contains("3000 rows in 2 parts; effects: linear_drag (2 of 2 parts)"),
+        "{}",
+        run.stdout
+    );
+    let markdown = std::fs::read_to_string(dir.join("out/mismatch.md")).unwrap();
+    assert!(markdown.contains("analysed in 2 consecutive parts of at most 1500 rows"));
+    assert!(
+        markdown.contains("| 2 | 1500:3000 | 30.0–60.0 | linear_drag |"),
+        "{markdown}"
+    );
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/mismatch.json")).unwrap())
+            .unwrap();
+    let d = &report["effects"][0]["parameters"][0]["numbers"];
+    for (axis, truth) in [0.35, 0.35, 0.1].into_iter().enumerate() {
+        let found = d[axis]["value"].as_f64().unwrap();
+        assert!((found - truth).abs() < 0.1 * truth, "d[{axis}] = {found}");
+    }
+    assert_eq!(report["parts"][1]["rows"], json!([1500, 3000]));
+    assert_eq!(
+        report["parts"][1]["report"]["effects"][0]["id"],
+        "linear_drag"
+    );
+    assert!(
+        std::fs::read_to_string(dir.join("out/mismatch.svg"))
+            .unwrap()
+            .contains("linear_drag.d")
+    );
     mismatch(
         &dir,
         "flight.csv",
         "held.json",
-        &["--rows", &format!("10:{}", bound + 5), "--force"],
+        &["--rows", "10:3005", "--force"],
     )
-    .one_line_error(&["flight.csv: --rows 10:", "reaches past its"]);
+    .one_line_error(&["flight.csv: --rows 10:3005", "reaches past its"]);
 }
 
 /// The bound the refusal states, as the library has it.

@@ -1,7 +1,9 @@
 //! The whole analysis of one recording: compare, locate, explain, fit, judge the evidence, validate
-//! on held-out data; its files ([`files`]).
+//! on held-out data; its files ([`files`]); a recording longer than one analysis, in parts
+//! ([`parts`]).
 
 pub(crate) mod files;
+pub mod parts;
 mod report_json;
 
 pub use report_json::{EffectReport, Report};

@@ -35,16 +35,13 @@ pub const NOISE_RESOLUTION: f64 = 3e-4;
 /// ground, falling, or its thrust column holds something else.
 pub const MIN_THRUST_TO_WEIGHT: f64 = 0.1;
 
-/// The most rows one analysis accepts. The analysis's time grows faster than the rows: with the
-/// dev profile on the 2-core development machine (configuration A of the demo, CPU time) 5,000
-/// rows took 12 s, 10,000 23 s, 20,000 53 s and 40,000 122 s (n^1.2; 597 s of wall time under a
-/// load of 14); the first probe saw n^1.75 (2,500 rows 3.4 s, 30,000 rows 193 s). At this bound an
-/// analysis takes at most about ten minutes on that machine, even busy.
+/// The most rows one analysis accepts: it holds every row's comparison, candidates and predictions
+/// at once (about 8 KB per row, so about 300 MB at this bound). A longer recording is analysed in
+/// parts of at most this many rows ([`crate::analyze_in_parts`]).
 pub const MAX_ANALYSED_ROWS: usize = 40_000;
 
 /// What the bound rests on, as the refusal says it.
-pub const COST_MEASURED: &str =
-    "as n^1.2 to n^1.75: 40,000 rows took 10 minutes on a busy 2-core machine";
+pub const COST_MEASURED: &str = "one analysis holds every row in memory, about 8 KB per row";
 
 impl std::fmt::Display for Degeneracy {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

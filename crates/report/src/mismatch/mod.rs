@@ -1,6 +1,7 @@
 //! The outputs of the sim-to-real mismatch tool (the `mismatch` crate): one recording against a
 //! nominal model ([`recording`]: `mismatch.md` and `mismatch.svg`), several flights of one vehicle
-//! analysed together ([`fleet`]: `<model stem>.md`, its figure and the terminal lines), and the demo
+//! analysed together ([`fleet`]: `<model stem>.md`, its figure and the terminal lines), a recording
+//! longer than one analysis in parts ([`parts`]), and the demo
 //! matrix on simulated recordings ([`demo`]: `summary.md` and the terminal table).
 //!
 //! Each module holds the plain result types the outputs record as they are (numbers, strings,
@@ -11,6 +12,7 @@
 
 pub mod demo;
 pub mod fleet;
+pub mod parts;
 pub mod recording;
 mod residual_figure;
 mod scale;

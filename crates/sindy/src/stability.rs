@@ -109,6 +109,66 @@ impl BlockDesign {
         design
     }
 
+    /// [`Self::from_samples`] over the columns `leading ++ trailing`, where `trailing` holds the
+    /// statistics of the trailing columns alone over the same samples and blocks (built by
+    /// `from_samples`; its target is not used). Only the entries that involve a leading column or
+    /// the target are summed, each in the same order as `from_samples` sums it, so the result has
+    /// the same bits: a search that changes the target and a few columns against fixed ones sums
+    /// the fixed ones' Gram matrix once. `sample(i, x)` writes all `leading + trailing` columns.
+    pub fn with_leading_columns(
+        trailing: &Self,
+        samples: usize,
+        block_samples: usize,
+        leading: usize,
+        mut sample: impl FnMut(usize, &mut [f64]) -> f64,
+    ) -> Self {
+        let p = leading + trailing.parameters;
+        let mut design = Self {
+            grams: Vec::with_capacity(trailing.blocks()),
+            cross: Vec::with_capacity(trailing.blocks()),
+            target_squares: Vec::with_capacity(trailing.blocks()),
+            counts: Vec::with_capacity(trailing.blocks()),
+            parameters: p,
+        };
+        let mut x = vec![0.0; p];
+        // Rows of the leading columns against every column: `lead[i][j]` for i < leading.
+        let mut lead = vec![0.0; leading * p];
+        let mut start = 0;
+        let mut block = 0;
+        while start < samples {
+            let end = (start + block_samples.max(1)).min(samples);
+            lead.fill(0.0);
+            let mut cross = vec![0.0; p];
+            let mut squares = 0.0;
+            for k in start..end {
+                let y = sample(k, &mut x);
+                for (i, &xi) in x.iter().enumerate() {
+                    cross[i] += xi * y;
+                }
+                for (i, &xi) in x[..leading].iter().enumerate() {
+                    for (entry, &xj) in lead[i * p..(i + 1) * p].iter_mut().zip(&x) {
+                        *entry += xi * xj;
+                    }
+                }
+                squares += y * y;
+            }
+            let fixed = &trailing.grams[block];
+            let entry = |i: usize, j: usize| match (i < leading, j < leading) {
+                (true, _) => lead[i * p + j],
+                (false, true) => lead[j * p + i],
+                (false, false) => fixed[(i - leading, j - leading)],
+            };
+            design.grams.push(Mat::<f64>::from_fn(p, p, entry));
+            design.cross.push(cross);
+            design.target_squares.push(squares);
+            design.counts.push((end - start) as f64);
+            start = end;
+            block += 1;
+        }
+        assert_eq!(block, trailing.blocks(), "the same samples and blocks");
+        design
+    }
+
     /// Number of blocks.
     pub fn blocks(&self) -> usize {
         self.grams.len()
@@ -381,5 +441,47 @@ mod tests {
         assert_eq!(trimmed_gain(&transient), 0.0);
         let spread: Vec<(f64, f64)> = (0..10).map(|_| (1.0, 0.2)).collect();
         assert!((trimmed_gain(&spread) - 0.2).abs() < 1e-12);
+    }
+
+    /// Summing only the entries that involve the leading columns or the target, beside the
+    /// trailing columns' own statistics, gives `from_samples`'s bits (the last block shorter).
+    #[test]
+    fn leading_columns_beside_fixed_ones_give_the_same_bits() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let rows: Vec<([f64; 6], f64)> = (0..1037)
+            .map(|_| {
+                let x = std::array::from_fn(|_| StandardNormal.sample(&mut rng));
+                (x, StandardNormal.sample(&mut rng))
+            })
+            .collect();
+        for leading in 0..=2 {
+            let whole = BlockDesign::from_samples(rows.len(), 100, 6, |i, x| {
+                x.copy_from_slice(&rows[i].0);
+                rows[i].1
+            });
+            let trailing = BlockDesign::from_samples(rows.len(), 100, 6 - leading, |i, x| {
+                x.copy_from_slice(&rows[i].0[leading..]);
+                f64::NAN
+            });
+            let parts =
+                BlockDesign::with_leading_columns(&trailing, rows.len(), 100, leading, |i, x| {
+                    x.copy_from_slice(&rows[i].0);
+                    rows[i].1
+                });
+            assert_eq!(parts.blocks(), 11);
+            let bits = |d: &BlockDesign| -> Vec<u64> {
+                let mut out = Vec::new();
+                for b in 0..d.blocks() {
+                    for i in 0..6 {
+                        out.extend((0..6).map(|j| d.grams[b][(i, j)].to_bits()));
+                        out.push(d.cross[b][i].to_bits());
+                    }
+                    out.push(d.target_squares[b].to_bits());
+                    out.push(d.counts[b].to_bits());
+                }
+                out
+            };
+            assert_eq!(bits(&parts), bits(&whole), "{leading} leading columns");
+        }
     }
 }

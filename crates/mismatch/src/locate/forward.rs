@@ -10,7 +10,7 @@
 //! angular acceleration goes through the same first-order filter, as the logged rate did.
 
 use physics::vector::{Mat3, Vec3};
-use physics::{Actuators, CommandLogging, Effects, Logger, MAX_ACTUATORS, NominalModel};
+use physics::{Actuators, CommandLogging, Effects, Logger, MAX_ACTUATORS, NominalModel, Wrench};
 
 use sindy::sampling::Sampling;
 
@@ -34,16 +34,67 @@ pub fn predict_substeps(
     model: &NominalModel,
     effects: &Effects,
 ) -> SubstepPrediction {
-    let n = recording.len();
-    let actuators = actuator_trace(
-        &recording.samples,
-        &recording.sampling,
-        &model.logger,
-        effects.delay_s(),
-        effects.lag_s(),
+    predict_substeps_with(
+        recording,
+        model,
+        effects,
+        &WrenchTrace::new(recording, model, effects),
+    )
+}
+
+/// The model's thrust and torques at every sub-interval midpoint, from the commands reconstructed
+/// with one delay and motor lag: what a prediction takes from the commands, the same for every
+/// set of effects with that timing (a search over other parameters computes it once).
+#[derive(Clone, Debug)]
+pub struct WrenchTrace {
+    delay_s: f64,
+    lag_s: f64,
+    wrenches: Vec<Wrench>,
+}
+
+impl WrenchTrace {
+    /// The trace for the delay and motor lag of `effects`.
+    pub fn new(recording: &Recording, model: &NominalModel, effects: &Effects) -> Self {
+        let (delay_s, lag_s) = (effects.delay_s(), effects.lag_s());
+        let actuators = actuator_trace(
+            &recording.samples,
+            &recording.sampling,
+            &model.logger,
+            delay_s,
+            lag_s,
+        );
+        let spread = spread_after_lag(recording, lag_s);
+        let wrenches = actuators
+            .iter()
+            .map(|a| model.wrench_with_spread(a, &spread))
+            .collect();
+        Self {
+            delay_s,
+            lag_s,
+            wrenches,
+        }
+    }
+
+    /// Whether `effects` have the timing this trace was made with.
+    pub fn serves(&self, effects: &Effects) -> bool {
+        self.delay_s.to_bits() == effects.delay_s().to_bits()
+            && self.lag_s.to_bits() == effects.lag_s().to_bits()
+    }
+}
+
+/// [`predict_substeps`] with the commands' wrench already traced for the effects' timing.
+pub fn predict_substeps_with(
+    recording: &Recording,
+    model: &NominalModel,
+    effects: &Effects,
+    wrenches: &WrenchTrace,
+) -> SubstepPrediction {
+    assert!(
+        wrenches.serves(effects),
+        "a wrench trace serves only effects with its delay and motor lag"
     );
+    let n = recording.len();
     let angular_wanted = model.predicts_torque();
-    let spread = spread_after_lag(recording, effects.lag_s());
     let total = (n - 1) * SUBSTEPS;
     let air_velocity = air_velocity_trace(recording, effects.drag_lag_s());
     let mut translational = Vec::with_capacity(total);
@@ -57,7 +108,7 @@ pub fn predict_substeps(
                 None => lerp(recording.velocity[k], recording.velocity[k + 1], s),
             };
             let position = lerp(recording.position[k], recording.position[k + 1], s);
-            let wrench = model.wrench_with_spread(&actuators[k * SUBSTEPS + j], &spread);
+            let wrench = &wrenches.wrenches[k * SUBSTEPS + j];
             let air_body = effects.body_airspeed(&rotation, velocity, position);
             translational.push(effects.translational_acceleration_in_air(
                 model,

@@ -8,7 +8,8 @@ use sindy::weak_form::{TestFunction, WeakForm};
 
 use crate::error::{MismatchError, Result};
 use crate::locate::forward::{
-    RowPrediction, SUBSTEPS, accelerations_at_rows, predict_at_rows, predict_substeps,
+    RowPrediction, SUBSTEPS, WrenchTrace, accelerations_at_rows, predict_at_rows,
+    predict_substeps_with,
 };
 use crate::recording::Recording;
 
@@ -63,6 +64,19 @@ impl Problem {
         range: std::ops::Range<usize>,
         block_rows: usize,
     ) -> BlockDesign {
+        let columns: Vec<&Vec<Channels>> = columns.iter().collect();
+        self.design_of(residual, &columns, range, block_rows)
+    }
+
+    /// [`Self::design`] over borrowed columns; with an empty `residual` the target is 0 (for the
+    /// columns' statistics alone).
+    pub(crate) fn design_of(
+        &self,
+        residual: &[Channels],
+        columns: &[&Vec<Channels>],
+        range: std::ops::Range<usize>,
+        block_rows: usize,
+    ) -> BlockDesign {
         let channels = self.channels;
         let samples = range.len() * channels;
         BlockDesign::from_samples(samples, block_rows * channels, columns.len(), |i, x| {
@@ -71,7 +85,11 @@ impl Problem {
             for (value, column) in x.iter_mut().zip(columns) {
                 *value = column[row][c] * scale;
             }
-            residual[row][c] * scale
+            if residual.is_empty() {
+                0.0
+            } else {
+                residual[row][c] * scale
+            }
         })
     }
 
@@ -190,7 +208,16 @@ impl Problem {
 
     /// The model's value of the weak form with a set of effects, per analysed row.
     pub fn predict(&self, effects: &Effects) -> Vec<Channels> {
-        let substeps = predict_substeps(&self.recording, &self.model, effects);
+        self.predict_with(
+            effects,
+            &WrenchTrace::new(&self.recording, &self.model, effects),
+        )
+    }
+
+    /// [`Self::predict`] with the commands' wrench already traced for the effects' delay and motor
+    /// lag ([`WrenchTrace`]); the same numbers, without tracing it again.
+    pub fn predict_with(&self, effects: &Effects, wrenches: &WrenchTrace) -> Vec<Channels> {
+        let substeps = predict_substeps_with(&self.recording, &self.model, effects, wrenches);
         let mut out = vec![[0.0; 6]; self.rows()];
         let translational = self
             .weak_form
@@ -210,10 +237,18 @@ impl Problem {
 
     /// Target minus prediction.
     pub fn residual(&self, effects: &Effects) -> Vec<Channels> {
-        let predicted = self.predict(effects);
+        self.residual_from(&self.predict(effects))
+    }
+
+    /// [`Self::residual`] with the commands' wrench already traced ([`Self::predict_with`]).
+    pub fn residual_with(&self, effects: &Effects, wrenches: &WrenchTrace) -> Vec<Channels> {
+        self.residual_from(&self.predict_with(effects, wrenches))
+    }
+
+    fn residual_from(&self, predicted: &[Channels]) -> Vec<Channels> {
         self.target
             .iter()
-            .zip(&predicted)
+            .zip(predicted)
             .map(|(t, p)| {
                 let mut r = [0.0; 6];
                 for c in 0..self.channels {

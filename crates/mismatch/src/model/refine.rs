@@ -3,12 +3,14 @@
 //! ground-effect radius), then Levenberg–Marquardt on all parameters together (whitened residual,
 //! fit rows only).
 
-use std::sync::LazyLock;
+use std::sync::{Arc, LazyLock, Mutex};
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use physics::{EffectNumber, Effects, QuadraticDrag, Wind};
+use sindy::stability::BlockDesign;
 
+use crate::locate::forward::WrenchTrace;
 use crate::locate::problem::{Channels, Problem};
 use crate::model::least_squares::{
     ActiveBounds, DenseProblem, LevenbergMarquardt, LevenbergMarquardtParams, Solution,
@@ -137,18 +139,6 @@ impl StepBasis {
 }
 
 /// The whitened residual on the fit's rows of the effects `parameters` take at `values`.
-fn whitened_residual(
-    problem: &Problem,
-    parameters: &[EffectNumber],
-    values: &[f64],
-    rows: &FitRows,
-) -> Vec<f64> {
-    whitened(
-        problem,
-        &problem.residual(&effects_from(parameters, values)),
-        rows,
-    )
-}
 
 /// Standard errors of fitted `values`: `√diag(scale · (JᵀJ)⁻¹)` with `J` the Jacobian of the
 /// (weighted) whitened residual on the fit's rows, and `scale` the variance of a whitened residual
@@ -161,11 +151,7 @@ pub fn standard_errors(
     rows: &FitRows,
     scale: f64,
 ) -> Vec<f64> {
-    let fit = WhitenedFit {
-        problem,
-        parameters,
-        rows,
-    };
+    let fit = WhitenedFit::new(problem, parameters, rows);
     let residual = fit.residual(values);
     let jacobian = forward_jacobian(&fit, values, &residual);
     let k = parameters.len();
@@ -189,6 +175,41 @@ struct WhitenedFit<'a> {
     problem: &'a Problem,
     parameters: &'a [EffectNumber],
     rows: &'a FitRows<'a>,
+    /// The commands' wrench of the last timing evaluated: most fits change no delay or motor lag.
+    wrenches: Mutex<Option<Arc<WrenchTrace>>>,
+}
+
+impl<'a> WhitenedFit<'a> {
+    fn new(problem: &'a Problem, parameters: &'a [EffectNumber], rows: &'a FitRows<'a>) -> Self {
+        Self {
+            problem,
+            parameters,
+            rows,
+            wrenches: Mutex::new(None),
+        }
+    }
+
+    /// The wrench trace for `effects`' timing: the last one when it serves, else a new one.
+    fn wrenches_for(&self, effects: &Effects) -> Arc<WrenchTrace> {
+        let last = self
+            .wrenches
+            .lock()
+            .expect("no fit panics holding the trace");
+        if let Some(trace) = last.as_ref().filter(|t| t.serves(effects)) {
+            return trace.clone();
+        }
+        drop(last);
+        let trace = Arc::new(WrenchTrace::new(
+            &self.problem.recording,
+            &self.problem.model,
+            effects,
+        ));
+        *self
+            .wrenches
+            .lock()
+            .expect("no fit panics holding the trace") = Some(trace.clone());
+        trace
+    }
 }
 
 impl DenseProblem for WhitenedFit<'_> {
@@ -201,7 +222,10 @@ impl DenseProblem for WhitenedFit<'_> {
     }
 
     fn residual(&self, values: &[f64]) -> Vec<f64> {
-        whitened_residual(self.problem, self.parameters, values, self.rows)
+        let effects = effects_from(self.parameters, values);
+        let wrenches = self.wrenches_for(&effects);
+        let residual = self.problem.residual_with(&effects, &wrenches);
+        whitened(self.problem, &residual, self.rows)
     }
 
     fn difference_step(&self, index: usize, value: f64) -> f64 {
@@ -238,31 +262,48 @@ pub fn levenberg_marquardt(
     rows: &FitRows,
     iterations: usize,
 ) -> Solution {
-    let fit = WhitenedFit {
-        problem,
-        parameters,
-        rows,
-    };
+    let fit = WhitenedFit::new(problem, parameters, rows);
     SOLVER.with_iterations(iterations).run(&fit, initial)
 }
 
-/// Whitened sum of squares of `residual` after regressing it on `extra` and `columns[others]`.
+/// The fixed columns of a search (`columns[others]`: the linear screen's columns of the other
+/// effects) on rows `range` in blocks of `block_rows`, with their block Gram matrices summed once
+/// ([`sindy::stability::BlockDesign::with_leading_columns`]).
+pub struct FixedColumns<'a> {
+    columns: Vec<&'a Vec<Channels>>,
+    design: BlockDesign,
+    range: std::ops::Range<usize>,
+    block_rows: usize,
+}
+
+impl<'a> FixedColumns<'a> {
+    pub fn new(
+        problem: &Problem,
+        columns: &'a [Vec<Channels>],
+        others: &[usize],
+        range: std::ops::Range<usize>,
+        block_rows: usize,
+    ) -> Self {
+        let columns: Vec<&Vec<Channels>> = others.iter().map(|&c| &columns[c]).collect();
+        let design = problem.design_of(&[], &columns, range.clone(), block_rows);
+        Self {
+            columns,
+            design,
+            range,
+            block_rows,
+        }
+    }
+}
+
+/// Whitened sum of squares of `residual` after regressing it on `extra` and the fixed columns.
 pub fn projected_sse(
     problem: &Problem,
     residual: &[Channels],
     extra: &[&Vec<Channels>],
-    columns: &[Vec<Channels>],
-    others: &[usize],
-    range: std::ops::Range<usize>,
-    block_rows: usize,
+    fixed: &FixedColumns,
 ) -> f64 {
-    let used: Vec<Vec<Channels>> = extra
-        .iter()
-        .map(|c| (*c).clone())
-        .chain(others.iter().map(|&c| columns[c].clone()))
-        .collect();
-    let design = problem.design(residual, &used, range, block_rows);
-    let all: Vec<usize> = (0..used.len()).collect();
+    let design = problem.design_with_fixed(residual, extra, fixed);
+    let all: Vec<usize> = (0..design.parameters()).collect();
     if !extra.is_empty() {
         // Extra columns are physical effects with non-negative coefficients (drag): a negative
         // fit means the column does not help, so it is left out.
@@ -273,6 +314,36 @@ pub fn projected_sse(
         }
     }
     design.fitted_sse(&all)
+}
+
+impl Problem {
+    /// [`Problem::design`] of `residual` on `extra` followed by the fixed columns, summing only
+    /// what involves `extra` or `residual` (the same bits).
+    fn design_with_fixed(
+        &self,
+        residual: &[Channels],
+        extra: &[&Vec<Channels>],
+        fixed: &FixedColumns,
+    ) -> BlockDesign {
+        let channels = self.channels;
+        let samples = fixed.range.len() * channels;
+        let start = fixed.range.start;
+        BlockDesign::with_leading_columns(
+            &fixed.design,
+            samples,
+            fixed.block_rows * channels,
+            extra.len(),
+            |i, x| {
+                let (row, c) = (start + i / channels, i % channels);
+                let scale = 1.0 / self.noise_floor[c];
+                let all = extra.iter().chain(&fixed.columns);
+                for (value, column) in x.iter_mut().zip(all) {
+                    *value = column[row][c] * scale;
+                }
+                residual[row][c] * scale
+            },
+        )
+    }
 }
 
 /// 1-D profile search of one nonlinear effect: for each grid value, the residual of the nominal
@@ -288,18 +359,22 @@ pub fn profile_search(
     effect: impl Fn(f64) -> Effects + Sync,
 ) -> (f64, f64) {
     use rayon::prelude::*;
+    // A grid over anything but a delay or a motor lag keeps the commands' wrench: traced once.
+    let first = effect(grid[0]);
+    let timing = |e: &Effects| (e.delay_s().to_bits(), e.lag_s().to_bits());
+    let shared = grid
+        .iter()
+        .all(|&value| timing(&effect(value)) == timing(&first))
+        .then(|| WrenchTrace::new(&problem.recording, &problem.model, &first));
+    let fixed = FixedColumns::new(problem, columns, other_columns, range, block_rows);
     grid.par_iter()
         .map(|&value| {
-            let residual = problem.residual(&effect(value));
-            let sse = projected_sse(
-                problem,
-                &residual,
-                &[],
-                columns,
-                other_columns,
-                range.clone(),
-                block_rows,
-            );
+            let effects = effect(value);
+            let residual = match &shared {
+                Some(wrenches) => problem.residual_with(&effects, wrenches),
+                None => problem.residual(&effects),
+            };
+            let sse = projected_sse(problem, &residual, &[], &fixed);
             (value, sse)
         })
         .collect::<Vec<_>>()
@@ -315,8 +390,17 @@ pub fn effect_column(
     effects: &Effects,
     scale: f64,
 ) -> Vec<Channels> {
-    problem
-        .predict(effects)
+    column_from(problem, &problem.predict(effects), base, scale)
+}
+
+/// `(predicted − base) / scale` on the compared channels.
+fn column_from(
+    problem: &Problem,
+    predicted: &[Channels],
+    base: &[Channels],
+    scale: f64,
+) -> Vec<Channels> {
+    predicted
         .iter()
         .zip(base)
         .map(|(p, b)| {
@@ -350,18 +434,22 @@ pub fn profile_wind(
 ) -> ([f64; 3], f64) {
     use rayon::prelude::*;
     let base = problem.predict(&Effects::default());
+    // The drag in wind changes no delay or motor lag: the commands' wrench is traced once.
+    let wrenches = WrenchTrace::new(
+        &problem.recording,
+        &problem.model,
+        &unit_drag_in_wind([0.0; 3]),
+    );
+    let fixed = FixedColumns::new(problem, columns, others, range, block_rows);
     let score = |w: [f64; 3]| {
         let effects = unit_drag_in_wind(w);
-        let column = effect_column(problem, &base, &effects, 1.0);
-        projected_sse(
+        let column = column_from(
             problem,
-            residual,
-            &[&column],
-            columns,
-            others,
-            range.clone(),
-            block_rows,
-        )
+            &problem.predict_with(&effects, &wrenches),
+            &base,
+            1.0,
+        );
+        projected_sse(problem, residual, &[&column], &fixed)
     };
     let mut best = ([0.0; 3], score([0.0; 3]));
     for (step, span) in [(0.5, 12), (0.1, 5), (0.02, 5)] {

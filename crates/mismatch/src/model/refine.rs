@@ -138,8 +138,6 @@ impl StepBasis {
     }
 }
 
-/// The whitened residual on the fit's rows of the effects `parameters` take at `values`.
-
 /// Standard errors of fitted `values`: `√diag(scale · (JᵀJ)⁻¹)` with `J` the Jacobian of the
 /// (weighted) whitened residual on the fit's rows, and `scale` the variance of a whitened residual
 /// element times the residual's integrated autocorrelation (neighbouring rows share samples). NaN

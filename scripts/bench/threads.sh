@@ -7,7 +7,10 @@
 # arithmetic floor of the fit. A reading-dominated fit of the same file (poly:1, 13 features) gives
 # the rows parsed per second. The same columns as Parquet (written by pyarrow: one row group,
 # snappy) are fitted with 2 threads, their model compared with the CSV's, and read by pyarrow as
-# the Python reference of ingestion (scripts/bench/ingest_reference.py).
+# the Python reference of ingestion (scripts/bench/ingest_reference.py). With one thread the reading
+# thread still runs beside the fit, so each input is also fitted on one core (taskset -c 0), the
+# baseline Amdahl's law assumes, and the cores each run kept busy (CPU seconds over wall seconds)
+# are printed.
 #
 # THREADS_ROWS=1000000 scripts/bench/threads.sh
 set -euo pipefail
@@ -27,30 +30,43 @@ states=$(seq -s, -f 'x%g' 0 9)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# Seconds and peak RSS (KiB) of one fit of file $4 (the CSV by default) with $1 threads and
-# library $2, its model saved to $3.
+# Seconds, peak RSS (KiB) and CPU seconds of one fit of file $4 (the CSV by default) with $1
+# threads and library $2, its model saved to $3; $PIN (e.g. "taskset -c 0") runs it on fewer cores.
 fit() {
-    { RAYON_NUM_THREADS=$1 /usr/bin/time -f '%e %M' "$learn" sindy --quiet --csv "${4:-$csv}" \
-        --state "$states" --control u0,u1 --library "$2" --threshold 0.1 --derivative central \
-        --out "$3" >/dev/null; } 2>&1 | tail -1
+    { RAYON_NUM_THREADS=$1 /usr/bin/time -f '%e %M %U %S' ${PIN:-} "$learn" sindy --quiet \
+        --csv "${4:-$csv}" --state "$states" --control u0,u1 --library "$2" --threshold 0.1 \
+        --derivative central --out "$3" >/dev/null; } 2>&1 | tail -1
 }
 
-read -r one one_kib <<<"$(fit 1 poly:3 "$work/one.json")"
-read -r two two_kib <<<"$(fit 2 poly:3 "$work/two.json")"
+# CPU seconds over wall seconds of a fit's "wall kib user sys".
+cores() { python3 -c "import sys; w, _, u, s = map(float, sys.argv[1:]); print(f'{(u + s) / w:.2f}')" $1; }
+
+one_run=$(fit 1 poly:3 "$work/one.json")
+two_run=$(fit 2 poly:3 "$work/two.json")
+read -r one one_kib _ <<<"$one_run"
+read -r two two_kib _ <<<"$two_run"
+core_run=$(PIN="taskset -c 0" fit 1 poly:3 "$work/core.json")
+pq_core_run=$(PIN="taskset -c 0" fit 1 poly:3 "$work/pq-core.json" "$parquet")
+read -r core _ <<<"$core_run"
+read -r pq_core _ <<<"$pq_core_run"
 read -r read_one _ <<<"$(fit 1 poly:1 "$work/read-one.json")"
 read -r read_two _ <<<"$(fit 2 poly:1 "$work/read-two.json")"
-read -r pq_one pq_one_kib <<<"$(fit 1 poly:3 "$work/pq-one.json" "$parquet")"
-read -r pq_two pq_two_kib <<<"$(fit 2 poly:3 "$work/pq-two.json" "$parquet")"
+pq_one_run=$(fit 1 poly:3 "$work/pq-one.json" "$parquet")
+pq_two_run=$(fit 2 poly:3 "$work/pq-two.json" "$parquet")
+read -r pq_one pq_one_kib _ <<<"$pq_one_run"
+read -r pq_two pq_two_kib _ <<<"$pq_two_run"
 read -r pq_read_one _ <<<"$(fit 1 poly:1 "$work/pq-read-one.json" "$parquet")"
 read -r pq_read_two _ <<<"$(fit 2 poly:1 "$work/pq-read-two.json" "$parquet")"
 same=no
-cmp -s "$work/one.json" "$work/two.json" && same=yes
+cmp -s "$work/one.json" "$work/two.json" && cmp -s "$work/core.json" "$work/two.json" && same=yes
 same_parquet=no
 cmp -s "$work/two.json" "$work/pq-two.json" && cmp -s "$work/pq-one.json" "$work/pq-two.json" \
     && same_parquet=yes
 gram=$(env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE .venv/bin/python scripts/bench/gram_floor.py "$csv" 10 2)
 ingest=$(.venv/bin/python scripts/bench/ingest_reference.py "$csv" "$parquet" 10 2)
 
+export CORE=$core PQ_CORE=$pq_core CORES_ONE=$(cores "$one_run") CORES_TWO=$(cores "$two_run")
+export CORES_CORE=$(cores "$core_run") PQ_CORES_ONE=$(cores "$pq_one_run") PQ_CORES_TWO=$(cores "$pq_two_run")
 export PQ_ONE=$pq_one PQ_TWO=$pq_two PQ_ONE_KIB=$pq_one_kib PQ_TWO_KIB=$pq_two_kib
 export PQ_READ_ONE=$pq_read_one PQ_READ_TWO=$pq_read_two SAME_PARQUET=$same_parquet INGEST="$ingest"
 ROWS=$rows ONE=$one TWO=$two ONE_KIB=$one_kib TWO_KIB=$two_kib READ_ONE=$read_one READ_TWO=$read_two SAME=$same GRAM="$gram" python3 - <<'PY'
@@ -63,21 +79,29 @@ gram = json.loads(os.environ["GRAM"])["seconds"]
 serial = 2 * two / one - 1
 print(f"{rows} rows x 455 features, learn sindy (whole command, CSV read in blocks)")
 one_mb, two_mb = int(os.environ["ONE_KIB"]) // 1024, int(os.environ["TWO_KIB"]) // 1024
-print(f"{'1 thread':<34}{one:>8.2f} s   peak RSS {one_mb} MB")
+env = os.environ
+print(f"{'1 thread':<34}{one:>8.2f} s   peak RSS {one_mb} MB; {env['CORES_ONE']} cores busy")
 print(f"{'2 threads':<34}{two:>8.2f} s   peak RSS {two_mb} MB; speed-up {one / two:.2f}x,"
-      f" serial fraction {100 * serial:.0f}%")
+      f" serial fraction {100 * serial:.0f}%; {env['CORES_TWO']} cores busy")
+core = float(env["CORE"])
+print(f"{'1 thread on one core (taskset)':<34}{core:>8.2f} s   two threads on two cores"
+      f" {core / two:.2f}x faster, serial fraction {100 * (2 * two / core - 1):.0f}%")
 print(f"{'models identical across threads':<34}{os.environ['SAME']:>8}")
 print(f"{'NumPy Gram matrix, 2 threads':<34}{gram:>8.2f} s   learn sindy / Gram {two / gram:.1f}x")
 print(f"{'poly:1 (reading-dominated), 1 / 2':<34}{read_one:>8.2f} s {read_two:>6.2f} s"
       f"   {rows / read_one / 1e3:.0f}k / {rows / read_two / 1e3:.0f}k rows/s")
-env = os.environ
 pq_one, pq_two = float(env["PQ_ONE"]), float(env["PQ_TWO"])
 pq_read_one, pq_read_two = float(env["PQ_READ_ONE"]), float(env["PQ_READ_TWO"])
 pq_serial = 2 * pq_two / pq_one - 1
 print("the same columns as Parquet (pyarrow: one row group, snappy)")
-print(f"{'1 thread':<34}{pq_one:>8.2f} s   peak RSS {int(env['PQ_ONE_KIB']) // 1024} MB")
+print(f"{'1 thread':<34}{pq_one:>8.2f} s   peak RSS {int(env['PQ_ONE_KIB']) // 1024} MB;"
+      f" {env['PQ_CORES_ONE']} cores busy")
 print(f"{'2 threads':<34}{pq_two:>8.2f} s   peak RSS {int(env['PQ_TWO_KIB']) // 1024} MB;"
-      f" speed-up {pq_one / pq_two:.2f}x, serial fraction {100 * pq_serial:.0f}%")
+      f" speed-up {pq_one / pq_two:.2f}x, serial fraction {100 * pq_serial:.0f}%;"
+      f" {env['PQ_CORES_TWO']} cores busy")
+pq_core = float(env["PQ_CORE"])
+print(f"{'1 thread on one core (taskset)':<34}{pq_core:>8.2f} s   two threads on two cores"
+      f" {pq_core / pq_two:.2f}x faster, serial fraction {100 * (2 * pq_two / pq_core - 1):.0f}%")
 print(f"{'models identical to the CSV fit':<34}{env['SAME_PARQUET']:>8}")
 print(f"{'NumPy Gram matrix, 2 threads':<34}{gram:>8.2f} s   learn sindy / Gram {pq_two / gram:.1f}x")
 print(f"{'poly:1 (reading-dominated), 1 / 2':<34}{pq_read_one:>8.2f} s {pq_read_two:>6.2f} s"

@@ -385,19 +385,27 @@ impl FeatureLibrary {
     /// # Ok::<(), sindy::SindyError>(())
     /// ```
     pub fn transform(&self, inputs: MatRef<'_, f64>) -> Mat<f64> {
+        let mut theta = Mat::new();
+        self.transform_into(inputs, &mut theta);
+        theta
+    }
+
+    /// [`Self::transform`] into `theta`, resized to fit (its memory reused when it holds enough:
+    /// a block loop allocates Θ once); every entry is written.
+    pub(crate) fn transform_into(&self, inputs: MatRef<'_, f64>, theta: &mut Mat<f64>) {
         crate::linalg::clear_upper_vector_state();
         let (n, dim) = (inputs.nrows(), inputs.ncols());
         let columns: Vec<Vec<f64>> = (0..dim)
             .map(|j| inputs.col(j).iter().copied().collect())
             .collect();
-        let mut theta = Mat::<f64>::zeros(n, self.feature_count(dim));
+        theta.resize_with(n, self.feature_count(dim), |_, _| 0.0);
         let mut next = 0;
         let mut cosines = vec![0.0; n];
         for part in &self.parts {
             match part {
                 Part::Polynomial { degree, constant } => {
                     for term in monomials(dim, *degree, *constant) {
-                        let out = column_slice(&mut theta, next);
+                        let out = column_slice(theta, next);
                         next += 1;
                         out.fill(1.0);
                         for &j in &term {
@@ -409,12 +417,12 @@ impl FeatureLibrary {
                     for k in 1..=*frequencies {
                         let k = k as f64;
                         for input in &columns {
-                            let sines = column_slice(&mut theta, next);
+                            let sines = column_slice(theta, next);
                             for ((sine, cosine), x) in sines.iter_mut().zip(&mut cosines).zip(input)
                             {
                                 (*sine, *cosine) = (k * x).sin_cos();
                             }
-                            column_slice(&mut theta, next + 1).copy_from_slice(&cosines);
+                            column_slice(theta, next + 1).copy_from_slice(&cosines);
                             next += 2;
                         }
                     }
@@ -422,7 +430,7 @@ impl FeatureLibrary {
                 Part::Custom(functions) => {
                     for function in functions {
                         for input in &columns {
-                            let out = column_slice(&mut theta, next);
+                            let out = column_slice(theta, next);
                             next += 1;
                             out.iter_mut()
                                 .zip(input)
@@ -432,7 +440,6 @@ impl FeatureLibrary {
                 }
             }
         }
-        theta
     }
 
     /// Θ of one sample `x`, written into `out` (cleared first). Used by simulation.
@@ -560,6 +567,33 @@ fn monomial_name(term: &[usize], inputs: &[&str]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Θ written into a buffer that held a longer, wider block of other numbers is the fresh Θ:
+    /// every entry is written (a block loop reuses one buffer).
+    #[test]
+    fn a_reused_buffer_gives_the_fresh_library() {
+        let library =
+            FeatureLibrary::from_spec(&LibrarySpec::parse("poly:3+fourier:1").unwrap()).unwrap();
+        let long = Mat::from_fn(50, 4, |i, j| (i as f64 - 7.0) * 0.1 + j as f64);
+        let short = Mat::from_fn(20, 3, |i, j| 0.05 * i as f64 - 0.3 * j as f64);
+        let mut buffer = Mat::new();
+        library.transform_into(long.as_ref(), &mut buffer);
+        library.transform_into(short.as_ref(), &mut buffer);
+        let fresh = library.transform(short.as_ref());
+        assert_eq!(
+            (buffer.nrows(), buffer.ncols()),
+            (fresh.nrows(), fresh.ncols())
+        );
+        for j in 0..fresh.ncols() {
+            for i in 0..fresh.nrows() {
+                assert_eq!(
+                    buffer[(i, j)].to_bits(),
+                    fresh[(i, j)].to_bits(),
+                    "({i}, {j})"
+                );
+            }
+        }
+    }
 
     #[test]
     fn polynomial_names_follow_scikit_learn_order() {

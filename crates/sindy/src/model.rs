@@ -248,10 +248,10 @@ impl SindyParams {
         let feature_names = self.library.feature_names(&input_names);
         let sizes = FeatureSizes::new(features);
         let shape = (inputs.nrows(), features, targets.ncols());
-        let block = |rows: std::ops::Range<usize>| {
+        let block = |rows: std::ops::Range<usize>, theta: &mut Mat<f64>| {
             let inputs = inputs.subrows(rows.start, rows.len());
-            let theta = self.library_block(inputs, rows.start, &feature_names, &sizes)?;
-            Ok::<_, SindyError>((theta, targets.subrows(rows.start, rows.len()).to_owned()))
+            self.library_block(inputs, rows.start, &feature_names, &sizes, theta)?;
+            Ok::<_, SindyError>(targets.subrows(rows.start, rows.len()).to_owned())
         };
         let solve = |reduced: Problem<'static>| {
             check_scale(&sizes.to_vec(), &feature_names)?;
@@ -271,14 +271,15 @@ impl SindyParams {
         first_row: usize,
         feature_names: &[String],
         sizes: &FeatureSizes,
-    ) -> Result<Mat<f64>> {
-        let theta = self.library.transform(inputs);
+        theta: &mut Mat<f64>,
+    ) -> Result<()> {
+        self.library.transform_into(inputs, theta);
         check_finite("library", theta.as_ref(), &|j| {
             format!("feature '{}'", feature_names[j])
         })
         .map_err(|error| error.offset_row(first_row))?;
         sizes.record(theta.as_ref());
-        Ok(theta)
+        Ok(())
     }
 
     /// [`Self::fit_matrices`], also returning Θ(X) of the inputs (to predict on them for free).

@@ -419,13 +419,11 @@ impl SindyParams {
         let sizes = FeatureSizes::new(features);
         let rows = segment.inputs.nrows();
         let width = features + segment.targets.ncols();
-        let part = segment_part(method, rows, width, |block| {
+        let part = segment_part(method, rows, width, |block, theta| {
             let inputs = segment.inputs.subrows(block.start, block.len());
-            let theta = self.library_block(inputs, segment.start + block.start, &names, &sizes)?;
-            Ok::<_, SindyError>((
-                theta,
-                segment.targets.subrows(block.start, block.len()).to_owned(),
-            ))
+            let first_row = segment.start + block.start;
+            self.library_block(inputs, first_row, &names, &sizes, theta)?;
+            Ok::<_, SindyError>(segment.targets.subrows(block.start, block.len()).to_owned())
         })?;
         let moments = (0..segment.targets.ncols())
             .map(|j| Moments::of(&segment.targets.col(j).iter().copied().collect::<Vec<_>>()))

@@ -60,11 +60,12 @@ pub struct Reduction {
 
 /// Reduces the rows `0..rows` by `method` (Householder as well, if the Gram matrix is refused)
 /// and solves the problem with `solve` (which returns it, and ξ with one row per target);
-/// `block(range)` returns Θ and Y on those rows (p and m columns), or an error that stops it.
+/// `block(range, theta)` writes Θ on those rows into `theta` (p columns) and returns Y (m
+/// columns), or an error that stops it.
 pub(crate) fn reduce_row_blocks<E: Send>(
     method: RowReduction,
     (rows, features, targets): (usize, usize, usize),
-    block: impl Fn(Range<usize>) -> std::result::Result<(Mat<f64>, Mat<f64>), E> + Sync,
+    block: impl Fn(Range<usize>, &mut Mat<f64>) -> std::result::Result<Mat<f64>, E> + Sync,
     solve: impl FnMut(Problem<'static>) -> std::result::Result<Solved, E>,
 ) -> std::result::Result<(Solved, Reduction), E> {
     let segments: Vec<Range<usize>> = (0..rows.div_ceil(SEGMENT_ROWS))
@@ -74,8 +75,11 @@ pub(crate) fn reduce_row_blocks<E: Send>(
         let parts = segments
             .par_iter()
             .map(|segment| {
-                segment_part(method, segment.len(), features + targets, |local| {
-                    block(segment.start + local.start..segment.start + local.end)
+                segment_part(method, segment.len(), features + targets, |local, theta| {
+                    block(
+                        segment.start + local.start..segment.start + local.end,
+                        theta,
+                    )
                 })
             })
             .collect::<std::result::Result<Vec<_>, E>>()?;
@@ -144,11 +148,11 @@ fn reduce_whole(
     targets: MatRef<'_, f64>,
 ) -> (Problem<'static>, Reduction) {
     let shape = (theta.nrows(), theta.ncols(), targets.ncols());
-    let block = |range: Range<usize>| {
-        Ok((
-            theta.subrows(range.start, range.len()).to_owned(),
-            targets.subrows(range.start, range.len()).to_owned(),
-        ))
+    let block = |range: Range<usize>, out: &mut Mat<f64>| {
+        let rows = theta.subrows(range.start, range.len());
+        out.resize_with(rows.nrows(), rows.ncols(), |_, _| 0.0);
+        out.copy_from(rows);
+        Ok(targets.subrows(range.start, range.len()).to_owned())
     };
     let solve = |problem: Problem<'static>| {
         let coefficients = problem.least_squares_solution().transpose().to_owned();
@@ -167,14 +171,16 @@ pub(crate) fn segment_part<E>(
     method: RowReduction,
     rows: usize,
     width: usize,
-    block: impl Fn(Range<usize>) -> std::result::Result<(Mat<f64>, Mat<f64>), E>,
+    mut block: impl FnMut(Range<usize>, &mut Mat<f64>) -> std::result::Result<Mat<f64>, E>,
 ) -> std::result::Result<Mat<f64>, E> {
     let mut part = match method {
         RowReduction::Gram => Mat::<f64>::zeros(width, width),
         RowReduction::Householder => Mat::<f64>::zeros(0, width),
     };
+    // One Θ for the segment's blocks: its pages are mapped once, not once per block.
+    let mut theta = Mat::new();
     for start in (0..rows).step_by(BLOCK_ROWS) {
-        let (theta, y) = block(start..(start + BLOCK_ROWS).min(rows))?;
+        let y = block(start..(start + BLOCK_ROWS).min(rows), &mut theta)?;
         match method {
             RowReduction::Gram => add_gram(part.as_mut(), theta.as_ref(), y.as_ref()),
             RowReduction::Householder => {

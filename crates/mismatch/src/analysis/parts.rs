@@ -58,7 +58,7 @@ pub fn part_ranges(rows: usize, part_rows: usize) -> Vec<Range<usize>> {
 /// One part: where it lies and its report, or why it could not be analysed.
 #[derive(Clone, Debug, Serialize)]
 pub struct Part {
-    /// Data rows `[start, end)` of the analysed log.
+    /// Data rows `[start, end)` of the analysed log, counted from 0.
     pub rows: [usize; 2],
     pub t_start: f64,
     pub t_end: f64,

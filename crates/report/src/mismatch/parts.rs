@@ -60,7 +60,8 @@ pub struct PooledEffect {
 /// One part as the summary lists it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PartLine {
-    /// Data rows `[start, end)`, counted from 0 in the recording.
+    /// Data rows `[start, end)` of the analysed rows, counted from 0 (from the start of the
+    /// `--rows` range when one was given).
     pub rows: [usize; 2],
     pub t_start: f64,
     pub t_end: f64,
@@ -97,7 +98,7 @@ impl PartsView<'_> {
         let _ = writeln!(md, "# Mismatch analysis of a long recording, in parts\n");
         let _ = writeln!(
             md,
-            "`{}` against `{}`: {} rows, longer than one analysis takes, analysed in {} consecutive parts of at most {} rows, each on its own (its own comparison, evidence and held-out last 30 %). An effect is named for the recording when more than half of the analysed parts name it ({analysed} parts analysed); its parameters are the inverse-variance mean over the parts that named it. A part's whole report is in `mismatch.json` (`parts[i].report`), or run `learn mismatch --recording ... --rows A:B` on its rows.\n",
+            "`{}` against `{}`: {} rows, analysed in {} consecutive parts of at most {} rows, each on its own (its own comparison, evidence and held-out last 30 %). An effect is named for the recording when more than half of the analysed parts name it ({analysed} parts analysed); its parameters are the inverse-variance mean over the parts that named it. A part's whole report is in `mismatch.json` (`parts[i].report`); its rows below are counted from the first row analysed.\n",
             self.recording,
             self.model,
             self.rows,

@@ -199,3 +199,76 @@ fn a_recording_over_the_cost_bound_is_refused_before_the_work() {
         "{message}"
     );
 }
+
+/// A long recording analysed in parts lists a part where nothing moves with its reason and pools
+/// the others; when every part is refused, the analysis is an error naming the first reason.
+#[test]
+fn a_part_where_nothing_moves_is_listed_and_the_others_pooled() {
+    let scenario = Scenario {
+        duration_s: 50.0,
+        noise: noisy(),
+        effects: Effects {
+            linear_drag: Some(physics::LinearDrag {
+                d: [0.35, 0.35, 0.1],
+            }),
+            ..Effects::default()
+        },
+        ..common::scenario(Effects::default(), 7)
+    };
+    let mut log = simulate(&model("vehicles/quad-a.json"), &scenario, "test").unwrap();
+    log.path = PathBuf::from("generated/flight.csv");
+    // Two parts: the first up to row `held`, the second from it.
+    let held = log.len() / 2;
+    let first = log.clone();
+    for k in held..log.len() {
+        log.velocity[k] = first.velocity[held];
+        log.body_rate[k] = first.body_rate[held];
+    }
+    let parted = mismatch::analyze_in_parts(
+        &log,
+        held + 1,
+        &model_for_scenario(),
+        "test",
+        &settings(),
+        &|_, _, _| {},
+    )
+    .unwrap();
+    let [analysed, refused] = parted.parts.as_slice() else {
+        panic!("{} parts", parted.parts.len());
+    };
+    assert!(analysed.report.is_some() && analysed.refused.is_none());
+    let reason = refused.refused.as_deref().unwrap();
+    assert!(
+        reason.starts_with("generated/flight.csv: degenerate recording, no excitation"),
+        "{reason}"
+    );
+    let [drag] = parted.effects.as_slice() else {
+        panic!("{:?}", parted.effects);
+    };
+    assert_eq!(
+        (drag.id.as_str(), drag.named_in, drag.named),
+        ("linear_drag", 1, true)
+    );
+    for (number, truth) in drag.parameters[0].numbers.iter().zip([0.35, 0.35, 0.1]) {
+        assert!((number.value - truth).abs() < 0.1 * truth, "{number:?}");
+        assert!(number.per_part[1].is_none());
+    }
+    // Every part held: nothing to pool.
+    for k in 0..log.len() {
+        log.velocity[k] = first.velocity[0];
+    }
+    let error = mismatch::analyze_in_parts(
+        &log,
+        held + 1,
+        &model_for_scenario(),
+        "test",
+        &settings(),
+        &|_, _, _| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        error.starts_with("generated/flight.csv: no part of the recording could be analysed (the first: generated/flight.csv: degenerate recording"),
+        "{error}"
+    );
+}

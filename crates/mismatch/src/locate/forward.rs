@@ -96,7 +96,11 @@ pub fn predict_substeps_with(
     let n = recording.len();
     let angular_wanted = model.predicts_torque();
     let total = (n - 1) * SUBSTEPS;
-    assert_eq!(wrenches.wrenches.len(), total, "a wrench trace of this recording");
+    assert_eq!(
+        wrenches.wrenches.len(),
+        total,
+        "a wrench trace of this recording"
+    );
     let air_velocity = air_velocity_trace(recording, effects.drag_lag_s());
     let mut translational = Vec::with_capacity(total);
     let mut angular = Vec::with_capacity(if angular_wanted { total } else { 0 });

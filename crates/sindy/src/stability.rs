@@ -63,50 +63,15 @@ impl BlockDesign {
         samples: usize,
         block_samples: usize,
         parameters: usize,
-        mut sample: impl FnMut(usize, &mut [f64]) -> f64,
+        sample: impl FnMut(usize, &mut [f64]) -> f64,
     ) -> Self {
         let p = parameters;
-        let mut design = Self {
-            grams: Vec::new(),
-            cross: Vec::new(),
-            target_squares: Vec::new(),
-            counts: Vec::new(),
-            parameters: p,
-        };
-        let mut x = vec![0.0; p];
         // The lower triangle, row by row: each entry summed over the samples in order.
-        let mut lower = vec![0.0; p * (p + 1) / 2];
-        let mut start = 0;
-        while start < samples {
-            let end = (start + block_samples.max(1)).min(samples);
-            lower.fill(0.0);
-            let mut cross = vec![0.0; p];
-            let mut squares = 0.0;
-            for k in start..end {
-                let y = sample(k, &mut x);
-                let mut row_start = 0;
-                for (i, &xi) in x.iter().enumerate() {
-                    cross[i] += xi * y;
-                    let row = &mut lower[row_start..row_start + i + 1];
-                    for (entry, &xj) in row.iter_mut().zip(&x) {
-                        *entry += xi * xj;
-                    }
-                    row_start += i + 1;
-                }
-                squares += y * y;
-            }
-            let entry = |i: usize, j: usize| {
-                let (row, column) = if j <= i { (i, j) } else { (j, i) };
-                lower[row * (row + 1) / 2 + column]
-            };
-            let gram = Mat::<f64>::from_fn(p, p, entry);
-            design.grams.push(gram);
-            design.cross.push(cross);
-            design.target_squares.push(squares);
-            design.counts.push((end - start) as f64);
-            start = end;
-        }
-        design
+        let lower = LowerTriangle {
+            p,
+            sums: vec![0.0; p * (p + 1) / 2],
+        };
+        Self::summed(samples, block_samples, p, sample, lower)
     }
 
     /// [`Self::from_samples`] over the columns `leading ++ trailing`, where `trailing` holds the
@@ -120,24 +85,44 @@ impl BlockDesign {
         samples: usize,
         block_samples: usize,
         leading: usize,
-        mut sample: impl FnMut(usize, &mut [f64]) -> f64,
+        sample: impl FnMut(usize, &mut [f64]) -> f64,
     ) -> Self {
         let p = leading + trailing.parameters;
+        let rows = LeadingRows {
+            trailing,
+            leading,
+            p,
+            sums: vec![0.0; leading * p],
+        };
+        let design = Self::summed(samples, block_samples, p, sample, rows);
+        assert_eq!(
+            design.blocks(),
+            trailing.blocks(),
+            "the same samples and blocks"
+        );
+        design
+    }
+
+    /// The blocks' statistics: the cross products with the target, its squares and the counts
+    /// summed here, the Gram matrix by `gram`.
+    fn summed(
+        samples: usize,
+        block_samples: usize,
+        p: usize,
+        mut sample: impl FnMut(usize, &mut [f64]) -> f64,
+        mut gram: impl GramSums,
+    ) -> Self {
         let mut design = Self {
-            grams: Vec::with_capacity(trailing.blocks()),
-            cross: Vec::with_capacity(trailing.blocks()),
-            target_squares: Vec::with_capacity(trailing.blocks()),
-            counts: Vec::with_capacity(trailing.blocks()),
+            grams: Vec::new(),
+            cross: Vec::new(),
+            target_squares: Vec::new(),
+            counts: Vec::new(),
             parameters: p,
         };
         let mut x = vec![0.0; p];
-        // Rows of the leading columns against every column: `lead[i][j]` for i < leading.
-        let mut lead = vec![0.0; leading * p];
         let mut start = 0;
-        let mut block = 0;
         while start < samples {
             let end = (start + block_samples.max(1)).min(samples);
-            lead.fill(0.0);
             let mut cross = vec![0.0; p];
             let mut squares = 0.0;
             for k in start..end {
@@ -145,27 +130,15 @@ impl BlockDesign {
                 for (i, &xi) in x.iter().enumerate() {
                     cross[i] += xi * y;
                 }
-                for (i, &xi) in x[..leading].iter().enumerate() {
-                    for (entry, &xj) in lead[i * p..(i + 1) * p].iter_mut().zip(&x) {
-                        *entry += xi * xj;
-                    }
-                }
+                gram.add(&x);
                 squares += y * y;
             }
-            let fixed = &trailing.grams[block];
-            let entry = |i: usize, j: usize| match (i < leading, j < leading) {
-                (true, _) => lead[i * p + j],
-                (false, true) => lead[j * p + i],
-                (false, false) => fixed[(i - leading, j - leading)],
-            };
-            design.grams.push(Mat::<f64>::from_fn(p, p, entry));
+            design.grams.push(gram.take(design.grams.len()));
             design.cross.push(cross);
             design.target_squares.push(squares);
             design.counts.push((end - start) as f64);
             start = end;
-            block += 1;
         }
-        assert_eq!(block, trailing.blocks(), "the same samples and blocks");
         design
     }
 
@@ -252,6 +225,76 @@ impl BlockDesign {
     /// Number of columns.
     pub fn parameters(&self) -> usize {
         self.parameters
+    }
+}
+
+/// How a block's Gram matrix is summed: each sample's columns added in order, then the block's
+/// matrix taken (and the sums started again).
+trait GramSums {
+    fn add(&mut self, x: &[f64]);
+    fn take(&mut self, block: usize) -> Mat<f64>;
+}
+
+/// Every entry of the lower triangle, row by row ([`BlockDesign::from_samples`]).
+struct LowerTriangle {
+    p: usize,
+    sums: Vec<f64>,
+}
+
+impl GramSums for LowerTriangle {
+    fn add(&mut self, x: &[f64]) {
+        let mut row_start = 0;
+        for (i, &xi) in x.iter().enumerate() {
+            let row = &mut self.sums[row_start..row_start + i + 1];
+            for (entry, &xj) in row.iter_mut().zip(x) {
+                *entry += xi * xj;
+            }
+            row_start += i + 1;
+        }
+    }
+
+    fn take(&mut self, _block: usize) -> Mat<f64> {
+        let sums = &self.sums;
+        let entry = |i: usize, j: usize| {
+            let (row, column) = if j <= i { (i, j) } else { (j, i) };
+            sums[row * (row + 1) / 2 + column]
+        };
+        let gram = Mat::<f64>::from_fn(self.p, self.p, entry);
+        self.sums.fill(0.0);
+        gram
+    }
+}
+
+/// The leading columns' rows against every column, the rest from the trailing columns' own
+/// design ([`BlockDesign::with_leading_columns`]).
+struct LeadingRows<'a> {
+    trailing: &'a BlockDesign,
+    leading: usize,
+    p: usize,
+    sums: Vec<f64>,
+}
+
+impl GramSums for LeadingRows<'_> {
+    fn add(&mut self, x: &[f64]) {
+        let p = self.p;
+        for (i, &xi) in x[..self.leading].iter().enumerate() {
+            for (entry, &xj) in self.sums[i * p..(i + 1) * p].iter_mut().zip(x) {
+                *entry += xi * xj;
+            }
+        }
+    }
+
+    fn take(&mut self, block: usize) -> Mat<f64> {
+        let (leading, p, sums) = (self.leading, self.p, &self.sums);
+        let fixed = &self.trailing.grams[block];
+        let entry = |i: usize, j: usize| match (i < leading, j < leading) {
+            (true, _) => sums[i * p + j],
+            (false, true) => sums[j * p + i],
+            (false, false) => fixed[(i - leading, j - leading)],
+        };
+        let gram = Mat::<f64>::from_fn(p, p, entry);
+        self.sums.fill(0.0);
+        gram
     }
 }
 

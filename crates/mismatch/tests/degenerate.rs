@@ -224,15 +224,17 @@ fn a_part_where_nothing_moves_is_listed_and_the_others_pooled() {
         log.velocity[k] = first.velocity[held];
         log.body_rate[k] = first.body_rate[held];
     }
-    let parted = mismatch::analyze_in_parts(
-        &log,
-        held + 1,
-        &model_for_scenario(),
-        "test",
-        &settings(),
-        &|_, _, _| {},
-    )
-    .unwrap();
+    let in_two_parts = |log: &data::FlightLog| {
+        mismatch::analyze_in_parts(
+            log,
+            held + 1,
+            &model_for_scenario(),
+            "test",
+            &settings(),
+            &|_, _, _| {},
+        )
+    };
+    let parted = in_two_parts(&log).unwrap();
     let [analysed, refused] = parted.parts.as_slice() else {
         panic!("{} parts", parted.parts.len());
     };
@@ -257,16 +259,7 @@ fn a_part_where_nothing_moves_is_listed_and_the_others_pooled() {
     for k in 0..log.len() {
         log.velocity[k] = first.velocity[0];
     }
-    let error = mismatch::analyze_in_parts(
-        &log,
-        held + 1,
-        &model_for_scenario(),
-        "test",
-        &settings(),
-        &|_, _, _| {},
-    )
-    .unwrap_err()
-    .to_string();
+    let error = in_two_parts(&log).unwrap_err().to_string();
     assert!(
         error.starts_with("generated/flight.csv: no part of the recording could be analysed (the first: generated/flight.csv: degenerate recording"),
         "{error}"

@@ -14,14 +14,16 @@ all: build
 data:
 	@scripts/fetch-data.sh
 
-# Binaries, tests and examples in one build: with dev-dependencies in the same feature resolution,
+# Libraries (the Python extension crates/python among them), binaries, tests and examples in one
+# build: with dev-dependencies in the same feature resolution,
 # `cargo test` then reuses every artifact (building the binaries alone resolves features differently
 # and recompiles faer, minutes on 2 cores).
 build:
-	$(CARGO) build --workspace --bins --tests --examples
+	$(CARGO) build --workspace --lib --bins --tests --examples
 
 test: data build
 	$(CARGO) test --workspace
+	scripts/python-package.sh
 	$(MAKE) check-paper
 
 # The paper's tables and figures from one command (experiments/reproduce.json): results/,

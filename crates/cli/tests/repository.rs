@@ -76,6 +76,7 @@ fn markdown_files() -> Vec<PathBuf> {
         ".venv",
         ".venv-torch",
         ".venv-ulog",
+        ".venv-python",
         ".scratch",
     ];
     let mut found = Vec::new();

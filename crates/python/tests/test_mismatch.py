@@ -1,0 +1,56 @@
+"""The mismatch analysis from Python gives the CLI's files and numbers; bad input is one line."""
+
+import json
+import shutil
+
+import pytest
+
+import learn_sysid as ls
+
+
+@pytest.fixture(scope="module")
+def flight(tmp_path_factory, root, learn_binary):
+    import subprocess
+
+    folder = tmp_path_factory.mktemp("mismatch")
+    shutil.copy(root / "experiments/mismatch/vehicles/quad-a.json", folder / "quad.json")
+    scenario = json.loads((root / "experiments/mismatch/configurations/a.json").read_text())
+    scenario.update(model="quad.json", duration_s=30.0, effects={"linear_drag": {"d": [0.35, 0.35, 0.1]}})
+    (folder / "scenario.json").write_text(json.dumps(scenario))
+    for args in (["simulate", "--scenario", "scenario.json", "--out", "flight.csv"],
+                 ["mismatch", "--recording", "flight.csv", "--model", "quad.json", "--out", "cli"]):
+        result = subprocess.run([str(learn_binary), "--quiet", *args], cwd=folder, capture_output=True, text=True)
+        assert result.returncode == 0, result.stderr
+    return folder
+
+
+def test_the_analysis_equals_the_cli(flight, monkeypatch):
+    monkeypatch.chdir(flight)
+    report = ls.analyze("flight.csv", "quad.json", out="python")
+    for name in ls.ANALYSIS_FILES:
+        assert (flight / "python" / name).read_text() == (flight / "cli" / name).read_text(), name
+    assert [effect["id"] for effect in report["effects"]] == ["linear_drag"]
+    assert report == json.loads((flight / "cli" / "mismatch.json").read_text())
+    with pytest.raises(ls.LearnSysidError, match="exists"):
+        ls.analyze("flight.csv", "quad.json", out="python")
+    assert not list((flight / "python").glob(".learn-staging-*"))
+
+
+def test_a_model_given_as_a_dict_names_the_same_effects(flight):
+    model = json.loads((flight / "quad.json").read_text())
+    report = ls.analyze(flight / "flight.csv", model)
+    expected = json.loads((flight / "cli" / "mismatch.json").read_text())
+    assert [e["id"] for e in report["effects"]] == [e["id"] for e in expected["effects"]]
+    assert report["effects"][0]["parameters"] == expected["effects"][0]["parameters"]
+
+
+def test_bad_input_raises_one_line_errors(flight, tmp_path):
+    with pytest.raises(ls.LearnSysidError, match="absent.csv"):
+        ls.analyze(tmp_path / "absent.csv", flight / "quad.json")
+    model = json.loads((flight / "quad.json").read_text())
+    model["mass_kg"] = -1.0
+    with pytest.raises(ls.LearnSysidError) as error:
+        ls.analyze(flight / "flight.csv", model)
+    assert "mass" in str(error.value) and "\n" not in str(error.value)
+    with pytest.raises(ls.LearnSysidError, match="part"):
+        ls.analyze(flight / "flight.csv", flight / "quad.json", part_rows=10)

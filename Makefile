@@ -72,6 +72,7 @@ bench: data build
 	scripts/bench/scaling.sh
 	scripts/bench/threads.sh
 	scripts/bench/mismatch_length.sh
+	scripts/bench/python_package.sh
 
 # Sim-to-real mismatch: the tool blind on simulated flights with concealed effects (every case under
 # every simulator/logger configuration of experiments/mismatch/demo.json: the matrix), then every

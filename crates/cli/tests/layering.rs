@@ -6,7 +6,8 @@
 //! `sindy`, no linear algebra, no output sets); `evaluation` draws no progress bar (the `learn`
 //! binary does); `mismatch` returns results and file contents (the binary checks and writes
 //! them); `report` depends on no crate that computes results, however indirectly (data flows
-//! cli → evaluation / mismatch → report).
+//! cli → evaluation / mismatch → report); the Python package `python` reuses the libraries, not
+//! the command line's crates.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -150,6 +151,26 @@ fn the_rotation_maths_depends_on_nothing() {
 #[test]
 fn mismatch_returns_results_and_writes_no_output_set() {
     assert_layered("mismatch", &["report"], &["output_set", "indicatif"]);
+}
+
+#[test]
+fn the_python_package_reuses_the_libraries_not_the_command_line() {
+    let forbidden = ["cli", "clap", "indicatif", "anyhow"];
+    assert_layered(
+        "python",
+        &["sindy", "learn", "mismatch", "pyo3"],
+        &forbidden,
+    );
+    // Output sets (whose staging installs an interrupt handler) are the binary's: the extension
+    // writes through Python, and `output_set` reaches it only inside `evaluation`.
+    assert!(!direct("python").contains("output_set"));
+    // A shell like the `learn` binary: no crate of the workspace depends on it.
+    for (package, dependencies) in graph() {
+        assert!(
+            !dependencies.contains("python"),
+            "{package} depends on python"
+        );
+    }
 }
 
 #[test]

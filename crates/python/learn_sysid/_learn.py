@@ -50,6 +50,25 @@ class LeARN:
         return cls(native)
 
     @classmethod
+    def meta_train_files(cls, pattern, state, control=(), *, time="t", differentiation_method=None, config=None,
+                         seed=None, task_column=None):
+        """``learn meta-train --tasks PATTERN``: every CSV or Parquet file ``pattern`` matches is a
+        task (or, with ``task_column``, each run of one value of that column of the file
+        ``pattern``), read with its ``time``, ``state`` and ``control`` columns; the model records
+        the files and their SHA-256. The same file as the CLI writes (tested)."""
+        native = _native.meta_train_files(
+            os.fspath(pattern),
+            time,
+            list(state),
+            list(control),
+            _differentiation(differentiation_method)._spec(),
+            config=None if config is None else os.fspath(config),
+            seed=seed,
+            task_column=task_column,
+        )
+        return cls(native)
+
+    @classmethod
     def load(cls, path) -> "LeARN":
         """A checkpoint written by ``learn meta-train --tasks`` or ``save``."""
         return cls(_native.NativeLearnModel.load(os.fspath(path)))

@@ -4,6 +4,7 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
+use evaluation::own_data;
 use learn::{
     ColumnSpec, EquationRule, MetaTrainedModel, Recording, TaskConfig, TaskSet, TaskSource,
 };
@@ -17,6 +18,7 @@ use crate::errors::raise;
 pub fn register(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<NativeLearnModel>()?;
     module.add_function(wrap_pyfunction!(meta_train_arrays, module)?)?;
+    module.add_function(wrap_pyfunction!(meta_train_files, module)?)?;
     Ok(())
 }
 
@@ -104,6 +106,59 @@ fn meta_train_arrays(
     Ok(NativeLearnModel {
         model: model.map_err(raise)?,
     })
+}
+
+/// Meta-trains on CSV (or Parquet) task files as `learn meta-train --tasks` does: every file
+/// `pattern` matches is a task, or, with `task_column`, each run of one value of that column of
+/// the file `pattern`; the model records the files and their SHA-256.
+#[pyfunction]
+#[pyo3(signature = (pattern, time, state, control, derivative, config=None, seed=None, task_column=None))]
+#[allow(clippy::too_many_arguments)]
+fn meta_train_files(
+    py: Python<'_>,
+    pattern: String,
+    time: String,
+    state: Vec<String>,
+    control: Vec<String>,
+    derivative: &str,
+    config: Option<PathBuf>,
+    seed: Option<u64>,
+    task_column: Option<String>,
+) -> PyResult<NativeLearnModel> {
+    let derivative: Derivative = serde_json::from_str(derivative)
+        .map_err(|e| raise(format!("differentiation method {derivative}: {e}")))?;
+    let spec = ColumnSpec {
+        time,
+        state,
+        control,
+        derivative,
+    };
+    spec.check()
+        .map_err(|message| raise(format!("state/control: {message}")))?;
+    let source = match task_column {
+        Some(column) => TaskSource::Column {
+            file: PathBuf::from(pattern),
+            column,
+        },
+        None => TaskSource::Files { pattern },
+    };
+    let mut settings = TaskConfig::load(config.as_deref()).map_err(raise)?;
+    if let Some(seed) = seed {
+        settings = settings.with_seed(seed);
+    }
+    let model = py.detach(|| -> PyResult<MetaTrainedModel> {
+        let tasks = own_data::read_tasks(&source, &spec).map_err(raise)?;
+        let files = own_data::data_files(&tasks).map_err(raise)?;
+        let recordings: Vec<Recording> = tasks.iter().map(own_data::recording).collect();
+        let set = TaskSet {
+            source: &source,
+            spec: &spec,
+            tasks: &recordings,
+            files,
+        };
+        learn::meta_train_tasks(set, &settings, &|_| {}).map_err(raise)
+    })?;
+    Ok(NativeLearnModel { model })
 }
 
 fn rows(range: (usize, usize)) -> Range<usize> {

@@ -52,6 +52,9 @@ def test_python_and_the_cli_meta_train_the_same_parameters(trained, run_learn, m
     from_python = json.loads((folder / "python.json").read_text())
     assert from_python["parameters"] == from_cli["parameters"]
     assert from_python["meta_loss_history"] == from_cli["meta_loss_history"]
+    # from the same files, the same checkpoint as the CLI's, byte for byte
+    ls.LeARN.meta_train_files("train-*.csv", ["x", "v"], ["u"], config="small.json", seed=3).save(folder / "files.json")
+    assert (folder / "files.json").read_bytes() == (folder / "cli.json").read_bytes()
     cli_model = ls.LeARN.load(folder / "cli.json")
     assert cli_model.input_names == ["x", "v", "u"] and cli_model.output_names == ["x'", "v'"]
     assert model.seed == 3 and model.interval == 0.05 and len(model.meta_loss_history) == 60

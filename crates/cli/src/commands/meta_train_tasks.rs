@@ -5,10 +5,9 @@
 use std::path::PathBuf;
 
 use anyhow::bail;
-use data::file_sha256;
-use evaluation::own_data::{read_tasks, recording};
+use evaluation::own_data::{data_files, read_tasks, recording};
 use indicatif::{ProgressBar, ProgressStyle};
-use learn::{ColumnSpec, DataFile, TaskConfig, TaskSet, TaskSource};
+use learn::{ColumnSpec, TaskConfig, TaskSet, TaskSource};
 use output_set::{Existing, OutputSet};
 use sindy::Derivative;
 
@@ -116,15 +115,7 @@ pub fn run(global: &Global, args: &Args) -> anyhow::Result<()> {
         set.input(format!("the task {}", task.name), &task.path);
     }
     let staged = set.prepare()?;
-    let mut files: Vec<DataFile> = Vec::new();
-    for task in &tasks {
-        if !files.iter().any(|file| file.path == task.path) {
-            files.push(DataFile {
-                path: task.path.clone(),
-                sha256: file_sha256(&task.path)?,
-            });
-        }
-    }
+    let files = data_files(&tasks)?;
     let bar = iteration_bar(
         global.show_progress(),
         settings.get().meta_training.iterations,

@@ -23,7 +23,7 @@ use sindy::{FeatureLibrary, OptimizerSpec, SindyModel, SindyParams};
 use crate::error::{EvaluationError, Result};
 
 pub use family::{FamilyConfig, ParameterRange, SimulatedTask, TaskParameters, simulate_task};
-pub use tasks::{check_interval, read_recording, read_tasks, recording};
+pub use tasks::{check_interval, data_files, read_recording, read_tasks, recording};
 
 /// Adaptation (support rows) and generalisation (query rows) MSE of one method.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -7,8 +7,8 @@ use std::path::Path;
 
 use data::{DEFAULT_UNIFORM_TOLERANCE, TaskTable, interval_text};
 use learn::{
-    ColumnSpec, ColumnTraining, LearnError, MetaTrainedModel, Recording, RecordingEvaluation,
-    TaskSource,
+    ColumnSpec, ColumnTraining, DataFile, LearnError, MetaTrainedModel, Recording,
+    RecordingEvaluation, TaskSource,
 };
 
 use crate::error::Result;
@@ -23,6 +23,21 @@ pub fn read_tasks(source: &TaskSource, spec: &ColumnSpec) -> Result<Vec<TaskTabl
             data::read_column_tasks(file, column, &spec.time, &columns)?
         }
     })
+}
+
+/// The files `tasks` were read from, each once and in their order, with their SHA-256 (what a
+/// model records of its data).
+pub fn data_files(tasks: &[TaskTable]) -> Result<Vec<DataFile>> {
+    let mut files: Vec<DataFile> = Vec::new();
+    for task in tasks {
+        if !files.iter().any(|file| file.path == task.path) {
+            files.push(DataFile {
+                path: task.path.clone(),
+                sha256: data::file_sha256(&task.path)?,
+            });
+        }
+    }
+    Ok(files)
 }
 
 /// Reads one recording with the columns of `spec`.

@@ -2,7 +2,8 @@
 
 - SINDy with PySINDy's API (``SINDy``, ``PolynomialLibrary``, ``FourierLibrary``,
   ``FiniteDifference``, ``SavitzkyGolay``; optimizers ``STLSQ`` and ``Lasso``, also usable as
-  ``pysindy.SINDy(optimizer=learn_sysid.STLSQ(...))``), models saved as ``learn sindy`` saves them;
+  ``pysindy.SINDy(optimizer=learn_sysid.STLSQ(...))``; ``BaggedRegression`` with coefficient
+  intervals), models saved as ``learn sindy`` saves them;
 - LeARN (``LeARN.meta_train``, ``evaluate``, ``adapt``, ``predict``, ``explain``; checkpoints as
   ``learn meta-train --tasks`` writes them, ``read_checkpoint`` for NumPy);
 - the quadrotor mismatch analysis (``analyze``).
@@ -15,11 +16,12 @@ from ._learn import LeARN, numpy_predict, read_checkpoint
 from ._libraries import ConcatLibrary, FiniteDifference, FourierLibrary, PolynomialLibrary, SavitzkyGolay
 from ._mismatch import ANALYSIS_FILES, analyze
 from ._native import LearnSysidError
-from ._optimizers import STLSQ, Lasso
+from ._optimizers import STLSQ, BaggedRegression, Lasso
 from ._sindy import SINDy
 
 __all__ = [
     "ANALYSIS_FILES",
+    "BaggedRegression",
     "ConcatLibrary",
     "FiniteDifference",
     "FourierLibrary",

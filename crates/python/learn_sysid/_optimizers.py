@@ -112,13 +112,83 @@ class Lasso(_Optimizer):
         return f"Lasso(penalty={self.penalty})"
 
 
+class BaggedRegression(_Optimizer):
+    """The ``sindy`` crate's regression with a bagged ensemble, on a library matrix.
+
+    The columns are standardised; each target's penalty is chosen among ``candidates`` by
+    blocked ``folds``-fold cross-validation inside the rows given (``gap`` samples dropped beside
+    each validation block); the fit on all rows is ``coef_``; ``members`` refits on moving-block
+    bootstraps of ``block`` samples (drawn from ``seed``) give ``coef_members_`` and
+    ``coef_interval_`` (their 2.5 % and 97.5 % quantiles, the coefficients' 95 % interval), and
+    ``predict_band`` the members' mean ± 2√(s² + σ²) (s² the members' variance, σ² the
+    cross-validation error). ``penalty``: ``"stlsq"`` (``candidates`` are thresholds as
+    fractions of each target's standard deviation, ridge ``alpha``), ``"ridge"`` (λ per sample)
+    or ``"lasso"`` (fractions of the smallest λ that zeroes every coefficient).
+    """
+
+    def __init__(self, penalty="stlsq", candidates=(0.02, 0.05, 0.1, 0.2), alpha=0.05, members=20, block=125,
+                 folds=5, gap=0, seed=0, intercept=False):
+        self.penalty = penalty
+        self.candidates = candidates
+        self.alpha = alpha
+        self.members = members
+        self.block = block
+        self.folds = folds
+        self.gap = gap
+        self.seed = seed
+        self.intercept = intercept
+        self._base_init(1)
+
+    def _spec_dict(self) -> dict:
+        values = [float(v) for v in self.candidates]
+        penalty = {
+            "stlsq": {"kind": "stlsq", "thresholds": values, "alpha": float(self.alpha)},
+            "ridge": {"kind": "ridge", "lambdas": values},
+            "lasso": {"kind": "lasso", "fractions": values},
+        }.get(self.penalty)
+        if penalty is None:
+            raise _native.LearnSysidError(f"BaggedRegression: penalty '{self.penalty}' is not stlsq, ridge or lasso")
+        return {
+            "penalty": penalty,
+            "intercept": bool(self.intercept),
+            "folds": {"folds": int(self.folds), "gap": int(self.gap)},
+            "bagging": {"members": int(self.members), "block": int(self.block)},
+        }
+
+    def _solve(self, theta, targets):
+        self._fit = _native.fit_regression(theta, targets, json.dumps(self._spec_dict()), int(self.seed))
+        coefficients, intercepts = self._fit.full()
+        members = self._fit.members()
+        self.coef_members_ = np.stack([m[0] for m in members])
+        self.coef_interval_ = np.quantile(self.coef_members_, [0.025, 0.975], axis=0)
+        self.chosen_ = self._fit.chosen()
+        self._intercepts = np.asarray(intercepts)
+        return coefficients
+
+    def fit(self, x_, y, sample_weight=None, **kws):
+        super().fit(x_, y, sample_weight=sample_weight, **kws)
+        self.intercept_ = self._intercepts if self.intercept else 0.0
+        return self
+
+    def predict(self, x):
+        return _matrix(x, "library matrix") @ self.coef_.T + self.intercept_
+
+    def predict_band(self, x):
+        """The members' mean prediction and its predictive band: (mean, lower, upper)."""
+        return self._fit.ensemble(_matrix(x, "library matrix"))
+
+    def __repr__(self) -> str:
+        return (f"BaggedRegression(penalty={self.penalty!r}, candidates={tuple(self.candidates)}, "
+                f"members={self.members}, block={self.block}, seed={self.seed})")
+
+
 def _optimizer(optimizer) -> _Optimizer:
     if optimizer is None:
         return STLSQ()
-    if not isinstance(optimizer, _Optimizer):
+    if not isinstance(optimizer, (STLSQ, Lasso)):
         raise TypeError(
             f"optimizer: {type(optimizer).__name__} is not one of learn_sysid's STLSQ or Lasso "
-            "(PySINDy's own optimizers run in pysindy.SINDy)"
+            "(BaggedRegression and PySINDy's own optimizers run in pysindy.SINDy)"
         )
     return optimizer
 

@@ -2,7 +2,8 @@
 //!
 //! What it is for: handing NumPy arrays and Python values to the workspace's libraries and their
 //! results back — SINDy fits, predictions, simulations and saved models (`sindy`), the sparse
-//! regressions on a library matrix that `pysindy.SINDy` calls as its optimizer, the mismatch
+//! regressions on a library matrix that `pysindy.SINDy` calls as its optimizer (bagged, with
+//! coefficient intervals, where the crate bags), the mismatch
 //! analysis of a recording (`mismatch`, its files written as the CLI writes them) and LeARN's
 //! meta-training, adaptation and explanation on tasks in memory (`learn`). Arrays of `float64`
 //! are read in place whatever their strides (no copy), and the interpreter lock is released
@@ -18,6 +19,7 @@ mod arrays;
 mod errors;
 mod learn_api;
 mod mismatch_api;
+mod regression_api;
 mod sindy_api;
 
 use pyo3::prelude::*;
@@ -29,6 +31,7 @@ fn _native(module: &Bound<'_, PyModule>) -> PyResult<()> {
         module.py().get_type::<errors::LearnSysidError>(),
     )?;
     sindy_api::register(module)?;
+    regression_api::register(module)?;
     mismatch_api::register(module)?;
     learn_api::register(module)?;
     Ok(())

@@ -20,15 +20,21 @@ def library_and_targets(noise=0.05, seed=4):
     return theta, y
 
 
-def test_intervals_cover_the_truth_and_the_band_the_targets():
-    theta, y = library_and_targets()
-    model = ls.BaggedRegression(penalty="stlsq", members=30, block=100, seed=7).fit(theta, y)
-    low, high = model.coef_interval_
-    assert model.coef_members_.shape == (30, 2, 4)
-    for i, j in zip(*np.nonzero(TRUE)):
-        assert low[i, j] <= TRUE[i, j] <= high[i, j], (i, j, low[i, j], high[i, j])
-        assert high[i, j] - low[i, j] < 0.1 * abs(TRUE[i, j]) + 0.02
-    np.testing.assert_allclose(model.coef_, TRUE, atol=0.02)
+def test_intervals_cover_the_truth_over_noise_draws_and_the_band_the_targets():
+    # Nominal 95 % intervals of the four true terms over 20 noise draws: at least 80 % cover the
+    # truth (a moving-block bootstrap's percentile interval runs a little short), and none is wide.
+    covered, total = 0, 0
+    for seed in range(20):
+        theta, y = library_and_targets(seed=seed)
+        model = ls.BaggedRegression(penalty="stlsq", members=30, block=100, seed=7).fit(theta, y)
+        low, high = model.coef_interval_
+        assert model.coef_members_.shape == (30, 2, 4)
+        for i, j in zip(*np.nonzero(TRUE)):
+            covered += low[i, j] <= TRUE[i, j] <= high[i, j]
+            total += 1
+            assert high[i, j] - low[i, j] < 0.05
+        np.testing.assert_allclose(model.coef_, TRUE, atol=0.02)
+    assert covered >= 0.8 * total, (covered, total)
     mean, lower, upper = model.predict_band(theta)
     assert np.all(lower <= mean) and np.all(mean <= upper)
     inside = np.mean((lower <= y) & (y <= upper))

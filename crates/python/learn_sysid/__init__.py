@@ -14,7 +14,7 @@ Every computation runs in the workspace's Rust crates; errors are ``LearnSysidEr
 
 from ._learn import LeARN, numpy_predict, read_checkpoint
 from ._libraries import ConcatLibrary, FiniteDifference, FourierLibrary, PolynomialLibrary, SavitzkyGolay
-from ._mismatch import ANALYSIS_FILES, analyze
+from ._mismatch import ANALYSIS_FILES, analyze, write_recording
 from ._native import LearnSysidError
 from ._optimizers import STLSQ, BaggedRegression, Lasso
 from ._sindy import SINDy
@@ -35,4 +35,5 @@ __all__ = [
     "analyze",
     "numpy_predict",
     "read_checkpoint",
+    "write_recording",
 ]

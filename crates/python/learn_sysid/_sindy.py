@@ -134,6 +134,8 @@ class SINDy:
         self.n_control_features_ = n_controls
         self.n_features_in_ = len(names)
         self.n_output_features_ = len(self._model.feature_names())
+        # PySINDy's names are made here; the crate's features must be as many, in its order.
+        assert len(self.get_feature_names()) == self.n_output_features_, "library names out of step"
         self.optimizer.coef_ = self._model.coefficients()
 
     def _fitted(self):

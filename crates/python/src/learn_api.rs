@@ -10,10 +10,10 @@ use learn::{
 };
 use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
-use sindy::Derivative;
 
 use crate::arrays::{matrix, row_major_to_numpy};
 use crate::errors::raise;
+use crate::sindy_api::derivative_from;
 
 pub fn register(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<NativeLearnModel>()?;
@@ -64,8 +64,7 @@ fn meta_train_arrays(
     config: Option<PathBuf>,
     seed: Option<u64>,
 ) -> PyResult<NativeLearnModel> {
-    let derivative: Derivative = serde_json::from_str(derivative)
-        .map_err(|e| raise(format!("differentiation method {derivative}: {e}")))?;
+    let derivative = derivative_from(derivative)?;
     let spec = ColumnSpec {
         time: "t".to_string(),
         state,
@@ -125,8 +124,7 @@ fn meta_train_files(
     seed: Option<u64>,
     task_column: Option<String>,
 ) -> PyResult<NativeLearnModel> {
-    let derivative: Derivative = serde_json::from_str(derivative)
-        .map_err(|e| raise(format!("differentiation method {derivative}: {e}")))?;
+    let derivative = derivative_from(derivative)?;
     let spec = ColumnSpec {
         time,
         state,

@@ -1,6 +1,7 @@
 //! The mismatch analysis of one recording against a nominal model, as `learn mismatch
 //! --recording` runs it: the three files' contents are returned, the Python side writes them.
 
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
@@ -33,22 +34,39 @@ enum ModelSource {
     Text(String, String),
 }
 
-fn read_recording(recording: &Path, layout: Option<&Path>) -> PyResult<data::FlightLog> {
-    match layout {
-        Some(layout) => {
-            let layout = data::layout::RecordingLayout::load(layout).map_err(raise)?;
-            data::layout::read_rows_with_layout(recording, &layout, None).map_err(raise)
-        }
-        None => data::FlightLog::read_spaced(recording, data::Spacing::Any).map_err(raise),
+/// The recording, or its data rows `rows` (counted from 0, the end excluded) as `--rows` takes
+/// them: with a layout, before its checks, which then see only them.
+fn read_recording(
+    recording: &Path,
+    layout: Option<&Path>,
+    rows: Option<Range<usize>>,
+) -> PyResult<data::FlightLog> {
+    if let Some(layout) = layout {
+        let layout = data::layout::RecordingLayout::load(layout).map_err(raise)?;
+        return data::layout::read_rows_with_layout(recording, &layout, rows).map_err(raise);
     }
+    let log = data::FlightLog::read_spaced(recording, data::Spacing::Any).map_err(raise)?;
+    let Some(rows) = rows else {
+        return Ok(log);
+    };
+    let available = log.len();
+    log.row_range(rows.clone()).ok_or_else(|| {
+        raise(format!(
+            "{}: rows {}:{} reach past its {available} data rows",
+            recording.display(),
+            rows.start,
+            rows.end
+        ))
+    })
 }
 
 /// Analyses `recording` (the Neural-Fly layout, or any CSV, Parquet or ULog file with `layout`)
-/// against the model in `model_path` or `model_json`; a recording longer than `part_rows` rows
+/// (its data rows `rows` when given) against the model in `model_path` or `model_json`; a
+/// recording longer than `part_rows` rows
 /// is analysed in parts. Returns the contents of `mismatch.json`, `mismatch.svg` and
 /// `mismatch.md`, rendered for the folder `out` (named in the Markdown and in errors).
 #[pyfunction]
-#[pyo3(signature = (recording, out, model_path=None, model_json=None, layout=None, half_width=None, part_rows=None))]
+#[pyo3(signature = (recording, out, model_path=None, model_json=None, layout=None, half_width=None, part_rows=None, rows=None))]
 #[allow(clippy::too_many_arguments)]
 fn analyze_mismatch(
     py: Python<'_>,
@@ -59,6 +77,7 @@ fn analyze_mismatch(
     layout: Option<PathBuf>,
     half_width: Option<f64>,
     part_rows: Option<usize>,
+    rows: Option<(usize, usize)>,
 ) -> PyResult<(String, String, String)> {
     let source = match (model_path, model_json) {
         (Some(path), None) => ModelSource::File(path),
@@ -82,7 +101,7 @@ fn analyze_mismatch(
         ModelSource::Text(_, label) => label.clone(),
     };
     let files = py.detach(|| -> PyResult<[String; 3]> {
-        let log = read_recording(&recording, layout.as_deref())?;
+        let log = read_recording(&recording, layout.as_deref(), rows.map(|(a, b)| a..b))?;
         if log.len() > part_rows {
             let quiet = |_: usize, _: usize, _: mismatch::Stage| {};
             let analysis =

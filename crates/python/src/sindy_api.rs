@@ -26,11 +26,11 @@ pub fn register(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(differentiate, module)?)?;
     module.add_function(wrap_pyfunction!(stlsq, module)?)?;
     module.add_function(wrap_pyfunction!(lasso, module)?)?;
-    module.add_function(wrap_pyfunction!(library_width, module)?)?;
     Ok(())
 }
 
-fn derivative_from(json: &str) -> PyResult<Derivative> {
+/// A differentiation method from its JSON (`{"kind": "central"}`, …).
+pub fn derivative_from(json: &str) -> PyResult<Derivative> {
     serde_json::from_str(json).map_err(|e| raise(format!("differentiation method {json}: {e}")))
 }
 
@@ -134,12 +134,6 @@ fn lasso<'py>(
         .detach(|| optimizer.fit(theta, targets, &names))
         .map_err(raise)?;
     Ok(to_numpy(py, coefficients.as_ref()))
-}
-
-/// How many features `library` makes of `inputs` input columns.
-#[pyfunction]
-fn library_width(library: &str, inputs: usize) -> PyResult<usize> {
-    Ok(library_from(library)?.feature_count(inputs))
 }
 
 fn check_rows(theta: usize, targets: usize) -> PyResult<()> {

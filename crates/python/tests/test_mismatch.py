@@ -44,6 +44,30 @@ def test_a_model_given_as_a_dict_names_the_same_effects(flight):
     assert report["effects"][0]["parameters"] == expected["effects"][0]["parameters"]
 
 
+def read_columns(path):
+    """The recording's columns as arrays (list cells are JSON)."""
+    import csv
+
+    import numpy as np
+
+    with open(path, newline="") as file:
+        rows = list(csv.DictReader(file))
+    return {name: np.array([json.loads(row[name]) for row in rows]) for name in rows[0] if name}
+
+
+def test_a_recording_given_as_arrays_gives_the_same_analysis(flight):
+    columns = read_columns(flight / "flight.csv")
+    assert set(columns) >= {"t", "p", "v", "w", "q", "R", "T_sp", "hover_throttle", "pwm"}
+    report = ls.analyze(columns, flight / "quad.json")
+    expected = json.loads((flight / "cli" / "mismatch.json").read_text())
+    assert report["effects"] == expected["effects"]
+    assert report["fit"] == expected["fit"]
+    with pytest.raises(ls.LearnSysidError, match="different numbers of rows"):
+        ls.analyze({**columns, "t": columns["t"][:-1]}, flight / "quad.json")
+    with pytest.raises(ls.LearnSysidError, match="unknown column"):
+        ls.analyze({**columns, "speed": columns["t"]}, flight / "quad.json")
+
+
 def test_bad_input_raises_one_line_errors(flight, tmp_path):
     with pytest.raises(ls.LearnSysidError, match="absent.csv"):
         ls.analyze(tmp_path / "absent.csv", flight / "quad.json")
@@ -54,3 +78,19 @@ def test_bad_input_raises_one_line_errors(flight, tmp_path):
     assert "mass" in str(error.value) and "\n" not in str(error.value)
     with pytest.raises(ls.LearnSysidError, match="part"):
         ls.analyze(flight / "flight.csv", flight / "quad.json", part_rows=10)
+
+
+def test_the_jmavsim_log_gives_the_committed_analysis(root, tmp_path, monkeypatch):
+    # A PX4 ULog through its layout, as `make mismatch-demo` analyses it into results/.
+    monkeypatch.chdir(root)
+    report = ls.analyze(
+        "data/ulog/sample_px4_events.ulg",
+        "experiments/mismatch/vehicles/jmavsim-iris.json",
+        layout="experiments/layouts/px4-ulog.json",
+        half_width=0.4,
+        rows=(186, 262),
+        out=tmp_path / "jmavsim",
+    )
+    committed = root / "results/mismatch/shared/jmavsim"
+    assert report == json.loads((committed / "mismatch.json").read_text())
+    assert (tmp_path / "jmavsim" / "mismatch.svg").read_text() == (committed / "mismatch.svg").read_text()

@@ -15,7 +15,7 @@ Every computation runs in the workspace's Rust crates; errors are ``LearnSysidEr
 from ._learn import LeARN, numpy_predict, read_checkpoint
 from ._libraries import ConcatLibrary, FiniteDifference, FourierLibrary, PolynomialLibrary, SavitzkyGolay
 from ._mismatch import ANALYSIS_FILES, analyze, write_recording
-from ._native import LearnSysidError
+from ._native import LearnSysidError, __version__
 from ._optimizers import STLSQ, BaggedRegression, Lasso
 from ._sindy import SINDy
 
@@ -36,4 +36,5 @@ __all__ = [
     "numpy_predict",
     "read_checkpoint",
     "write_recording",
+    "__version__",
 ]

@@ -26,6 +26,7 @@ use pyo3::prelude::*;
 
 #[pymodule]
 fn _native(module: &Bound<'_, PyModule>) -> PyResult<()> {
+    module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     module.add(
         "LearnSysidError",
         module.py().get_type::<errors::LearnSysidError>(),

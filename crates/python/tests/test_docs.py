@@ -15,3 +15,10 @@ def test_the_ten_line_example_runs(root, tmp_path, monkeypatch, capsys):
     assert (tmp_path / "model.json").is_file()
     xs, x = namespace["xs"], namespace["x"]
     assert xs.shape == (500, 2) and abs(xs - x[:500]).max() < 0.013
+
+
+def test_the_version_is_the_workspace_crates(root):
+    import learn_sysid
+
+    cargo = (root / "Cargo.toml").read_text()
+    assert f'version = "{learn_sysid.__version__}"' in cargo

@@ -60,11 +60,11 @@ fn read_recording(
     })
 }
 
-/// Analyses `recording` (the Neural-Fly layout, or any CSV, Parquet or ULog file with `layout`)
-/// (its data rows `rows` when given) against the model in `model_path` or `model_json`; a
-/// recording longer than `part_rows` rows
-/// is analysed in parts. Returns the contents of `mismatch.json`, `mismatch.svg` and
-/// `mismatch.md`, rendered for the folder `out` (named in the Markdown and in errors).
+/// Analyses `recording` (the Neural-Fly layout, or any CSV, Parquet or ULog file with `layout`;
+/// only its data rows `rows` when given) against the model in `model_path` or `model_json`; a
+/// recording longer than `part_rows` rows is analysed in parts. Returns the contents of
+/// `mismatch.json`, `mismatch.svg` and `mismatch.md`, rendered for the folder `out` (named in
+/// the Markdown and in errors).
 #[pyfunction]
 #[pyo3(signature = (recording, out, model_path=None, model_json=None, layout=None, half_width=None, part_rows=None, rows=None))]
 #[allow(clippy::too_many_arguments)]

@@ -28,11 +28,14 @@ class LeARN:
         self._native = native
 
     @classmethod
-    def meta_train(cls, tasks, state, control=(), *, interval, differentiation_method=None, config=None, seed=None, names=None):
+    def meta_train(cls, tasks, state, control=(), *, interval, differentiation_method=None, config=None, seed=None, names=None,
+                   progress=None):
         """Meta-trains on ``tasks`` (arrays, one row per sample: the ``state`` columns, then the
         ``control`` columns, sampled every ``interval`` seconds), with the paper's settings or
         those a ``config`` file names (any subset of ``experiments/learn.json``); ``seed``
-        replaces the configuration's. The interpreter is released while it trains."""
+        replaces the configuration's. The interpreter is released while it trains;
+        ``progress(done, total)`` is called after each meta-iteration (an exception it raises is
+        raised when the training ends)."""
         arrays = [_matrix(task, "task") for task in tasks]
         names = list(names) if names is not None else [f"task {i}" for i in range(len(arrays))]
         if len(names) != len(arrays):
@@ -46,16 +49,18 @@ class LeARN:
             _differentiation(differentiation_method)._spec(),
             config=None if config is None else os.fspath(config),
             seed=seed,
+            progress=progress,
         )
         return cls(native)
 
     @classmethod
     def meta_train_files(cls, pattern, state, control=(), *, time="t", differentiation_method=None, config=None,
-                         seed=None, task_column=None):
+                         seed=None, task_column=None, progress=None):
         """``learn meta-train --tasks PATTERN``: every CSV or Parquet file ``pattern`` matches is a
         task (or, with ``task_column``, each run of one value of that column of the file
         ``pattern``), read with its ``time``, ``state`` and ``control`` columns; the model records
-        the files and their SHA-256. The same file as the CLI writes (tested)."""
+        the files and their SHA-256. The same file as the CLI writes (tested). ``progress`` as
+        for :meth:`meta_train`."""
         native = _native.meta_train_files(
             os.fspath(pattern),
             time,
@@ -65,6 +70,7 @@ class LeARN:
             config=None if config is None else os.fspath(config),
             seed=seed,
             task_column=task_column,
+            progress=progress,
         )
         return cls(native)
 

@@ -81,7 +81,8 @@ def write_recording(path, columns: dict) -> None:
             file.write(",".join(_cell(arrays[name][k]) for name in names) + "\n")
 
 
-def analyze(recording, model, *, layout=None, rows=None, out=None, overwrite=False, half_width=None, part_rows=None) -> dict:
+def analyze(recording, model, *, layout=None, rows=None, out=None, overwrite=False, half_width=None, part_rows=None,
+            progress=None) -> dict:
     """Analyses ``recording`` (a path: the Neural-Fly layout, or any CSV, Parquet or ULog file
     that ``layout`` maps; or a dict of arrays, written as :func:`write_recording` writes them to
     a temporary file, which the report names) against ``model`` (a nominal-model JSON file's path, or the same as a
@@ -90,7 +91,8 @@ def analyze(recording, model, *, layout=None, rows=None, out=None, overwrite=Fal
     writes ``mismatch.{json,svg,md}`` there, as ``learn mismatch --out`` does. A recording
     longer than ``part_rows`` rows (40,000 by default) is analysed in parts; ``rows=(start,
     end)`` takes only those data rows (``--rows``), ``half_width`` the test function's half
-    width in seconds (``--half-width``). The interpreter is released while the analysis runs."""
+    width in seconds (``--half-width``). The interpreter is released while the analysis runs;
+    ``progress(message)`` (e.g. ``print``) is told each stage, as the CLI's spinner."""
     model_path = model_json = None
     if isinstance(model, dict):
         model_json = json.dumps(model)
@@ -105,11 +107,11 @@ def analyze(recording, model, *, layout=None, rows=None, out=None, overwrite=Fal
         with tempfile.TemporaryDirectory(prefix="learn-sysid-") as scratch:
             path = Path(scratch) / "recording.csv"
             write_recording(path, recording)
-            return _analyze(path, folder, model_path, model_json, None, half_width, part_rows, rows)
-    return _analyze(recording, folder, model_path, model_json, layout, half_width, part_rows, rows)
+            return _analyze(path, folder, model_path, model_json, None, half_width, part_rows, rows, progress)
+    return _analyze(recording, folder, model_path, model_json, layout, half_width, part_rows, rows, progress)
 
 
-def _analyze(recording, folder, model_path, model_json, layout, half_width, part_rows, rows) -> dict:
+def _analyze(recording, folder, model_path, model_json, layout, half_width, part_rows, rows, progress) -> dict:
     contents = _native.analyze_mismatch(
         os.fspath(recording),
         os.fspath(folder) if folder is not None else ".",
@@ -119,6 +121,7 @@ def _analyze(recording, folder, model_path, model_json, layout, half_width, part
         half_width=half_width,
         part_rows=part_rows,
         rows=None if rows is None else (int(rows[0]), int(rows[1])),
+        progress=progress,
     )
     if folder is not None:
         _write(folder, contents)

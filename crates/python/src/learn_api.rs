@@ -12,7 +12,7 @@ use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::arrays::{matrix, row_major_to_numpy};
-use crate::errors::raise;
+use crate::errors::{Progress, raise};
 use crate::sindy_api::derivative_from;
 
 pub fn register(module: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -51,7 +51,7 @@ fn check_width(what: &str, columns: &[Vec<f64>], spec: &ColumnSpec) -> PyResult<
 /// `experiments/learn.json`'s fields; the paper's defaults without one), its seed replaced by
 /// `seed` when given.
 #[pyfunction]
-#[pyo3(signature = (tasks, names, state, control, interval, derivative, config=None, seed=None))]
+#[pyo3(signature = (tasks, names, state, control, interval, derivative, config=None, seed=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn meta_train_arrays(
     py: Python<'_>,
@@ -63,6 +63,7 @@ fn meta_train_arrays(
     derivative: &str,
     config: Option<PathBuf>,
     seed: Option<u64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<NativeLearnModel> {
     let derivative = derivative_from(derivative)?;
     let spec = ColumnSpec {
@@ -83,6 +84,8 @@ fn meta_train_arrays(
     let source = TaskSource::Files {
         pattern: IN_MEMORY.to_string(),
     };
+    let iterations = settings.get().meta_training.iterations;
+    let progress = Progress::new(progress);
     let model = py.detach(|| {
         let recordings: Vec<Recording> = names
             .iter()
@@ -100,18 +103,17 @@ fn meta_train_arrays(
             tasks: &recordings,
             files: Vec::new(),
         };
-        learn::meta_train_tasks(set, &settings, &|_| {})
+        learn::meta_train_tasks(set, &settings, &|done| progress.report((done, iterations)))
     });
-    Ok(NativeLearnModel {
-        model: model.map_err(raise)?,
-    })
+    let model = progress.finish(model.map_err(raise))?;
+    Ok(NativeLearnModel { model })
 }
 
 /// Meta-trains on CSV (or Parquet) task files as `learn meta-train --tasks` does: every file
 /// `pattern` matches is a task, or, with `task_column`, each run of one value of that column of
 /// the file `pattern`; the model records the files and their SHA-256.
 #[pyfunction]
-#[pyo3(signature = (pattern, time, state, control, derivative, config=None, seed=None, task_column=None))]
+#[pyo3(signature = (pattern, time, state, control, derivative, config=None, seed=None, task_column=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn meta_train_files(
     py: Python<'_>,
@@ -123,6 +125,7 @@ fn meta_train_files(
     config: Option<PathBuf>,
     seed: Option<u64>,
     task_column: Option<String>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<NativeLearnModel> {
     let derivative = derivative_from(derivative)?;
     let spec = ColumnSpec {
@@ -144,6 +147,8 @@ fn meta_train_files(
     if let Some(seed) = seed {
         settings = settings.with_seed(seed);
     }
+    let iterations = settings.get().meta_training.iterations;
+    let progress = Progress::new(progress);
     let model = py.detach(|| -> PyResult<MetaTrainedModel> {
         let tasks = own_data::read_tasks(&source, &spec).map_err(raise)?;
         let files = own_data::data_files(&tasks).map_err(raise)?;
@@ -154,8 +159,10 @@ fn meta_train_files(
             tasks: &recordings,
             files,
         };
-        learn::meta_train_tasks(set, &settings, &|_| {}).map_err(raise)
-    })?;
+        let report = |done| progress.report((done, iterations));
+        learn::meta_train_tasks(set, &settings, &report).map_err(raise)
+    });
+    let model = progress.finish(model)?;
     Ok(NativeLearnModel { model })
 }
 

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
 
-use crate::errors::raise;
+use crate::errors::{Progress, raise};
 
 pub fn register(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(analyze_mismatch, module)?)?;
@@ -66,7 +66,7 @@ fn read_recording(
 /// `mismatch.json`, `mismatch.svg` and `mismatch.md`, rendered for the folder `out` (named in
 /// the Markdown and in errors).
 #[pyfunction]
-#[pyo3(signature = (recording, out, model_path=None, model_json=None, layout=None, half_width=None, part_rows=None, rows=None))]
+#[pyo3(signature = (recording, out, model_path=None, model_json=None, layout=None, half_width=None, part_rows=None, rows=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn analyze_mismatch(
     py: Python<'_>,
@@ -78,6 +78,7 @@ fn analyze_mismatch(
     half_width: Option<f64>,
     part_rows: Option<usize>,
     rows: Option<(usize, usize)>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<(String, String, String)> {
     let source = match (model_path, model_json) {
         (Some(path), None) => ModelSource::File(path),
@@ -100,19 +101,33 @@ fn analyze_mismatch(
         ModelSource::File(path) => path.display().to_string(),
         ModelSource::Text(_, label) => label.clone(),
     };
+    let progress = Progress::new(progress);
     let files = py.detach(|| -> PyResult<[String; 3]> {
         let log = read_recording(&recording, layout.as_deref(), rows.map(|(a, b)| a..b))?;
         if log.len() > part_rows {
-            let quiet = |_: usize, _: usize, _: mismatch::Stage| {};
-            let analysis =
-                mismatch::analyze_in_parts(&log, part_rows, &model, &model_name, &settings, &quiet)
-                    .map_err(raise)?;
+            let parts = mismatch::part_ranges(log.len(), part_rows).len();
+            let observe = |part: usize, pass: usize, stage: mismatch::Stage| {
+                let (part, stage) = (part + 1, stage.describe());
+                progress.report((format!("part {part} of {parts}, pass {pass}: {stage}"),));
+            };
+            let analysis = mismatch::analyze_in_parts(
+                &log,
+                part_rows,
+                &model,
+                &model_name,
+                &settings,
+                &observe,
+            )
+            .map_err(raise)?;
             return analysis.render(&out).map_err(raise);
         }
-        let analysis = mismatch::analyze_observed(&log, &model, &model_name, &settings, &|_, _| {})
+        let observe = |pass: usize, stage: mismatch::Stage| {
+            progress.report((format!("pass {pass}: {}", stage.describe()),));
+        };
+        let analysis = mismatch::analyze_observed(&log, &model, &model_name, &settings, &observe)
             .map_err(raise)?;
         analysis.render(&out).map_err(raise)
-    })?;
-    let [json, svg, markdown] = files;
+    });
+    let [json, svg, markdown] = progress.finish(files)?;
     Ok((json, svg, markdown))
 }

@@ -120,3 +120,16 @@ def test_bad_input_raises_one_line_errors(trained, tmp_path):
         ls.LeARN.meta_train(tasks, ["x", "v"], ["u"], interval=0.05, config=bad)
     with pytest.raises(ls.LearnSysidError, match="absent.json"):
         ls.LeARN.load(tmp_path / "absent.json")
+
+
+def test_progress_is_reported_and_its_exceptions_raised(trained):
+    folder, config, tasks, _ = trained
+    seen = []
+    ls.LeARN.meta_train(tasks, ["x", "v"], ["u"], interval=0.05, config=config, progress=lambda *a: seen.append(a))
+    assert seen == [(done, 60) for done in range(1, 61)]
+
+    def stop(done, total):
+        raise RuntimeError(f"stopped at {done}")
+
+    with pytest.raises(RuntimeError, match="stopped at 1"):
+        ls.LeARN.meta_train(tasks, ["x", "v"], ["u"], interval=0.05, config=config, progress=stop)

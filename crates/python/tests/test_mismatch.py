@@ -38,7 +38,9 @@ def test_the_analysis_equals_the_cli(flight, monkeypatch):
 
 def test_a_model_given_as_a_dict_names_the_same_effects(flight):
     model = json.loads((flight / "quad.json").read_text())
-    report = ls.analyze(flight / "flight.csv", model)
+    stages = []
+    report = ls.analyze(flight / "flight.csv", model, progress=stages.append)
+    assert stages and stages[0].startswith("pass 1: ")
     expected = json.loads((flight / "cli" / "mismatch.json").read_text())
     assert [e["id"] for e in report["effects"]] == [e["id"] for e in expected["effects"]]
     assert report["effects"][0]["parameters"] == expected["effects"][0]["parameters"]

@@ -50,8 +50,8 @@ def _trajectories(x, t, x_dot, u):
     xs = [_matrix(xi, "x") for xi in (x if multiple else [x])]
     if not xs:
         raise _native.LearnSysidError("x: no trajectory")
-    if multiple and (t is None or np.ndim(t) == 0):
-        ts = [t] * len(xs)
+    if multiple and (t is None or np.ndim(t) == 0 or isinstance(t, np.ndarray)):
+        ts = [t] * len(xs)  # one step or one array of times for every trajectory, as PySINDy
     else:
         ts = _as_list(t, multiple, "t") or [None] * len(xs)
     x_dots = _as_list(x_dot, multiple, "x_dot") or [None] * len(xs)

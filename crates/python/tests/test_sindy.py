@@ -76,6 +76,9 @@ def test_several_trajectories_and_names_equal_pysindy():
     model = ls.SINDy().fit(xs, t=dt, u=us, feature_names=names)
     np.testing.assert_allclose(model.coefficients(), reference.coefficients(), rtol=0, atol=TOLERANCE)
     assert model.get_feature_names() == reference.get_feature_names()
+    # one array of times for every trajectory, as PySINDy takes it
+    same_times = ls.SINDy().fit(xs, t=runs[0][0], u=us, feature_names=names)
+    np.testing.assert_allclose(same_times.coefficients(), reference.coefficients(), rtol=0, atol=TOLERANCE)
     predicted, expected = model.predict(xs, u=us), reference.predict(xs, u=us)
     assert len(predicted) == 3
     for ours, theirs in zip(predicted, expected):

@@ -46,6 +46,45 @@ fn check_width(what: &str, columns: &[Vec<f64>], spec: &ColumnSpec) -> PyResult<
     )))
 }
 
+/// The columns a model of tasks learns from, checked: ẋ of the states by `derivative`.
+fn column_spec(
+    time: String,
+    state: Vec<String>,
+    control: Vec<String>,
+    derivative: &str,
+) -> PyResult<ColumnSpec> {
+    let spec = ColumnSpec {
+        time,
+        state,
+        control,
+        derivative: derivative_from(derivative)?,
+    };
+    spec.check()
+        .map_err(|message| raise(format!("state/control: {message}")))?;
+    Ok(spec)
+}
+
+/// Meta-trains with `settings` (a `config` file's, the paper's without one; its seed replaced by
+/// `seed` when given) on the task set `train` makes, the interpreter released, `progress` told
+/// of each meta-iteration.
+fn meta_train_released(
+    py: Python<'_>,
+    config: Option<PathBuf>,
+    seed: Option<u64>,
+    progress: Option<Py<PyAny>>,
+    train: impl FnOnce(&TaskConfig, &dyn Fn(usize)) -> PyResult<MetaTrainedModel> + Send,
+) -> PyResult<NativeLearnModel> {
+    let mut settings = TaskConfig::load(config.as_deref()).map_err(raise)?;
+    if let Some(seed) = seed {
+        settings = settings.with_seed(seed);
+    }
+    let iterations = settings.get().meta_training.iterations;
+    let progress = Progress::new(progress);
+    let model = py.detach(|| train(&settings, &|done| progress.report((done, iterations))));
+    let model = progress.finish(model)?;
+    Ok(NativeLearnModel { model })
+}
+
 /// Meta-trains a LeARN model on `tasks` (each rows × (states + controls), sampled every
 /// `interval` seconds), with the settings of `config` (a file with any subset of
 /// `experiments/learn.json`'s fields; the paper's defaults without one), its seed replaced by
@@ -65,17 +104,7 @@ fn meta_train_arrays(
     seed: Option<u64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<NativeLearnModel> {
-    let derivative = derivative_from(derivative)?;
-    let spec = ColumnSpec {
-        time: "t".to_string(),
-        state,
-        control,
-        derivative,
-    };
-    let mut settings = TaskConfig::load(config.as_deref()).map_err(raise)?;
-    if let Some(seed) = seed {
-        settings = settings.with_seed(seed);
-    }
+    let spec = column_spec("t".to_string(), state, control, derivative)?;
     let columns: Vec<Vec<Vec<f64>>> = tasks.iter().map(columns_of).collect();
     for (name, task) in names.iter().zip(&columns) {
         check_width(&format!("task '{name}'"), task, &spec)?;
@@ -84,9 +113,7 @@ fn meta_train_arrays(
     let source = TaskSource::Files {
         pattern: IN_MEMORY.to_string(),
     };
-    let iterations = settings.get().meta_training.iterations;
-    let progress = Progress::new(progress);
-    let model = py.detach(|| {
+    meta_train_released(py, config, seed, progress, |settings, report| {
         let recordings: Vec<Recording> = names
             .iter()
             .zip(&columns)
@@ -103,10 +130,8 @@ fn meta_train_arrays(
             tasks: &recordings,
             files: Vec::new(),
         };
-        learn::meta_train_tasks(set, &settings, &|done| progress.report((done, iterations)))
-    });
-    let model = progress.finish(model.map_err(raise))?;
-    Ok(NativeLearnModel { model })
+        learn::meta_train_tasks(set, settings, report).map_err(raise)
+    })
 }
 
 /// Meta-trains on CSV (or Parquet) task files as `learn meta-train --tasks` does: every file
@@ -127,15 +152,7 @@ fn meta_train_files(
     task_column: Option<String>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<NativeLearnModel> {
-    let derivative = derivative_from(derivative)?;
-    let spec = ColumnSpec {
-        time,
-        state,
-        control,
-        derivative,
-    };
-    spec.check()
-        .map_err(|message| raise(format!("state/control: {message}")))?;
+    let spec = column_spec(time, state, control, derivative)?;
     let source = match task_column {
         Some(column) => TaskSource::Column {
             file: PathBuf::from(pattern),
@@ -143,13 +160,7 @@ fn meta_train_files(
         },
         None => TaskSource::Files { pattern },
     };
-    let mut settings = TaskConfig::load(config.as_deref()).map_err(raise)?;
-    if let Some(seed) = seed {
-        settings = settings.with_seed(seed);
-    }
-    let iterations = settings.get().meta_training.iterations;
-    let progress = Progress::new(progress);
-    let model = py.detach(|| -> PyResult<MetaTrainedModel> {
+    meta_train_released(py, config, seed, progress, |settings, report| {
         let tasks = own_data::read_tasks(&source, &spec).map_err(raise)?;
         let files = own_data::data_files(&tasks).map_err(raise)?;
         let recordings: Vec<Recording> = tasks.iter().map(own_data::recording).collect();
@@ -159,11 +170,8 @@ fn meta_train_files(
             tasks: &recordings,
             files,
         };
-        let report = |done| progress.report((done, iterations));
-        learn::meta_train_tasks(set, &settings, &report).map_err(raise)
-    });
-    let model = progress.finish(model)?;
-    Ok(NativeLearnModel { model })
+        learn::meta_train_tasks(set, settings, report).map_err(raise)
+    })
 }
 
 fn rows(range: (usize, usize)) -> Range<usize> {

@@ -1,5 +1,7 @@
 //! NumPy arrays as faer matrices, in place, and results back as new arrays.
 
+use std::borrow::Cow;
+
 use faer::{Mat, MatRef};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -15,9 +17,12 @@ pub fn matrix<'a>(array: &'a PyReadonlyArray2<'_, f64>) -> MatRef<'a, f64> {
     unsafe { MatRef::from_raw_parts(view.as_ptr(), rows, columns, strides[0], strides[1]) }
 }
 
-/// The values of a one-dimensional array (copied only when it is not contiguous).
-pub fn values(array: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
-    array.as_array().to_vec()
+/// The values of a one-dimensional array, in place when it is contiguous, copied otherwise.
+pub fn values<'a>(array: &'a PyReadonlyArray1<'_, f64>) -> Cow<'a, [f64]> {
+    match array.as_slice() {
+        Ok(slice) => Cow::Borrowed(slice),
+        Err(_) => Cow::Owned(array.as_array().to_vec()),
+    }
 }
 
 /// A new C-ordered array holding `matrix`.

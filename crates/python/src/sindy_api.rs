@@ -46,7 +46,8 @@ fn library_from(spec: &str) -> PyResult<FeatureLibrary> {
 fn trajectory(index: usize, arrays: &TrajectoryArrays<'_>) -> PyResult<Trajectory> {
     let (time, states, controls, derivatives) = arrays;
     let label = |e: sindy::SindyError| raise(format!("trajectory {index}: {e}"));
-    let mut trajectory = Trajectory::new(values(time), owned(states)).map_err(label)?;
+    let mut trajectory =
+        Trajectory::new(values(time).into_owned(), owned(states)).map_err(label)?;
     if let Some(controls) = controls {
         trajectory = trajectory.with_controls(owned(controls)).map_err(label)?;
     }

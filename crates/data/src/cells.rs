@@ -172,6 +172,14 @@ impl NumericColumn {
         cell: &str,
         buffer: &mut Vec<f64>,
     ) -> Result<f64> {
+        // A plain number first: what it parses, `cell_numbers` reads as its one number (a cell
+        // with a ',', '[' or ']' does not parse as one).
+        if self.element.is_none()
+            && let Ok(value) = cell.trim().parse::<f64>()
+            && value.is_finite()
+        {
+            return Ok(value);
+        }
         cell_numbers(path, line, &self.name, cell, buffer)?;
         let value = match self.element {
             Some(element) => *buffer.get(element).ok_or_else(|| {

@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use crate::cells::NumericColumn;
 use crate::error::{DataError, Result};
 use crate::pieces::cuts;
+use crate::plain::plain_rows;
 use crate::records::{CsvRecords, Record};
 
 /// Bytes read at once per thread (the pieces of a chunk are about this size over two).
@@ -164,8 +165,13 @@ impl ChunkedRows {
         Ok(())
     }
 
-    /// The rows of one piece that begins at a record start on line `line`, up to its first error.
+    /// The rows of one piece that begins at a record start on line `line`, up to its first error:
+    /// read by the fast path when the piece is plain text ([`crate::plain`]), else by the splitter.
     fn parse_piece(&self, text: &[u8], line: usize) -> ParsedRows {
+        let width = self.header.len();
+        if let Some(piece) = plain_rows(&self.path, text, line, width, &self.columns) {
+            return piece;
+        }
         let mut piece = ParsedRows::new(self.columns.len());
         if let Err(error) = self.read_piece(text, line, &mut piece) {
             piece.error = Some(error);

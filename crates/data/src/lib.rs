@@ -29,6 +29,7 @@ pub mod layout;
 mod motors;
 mod numeric;
 mod pieces;
+mod plain;
 mod records;
 mod source;
 mod split;

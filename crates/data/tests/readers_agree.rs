@@ -467,22 +467,42 @@ enum PlainLine {
     Comment,
     ExtraCell,
     NotANumber,
+    TooFewCells,
+    EmptyCell,
+    NotFinite,
+    Tab,
+    LoneCarriageReturn,
+    ControlByte,
+    NotAscii,
 }
 
-/// Files without a quote, whose pieces are cut without looking at every byte: plain rows with
-/// blank lines (between rows, an error; at the end, allowed), comments and bad rows among them.
-fn plain_file() -> impl Strategy<Value = (Vec<PlainLine>, bool)> {
+/// Files without a quote, whose pieces are cut without looking at every byte and read by the fast
+/// path where they are plain: plain rows with blank lines (between rows, an error; at the end,
+/// allowed), comments, bad rows and bytes the fast path leaves to the splitter among them.
+fn plain_file() -> impl Strategy<Value = (Vec<PlainLine>, bool, bool)> {
     let line = prop_oneof![
-        40 => any::<u16>().prop_map(PlainLine::Row),
+        60 => any::<u16>().prop_map(PlainLine::Row),
         3 => Just(PlainLine::Blank),
         1 => Just(PlainLine::Comment),
         1 => Just(PlainLine::ExtraCell),
         1 => Just(PlainLine::NotANumber),
+        1 => Just(PlainLine::TooFewCells),
+        1 => Just(PlainLine::EmptyCell),
+        1 => Just(PlainLine::NotFinite),
+        2 => Just(PlainLine::Tab),
+        1 => Just(PlainLine::LoneCarriageReturn),
+        1 => Just(PlainLine::ControlByte),
+        1 => Just(PlainLine::NotAscii),
     ];
-    (proptest::collection::vec(line, 0..40), any::<bool>())
+    (
+        proptest::collection::vec(line, 0..40),
+        any::<bool>(),
+        any::<bool>(),
+    )
 }
 
-fn plain_text(lines: &[PlainLine], crlf: bool) -> Vec<u8> {
+/// The text of `lines`, with CRLF line ends or LF, and a line end after the last line or not.
+fn plain_text(lines: &[PlainLine], crlf: bool, last_end: bool) -> Vec<u8> {
     let end = if crlf { "\r\n" } else { "\n" };
     let mut text = format!("t,x{end}");
     for line in lines {
@@ -492,9 +512,19 @@ fn plain_text(lines: &[PlainLine], crlf: bool) -> Vec<u8> {
             PlainLine::Comment => "# note".to_string(),
             PlainLine::ExtraCell => "1,2,3".to_string(),
             PlainLine::NotANumber => "1,x".to_string(),
+            PlainLine::TooFewCells => "1".to_string(),
+            PlainLine::EmptyCell => "1,".to_string(),
+            PlainLine::NotFinite => "1,inf".to_string(),
+            PlainLine::Tab => "1,\t2.5".to_string(),
+            PlainLine::LoneCarriageReturn => "1,2\r5".to_string(),
+            PlainLine::ControlByte => "1,2\u{1}".to_string(),
+            PlainLine::NotAscii => "1,2é".to_string(),
         };
         text.push_str(&body);
         text.push_str(end);
+    }
+    if !last_end {
+        text.truncate(text.len() - end.len());
     }
     text.into_bytes()
 }
@@ -505,9 +535,9 @@ fn files_without_quotes_read_the_same_in_pieces() {
     let path = dir.join("plain.csv");
     runner(33)
         .run(
-            &(plain_file(), 1usize..4, 1usize..64),
-            |((lines, crlf), block_rows, chunk)| {
-                std::fs::write(&path, plain_text(&lines, crlf)).unwrap();
+            &(plain_file(), 1usize..4, 1usize..1024),
+            |((lines, crlf, last_end), block_rows, chunk)| {
+                std::fs::write(&path, plain_text(&lines, crlf, last_end)).unwrap();
                 let whole = read_whole(&path, &["x", "t"]);
                 let chunked = read_in_chunks(&path, &["x", "t"], block_rows, chunk);
                 prop_assert_eq!(&whole, &chunked, "chunks of {}: {:?}", chunk, lines);

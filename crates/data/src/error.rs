@@ -130,6 +130,12 @@ pub enum DataError {
         rows: usize,
         needed: usize,
     },
+    #[error("{}: rows {}:{} reach past its {count} data rows", path.display(), rows.start, rows.end)]
+    RowsPastEnd {
+        path: PathBuf,
+        rows: std::ops::Range<usize>,
+        count: usize,
+    },
     #[error("{}: {field}: {message}", path.display())]
     Config {
         path: PathBuf,

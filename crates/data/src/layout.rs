@@ -217,6 +217,30 @@ impl RecordingLayout {
     }
 }
 
+/// A recording for an analysis: in the Neural-Fly layout (any spacing), or as `layout` (a layout
+/// description's file) describes it; only its data rows `rows` (counted from 0, the end excluded)
+/// when given, taken before the layout's checks, which then see only them.
+pub fn read_recording(
+    path: &Path,
+    layout: Option<&Path>,
+    rows: Option<std::ops::Range<usize>>,
+) -> Result<FlightLog> {
+    if let Some(layout) = layout {
+        return read_rows_with_layout(path, &RecordingLayout::load(layout)?, rows);
+    }
+    let log = FlightLog::read_spaced(path, crate::Spacing::Any)?;
+    let Some(rows) = rows else {
+        return Ok(log);
+    };
+    let count = log.len();
+    log.row_range(rows.clone())
+        .ok_or_else(|| DataError::RowsPastEnd {
+            path: path.to_path_buf(),
+            rows,
+            count,
+        })
+}
+
 /// Reads `path` (a CSV file, a PX4 ULog when its extension is `.ulg`, or a folder holding a PX4 log
 /// exported to CSV, one file per topic) as `layout` says. The
 /// time stamps are kept as logged (strictly increasing, every interval within
@@ -268,13 +292,10 @@ pub fn read_rows_with_layout(
             let count = table.rows();
             let sliced = table
                 .rows_in(rows.clone())
-                .ok_or_else(|| DataError::Config {
+                .ok_or_else(|| DataError::RowsPastEnd {
                     path: path.to_path_buf(),
-                    field: "rows".into(),
-                    message: format!(
-                        "rows {}:{} reach past its {count} data rows",
-                        rows.start, rows.end
-                    ),
+                    rows: rows.clone(),
+                    count,
                 })?;
             (time[rows].to_vec(), sliced)
         }

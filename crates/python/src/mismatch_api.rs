@@ -1,7 +1,6 @@
 //! The mismatch analysis of one recording against a nominal model, as `learn mismatch
 //! --recording` runs it: the three files' contents are returned, the Python side writes them.
 
-use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
@@ -32,32 +31,6 @@ fn nominal_model(source: &ModelSource) -> PyResult<physics::NominalModel> {
 enum ModelSource {
     File(PathBuf),
     Text(String, String),
-}
-
-/// The recording, or its data rows `rows` (counted from 0, the end excluded) as `--rows` takes
-/// them: with a layout, before its checks, which then see only them.
-fn read_recording(
-    recording: &Path,
-    layout: Option<&Path>,
-    rows: Option<Range<usize>>,
-) -> PyResult<data::FlightLog> {
-    if let Some(layout) = layout {
-        let layout = data::layout::RecordingLayout::load(layout).map_err(raise)?;
-        return data::layout::read_rows_with_layout(recording, &layout, rows).map_err(raise);
-    }
-    let log = data::FlightLog::read_spaced(recording, data::Spacing::Any).map_err(raise)?;
-    let Some(rows) = rows else {
-        return Ok(log);
-    };
-    let available = log.len();
-    log.row_range(rows.clone()).ok_or_else(|| {
-        raise(format!(
-            "{}: rows {}:{} reach past its {available} data rows",
-            recording.display(),
-            rows.start,
-            rows.end
-        ))
-    })
 }
 
 /// Analyses `recording` (the Neural-Fly layout, or any CSV, Parquet or ULog file with `layout`;
@@ -103,7 +76,9 @@ fn analyze_mismatch(
     };
     let progress = Progress::new(progress);
     let files = py.detach(|| -> PyResult<[String; 3]> {
-        let log = read_recording(&recording, layout.as_deref(), rows.map(|(a, b)| a..b))?;
+        let rows = rows.map(|(start, end)| start..end);
+        let log =
+            data::layout::read_recording(&recording, layout.as_deref(), rows).map_err(raise)?;
         if log.len() > part_rows {
             let parts = mismatch::part_ranges(log.len(), part_rows).len();
             let observe = |part: usize, pass: usize, stage: mismatch::Stage| {

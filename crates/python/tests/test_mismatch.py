@@ -80,6 +80,9 @@ def test_bad_input_raises_one_line_errors(flight, tmp_path):
     assert "mass" in str(error.value) and "\n" not in str(error.value)
     with pytest.raises(ls.LearnSysidError, match="part"):
         ls.analyze(flight / "flight.csv", flight / "quad.json", part_rows=10)
+    # The CLI's --rows message: one reading of a recording serves both.
+    with pytest.raises(ls.LearnSysidError, match=r"flight.csv: rows 10:99999 reach past its \d+ data rows"):
+        ls.analyze(flight / "flight.csv", flight / "quad.json", rows=(10, 99999))
 
 
 def test_the_jmavsim_log_gives_the_committed_analysis(root, tmp_path, monkeypatch):

@@ -214,38 +214,6 @@ fn run_flights(
     Ok(())
 }
 
-/// The recording (through its layout, when given), or the rows of it that `--rows` asks for.
-fn read_recording(
-    recording: &Path,
-    layout: Option<&Path>,
-    rows: Option<&std::ops::Range<usize>>,
-) -> anyhow::Result<data::FlightLog> {
-    let log = match layout {
-        Some(layout) => {
-            // The rows are taken before the layout's checks, which then see only them.
-            let layout = data::layout::RecordingLayout::load(layout)?;
-            return Ok(data::layout::read_rows_with_layout(
-                recording,
-                &layout,
-                rows.cloned(),
-            )?);
-        }
-        None => data::FlightLog::read_spaced(recording, data::Spacing::Any)?,
-    };
-    let Some(rows) = rows else {
-        return Ok(log);
-    };
-    log.row_range(rows.clone()).ok_or_else(|| {
-        anyhow::anyhow!(
-            "{}: --rows {}:{} reaches past its {} data rows",
-            recording.display(),
-            rows.start,
-            rows.end,
-            log.len()
-        )
-    })
-}
-
 fn run_recording(
     global: &Global,
     recording: &Path,
@@ -270,7 +238,7 @@ fn run_recording(
     set.check()?;
     let model = load_model(model_path)?;
     let staged = set.prepare()?;
-    let log = read_recording(recording, args.layout.as_deref(), args.rows.as_ref())?;
+    let log = data::layout::read_recording(recording, args.layout.as_deref(), args.rows.clone())?;
     if log.len() > part_rows {
         let analysis = analyze_in_parts(global, &log, part_rows, (&model, model_path), settings)?;
         super::staged_write(&staged, || {

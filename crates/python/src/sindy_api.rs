@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use faer::MatRef;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use sindy::{
@@ -113,8 +114,7 @@ fn stlsq<'py>(
     max_iter: usize,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Vec<usize>)> {
     let optimizer = Stlsq::new(threshold, alpha, max_iter).map_err(raise)?;
-    let (theta, targets) = (matrix(&theta), matrix(&targets));
-    check_rows(theta.nrows(), targets.nrows())?;
+    let (theta, targets) = library_and_targets(&theta, &targets)?;
     let fit = py.detach(|| optimizer.fit(theta, targets));
     Ok((to_numpy(py, fit.coefficients.as_ref()), fit.iterations))
 }
@@ -128,8 +128,7 @@ fn lasso<'py>(
     penalty: f64,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let optimizer = Lasso::new(penalty).map_err(raise)?;
-    let (theta, targets) = (matrix(&theta), matrix(&targets));
-    check_rows(theta.nrows(), targets.nrows())?;
+    let (theta, targets) = library_and_targets(&theta, &targets)?;
     let names: Vec<String> = (0..targets.ncols()).map(|j| format!("x{j}")).collect();
     let coefficients = py
         .detach(|| optimizer.fit(theta, targets, &names))
@@ -137,13 +136,19 @@ fn lasso<'py>(
     Ok(to_numpy(py, coefficients.as_ref()))
 }
 
-fn check_rows(theta: usize, targets: usize) -> PyResult<()> {
-    if theta == targets {
-        return Ok(());
+/// A library matrix and its targets, read in place; they must have the same rows.
+fn library_and_targets<'a>(
+    theta: &'a PyReadonlyArray2<'_, f64>,
+    targets: &'a PyReadonlyArray2<'_, f64>,
+) -> PyResult<(MatRef<'a, f64>, MatRef<'a, f64>)> {
+    let (theta, targets) = (matrix(theta), matrix(targets));
+    let (library_rows, target_rows) = (theta.nrows(), targets.nrows());
+    if library_rows != target_rows {
+        return Err(raise(format!(
+            "the library matrix has {library_rows} rows and the targets {target_rows}"
+        )));
     }
-    Err(raise(format!(
-        "the library matrix has {theta} rows and the targets {targets}"
-    )))
+    Ok((theta, targets))
 }
 
 /// A fitted SINDy model (the `sindy` crate's), held for the Python `SINDy` class.

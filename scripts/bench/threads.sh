@@ -54,17 +54,15 @@ fit() {
 # busy too. On a VM whose two cores share a host core's resources this is longer than a fit on one
 # core alone, and half of it is the most two threads can reach.
 pair() {
-    local best="" slower first second
+    local best="" slower core
     for _ in $(seq "${THREADS_RUNS:-3}"); do
-        first=$(mktemp -p "$work") second=$(mktemp -p "$work")
         for core in 0 1; do
-            out=$([ "$core" = 0 ] && echo "$first" || echo "$second")
-            ( RAYON_NUM_THREADS=1 /usr/bin/time -f '%e' taskset -c "$core" "$learn" sindy --quiet \
-                --csv "$1" --state "$states" --control u0,u1 --library poly:3 --threshold 0.1 \
-                --derivative central --out "$work/pair-$core.json" --force >/dev/null 2>"$out" ) &
+            ( RAYON_NUM_THREADS=1 /usr/bin/time -f '%e' -o "$work/pair-$core.time" taskset -c "$core" \
+                "$learn" sindy --quiet --csv "$1" --state "$states" --control u0,u1 --library poly:3 \
+                --threshold 0.1 --derivative central --out "$work/pair-$core.json" --force >/dev/null ) &
         done
         wait
-        slower=$(tail -q -n1 "$first" "$second" | sort -g | tail -1)
+        slower=$(cat "$work/pair-0.time" "$work/pair-1.time" | sort -g | tail -1)
         if [ -z "$best" ] || awk -v a="$slower" -v b="$best" 'BEGIN { exit !(a < b) }'; then
             best=$slower
         fi

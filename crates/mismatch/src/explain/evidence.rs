@@ -14,9 +14,11 @@
 //!   `ΔSSE` of a noise-only term is about `κ s² χ²_p`;
 //! - **size** (fit part): the mean gain per row and channel of its groups is at least `min_gain`
 //!   noise variances;
-//! - **consistency** (fit part): the mean gain is still at least `min_trimmed_gain` when the two
-//!   blocks (of about a second) that gain most are left out ([`sindy::stability::trimmed_gain`]):
-//!   not one transient;
+//! - **consistency** (every block): over the fit part's blocks (of about a second) and the
+//!   held-out part's, cut alike and each scored with the parameters fitted on the fit part, the
+//!   mean gain per row and channel is still at least `min_trimmed_gain` when the two blocks that
+//!   gain most are left out ([`sindy::stability::trimmed_gain`]): not one or two transients, while
+//!   an effect whose evidence recurs in the held-out part is credited for it;
 //! - **held out**: on the held-out part, which no fit or choice has seen, the noise-normalised
 //!   residual sum of squares of its groups (each divided by its `s²_g`) falls by at least
 //!   `min_heldout_reduction` of its value without the effect.
@@ -67,7 +69,7 @@ pub struct Evidence {
     pub likelihood_ratio_threshold: f64,
     /// Mean gain per row and channel on the fit part, in noise-floor units.
     pub fit_gain: f64,
-    /// The mean gain once the two blocks that gain most are left out.
+    /// The mean gain over the fit and held-out blocks once the two that gain most are left out.
     pub trimmed_gain: f64,
     /// Held-out noise-normalised sum of squares without and with the effect.
     pub heldout_without: f64,
@@ -80,12 +82,15 @@ pub struct Evidence {
 }
 
 /// Noise-normalised sums of squares of a set's residual, per compared channel group (in the order
-/// of [`Problem::channel_groups`]): per fit block, and over the held-out part.
+/// of [`Problem::channel_groups`]): per fit block, per held-out block, and over the held-out part.
 struct Scores {
-    /// `blocks[b][g]`: block `b`, group `g`.
+    /// `blocks[b][g]`: fit block `b`, group `g`.
     blocks: Vec<Vec<f64>>,
-    /// Rows times channels of each block, per group.
+    /// Rows times channels of each fit block, per group.
     counts: Vec<Vec<f64>>,
+    /// The held-out part cut into blocks as the fit part is, and their rows times channels.
+    heldout_blocks: Vec<Vec<f64>>,
+    heldout_counts: Vec<Vec<f64>>,
     heldout: Vec<f64>,
 }
 
@@ -123,25 +128,11 @@ fn scores(problem: &Problem, set: &FittedSet, block_rows: usize) -> Scores {
 
 /// The scores of a residual.
 fn scores_of(problem: &Problem, residual: &[Channels], block_rows: usize) -> Scores {
-    let groups = problem.channel_groups();
-    let mut blocks = Vec::new();
-    let mut counts = Vec::new();
-    let mut start = 0;
-    while start < problem.split {
-        let end = (start + block_rows).min(problem.split);
-        let of_group = |(_, channels): &(ChannelGroup, std::ops::Range<usize>)| {
-            problem.whitened_sse_of(residual, start..end, channels.clone())
-        };
-        blocks.push(groups.iter().map(of_group).collect());
-        counts.push(
-            groups
-                .iter()
-                .map(|(_, channels)| ((end - start) * channels.len()) as f64)
-                .collect(),
-        );
-        start = end;
-    }
-    let heldout = groups
+    let (blocks, counts) = block_scores(problem, residual, 0..problem.split, block_rows);
+    let (heldout_blocks, heldout_counts) =
+        block_scores(problem, residual, problem.split..problem.rows(), block_rows);
+    let heldout = problem
+        .channel_groups()
         .iter()
         .map(|(_, channels)| {
             problem.whitened_sse_of(residual, problem.split..problem.rows(), channels.clone())
@@ -150,8 +141,40 @@ fn scores_of(problem: &Problem, residual: &[Channels], block_rows: usize) -> Sco
     Scores {
         blocks,
         counts,
+        heldout_blocks,
+        heldout_counts,
         heldout,
     }
+}
+
+/// Per block of `block_rows` rows of `rows` (the last one shorter), the noise-normalised sum of
+/// squares of each compared channel group and its rows times channels.
+fn block_scores(
+    problem: &Problem,
+    residual: &[Channels],
+    rows: std::ops::Range<usize>,
+    block_rows: usize,
+) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    let groups = problem.channel_groups();
+    let (mut sums, mut counts) = (Vec::new(), Vec::new());
+    let mut start = rows.start;
+    while start < rows.end {
+        let end = (start + block_rows.max(1)).min(rows.end);
+        sums.push(
+            groups
+                .iter()
+                .map(|(_, channels)| problem.whitened_sse_of(residual, start..end, channels.clone()))
+                .collect(),
+        );
+        counts.push(
+            groups
+                .iter()
+                .map(|(_, channels)| ((end - start) * channels.len()) as f64)
+                .collect(),
+        );
+        start = end;
+    }
+    (sums, counts)
 }
 
 /// The integrated autocorrelation of a residual over lags up to `lags`, averaged over all compared
@@ -317,6 +340,21 @@ fn judged_groups(problem: &Problem, id: EffectId) -> (Vec<usize>, ChannelGroup) 
     }
 }
 
+/// The gain per row and channel of groups `groups` in every block, the fit part's and the held-out
+/// part's (each scored with the parameters fitted on the fit part), weighted 1 each: what the
+/// consistency test trims.
+fn block_gains(without: &Scores, full: &Scores, groups: &[usize]) -> Vec<(f64, f64)> {
+    let sum_over = |values: &[f64]| groups.iter().map(|&g| values[g]).sum::<f64>();
+    without
+        .blocks
+        .iter()
+        .chain(&without.heldout_blocks)
+        .zip(full.blocks.iter().chain(&full.heldout_blocks))
+        .zip(full.counts.iter().chain(&full.heldout_counts))
+        .map(|((w, f), n)| (1.0, (sum_over(w) - sum_over(f)) / sum_over(n)))
+        .collect()
+}
+
 /// The evidence for effect `id` of the judged set; returns it with the refitted set without the
 /// effect.
 fn evidence_for(judge: &Judge, id: EffectId) -> (Evidence, FittedSet) {
@@ -335,17 +373,10 @@ fn evidence_for(judge: &Judge, id: EffectId) -> (Evidence, FittedSet) {
     let without = scores(problem, &reduced, block_rows);
     let (groups, judged_on) = judged_groups(problem, id);
     let sum_over = |values: &[f64]| groups.iter().map(|&g| values[g]).sum::<f64>();
-    let gains: Vec<(f64, f64)> = without
-        .blocks
-        .iter()
-        .zip(&full.blocks)
-        .zip(&full.counts)
-        .map(|((w, f), n)| (1.0, (sum_over(w) - sum_over(f)) / sum_over(n)))
-        .collect();
+    let trimmed = trimmed_gain(&block_gains(&without, full, &groups));
     let removed_in = |g: usize| without.fit(g) - full.fit(g);
     let removed: f64 = groups.iter().map(|&g| removed_in(g)).sum();
     let mean = removed / groups.iter().map(|&g| full.count(g)).sum::<f64>();
-    let trimmed = trimmed_gain(&gains);
     let parameters = set.parameters.len() - reduced.parameters.len();
     let likelihood_ratio = without.excess_over(full, &groups, noise);
     let threshold = chi_square_quantile(parameters, settings.significance);
@@ -501,6 +532,33 @@ mod tests {
         let worse = explained_fractions(&[evidence(-5.0)], 1000.0, 1200.0);
         assert_eq!(worse, [0.0]);
         assert!(shares.iter().all(|s| (0.0..=1.0).contains(s)));
+    }
+
+    /// Scores of four fit blocks and two held-out blocks, one group, 10 rows × channels each.
+    fn block_scores_of(fit: [f64; 4], heldout: [f64; 2]) -> Scores {
+        let per_block = |values: &[f64]| values.iter().map(|v| vec![*v]).collect::<Vec<_>>();
+        Scores {
+            blocks: per_block(&fit),
+            counts: vec![vec![10.0]; 4],
+            heldout_blocks: per_block(&heldout),
+            heldout_counts: vec![vec![10.0]; 2],
+            heldout: vec![heldout.iter().sum()],
+        }
+    }
+
+    /// An effect whose gain sits in two transients of the fit part and recurs in both held-out
+    /// blocks is consistent: the held-out blocks count, each with its own gain.
+    #[test]
+    fn consistency_counts_the_heldout_blocks() {
+        let full = block_scores_of([10.0; 4], [10.0; 2]);
+        let without = block_scores_of([110.0, 10.0, 110.0, 10.0], [60.0, 40.0]);
+        let gains = block_gains(&without, &full, &[0]);
+        assert_eq!(gains, [(1.0, 10.0), (1.0, 0.0), (1.0, 10.0), (1.0, 0.0), (1.0, 5.0), (1.0, 3.0)]);
+        // Trimming the two largest (both in the fit part) leaves 0, 0, 5 and 3.
+        assert!((trimmed_gain(&gains) - 2.0).abs() < 1e-12);
+        // Gains in the fit part's two transients alone, nothing held out: not consistent.
+        let transient = block_scores_of([110.0, 10.0, 110.0, 10.0], [10.0; 2]);
+        assert_eq!(trimmed_gain(&block_gains(&transient, &full, &[0])), 0.0);
     }
 
     #[test]

@@ -133,7 +133,7 @@ pub struct EvidenceRule {
     pub significance: f64,
     /// Least gain per row and channel on the fit part, in noise-floor units.
     pub min_gain: f64,
-    /// Least gain once the two blocks that gain most are left out.
+    /// Least gain over the fit and held-out blocks once the two that gain most are left out.
     pub min_trimmed_gain: f64,
     /// Least fractional reduction of the held-out residual.
     pub min_heldout_reduction: f64,
@@ -542,11 +542,11 @@ impl RecordingView<'_> {
         let rule = self.rule;
         let _ = writeln!(
             md,
-            "An effect is named only when, with the others refitted without it, it passes four tests on the channels it acts on: on the fit part, its likelihood ratio (corrected for the correlation of neighbouring rows) exceeds the {} quantile of χ², it lowers the noise-normalised residual by at least {} per row and channel, and by at least {} when the two {} s blocks that gain most are left out (not one transient); and it lowers the held-out residual by at least {:.0}%.\n",
+            "An effect is named only when, with the others refitted without it, it passes four tests on the channels it acts on: on the fit part, its likelihood ratio (corrected for the correlation of neighbouring rows) exceeds the {} quantile of χ², it lowers the noise-normalised residual by at least {} per row and channel; over the {} s blocks of the fit and held-out parts, by at least {} when the two that gain most are left out (not one or two transients); and it lowers the held-out residual by at least {:.0}%.\n",
             rule.significance,
             rule.min_gain,
-            rule.min_trimmed_gain,
             rule.block_s,
+            rule.min_trimmed_gain,
             100.0 * rule.min_heldout_reduction
         );
         if self.effects.is_empty() {

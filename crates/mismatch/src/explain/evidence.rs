@@ -163,7 +163,9 @@ fn block_scores(
         sums.push(
             groups
                 .iter()
-                .map(|(_, channels)| problem.whitened_sse_of(residual, start..end, channels.clone()))
+                .map(|(_, channels)| {
+                    problem.whitened_sse_of(residual, start..end, channels.clone())
+                })
                 .collect(),
         );
         counts.push(
@@ -553,7 +555,17 @@ mod tests {
         let full = block_scores_of([10.0; 4], [10.0; 2]);
         let without = block_scores_of([110.0, 10.0, 110.0, 10.0], [60.0, 40.0]);
         let gains = block_gains(&without, &full, &[0]);
-        assert_eq!(gains, [(1.0, 10.0), (1.0, 0.0), (1.0, 10.0), (1.0, 0.0), (1.0, 5.0), (1.0, 3.0)]);
+        assert_eq!(
+            gains,
+            [
+                (1.0, 10.0),
+                (1.0, 0.0),
+                (1.0, 10.0),
+                (1.0, 0.0),
+                (1.0, 5.0),
+                (1.0, 3.0)
+            ]
+        );
         // Trimming the two largest (both in the fit part) leaves 0, 0, 5 and 3.
         assert!((trimmed_gain(&gains) - 2.0).abs() < 1e-12);
         // Gains in the fit part's two transients alone, nothing held out: not consistent.

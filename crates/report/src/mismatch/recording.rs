@@ -567,7 +567,7 @@ impl RecordingView<'_> {
                 };
                 let _ = writeln!(
                     md,
-                    "- **{}** — {}{} It accounts for {:.0}% of the nominal model's (noise-normalised) residual; without it the held-out residual is {:.0}% higher (likelihood ratio {:.0} against {:.1}, gain {:.2} per row and channel, {:.2} without its two largest blocks).",
+                    "- **{}** — {}{} It accounts for {:.0}% of the nominal model's (noise-normalised) residual; without it the held-out residual is {:.0}% higher (likelihood ratio {:.0} against {:.1}, gain {:.2} per row and channel on the fit part, {:.2} over every block but its two largest).",
                     evidence.id,
                     e.description,
                     errors,
@@ -593,7 +593,7 @@ impl RecordingView<'_> {
         for d in &self.dropped {
             let _ = writeln!(
                 md,
-                "- not named: {} (likelihood ratio {:.1} against {:.1}, gain {:.3}, {:.3} without its two largest blocks, held-out reduction {:.1}%): below the evidence rule.",
+                "- not named: {} (likelihood ratio {:.1} against {:.1}, gain {:.3}, {:.3} over every block but its two largest, held-out reduction {:.1}%): below the evidence rule.",
                 d.id,
                 d.likelihood_ratio,
                 d.likelihood_ratio_threshold,
@@ -952,11 +952,11 @@ mod tests {
             "| vdot_x | 0.2500 | 0.0100 | yes |\n| vdot_y | 0.0050 | 0.0100 | no |\n",
             "\nThe model's torques say nothing about the recorded angular accelerations: each angular channel's response to the model's prediction (1 when the torques are right, 0 when they are unrelated) is [0.00, -0.02, 0.23] ± [0.23, 0.24, 0.05] (x, y, z), not clearly positive on every axis.",
             "(1 s moving RMS):\n\n- vdot_x from 1.2 s to 7.5 s\n",
-            "- **linear_drag** — Drag. Standard errors: d ± [0.012, 0.25, 3.0]. It accounts for 62% of the nominal model's (noise-normalised) residual; without it the held-out residual is 50% higher (likelihood ratio 120 against 16.3, gain 0.75 per row and channel, 0.50 without its two largest blocks).\n",
+            "- **linear_drag** — Drag. Standard errors: d ± [0.012, 0.25, 3.0]. It accounts for 62% of the nominal model's (noise-normalised) residual; without it the held-out residual is 50% higher (likelihood ratio 120 against 16.3, gain 0.75 per row and channel on the fit part, 0.50 over every block but its two largest).\n",
             "- **not separable from this recording: delay** — A delay of 30 ms. Fitted in its place, with the others refitted, these explain the recording as well: motor_lag (tau_s = 0.031): fit-part likelihood ratio 3.2 against 10.8, held-out residual 2% lower. It stays",
             "**What the log holds.** The rows come at 50.0 Hz, but not every signal is new at every row: motor commands held (12.5 new values per second). A command's effect is seen only as often as the command changes: a delay or a motor lag shorter than 80 ms cannot be identified from this log",
             "- not named: delay of 30 ms, shorter than the 80 ms between the motor commands' new values: below what the log resolves (left out of the fit).\n",
-            "- not named: wind (likelihood ratio 3.2 against 16.3, gain 0.750, 0.500 without its two largest blocks, held-out reduction 33.3%): below the evidence rule.\n",
+            "- not named: wind (likelihood ratio 3.2 against 16.3, gain 0.750, 0.500 over every block but its two largest, held-out reduction 33.3%): below the evidence rule.\n",
             "- unexplained residual on vdot_x, 2.0–2.8 s\n",
             "- linear_drag (`drag_x` = −v_x [m/s]): 88%, kept\n",
             "noise-normalised fit errors: {\"both\":1.25,\"delay\":1.5,\"motor_lag\":2.0}. The smallest was kept, then judged by the evidence rule.\n",

@@ -7,6 +7,13 @@ CARGO ?= cargo
 LEARN := target/debug/learn
 QUIET := $(if $(CI),--quiet,)
 
+# A CI run builds a fresh clone once, where incremental compilation only writes its cache: without
+# it the clean build took 8 min 40 s against 10 min on 2 cores. Kept elsewhere, where edits rebuild
+# (every cargo call of one run must agree: switching it rebuilds the workspace).
+ifdef CI
+export CARGO_INCREMENTAL ?= 0
+endif
+
 .PHONY: all data build test reproduce ablations check-paper bench mismatch-demo own-data-example lint fmt clean-results
 
 all: build

@@ -346,7 +346,7 @@ fn judged_groups(problem: &Problem, id: EffectId) -> (Vec<usize>, ChannelGroup) 
 /// part's (each scored with the parameters fitted on the fit part), weighted 1 each: what the
 /// consistency test trims.
 fn block_gains(without: &Scores, full: &Scores, groups: &[usize]) -> Vec<(f64, f64)> {
-    let sum_over = |values: &[f64]| groups.iter().map(|&g| values[g]).sum::<f64>();
+    let sum_over = |values: &[f64]| group_sum(values, groups);
     without
         .blocks
         .iter()
@@ -355,6 +355,11 @@ fn block_gains(without: &Scores, full: &Scores, groups: &[usize]) -> Vec<(f64, f
         .zip(full.counts.iter().chain(&full.heldout_counts))
         .map(|((w, f), n)| (1.0, (sum_over(w) - sum_over(f)) / sum_over(n)))
         .collect()
+}
+
+/// The sum of per-group `values` over groups `groups`.
+fn group_sum(values: &[f64], groups: &[usize]) -> f64 {
+    groups.iter().map(|&g| values[g]).sum()
 }
 
 /// The evidence for effect `id` of the judged set; returns it with the refitted set without the
@@ -374,7 +379,6 @@ fn evidence_for(judge: &Judge, id: EffectId) -> (Evidence, FittedSet) {
     reduced.refit(problem, iterations);
     let without = scores(problem, &reduced, block_rows);
     let (groups, judged_on) = judged_groups(problem, id);
-    let sum_over = |values: &[f64]| groups.iter().map(|&g| values[g]).sum::<f64>();
     let trimmed = trimmed_gain(&block_gains(&without, full, &groups));
     let removed_in = |g: usize| without.fit(g) - full.fit(g);
     let removed: f64 = groups.iter().map(|&g| removed_in(g)).sum();
@@ -397,8 +401,8 @@ fn evidence_for(judge: &Judge, id: EffectId) -> (Evidence, FittedSet) {
             likelihood_ratio_threshold: threshold,
             fit_gain: mean,
             trimmed_gain: trimmed,
-            heldout_without: sum_over(&without.heldout),
-            heldout_with: sum_over(&full.heldout),
+            heldout_without: group_sum(&without.heldout, &groups),
+            heldout_with: group_sum(&full.heldout, &groups),
             heldout_reduction: reduction,
             fit_sse_removed: removed,
             passes,

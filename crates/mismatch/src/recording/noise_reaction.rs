@@ -118,6 +118,7 @@ pub fn remove_velocity(
         return false;
     }
     let velocity = &recording.velocity;
+    let lengths = interval_lengths(recording);
     let noise = per_axis(|a| {
         let increments: Vec<f64> = (0..recording.len() - 1)
             .map(|k| velocity[k + 1][a] - velocity[k][a] - predicted_change[k][a])
@@ -125,7 +126,7 @@ pub fn remove_velocity(
         let logged: Vec<f64> = velocity.iter().map(|v| v[a]).collect();
         let sigma = recording.white_noise_sigma(&logged);
         let step = prediction_noise[a].max(VELOCITY_STEP_FLOOR * sigma);
-        smooth_noise(&increments, sigma, step)
+        smooth_noise(&increments, sigma, step, &lengths)
     });
     subtract(recording, &mut reaction, &[(6, &noise)]);
     reaction.velocity = true;
@@ -342,10 +343,11 @@ fn attitude_noise(recording: &Recording, states: &[[f64; STATES]]) -> Vec<Vec3> 
             })
         })
         .collect();
+    let lengths = interval_lengths(recording);
     per_axis(|a| {
         let (sigma, step) = attitude_smoothing_scales(recording, states, a);
         let series: Vec<f64> = increments.iter().map(|e| e[a]).collect();
-        smooth_noise(&series, sigma, step)
+        smooth_noise(&series, sigma, step, &lengths)
     })
 }
 
@@ -378,17 +380,18 @@ pub fn attitude_estimate_error_response(
     normal: &mut dyn FnMut() -> f64,
 ) -> Vec<Actuators> {
     let states = state_fourth_differences(recording);
-    let rows = recording.len();
+    let lengths = interval_lengths(recording);
     let error = per_axis(|a| {
         let (sigma, step) = attitude_smoothing_scales(recording, &states, a);
-        smoothing_error_draw(rows, sigma, step, normal)
+        smoothing_error_draw(sigma, step, &lengths, normal)
     });
-    unfelt_response(reaction, rows, |k, a| (0.0, error[k][a]))
+    unfelt_response(reaction, recording.len(), |k, a| (0.0, error[k][a]))
 }
 
 /// Each row's position noise: the logged step minus the trapezoid of the logged velocities.
 fn position_noise(recording: &Recording) -> Vec<Vec3> {
     let (p, v) = (&recording.position, &recording.velocity);
+    let lengths = interval_lengths(recording);
     per_axis(|a| {
         let series: Vec<f64> = (0..recording.len() - 1)
             .map(|k| {
@@ -399,7 +402,12 @@ fn position_noise(recording: &Recording) -> Vec<Vec3> {
         let position: Vec<f64> = p.iter().map(|x| x[a]).collect();
         let velocity: Vec<f64> = v.iter().map(|x| x[a]).collect();
         let step = recording.dt() * recording.white_noise_sigma(&velocity);
-        smooth_noise(&series, recording.white_noise_sigma(&position), step)
+        smooth_noise(
+            &series,
+            recording.white_noise_sigma(&position),
+            step,
+            &lengths,
+        )
     })
 }
 
@@ -408,32 +416,50 @@ fn per_axis(mut axis: impl FnMut(usize) -> Vec<f64>) -> Vec<Vec3> {
     (0..x.len()).map(|k| [x[k], y[k], z[k]]).collect()
 }
 
+/// Each row interval's length in nominal intervals, infinite across a gap. An increment's error
+/// (the trapezoid of the rates or velocities, the model's prediction) grows with its interval, and
+/// across a gap the increment says nothing of the noise: the smoother treats the segments apart.
+fn interval_lengths(recording: &Recording) -> Vec<f64> {
+    let sampling = &recording.sampling;
+    (0..recording.len().saturating_sub(1))
+        .map(|k| {
+            if sampling.is_gap(k) {
+                f64::INFINITY
+            } else {
+                sampling.interval_at(k) / sampling.interval()
+            }
+        })
+        .collect()
+}
+
 /// The white noise `n` (standard deviation `sigma`) whose increments the series `e` measures with
-/// errors of standard deviation `step`: minimises `Σ n_k²/σ² + Σ (e_k − (n_{k+1} − n_k))²/step²`
-/// (a tridiagonal system, solved directly). Zero when there is no noise to find.
-pub(crate) fn smooth_noise(increments: &[f64], sigma: f64, step: f64) -> Vec<f64> {
+/// errors of standard deviation `step` times each interval's length (`lengths`, in nominal
+/// intervals; infinite: no link): minimises `Σ n_k²/σ² + Σ (e_k − (n_{k+1} − n_k))²/(step
+/// lengths_k)²` (a tridiagonal system, solved directly). Zero when there is no noise to find.
+pub(crate) fn smooth_noise(increments: &[f64], sigma: f64, step: f64, lengths: &[f64]) -> Vec<f64> {
     let rows = increments.len() + 1;
     if !(sigma > 0.0 && sigma.is_finite()) {
         return vec![0.0; rows];
     }
-    let (prior, link) = smoother_precisions(sigma, step);
+    let (prior, links) = smoother_precisions(sigma, step, lengths);
     let mut diagonal = vec![prior; rows];
     let mut rhs = vec![0.0; rows];
-    for (k, e) in increments.iter().enumerate() {
+    for (k, (e, link)) in increments.iter().zip(&links).enumerate() {
         diagonal[k] += link;
         diagonal[k + 1] += link;
         rhs[k] -= link * e;
         rhs[k + 1] += link * e;
     }
-    // Thomas algorithm; every off-diagonal entry is −link.
+    // Thomas algorithm; the off-diagonal entries are −links.
     let mut upper = vec![0.0; rows];
     let mut solution = rhs;
     let mut pivot = diagonal[0];
-    upper[0] = -link / pivot;
+    upper[0] = -links.first().copied().unwrap_or(0.0) / pivot;
     solution[0] /= pivot;
     for k in 1..rows {
+        let link = links[k - 1];
         pivot = diagonal[k] + link * upper[k - 1];
-        upper[k] = -link / pivot;
+        upper[k] = -links.get(k).copied().unwrap_or(0.0) / pivot;
         solution[k] = (solution[k] + link * solution[k - 1]) / pivot;
     }
     for k in (0..rows - 1).rev() {
@@ -443,38 +469,44 @@ pub(crate) fn smooth_noise(increments: &[f64], sigma: f64, step: f64) -> Vec<f64
 }
 
 /// The smoother's precisions: of the noise's prior (`1/σ²`) and of each increment's link
-/// (`1/step²`, the step kept above `10⁻⁶ σ`).
-fn smoother_precisions(sigma: f64, step: f64) -> (f64, f64) {
+/// (`1/(step lengths_k)²`, the step kept above `10⁻⁶ σ`; zero across a gap).
+fn smoother_precisions(sigma: f64, step: f64, lengths: &[f64]) -> (f64, Vec<f64>) {
     let step = step.max(1e-6 * sigma);
-    (1.0 / (sigma * sigma), 1.0 / (step * step))
+    let links = lengths
+        .iter()
+        .map(|l| {
+            let error = step * l;
+            1.0 / (error * error)
+        })
+        .collect();
+    (1.0 / (sigma * sigma), links)
 }
 
-/// A draw of the error of [`smooth_noise`]'s estimate over `rows` rows: Gaussian with the
-/// posterior covariance, the inverse of the system's tridiagonal matrix `P` (drawn as `L⁻ᵀ z` with
-/// `P = L Lᵀ`). Zero when there is no noise to find.
+/// A draw of the error of [`smooth_noise`]'s estimate over the `lengths.len() + 1` rows: Gaussian
+/// with the posterior covariance, the inverse of the system's tridiagonal matrix `P` (drawn as
+/// `L⁻ᵀ z` with `P = L Lᵀ`). Zero when there is no noise to find.
 pub(crate) fn smoothing_error_draw(
-    rows: usize,
     sigma: f64,
     step: f64,
+    lengths: &[f64],
     normal: &mut dyn FnMut() -> f64,
 ) -> Vec<f64> {
-    if !(sigma > 0.0 && sigma.is_finite()) || rows == 0 {
+    let rows = lengths.len() + 1;
+    if !(sigma > 0.0 && sigma.is_finite()) {
         return vec![0.0; rows];
     }
-    let (prior, link) = smoother_precisions(sigma, step);
+    let (prior, links) = smoother_precisions(sigma, step, lengths);
+    let link = |k: usize| links.get(k).copied().unwrap_or(0.0);
     let mut diagonal = vec![0.0; rows];
     let mut lower = vec![0.0; rows];
     for k in 0..rows {
-        let links = [k > 0, k + 1 < rows].iter().filter(|&&x| x).count() as f64;
-        let previous = if k > 0 {
-            lower[k - 1] * lower[k - 1]
+        let (before, previous) = if k > 0 {
+            (link(k - 1), lower[k - 1] * lower[k - 1])
         } else {
-            0.0
+            (0.0, 0.0)
         };
-        diagonal[k] = (prior + link * links - previous).sqrt();
-        if k + 1 < rows {
-            lower[k] = -link / diagonal[k];
-        }
+        diagonal[k] = (prior + before + link(k) - previous).sqrt();
+        lower[k] = -link(k) / diagonal[k];
     }
     let z: Vec<f64> = (0..rows).map(|_| normal()).collect();
     let mut draw = vec![0.0; rows];

@@ -505,7 +505,7 @@ pub(crate) fn smoothing_error_draw(
         } else {
             (0.0, 0.0)
         };
-        diagonal[k] = (prior + before + link(k) - previous).sqrt();
+        diagonal[k] = (prior + (before + link(k)) - previous).sqrt();
         lower[k] = -link(k) / diagonal[k];
     }
     let z: Vec<f64> = (0..rows).map(|_| normal()).collect();

@@ -11,8 +11,8 @@
 //! The reaction is identified from the log (a robust regression of the commands' fourth differences
 //! on those of the logged rate, attitude, velocity and position); each row's attitude and position
 //! noise is estimated by a fixed-interval smoother against the kinematics the log itself holds (the
-//! attitude against the integrated rates, the position against the integrated velocities), which no
-//! effect of the library changes. The reaction to the rate and velocity noise stays: no kinematic
+//! attitude against the integrated rates, the position against the integrated velocities; nothing
+//! linked across a gap), which no effect of the library changes. The reaction to the rate and velocity noise stays: no kinematic
 //! relation separates it from the motion.
 
 use faer::Mat;

@@ -450,17 +450,17 @@ pub(crate) fn smooth_noise(increments: &[f64], sigma: f64, step: f64, lengths: &
         rhs[k] -= link * e;
         rhs[k + 1] += link * e;
     }
-    // Thomas algorithm; the off-diagonal entries are −links.
+    // Thomas algorithm; the off-diagonal entries are −links (none after the last row).
+    let link = |k: usize| links.get(k).copied().unwrap_or(0.0);
     let mut upper = vec![0.0; rows];
     let mut solution = rhs;
     let mut pivot = diagonal[0];
-    upper[0] = -links.first().copied().unwrap_or(0.0) / pivot;
+    upper[0] = -link(0) / pivot;
     solution[0] /= pivot;
     for k in 1..rows {
-        let link = links[k - 1];
-        pivot = diagonal[k] + link * upper[k - 1];
-        upper[k] = -links.get(k).copied().unwrap_or(0.0) / pivot;
-        solution[k] = (solution[k] + link * solution[k - 1]) / pivot;
+        pivot = diagonal[k] + link(k - 1) * upper[k - 1];
+        upper[k] = -link(k) / pivot;
+        solution[k] = (solution[k] + link(k - 1) * solution[k - 1]) / pivot;
     }
     for k in (0..rows - 1).rev() {
         solution[k] -= upper[k] * solution[k + 1];

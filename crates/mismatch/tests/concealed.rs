@@ -3,7 +3,10 @@
 
 use mismatch::model::least_squares::Termination;
 use mismatch::{ANALYSIS_FILES, CheckedSettings, NoiseFree, Settings, analyze};
-use physics::{EffectId, Effects, NominalModel, Scenario, ThrustScale, TorqueBias, simulate};
+use physics::{
+    EffectId, Effects, InertiaScale, LowPass, NominalModel, Scenario, ThrustScale, TorqueBias,
+    Trajectory, simulate,
+};
 
 mod common;
 
@@ -86,6 +89,68 @@ fn names_a_torque_bias_and_renders_its_files() {
     }
     assert!(markdown.contains("Standard errors: b ± ["), "{markdown}");
     assert!(svg.contains("<text") && svg.contains("wdot_x"));
+    // A constant offset is read on every row: half of its weight takes a good part of the flight.
+    let spans = &json["effects"][0]["weight_spans"]["b"];
+    for i in 0..3 {
+        let (start, end) = (spans[i]["start_s"].as_f64(), spans[i]["end_s"].as_f64());
+        let (start, end) = (start.unwrap(), end.unwrap());
+        assert!(0.0 <= start && start < end && end <= 14.0, "{spans}");
+        assert!(end - start > 3.0, "{spans}");
+    }
+    assert!(
+        markdown.contains("Half of each estimate's weight lies in the rows of b: "),
+        "{markdown}"
+    );
+}
+
+/// An inertia factor is read where the vehicle turns hard: on a figure-8 whose strongest angular
+/// manoeuvres are the corners of a low pass (where the reference's vertical acceleration jumps),
+/// half of the roll and pitch factors' weight lies within a second around one of them.
+#[test]
+fn an_estimate_read_in_one_manoeuvre_says_where() {
+    let effects = Effects {
+        inertia_scale: Some(InertiaScale {
+            k: [1.25, 0.85, 1.15],
+        }),
+        ..Effects::default()
+    };
+    let mut flown = scenario(effects, 5);
+    flown.trajectory = match flown.trajectory {
+        Trajectory::Figure8 {
+            center,
+            first,
+            second,
+            period_s,
+            yaw_amplitude_rad,
+            yaw_period_s,
+            ..
+        } => Trajectory::Figure8 {
+            center,
+            first,
+            second,
+            period_s,
+            low_passes: vec![LowPass {
+                start_s: 4.0,
+                end_s: 10.0,
+                height_m: 0.25,
+                ramp_s: 1.5,
+            }],
+            yaw_amplitude_rad,
+            yaw_period_s,
+        },
+        other => other,
+    };
+    let log = simulate(&model(), &flown, "test").unwrap();
+    let analysis = analyze(&log, &model(), "demo", &fast_settings()).unwrap();
+    assert_eq!(analysis.fitted.ids(), [EffectId::InertiaScale]);
+    let effect = &analysis.report.effects[0];
+    let spans = &effect.weight_spans.as_ref().expect("determined")["k"];
+    for span in &spans[..2] {
+        let at_a_corner = [4.0, 10.0]
+            .iter()
+            .any(|corner| (span.start_s..span.end_s).contains(corner));
+        assert!(span.end_s - span.start_s < 1.5 && at_a_corner, "{spans:?}");
+    }
 }
 
 #[test]

@@ -156,6 +156,14 @@ impl Analysis {
                         .flatten()
                         .map(|(name, value)| (*name, value.numbers()))
                         .collect(),
+                    weight_spans: e
+                        .weight_spans
+                        .iter()
+                        .flatten()
+                        .map(|(name, spans)| {
+                            (*name, spans.iter().map(|s| [s.start_s, s.end_s]).collect())
+                        })
+                        .collect(),
                     explained_fraction: e.explained_fraction,
                 })
                 .collect(),

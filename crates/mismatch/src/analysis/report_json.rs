@@ -17,6 +17,7 @@ use crate::explain::fit::{BelowResolution, FitAlternatives};
 use crate::explain::library::Candidate;
 use crate::improve::estimate::Estimate;
 use crate::improve::simex::NoiseSources;
+use crate::improve::weight::WeightSpan;
 use crate::locate::problem::Problem;
 use crate::locate::response::AngularResponse;
 use crate::locate::windows::{Residuals, channel_reports, locate_windows, without_steps};
@@ -38,6 +39,11 @@ pub struct EffectReport {
     /// does not determine it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub standard_errors: Option<BTreeMap<&'static str, ParameterValue>>,
+    /// Per parameter (and component), the shortest stretch of the recording whose rows hold half
+    /// of the estimate's weight ([`crate::improve::weight`]); absent where the fit does not
+    /// determine it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weight_spans: Option<BTreeMap<&'static str, Vec<WeightSpan>>>,
     /// The parameters fitted on the fit part only, with which the evidence rule judged the effect
     /// and the held-out part checked it.
     pub fit_part_parameters: EffectParameters,
@@ -193,6 +199,7 @@ pub(super) fn build_report(
     let fitted_sse = problem.whitened_sse(residuals.after, fit_rows.clone());
     let shares = explained_fractions(&judgement.evidence, nominal_sse, fitted_sse);
     let errors = effects_from(&estimate.set.parameters, &estimate.standard_errors);
+    let spans = weight_spans(estimate);
     let biases = estimate
         .noise_bias
         .as_ref()
@@ -213,6 +220,7 @@ pub(super) fn build_report(
                     .all(|(_, v)| v.numbers().iter().all(|x| x.is_finite()));
                 finite.then(|| values.into_iter().collect())
             }),
+            weight_spans: spans(evidence.id),
             fit_part_parameters: fit_part
                 .parameters(evidence.id)
                 .expect("a named effect is in the judged set"),
@@ -309,6 +317,42 @@ pub(super) fn build_report(
             below_resolution: screen.below_resolution,
         },
         settings: settings.analysis_record(),
+    }
+}
+
+/// Each named effect's weight spans by parameter name, in the parameters' shape (`None` unless
+/// every component has one).
+fn weight_spans(
+    estimate: &Estimate,
+) -> impl Fn(EffectId) -> Option<BTreeMap<&'static str, Vec<WeightSpan>>> {
+    let end = |pick: fn(&WeightSpan) -> f64| -> Vec<f64> {
+        estimate
+            .weight_spans
+            .iter()
+            .map(|s| s.as_ref().map_or(f64::NAN, pick))
+            .collect()
+    };
+    let starts = effects_from(&estimate.set.parameters, &end(|s| s.start_s));
+    let ends = effects_from(&estimate.set.parameters, &end(|s| s.end_s));
+    move |id| {
+        let (starts, ends) = (starts.parameters(id)?, ends.parameters(id)?);
+        starts
+            .values()
+            .into_iter()
+            .zip(ends.values())
+            .map(|((name, start), (_, end))| {
+                let spans: Vec<WeightSpan> = start
+                    .numbers()
+                    .iter()
+                    .zip(end.numbers())
+                    .map(|(&start_s, end_s)| WeightSpan { start_s, end_s })
+                    .collect();
+                let finite = spans
+                    .iter()
+                    .all(|s| s.start_s.is_finite() && s.end_s.is_finite());
+                finite.then_some((name, spans))
+            })
+            .collect()
     }
 }
 

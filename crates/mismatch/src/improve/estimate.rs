@@ -30,9 +30,10 @@ use sindy::median::robust_standard_deviation;
 use crate::explain::evidence::autocorrelation_factor;
 use crate::explain::fit::FittedSet;
 use crate::improve::simex::{NoiseBias, SimexSettings, noise_bias};
+use crate::improve::weight::WeightSpan;
 use crate::locate::problem::{Channels, Problem};
 use crate::model::least_squares::Termination;
-use crate::model::refine::{FitRows, StepBasis, levenberg_marquardt, standard_errors};
+use crate::model::refine::{FitRows, StepBasis, levenberg_marquardt, precision};
 
 /// Settings of the final estimate (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -60,6 +61,9 @@ impl Default for EstimateSettings {
 pub struct Estimate {
     pub set: FittedSet,
     pub standard_errors: Vec<f64>,
+    /// Per parameter, the stretch of the recording holding half of its weight
+    /// ([`crate::improve::weight`]); `None` where the fit does not determine it.
+    pub weight_spans: Vec<Option<WeightSpan>>,
     /// Share of the (row, channel) residuals that carry a weight below 1 at the end.
     pub downweighted_fraction: f64,
     /// The bias removed from the values, when the commands are instantaneous samples of a faster
@@ -85,6 +89,7 @@ pub fn estimate(
         return Estimate {
             set,
             standard_errors: Vec::new(),
+            weight_spans: Vec::new(),
             downweighted_fraction: 0.0,
             noise_bias: None,
             step_times,
@@ -134,7 +139,13 @@ pub fn estimate(
         steps: Some(&steps),
         ..weighted_rows
     };
-    let mut standard_errors = standard_errors(problem, &set.parameters, &set.values, &rows, scale);
+    let precision = precision(problem, &set.parameters, &set.values, &rows, scale);
+    let mut standard_errors = precision.standard_errors;
+    let weight_spans = precision
+        .half_weight_rows
+        .iter()
+        .map(|rows| rows.map(|(first, last)| stretch(problem, first, last)))
+        .collect();
     let noise_bias = noise_bias(problem, &set, &rows, &settings.noise_bias, iterations);
     if let Some(bias) = &noise_bias {
         for (j, parameter) in set.parameters.iter().enumerate() {
@@ -151,10 +162,22 @@ pub fn estimate(
     Estimate {
         set,
         standard_errors,
+        weight_spans,
         downweighted_fraction: downweighted as f64 / count,
         noise_bias,
         step_times,
         termination,
+    }
+}
+
+/// The recording's stretch that analysed rows `first..=last` read: from the first one's test
+/// function's start to the last one's end.
+fn stretch(problem: &Problem, first: usize, last: usize) -> WeightSpan {
+    let time = &problem.recording.time;
+    let half = problem.weak_form.function.half_width_s;
+    WeightSpan {
+        start_s: (problem.time[first] - half).max(time[0]),
+        end_s: (problem.time[last] + half).min(time[time.len() - 1]),
     }
 }
 

@@ -1,5 +1,7 @@
 //! Step 3, improve: the named effects' parameters estimated again on all rows with robust
-//! weights ([`estimate`]), the bias the sampled commands' noise leaves removed ([`simex`]).
+//! weights ([`estimate`]), the bias the sampled commands' noise leaves removed ([`simex`]), and
+//! where each estimate's weight lies in the recording ([`weight`]).
 
 pub mod estimate;
 pub mod simex;
+pub mod weight;

@@ -10,6 +10,7 @@ use faer::linalg::solvers::Solve;
 use physics::{EffectNumber, Effects, QuadraticDrag, Wind};
 use sindy::stability::BlockDesign;
 
+use crate::improve::weight;
 use crate::locate::forward::WrenchTrace;
 use crate::locate::problem::{Channels, Problem};
 use crate::model::least_squares::{
@@ -149,6 +150,28 @@ pub fn standard_errors(
     rows: &FitRows,
     scale: f64,
 ) -> Vec<f64> {
+    precision(problem, parameters, values, rows, scale).standard_errors
+}
+
+/// How precisely the rows determine each fitted parameter, and where.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Precision {
+    /// As [`standard_errors`] gives them.
+    pub standard_errors: Vec<f64>,
+    /// Per parameter, the first and last of the fit's rows (indexed as the problem's) of the
+    /// shortest stretch holding half of its weight ([`crate::improve::weight`]); `None` where
+    /// `JᵀJ` is singular.
+    pub half_weight_rows: Vec<Option<(usize, usize)>>,
+}
+
+/// [`standard_errors`] and where each parameter's weight lies, from one Jacobian.
+pub fn precision(
+    problem: &Problem,
+    parameters: &[EffectNumber],
+    values: &[f64],
+    rows: &FitRows,
+    scale: f64,
+) -> Precision {
     let fit = WhitenedFit::new(problem, parameters, rows);
     let residual = fit.residual(values);
     let jacobian = forward_jacobian(&fit, values, &residual);
@@ -156,7 +179,7 @@ pub fn standard_errors(
     let inverse = normal_matrix(&jacobian)
         .full_piv_lu()
         .solve(Mat::<f64>::identity(k, k));
-    (0..k)
+    let standard_errors = (0..k)
         .map(|i| {
             let variance = scale * inverse[(i, i)];
             if variance.is_finite() && variance >= 0.0 {
@@ -165,7 +188,22 @@ pub fn standard_errors(
                 f64::NAN
             }
         })
-        .collect()
+        .collect();
+    let inverse_rows: Vec<Vec<f64>> = (0..k)
+        .map(|i| (0..k).map(|j| inverse[(i, j)]).collect())
+        .collect();
+    let time = &problem.time[rows.range.clone()];
+    let half_weight_rows = weight::row_weights(&jacobian, &inverse_rows, problem.channels)
+        .into_iter()
+        .map(|weights| {
+            let (first, last) = weight::half_weight_rows(time, &weights?)?;
+            Some((rows.range.start + first, rows.range.start + last))
+        })
+        .collect();
+    Precision {
+        standard_errors,
+        half_weight_rows,
+    }
 }
 
 /// The whitened residual of the fit's rows as a function of the parameters' values.

@@ -163,6 +163,9 @@ pub struct NamedEffect<'a> {
     pub description: &'a str,
     /// Each parameter's name and standard errors (empty when the fit does not determine them).
     pub standard_errors: Vec<(&'a str, Vec<f64>)>,
+    /// Each parameter's name and, per component, the stretch (s) whose rows hold half of the
+    /// estimate's weight (empty when the fit does not determine them).
+    pub weight_spans: Vec<(&'a str, Vec<[f64; 2]>)>,
     pub explained_fraction: f64,
 }
 
@@ -221,6 +224,21 @@ fn standard_errors_text(errors: &[(&str, Vec<f64>)]) -> String {
         .map(|(name, values)| format!("{name} ± {}", super::two_digit_list(values)))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// Where each parameter's estimate rests: `k: 30.0–37.7 s, 36.2–37.7 s; d: 0.2–20.1 s`.
+fn weight_spans_text(spans: &[(&str, Vec<[f64; 2]>)]) -> String {
+    spans
+        .iter()
+        .map(|(name, spans)| {
+            let stretches: Vec<String> = spans
+                .iter()
+                .map(|[start, end]| format!("{start:.1}–{end:.1} s"))
+                .collect();
+            format!("{name}: {}", stretches.join(", "))
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 /// One term of a candidate.
@@ -565,12 +583,21 @@ impl RecordingView<'_> {
                         standard_errors_text(&e.standard_errors)
                     )
                 };
+                let spans = if e.weight_spans.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        " Half of each estimate's weight lies in the rows of {}.",
+                        weight_spans_text(&e.weight_spans)
+                    )
+                };
                 let _ = writeln!(
                     md,
-                    "- **{}** — {}{} It accounts for {:.0}% of the nominal model's (noise-normalised) residual; without it the held-out residual is {:.0}% higher (likelihood ratio {:.0} against {:.1}, gain {:.2} per row and channel on the fit part, {:.2} over every block but its two largest).",
+                    "- **{}** — {}{}{} It accounts for {:.0}% of the nominal model's (noise-normalised) residual; without it the held-out residual is {:.0}% higher (likelihood ratio {:.0} against {:.1}, gain {:.2} per row and channel on the fit part, {:.2} over every block but its two largest).",
                     evidence.id,
                     e.description,
                     errors,
+                    spans,
                     100.0 * e.explained_fraction,
                     100.0 * (evidence.heldout_without / evidence.heldout_with.max(1e-300) - 1.0),
                     evidence.likelihood_ratio,
@@ -896,6 +923,7 @@ mod tests {
                 evidence: evidence("linear_drag", 120.4),
                 description: "Drag.",
                 standard_errors: vec![("d", vec![0.0123, 0.25, 3.0])],
+                weight_spans: vec![("d", vec![[0.2, 20.14], [3.0, 4.46], [12.04, 12.96]])],
                 explained_fraction: 0.625,
             }],
             not_separable: vec![Inseparable {
@@ -952,7 +980,7 @@ mod tests {
             "| vdot_x | 0.2500 | 0.0100 | yes |\n| vdot_y | 0.0050 | 0.0100 | no |\n",
             "\nThe model's torques say nothing about the recorded angular accelerations: each angular channel's response to the model's prediction (1 when the torques are right, 0 when they are unrelated) is [0.00, -0.02, 0.23] ± [0.23, 0.24, 0.05] (x, y, z), not clearly positive on every axis.",
             "(1 s moving RMS):\n\n- vdot_x from 1.2 s to 7.5 s\n",
-            "- **linear_drag** — Drag. Standard errors: d ± [0.012, 0.25, 3.0]. It accounts for 62% of the nominal model's (noise-normalised) residual; without it the held-out residual is 50% higher (likelihood ratio 120 against 16.3, gain 0.75 per row and channel on the fit part, 0.50 over every block but its two largest).\n",
+            "- **linear_drag** — Drag. Standard errors: d ± [0.012, 0.25, 3.0]. Half of each estimate's weight lies in the rows of d: 0.2–20.1 s, 3.0–4.5 s, 12.0–13.0 s. It accounts for 62% of the nominal model's (noise-normalised) residual; without it the held-out residual is 50% higher (likelihood ratio 120 against 16.3, gain 0.75 per row and channel on the fit part, 0.50 over every block but its two largest).\n",
             "- **not separable from this recording: delay** — A delay of 30 ms. Fitted in its place, with the others refitted, these explain the recording as well: motor_lag (tau_s = 0.031): fit-part likelihood ratio 3.2 against 10.8, held-out residual 2% lower. It stays",
             "**What the log holds.** The rows come at 50.0 Hz, but not every signal is new at every row: motor commands held (12.5 new values per second). A command's effect is seen only as often as the command changes: a delay or a motor lag shorter than 80 ms cannot be identified from this log",
             "- not named: delay of 30 ms, shorter than the 80 ms between the motor commands' new values: below what the log resolves (left out of the fit).\n",

@@ -17,12 +17,12 @@ use crate::explain::fit::{BelowResolution, FitAlternatives};
 use crate::explain::library::Candidate;
 use crate::improve::estimate::Estimate;
 use crate::improve::simex::NoiseSources;
-use crate::improve::weight::WeightSpan;
 use crate::locate::problem::Problem;
 use crate::locate::response::AngularResponse;
 use crate::locate::windows::{Residuals, channel_reports, locate_windows, without_steps};
 use crate::model::least_squares::Termination;
 use crate::model::refine::effects_from;
+use crate::model::weight::WeightSpan;
 use crate::recording::command_samples::ActuatorLimits;
 use crate::recording::content::{LogContent, Signal};
 use crate::recording::noise_reaction::NoiseReaction;
@@ -40,7 +40,7 @@ pub struct EffectReport {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub standard_errors: Option<BTreeMap<&'static str, ParameterValue>>,
     /// Per parameter (and component), the shortest stretch of the recording whose rows hold half
-    /// of the estimate's weight ([`crate::improve::weight`]); absent where the fit does not
+    /// of the estimate's weight ([`crate::model::weight`]); absent where the fit does not
     /// determine it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub weight_spans: Option<BTreeMap<&'static str, Vec<WeightSpan>>>,

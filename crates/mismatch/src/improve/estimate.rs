@@ -30,10 +30,10 @@ use sindy::median::robust_standard_deviation;
 use crate::explain::evidence::autocorrelation_factor;
 use crate::explain::fit::FittedSet;
 use crate::improve::simex::{NoiseBias, SimexSettings, noise_bias};
-use crate::improve::weight::WeightSpan;
 use crate::locate::problem::{Channels, Problem};
 use crate::model::least_squares::Termination;
 use crate::model::refine::{FitRows, StepBasis, levenberg_marquardt, precision};
+use crate::model::weight::WeightSpan;
 
 /// Settings of the final estimate (recorded in the output).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -62,7 +62,7 @@ pub struct Estimate {
     pub set: FittedSet,
     pub standard_errors: Vec<f64>,
     /// Per parameter, the stretch of the recording holding half of its weight
-    /// ([`crate::improve::weight`]); `None` where the fit does not determine it.
+    /// ([`crate::model::weight`]); `None` where the fit does not determine it.
     pub weight_spans: Vec<Option<WeightSpan>>,
     /// Share of the (row, channel) residuals that carry a weight below 1 at the end.
     pub downweighted_fraction: f64,

@@ -10,13 +10,13 @@ use faer::linalg::solvers::Solve;
 use physics::{EffectNumber, Effects, QuadraticDrag, Wind};
 use sindy::stability::BlockDesign;
 
-use crate::improve::weight;
 use crate::locate::forward::WrenchTrace;
 use crate::locate::problem::{Channels, Problem};
 use crate::model::least_squares::{
     ActiveBounds, DenseProblem, LevenbergMarquardt, LevenbergMarquardtParams, Solution,
     forward_jacobian, normal_matrix,
 };
+use crate::model::weight;
 
 /// Effects built from parameter values (absent parameters keep their effect absent; the other
 /// numbers of a present effect are neutral).
@@ -159,7 +159,7 @@ pub struct Precision {
     /// As [`standard_errors`] gives them.
     pub standard_errors: Vec<f64>,
     /// Per parameter, the first and last of the fit's rows (indexed as the problem's) of the
-    /// shortest stretch holding half of its weight ([`crate::improve::weight`]); `None` where
+    /// shortest stretch holding half of its weight ([`crate::model::weight`]); `None` where
     /// `JᵀJ` is singular.
     pub half_weight_rows: Vec<Option<(usize, usize)>>,
 }

@@ -325,15 +325,16 @@ pub(super) fn build_report(
 fn weight_spans(
     estimate: &Estimate,
 ) -> impl Fn(EffectId) -> Option<BTreeMap<&'static str, Vec<WeightSpan>>> {
-    let end = |pick: fn(&WeightSpan) -> f64| -> Vec<f64> {
+    // One end of every parameter's span, NaN where it has none.
+    let each = |pick: fn(&WeightSpan) -> f64| -> Vec<f64> {
         estimate
             .weight_spans
             .iter()
             .map(|s| s.as_ref().map_or(f64::NAN, pick))
             .collect()
     };
-    let starts = effects_from(&estimate.set.parameters, &end(|s| s.start_s));
-    let ends = effects_from(&estimate.set.parameters, &end(|s| s.end_s));
+    let starts = effects_from(&estimate.set.parameters, &each(|s| s.start_s));
+    let ends = effects_from(&estimate.set.parameters, &each(|s| s.end_s));
     move |id| {
         let (starts, ends) = (starts.parameters(id)?, ends.parameters(id)?);
         starts

@@ -150,7 +150,8 @@ pub fn standard_errors(
     rows: &FitRows,
     scale: f64,
 ) -> Vec<f64> {
-    precision(problem, parameters, values, rows, scale).standard_errors
+    let (_, inverse) = linearised_covariance(problem, parameters, values, rows);
+    errors_from(&inverse, scale)
 }
 
 /// How precisely the rows determine each fitted parameter, and where.
@@ -172,23 +173,8 @@ pub fn precision(
     rows: &FitRows,
     scale: f64,
 ) -> Precision {
-    let fit = WhitenedFit::new(problem, parameters, rows);
-    let residual = fit.residual(values);
-    let jacobian = forward_jacobian(&fit, values, &residual);
+    let (jacobian, inverse) = linearised_covariance(problem, parameters, values, rows);
     let k = parameters.len();
-    let inverse = normal_matrix(&jacobian)
-        .full_piv_lu()
-        .solve(Mat::<f64>::identity(k, k));
-    let standard_errors = (0..k)
-        .map(|i| {
-            let variance = scale * inverse[(i, i)];
-            if variance.is_finite() && variance >= 0.0 {
-                variance.sqrt()
-            } else {
-                f64::NAN
-            }
-        })
-        .collect();
     let inverse_rows: Vec<Vec<f64>> = (0..k)
         .map(|i| (0..k).map(|j| inverse[(i, j)]).collect())
         .collect();
@@ -201,9 +187,41 @@ pub fn precision(
         })
         .collect();
     Precision {
-        standard_errors,
+        standard_errors: errors_from(&inverse, scale),
         half_weight_rows,
     }
+}
+
+/// The Jacobian `J` of the fit's whitened residual at `values` (one column per parameter) and
+/// `(JᵀJ)⁻¹`.
+fn linearised_covariance(
+    problem: &Problem,
+    parameters: &[EffectNumber],
+    values: &[f64],
+    rows: &FitRows,
+) -> (Vec<Vec<f64>>, Mat<f64>) {
+    let fit = WhitenedFit::new(problem, parameters, rows);
+    let residual = fit.residual(values);
+    let jacobian = forward_jacobian(&fit, values, &residual);
+    let k = parameters.len();
+    let inverse = normal_matrix(&jacobian)
+        .full_piv_lu()
+        .solve(Mat::<f64>::identity(k, k));
+    (jacobian, inverse)
+}
+
+/// `√(scale · inverseᵢᵢ)`, NaN where that is not a finite non-negative variance.
+fn errors_from(inverse: &Mat<f64>, scale: f64) -> Vec<f64> {
+    (0..inverse.nrows())
+        .map(|i| {
+            let variance = scale * inverse[(i, i)];
+            if variance.is_finite() && variance >= 0.0 {
+                variance.sqrt()
+            } else {
+                f64::NAN
+            }
+        })
+        .collect()
 }
 
 /// The whitened residual of the fit's rows as a function of the parameters' values.

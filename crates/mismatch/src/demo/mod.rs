@@ -7,6 +7,7 @@
 //! folder's as the run goes ([`DemoPlan::run`] hands them over), the summary's at the end
 //! ([`DemoSummary::render`]).
 
+mod chance;
 mod summary;
 #[cfg(test)]
 mod tests;

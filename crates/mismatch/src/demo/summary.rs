@@ -13,6 +13,8 @@ use serde::Serialize;
 
 use crate::analysis::Analysis;
 
+use super::chance::chance_within;
+
 use super::DemoConfiguration;
 
 /// The demo's targets.
@@ -39,6 +41,10 @@ pub struct ParameterCheck {
     /// |found − true| / |true| (vectors: Euclidean norms); for the factors `thrust_scale.k` and
     /// `inertia_scale.k`, relative to |true − 1|.
     pub relative_error: f64,
+    /// The probability that an unbiased estimate scattering as the standard error says (components
+    /// independent) is within the target ([`chance_within`]): what the recording's information
+    /// allows, whatever this estimate found.
+    pub chance_within_target: Option<f64>,
 }
 
 /// One cell's outcome.
@@ -113,6 +119,12 @@ impl CellOutcome {
                     .into_iter()
                     .collect();
                 why.extend(model_noise_note(p.effect, &report.channels));
+                why.extend(p.chance_within_target.map(|chance| {
+                    format!(
+                        "within {:.0}% with probability {chance:.2} at its standard errors",
+                        100.0 * TARGETS.parameters_within
+                    )
+                }));
                 let why = if why.is_empty() {
                     String::new()
                 } else {
@@ -266,6 +278,12 @@ fn parameter_checks(
                 })
             });
             let within = off.map(|z| z <= 2.0);
+            let limit = TARGETS.parameters_within * magnitude;
+            let chance = error
+                .as_ref()
+                .map(ParameterValue::numbers)
+                .filter(|e| e.len() == t.len())
+                .and_then(|e| chance_within(limit, &e));
             ParameterCheck {
                 effect,
                 parameter: name.to_string(),
@@ -279,6 +297,7 @@ fn parameter_checks(
                 } else {
                     f64::INFINITY
                 },
+                chance_within_target: chance,
             }
         })
         .collect()
@@ -434,6 +453,7 @@ fn cell_line(c: &CellOutcome) -> CellLine<'_> {
                 standard_error: p.standard_error.as_ref().map(ParameterValue::numbers),
                 within_two_standard_errors: p.within_two_standard_errors,
                 relative_error: p.relative_error,
+                chance_within_target: p.chance_within_target,
             })
             .collect(),
         heldout_mse_before: c.heldout_mse_before,

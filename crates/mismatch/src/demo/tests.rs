@@ -57,6 +57,7 @@ fn cell(c: &Value) -> CellOutcome {
                 within_two_standard_errors: from(&p["within_two_standard_errors"]),
                 standard_errors_off: from(&p["standard_errors_off"]),
                 relative_error: from(&p["relative_error"]),
+                chance_within_target: from(&p["chance_within_target"]),
             })
             .collect(),
         heldout_mse_before: from(&c["heldout_mse_before"]),

@@ -67,6 +67,9 @@ pub struct ParameterLine<'a> {
     /// Whether the true value lies within two standard errors of the found one.
     pub within_two_standard_errors: Option<bool>,
     pub relative_error: f64,
+    /// The probability that an unbiased estimate scattering as the standard error says meets the
+    /// parameter target.
+    pub chance_within_target: Option<f64>,
 }
 
 /// One cell's outcome.
@@ -247,6 +250,7 @@ impl DemoView<'_> {
             controls.len()
         );
         self.coverage_markdown(md);
+        self.reach_markdown(md);
         self.unexplained_markdown(md);
     }
 
@@ -300,6 +304,46 @@ impl DemoView<'_> {
             md,
             "\nEvery parameter is reported with its standard error from the noise (± below). True values within two of them: {}; the rest are off by more than the noise explains (a systematic error of the comparison or the fit).",
             counts.join(", ")
+        );
+    }
+
+    /// The probability, per configuration, that every parameter target would be met by unbiased
+    /// estimates scattering as their standard errors say: how far the recordings' information
+    /// reaches, whatever the estimates found (cells are separate flights, so the cells' chances
+    /// multiply).
+    fn reach_markdown(&self, md: &mut String) {
+        let chances: Vec<String> = self
+            .configurations
+            .iter()
+            .map(|configuration| {
+                let parameters: Vec<&ParameterLine> = self
+                    .cells
+                    .iter()
+                    .filter(|c| c.configuration == configuration.name)
+                    .flat_map(|c| &c.parameters)
+                    .collect();
+                let known: Vec<f64> = parameters
+                    .iter()
+                    .filter_map(|p| p.chance_within_target)
+                    .collect();
+                let unknown = parameters.len() - known.len();
+                format!(
+                    "{} {:.2}{}",
+                    configuration.name,
+                    known.iter().product::<f64>(),
+                    if unknown > 0 {
+                        format!(" ({unknown} without a standard error left out)")
+                    } else {
+                        String::new()
+                    }
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            md,
+            "\nHow far the recordings' information reaches: if every estimate were unbiased and scattered as its standard errors say (components independent), every parameter of a configuration would be within {:.0}% with probability {}. Well below 1, a configuration asks more than its flights determine, whatever the estimator.",
+            100.0 * self.targets.parameters_within,
+            chances.join(", ")
         );
     }
 
@@ -360,6 +404,89 @@ impl DemoView<'_> {
         let _ = writeln!(
             md,
             "\nPer-cell outputs (recording, mismatch.json/svg/md) and each configuration's `model.json` are written under the demo's work directory (`target/mismatch-demo/<configuration>/<case>/`, not committed)."
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parameter(chance: Option<f64>) -> ParameterLine<'static> {
+        ParameterLine {
+            effect: "inertia_scale",
+            parameter: "k",
+            truth: "[1.25, 0.85, 1.15]".into(),
+            found: "[1.25, 0.85, 1.15]".into(),
+            standard_error: chance.map(|_| vec![0.01; 3]),
+            within_two_standard_errors: chance.map(|_| true),
+            relative_error: 0.01,
+            chance_within_target: chance,
+        }
+    }
+
+    fn cell(configuration: &'static str, chances: &[Option<f64>]) -> CellLine<'static> {
+        CellLine {
+            configuration,
+            case: "inertia_scale",
+            true_effects: vec!["inertia_scale"],
+            found_effects: vec!["inertia_scale"],
+            named_exactly: true,
+            parameters: chances.iter().map(|c| parameter(*c)).collect(),
+            heldout_mse_before: 1.0,
+            heldout_mse_after: 0.1,
+            heldout_ratio: 0.1,
+            passed: true,
+            failures: &[],
+            unexplained: &[],
+        }
+    }
+
+    fn configuration(name: &'static str) -> ConfigurationLine<'static> {
+        ConfigurationLine {
+            name,
+            description: "",
+            vehicle: "",
+            controller_rate_hz: 500.0,
+            log_rate_hz: 50.0,
+            command: "sample",
+            command_time_offset_s: 0.0,
+            rate_low_pass_hz: None,
+            jitter: None,
+            velocity_noise_m_s: 0.005,
+            rate_noise_rad_s: 0.008,
+            trajectory: "",
+        }
+    }
+
+    /// Cells are separate flights: a configuration's chances multiply; parameters without a
+    /// standard error are counted, not guessed.
+    #[test]
+    fn the_reach_of_a_configuration_is_the_product_of_its_parameters_chances() {
+        let targets = Targets {
+            parameters_within: 0.1,
+            heldout_ratio_at_most: 0.4,
+            heldout_noise_multiple_at_most: 1.2,
+        };
+        let cases = [("inertia_scale".to_string(), "wrong inertia".to_string())];
+        let view = DemoView {
+            manifest: "demo.json".into(),
+            targets: &targets,
+            configurations: vec![configuration("A"), configuration("E")],
+            cases: &cases,
+            cells: vec![
+                cell("A", &[Some(0.99)]),
+                cell("E", &[Some(0.9), None]),
+                cell("E", &[Some(0.5)]),
+            ],
+        };
+        let mut md = String::new();
+        view.reach_markdown(&mut md);
+        assert!(
+            md.contains(
+                "within 10% with probability A 0.99, E 0.45 (1 without a standard error left out)."
+            ),
+            "{md}"
         );
     }
 }

@@ -13,9 +13,8 @@ use serde::Serialize;
 
 use crate::analysis::Analysis;
 
-use super::chance::chance_within;
-
 use super::DemoConfiguration;
+use super::chance::chance_within;
 
 /// The demo's targets.
 pub const TARGETS: Targets = Targets {

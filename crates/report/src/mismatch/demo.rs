@@ -254,10 +254,9 @@ impl DemoView<'_> {
         self.unexplained_markdown(md);
     }
 
-    /// How many cells report a residual that no effect explains: every simulated effect is in the
-    /// vocabulary, so each such stretch is a false alarm of the report (not a target).
-    fn unexplained_markdown(&self, md: &mut String) {
-        let counts: Vec<String> = self
+    /// One entry per configuration, `"<name> <line of its cells>"`, joined by commas.
+    fn per_configuration(&self, line: impl Fn(&[&CellLine]) -> String) -> String {
+        let entries: Vec<String> = self
             .configurations
             .iter()
             .map(|configuration| {
@@ -266,10 +265,19 @@ impl DemoView<'_> {
                     .iter()
                     .filter(|c| c.configuration == configuration.name)
                     .collect();
-                let flagged = cells.iter().filter(|c| !c.unexplained.is_empty()).count();
-                format!("{} {flagged} of {}", configuration.name, cells.len())
+                format!("{} {}", configuration.name, line(&cells))
             })
             .collect();
+        entries.join(", ")
+    }
+
+    /// How many cells report a residual that no effect explains: every simulated effect is in the
+    /// vocabulary, so each such stretch is a false alarm of the report (not a target).
+    fn unexplained_markdown(&self, md: &mut String) {
+        let counts = self.per_configuration(|cells| {
+            let flagged = cells.iter().filter(|c| !c.unexplained.is_empty()).count();
+            format!("{flagged} of {}", cells.len())
+        });
         let controls = self
             .cells
             .iter()
@@ -277,33 +285,25 @@ impl DemoView<'_> {
             .count();
         let _ = writeln!(
             md,
-            "\nEvery simulated effect is in the vocabulary, so a stretch reported as a residual no effect explains is a false alarm (not a target; listed per cell below). Cells with one: {}; controls with one: {controls}.",
-            counts.join(", ")
+            "\nEvery simulated effect is in the vocabulary, so a stretch reported as a residual no effect explains is a false alarm (not a target; listed per cell below). Cells with one: {counts}; controls with one: {controls}."
         );
     }
 
     /// How often the true value lies within two of the reported standard errors, per
     /// configuration: whether the uncertainty the tool reports can be trusted.
     fn coverage_markdown(&self, md: &mut String) {
-        let counts: Vec<String> = self
-            .configurations
-            .iter()
-            .map(|configuration| {
-                let judged: Vec<bool> = self
-                    .cells
-                    .iter()
-                    .filter(|c| c.configuration == configuration.name)
-                    .flat_map(|c| &c.parameters)
-                    .filter_map(|p| p.within_two_standard_errors)
-                    .collect();
-                let within = judged.iter().filter(|w| **w).count();
-                format!("{} {within} of {}", configuration.name, judged.len())
-            })
-            .collect();
+        let counts = self.per_configuration(|cells| {
+            let judged: Vec<bool> = cells
+                .iter()
+                .flat_map(|c| &c.parameters)
+                .filter_map(|p| p.within_two_standard_errors)
+                .collect();
+            let within = judged.iter().filter(|w| **w).count();
+            format!("{within} of {}", judged.len())
+        });
         let _ = writeln!(
             md,
-            "\nEvery parameter is reported with its standard error from the noise (± below). True values within two of them: {}; the rest are off by more than the noise explains (a systematic error of the comparison or the fit).",
-            counts.join(", ")
+            "\nEvery parameter is reported with its standard error from the noise (± below). True values within two of them: {counts}; the rest are off by more than the noise explains (a systematic error of the comparison or the fit)."
         );
     }
 
@@ -312,38 +312,28 @@ impl DemoView<'_> {
     /// reaches, whatever the estimates found (cells are separate flights, so the cells' chances
     /// multiply).
     fn reach_markdown(&self, md: &mut String) {
-        let chances: Vec<String> = self
-            .configurations
-            .iter()
-            .map(|configuration| {
-                let parameters: Vec<&ParameterLine> = self
-                    .cells
-                    .iter()
-                    .filter(|c| c.configuration == configuration.name)
-                    .flat_map(|c| &c.parameters)
-                    .collect();
-                let known: Vec<f64> = parameters
-                    .iter()
-                    .filter_map(|p| p.chance_within_target)
-                    .collect();
-                let unknown = parameters.len() - known.len();
-                format!(
-                    "{} {:.2}{}",
-                    configuration.name,
-                    known.iter().product::<f64>(),
-                    if unknown > 0 {
-                        format!(" ({unknown} without a standard error left out)")
-                    } else {
-                        String::new()
-                    }
-                )
-            })
-            .collect();
+        let chances = self.per_configuration(|cells| {
+            let parameters: Vec<&ParameterLine> =
+                cells.iter().flat_map(|c| &c.parameters).collect();
+            let known: Vec<f64> = parameters
+                .iter()
+                .filter_map(|p| p.chance_within_target)
+                .collect();
+            let unknown = parameters.len() - known.len();
+            format!(
+                "{:.2}{}",
+                known.iter().product::<f64>(),
+                if unknown > 0 {
+                    format!(" ({unknown} without a standard error left out)")
+                } else {
+                    String::new()
+                }
+            )
+        });
         let _ = writeln!(
             md,
-            "\nHow far the recordings' information reaches: if every estimate were unbiased and scattered as its standard errors say (components independent), every parameter of a configuration would be within {:.0}% with probability {}. Well below 1, a configuration asks more than its flights determine, whatever the estimator.",
-            100.0 * self.targets.parameters_within,
-            chances.join(", ")
+            "\nHow far the recordings' information reaches: if every estimate were unbiased and scattered as its standard errors say (components independent), every parameter of a configuration would be within {:.0}% with probability {chances}. Well below 1, a configuration asks more than its flights determine, whatever the estimator.",
+            100.0 * self.targets.parameters_within
         );
     }
 
